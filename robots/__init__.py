@@ -1,0 +1,1 @@
+"""Robot descriptions shipped with twolink-pin (installed as ``twolink_pin.robots``)."""
