@@ -1,0 +1,97 @@
+"""Exceptions of twolink-pin.
+
+Every error the package raises on bad input derives from :class:`TwolinkPinError`.
+Each subclass keeps the offending value(s) as attributes and its message says what was
+expected, so a caller can both show it and act on it. The CLI turns any of them into one
+line on stderr and exit status 2.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class TwolinkPinError(Exception):
+    """Base class of every error twolink-pin raises on bad input or a failed run."""
+
+
+class InvalidURDFError(TwolinkPinError):
+    """A robot description that cannot give a sound model.
+
+    Attributes:
+        path: The URDF file (or ``"<string>"`` for XML given as text).
+        element: The offending element, e.g. ``link 'link2' <mass>``.
+        reason: What is wrong and what was expected.
+    """
+
+    def __init__(self, path: str, element: str, reason: str) -> None:
+        self.path = path
+        self.element = element
+        self.reason = reason
+        super().__init__(f"{path}: {element}: {reason}")
+
+
+class InvalidParameterError(TwolinkPinError, ValueError):
+    """A configuration value outside its valid range.
+
+    Attributes:
+        name: The parameter's name.
+        value: The value received.
+        expected: A description of the valid values.
+    """
+
+    def __init__(self, name: str, value: Any, expected: str) -> None:
+        self.name = name
+        self.value = value
+        self.expected = expected
+        super().__init__(f"{name} = {value!r} is invalid: expected {expected}")
+
+
+class UnreachableTargetError(TwolinkPinError, ValueError):
+    """An end-effector target outside the reachable workspace.
+
+    Attributes:
+        target: The target (x, y) [m].
+        r_min: Inner radius of the reachable annulus [m].
+        r_max: Outer radius of the reachable annulus [m].
+    """
+
+    def __init__(self, target: tuple[float, float], r_min: float, r_max: float) -> None:
+        self.target = target
+        self.r_min = r_min
+        self.r_max = r_max
+        x, y = target
+        super().__init__(
+            f"target ({x:.4g}, {y:.4g}) m is outside the reachable annulus "
+            f"{r_min:.4g} <= r <= {r_max:.4g} m (r = {float((x * x + y * y) ** 0.5):.4g} m)"
+        )
+
+
+class SimulationDivergedError(TwolinkPinError):
+    """A closed-loop run whose state became non-finite or absurd.
+
+    Attributes:
+        controller: The controller's name.
+        time: Simulation time [s] at which divergence was detected.
+        detail: What was detected.
+    """
+
+    def __init__(self, controller: str, time: float, detail: str) -> None:
+        self.controller = controller
+        self.time = time
+        self.detail = detail
+        super().__init__(f"simulation with controller '{controller}' diverged at t = {time:.4f} s: {detail}")
+
+
+class OutputError(TwolinkPinError):
+    """An output location that cannot be written safely.
+
+    Attributes:
+        path: The offending path.
+        reason: Why it cannot be used.
+    """
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")

@@ -1,0 +1,483 @@
+"""Validation of URDF robot descriptions before they reach Pinocchio.
+
+Why this module exists: Pinocchio 4.1's URDF parser (``pin.buildModelFromUrdf`` and
+``pin.buildModelFromXML``, through urdfdom) does not protect its caller from bad files:
+
+* it **segfaults** on very long kinematic chains (about 5000 links and more), killing the
+  Python process with no exception to catch;
+* it silently **accepts a negative mass**, an inertia matrix that is **not positive
+  definite**, or one whose principal moments **violate the triangle inequality**
+  (physically impossible bodies whose dynamics are nonsense);
+* it silently accepts a **zero joint axis**, giving a joint that moves nothing and a
+  singular mass matrix;
+* it silently **drops a link's whole inertia** (mass and inertia become 0) when the mass
+  value is not a number, e.g. ``"abc"`` or ``"nan"``, with only a line on stderr;
+* it reports a truncated or malformed XML file only as a bare ``ValueError`` ("does not
+  contain a valid URDF model"), the actual reason and line going to stderr.
+
+:func:`validate_urdf_file` and :func:`validate_urdf_string` check a description with
+the standard library's XML parser and numpy, and raise
+:class:`~twolink_pin.errors.InvalidURDFError` on the first problem found. The error names
+the file, the offending element (``link 'link2' <inertial><mass>``,
+``joint 'joint2' <axis>``) and what was expected
+(``mass value="-1.0" must be a finite number > 0 kg``). A description that passes gives a
+sound Pinocchio model: no crash, no silent nonsense.
+
+Checks, in order:
+
+1. the file exists and is readable, and is well-formed XML whose root is ``<robot>``;
+2. at least one ``<link>``, at most :data:`MAX_LINKS` links and joints (counted before
+   any other work, so a huge file is rejected quickly);
+3. every link and joint has a unique, non-empty ``name``;
+4. every ``<inertial>`` (at most one per link): ``<mass value>`` finite and > 0 [kg];
+   ``<inertia>`` with the six attributes ``ixx ixy ixz iyy iyz izz`` finite [kg·m²], the
+   matrix positive definite and its principal moments satisfying the triangle
+   inequality; ``<origin xyz rpy>`` if present three finite numbers each [m], [rad];
+5. every ``<joint>``: ``type`` one of :data:`JOINT_TYPES`; ``<origin xyz rpy>`` if present
+   three finite numbers each; for revolute, continuous, prismatic and planar joints the
+   ``<axis xyz>`` if present three finite numbers with a nonzero norm (URDF's default axis
+   is ``1 0 0``); for revolute, continuous and prismatic joints ``<limit effort velocity>``
+   if present finite and >= 0, and for revolute and prismatic joints ``<limit lower upper>``
+   finite with ``lower <= upper`` (URDF defaults both to 0);
+   ``<parent link>`` and ``<child link>`` name declared links, different from each other,
+   and no link is the child of two joints;
+6. the links form one tree: exactly one root link (no joint's child) from which every link
+   is reachable (no cycles).
+
+Numbers are read as URDF writes them: decimal literals such as ``1``, ``-0.5``, ``.5``,
+``1e-3``. ``nan``, ``inf`` and Python-only spellings such as ``1_000`` are rejected.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import xml.etree.ElementTree as ET
+from collections import Counter
+from collections.abc import Iterable, Sequence
+from pathlib import Path
+from typing import Final
+
+import numpy as np
+
+from twolink_pin.errors import InvalidURDFError
+
+__all__ = [
+    "AXIS_JOINT_TYPES",
+    "JOINT_TYPES",
+    "MAX_LINKS",
+    "TRIANGLE_RTOL",
+    "validate_urdf_file",
+    "validate_urdf_string",
+]
+
+MAX_LINKS: Final[int] = 1000
+"""Most links (and joints) a description may have.
+
+Pinocchio 4.1 segfaults when parsing chains of about 5000 links; a 1000-link chain parses
+correctly in a fraction of a second. The cap keeps a wide margin below the crash and far
+above any arm this toolkit is meant for.
+"""
+
+JOINT_TYPES: Final[frozenset[str]] = frozenset(
+    {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
+)
+"""The joint types of the URDF specification."""
+
+AXIS_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "continuous", "prismatic", "planar"})
+"""Joint types whose ``<axis>`` is used (the planar joint's axis is the plane's normal)."""
+
+_LIMIT_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "continuous", "prismatic"})
+_BOUNDED_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "prismatic"})
+
+TRIANGLE_RTOL: Final[float] = 1e-12
+"""Relative tolerance of the triangle inequality on principal moments.
+
+The largest principal moment may exceed the sum of the other two by this fraction of that
+sum, so that a thin rod or a flat plate (equality) passes despite rounding.
+"""
+
+_INERTIA_ATTRIBUTES: Final[tuple[str, ...]] = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+_DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_ROBOT = "<robot>"
+
+
+def validate_urdf_file(path: str | os.PathLike[str]) -> None:
+    """Check that a URDF file can safely be given to Pinocchio.
+
+    Args:
+        path: The URDF file.
+
+    Raises:
+        InvalidURDFError: If the file is missing or unreadable (element ``file``), is not
+            well-formed XML (element ``XML document``, with the parser's line and column),
+            or fails any check of :func:`validate_urdf_string`. ``error.path`` is ``path``.
+    """
+    name = os.fsdecode(path)
+    try:
+        data = Path(name).read_bytes()
+    except FileNotFoundError:
+        raise InvalidURDFError(name, "file", "file not found; expected an existing URDF file") from None
+    except OSError as err:
+        detail = err.strerror or type(err).__name__
+        raise InvalidURDFError(
+            name, "file", f"cannot read the file ({detail}); expected a readable URDF file"
+        ) from None
+    _validate_robot(_parse(data, name), name)
+
+
+def validate_urdf_string(xml: str, path: str = "<string>") -> None:
+    """Check that URDF text can safely be given to Pinocchio.
+
+    Args:
+        xml: The URDF document.
+        path: Name used for the document in error messages (``error.path``).
+
+    Raises:
+        InvalidURDFError: On the first problem found; see the module docstring for the
+            checks. Physical quantities are SI: mass [kg], inertia [kg·m²] about the
+            centre of mass, lengths [m], angles [rad].
+    """
+    _validate_robot(_parse(xml, path), path)
+
+
+# --- document level -------------------------------------------------------------------------
+
+
+def _parse(text: str | bytes, path: str) -> ET.Element:
+    try:
+        return ET.fromstring(text)
+    except ET.ParseError as err:
+        # str(err) is e.g. "no element found: line 12, column 4".
+        raise InvalidURDFError(
+            path, "XML document", f"not well-formed XML ({err}); expected a complete, well-formed XML file"
+        ) from None
+
+
+def _validate_robot(robot: ET.Element, path: str) -> None:
+    if robot.tag != "robot":
+        raise InvalidURDFError(path, f"<{robot.tag}>", f"root element is <{robot.tag}>; expected <robot>")
+    links = robot.findall("link")
+    joints = robot.findall("joint")
+    # Count first: a huge file must be rejected before any per-element work.
+    if len(links) > MAX_LINKS:
+        raise InvalidURDFError(
+            path,
+            _ROBOT,
+            f"has {len(links)} links, more than the cap MAX_LINKS = {MAX_LINKS}; expected at most "
+            f"{MAX_LINKS} links (Pinocchio 4.1 crashes on chains of about 5000 links)",
+        )
+    if len(joints) > MAX_LINKS:
+        raise InvalidURDFError(
+            path,
+            _ROBOT,
+            f"has {len(joints)} joints, more than the cap MAX_LINKS = {MAX_LINKS}; expected at most "
+            f"{MAX_LINKS} joints (Pinocchio 4.1 crashes on chains of about 5000 links)",
+        )
+    if not links:
+        raise InvalidURDFError(path, _ROBOT, "contains no <link>; expected at least one link")
+
+    link_names = _names(links, "link", path)
+    joint_names = _names(joints, "joint", path)
+    for link, name in zip(links, link_names, strict=True):
+        _check_link(link, f"link '{name}'", path)
+    known = set(link_names)
+    edges = [
+        _check_joint(joint, f"joint '{name}'", link_names, known, path)
+        for joint, name in zip(joints, joint_names, strict=True)
+    ]
+    _check_tree(link_names, joint_names, edges, path)
+
+
+def _names(elements: Sequence[ET.Element], kind: str, path: str) -> list[str]:
+    """Names of ``elements`` (all ``<link>`` or all ``<joint>``), checked present and unique."""
+    names = []
+    for number, element in enumerate(elements, start=1):
+        name = element.get("name")
+        if name is None or not name.strip():
+            raise InvalidURDFError(
+                path, f"{kind} #{number}", f'has no name; expected <{kind} name="..."> with a non-empty name'
+            )
+        names.append(name)
+    for name, count in Counter(names).items():
+        if count > 1:
+            raise InvalidURDFError(
+                path, f"{kind} '{name}'", f"name is declared {count} times; expected unique {kind} names"
+            )
+    return names
+
+
+# --- links ----------------------------------------------------------------------------------
+
+
+def _check_link(link: ET.Element, where: str, path: str) -> None:
+    inertials = link.findall("inertial")
+    if not inertials:
+        return  # A massless link (e.g. a base or an end-effector frame) is fine.
+    if len(inertials) > 1:
+        raise InvalidURDFError(
+            path, f"{where} <inertial>", f"appears {len(inertials)} times; expected at most one per link"
+        )
+    inertial = inertials[0]
+    where = f"{where} <inertial>"
+
+    mass = inertial.find("mass")
+    if mass is None:
+        raise InvalidURDFError(
+            path, f"{where}<mass>", 'missing; expected <mass value="..."/> with a finite number > 0 kg'
+        )
+    raw = mass.get("value")
+    if raw is None:
+        raise InvalidURDFError(path, f"{where}<mass>", "value is missing; expected a finite number > 0 kg")
+    value = _finite_float(raw)
+    if value is None or not value > 0.0:
+        raise InvalidURDFError(path, f"{where}<mass>", f'mass value="{raw}" must be a finite number > 0 kg')
+
+    _check_inertia(inertial.find("inertia"), f"{where}<inertia>", path)
+    _check_origin(inertial.find("origin"), f"{where}<origin>", path)
+
+
+def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
+    if inertia is None:
+        raise InvalidURDFError(
+            path,
+            where,
+            "missing; expected <inertia ixx ixy ixz iyy iyz izz/> in kg m^2 about the centre of mass",
+        )
+    missing = [name for name in _INERTIA_ATTRIBUTES if inertia.get(name) is None]
+    if missing:
+        raise InvalidURDFError(
+            path,
+            where,
+            f"missing attribute(s) {', '.join(missing)}; "
+            f"expected all six of {', '.join(_INERTIA_ATTRIBUTES)}",
+        )
+    values = {}
+    for name in _INERTIA_ATTRIBUTES:
+        raw = inertia.get(name, "")
+        value = _finite_float(raw)
+        if value is None:
+            raise InvalidURDFError(path, where, f'{name}="{raw}" must be a finite number (kg m^2)')
+        values[name] = value
+
+    matrix = np.array(
+        [
+            [values["ixx"], values["ixy"], values["ixz"]],
+            [values["ixy"], values["iyy"], values["iyz"]],
+            [values["ixz"], values["iyz"], values["izz"]],
+        ]
+    )
+    with np.errstate(all="ignore"):
+        moments = np.linalg.eigvalsh(matrix)  # ascending
+    shown = ", ".join(f"{m:.6g}" for m in moments)
+    if not np.all(np.isfinite(moments)):
+        raise InvalidURDFError(
+            path, where, f"principal moments ({shown}) are not finite; expected moderate values in kg m^2"
+        )
+    if not moments[0] > 0.0:
+        raise InvalidURDFError(
+            path,
+            where,
+            f"inertia matrix is not positive definite: its eigenvalues are ({shown}) kg m^2; "
+            "expected all > 0",
+        )
+    small, middle, large = (float(m) for m in moments)
+    if large > (small + middle) * (1.0 + TRIANGLE_RTOL):
+        raise InvalidURDFError(
+            path,
+            where,
+            f"principal moments ({shown}) kg m^2 violate the triangle inequality: {large:.6g} > "
+            f"{small:.6g} + {middle:.6g}; expected each moment <= the sum of the other two",
+        )
+
+
+def _check_origin(origin: ET.Element | None, where: str, path: str) -> None:
+    if origin is None:
+        return
+    for attribute, unit in (("xyz", "m"), ("rpy", "rad")):
+        raw = origin.get(attribute)
+        if raw is not None and _finite_vector(raw) is None:
+            raise InvalidURDFError(path, where, f'{attribute}="{raw}" must be 3 finite numbers ({unit})')
+
+
+# --- joints ---------------------------------------------------------------------------------
+
+
+def _check_joint(
+    joint: ET.Element, where: str, link_names: Sequence[str], known: set[str], path: str
+) -> tuple[str, str]:
+    """Check one joint and return its (parent, child) link names."""
+    joint_type = joint.get("type")
+    expected_types = ", ".join(sorted(JOINT_TYPES))
+    if joint_type is None:
+        raise InvalidURDFError(path, where, f"has no type; expected one of {expected_types}")
+    if joint_type not in JOINT_TYPES:
+        raise InvalidURDFError(
+            path, where, f'type="{joint_type}" is not a URDF joint type; expected one of {expected_types}'
+        )
+
+    parent = _link_reference(joint, "parent", known, link_names, where, path)
+    child = _link_reference(joint, "child", known, link_names, where, path)
+    if parent == child:
+        raise InvalidURDFError(
+            path, f"{where} <child>", f"link '{child}' is also the parent; expected two different links"
+        )
+
+    _check_origin(joint.find("origin"), f"{where} <origin>", path)
+
+    axis = joint.find("axis")
+    if joint_type in AXIS_JOINT_TYPES and axis is not None:
+        raw = axis.get("xyz")
+        if raw is not None:  # No xyz: URDF's default axis 1 0 0.
+            vector = _finite_vector(raw)
+            if vector is None or not math.hypot(*vector) > 0.0:
+                raise InvalidURDFError(
+                    path,
+                    f"{where} <axis>",
+                    f'xyz="{raw}" must be 3 finite numbers with a nonzero norm (URDF default: 1 0 0)',
+                )
+
+    limit = joint.find("limit")
+    if joint_type in _LIMIT_JOINT_TYPES and limit is not None:
+        _check_limit(limit, joint_type, f"{where} <limit>", path)
+    return parent, child
+
+
+def _link_reference(
+    joint: ET.Element, tag: str, known: set[str], link_names: Sequence[str], where: str, path: str
+) -> str:
+    element = joint.find(tag)
+    name = None if element is None else element.get("link")
+    if name is None:
+        raise InvalidURDFError(
+            path, f"{where} <{tag}>", f'missing; expected <{tag} link="..."/> naming a declared link'
+        )
+    if name not in known:
+        raise InvalidURDFError(
+            path,
+            f"{where} <{tag}>",
+            f'link="{name}" names no declared link; expected one of {_some(link_names)}',
+        )
+    return name
+
+
+def _check_limit(limit: ET.Element, joint_type: str, where: str, path: str) -> None:
+    prismatic = joint_type == "prismatic"
+    units = {
+        "effort": "N" if prismatic else "N m",
+        "velocity": "m/s" if prismatic else "rad/s",
+        "lower": "m" if prismatic else "rad",
+        "upper": "m" if prismatic else "rad",
+    }
+    for attribute in ("effort", "velocity"):
+        raw = limit.get(attribute)
+        if raw is None:
+            continue
+        value = _finite_float(raw)
+        if value is None or not value >= 0.0:
+            raise InvalidURDFError(
+                path, where, f'{attribute}="{raw}" must be a finite number >= 0 ({units[attribute]})'
+            )
+    if joint_type not in _BOUNDED_JOINT_TYPES:
+        return
+    bounds = []
+    for attribute in ("lower", "upper"):
+        raw = limit.get(attribute, "0")  # URDF default: 0.
+        value = _finite_float(raw)
+        if value is None:
+            raise InvalidURDFError(
+                path, where, f'{attribute}="{raw}" must be a finite number ({units[attribute]})'
+            )
+        bounds.append(value)
+    lower, upper = bounds
+    if lower > upper:
+        raise InvalidURDFError(
+            path,
+            where,
+            f'lower="{limit.get("lower", "0")}" > upper="{limit.get("upper", "0")}"; expected lower <= upper '
+            f"({units['lower']}; an absent bound defaults to 0)",
+        )
+
+
+# --- tree -----------------------------------------------------------------------------------
+
+
+def _check_tree(
+    link_names: Sequence[str], joint_names: Sequence[str], edges: Sequence[tuple[str, str]], path: str
+) -> None:
+    parent_joint: dict[str, str] = {}
+    children: dict[str, list[str]] = {name: [] for name in link_names}
+    for joint_name, (parent, child) in zip(joint_names, edges, strict=True):
+        if child in parent_joint:
+            raise InvalidURDFError(
+                path,
+                f"joint '{joint_name}' <child>",
+                f"link '{child}' is already the child of joint '{parent_joint[child]}'; "
+                "expected each link to be the child of at most one joint",
+            )
+        parent_joint[child] = joint_name
+        children[parent].append(child)
+
+    roots = [name for name in link_names if name not in parent_joint]
+    if not roots:
+        raise InvalidURDFError(
+            path,
+            _ROBOT,
+            "has no root link: every link is the child of a joint, so the joints form a cycle; "
+            "expected exactly one link that is no joint's child",
+        )
+    if len(roots) > 1:
+        raise InvalidURDFError(
+            path,
+            _ROBOT,
+            f"has {len(roots)} root links ({_some(roots)}); expected exactly one link that is no "
+            "joint's child (the links must form one connected tree)",
+        )
+
+    root = roots[0]
+    reached = {root}
+    stack = [root]
+    while stack:
+        for child in children[stack.pop()]:
+            if child not in reached:
+                reached.add(child)
+                stack.append(child)
+    for name in link_names:
+        if name not in reached:
+            raise InvalidURDFError(
+                path,
+                f"link '{name}'",
+                f"is not connected to root link '{root}': its joints form a cycle; expected a tree",
+            )
+
+
+# --- numbers --------------------------------------------------------------------------------
+
+
+def _finite_float(raw: str) -> float | None:
+    """The value of a decimal literal, or None if ``raw`` is not one or is not finite."""
+    text = raw.strip()
+    if not _DECIMAL.fullmatch(text):
+        return None
+    value = float(text)
+    return value if math.isfinite(value) else None
+
+
+def _finite_vector(raw: str) -> tuple[float, float, float] | None:
+    """Three whitespace-separated finite numbers, or None."""
+    parts = raw.split()
+    if len(parts) != 3:
+        return None
+    values = [_finite_float(part) for part in parts]
+    if any(value is None for value in values):
+        return None
+    x, y, z = (float(value) for value in values if value is not None)
+    return x, y, z
+
+
+def _some(names: Iterable[str], count: int = 5) -> str:
+    """Up to ``count`` quoted names, for a message."""
+    names = list(names)
+    shown = ", ".join(f"'{name}'" for name in names[:count])
+    return shown + (f", ... ({len(names)} in all)" if len(names) > count else "")
