@@ -1,0 +1,149 @@
+"""Rigid-body dynamics from Pinocchio, plus joint friction.
+
+The equation of motion is ``M(q) q̈ + C(q, q̇) q̇ + g(q) + f(q̇) = τ``. Every rigid-body
+term comes from Pinocchio on the loaded model:
+
+=====================  ==========================================
+``mass_matrix``        CRBA (``pin.crba``), symmetric
+``coriolis_matrix``    ``pin.computeCoriolisMatrix`` (Christoffel form: Ṁ − 2C skew)
+``inverse_dynamics``   RNEA (``pin.rnea``)
+``forward_dynamics``   ABA (``pin.aba``)
+``regressor``          ``pin.computeJointTorqueRegressor``, polarised (below)
+=====================  ==========================================
+
+Friction ``f`` is not in Pinocchio's algorithms; :class:`Friction` adds it explicitly.
+All functions take the model and a ``pin.Data`` the caller owns (one per user).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.errors import InvalidParameterError
+
+
+def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """Joint-space inertia ``M(q)`` [kg·m²], shape (nv, nv), symmetric (CRBA)."""
+    M = pin.crba(model, data, q)
+    return np.triu(M) + np.triu(M, 1).T
+
+
+def coriolis_matrix(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Coriolis/centrifugal matrix ``C(q, q̇)`` [kg·m²/s], shape (nv, nv), Christoffel form."""
+    return pin.computeCoriolisMatrix(model, data, q, v).copy()
+
+
+def gravity_torque(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """Gravity torque ``g(q)`` [N·m], shape (nv,) (zero for the horizontal twolink)."""
+    return pin.computeGeneralizedGravity(model, data, q).copy()
+
+
+def inverse_dynamics(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """``τ = M(q) a + C(q, v) v + g(q)`` [N·m] by RNEA."""
+    return pin.rnea(model, data, q, v, a).copy()
+
+
+def forward_dynamics(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+) -> np.ndarray:
+    """``q̈ = M(q)⁻¹ (τ − C(q, v) v − g(q))`` [rad/s²] by ABA."""
+    return pin.aba(model, data, q, v, tau).copy()
+
+
+def model_torque(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """``M(q) a + C(q, v) w + g(q)`` [N·m]: RNEA plus the Coriolis matrix times ``w − v``.
+
+    The model term of every law that multiplies ``C(q, q̇)`` by a velocity other than
+    ``q̇`` (feedforward ``C q̇_d``, Slotine–Li ``C q̇_r``).
+    """
+    tau = pin.rnea(model, data, q, v, a).copy()
+    tau += pin.computeCoriolisMatrix(model, data, q, v) @ (w - v)
+    return tau
+
+
+def regressor(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """Inertial regressor ``Y_π`` with ``Y_π π = M(q) a + C(q, v) w + g(q)``.
+
+    Pinocchio's ``computeJointTorqueRegressor(q, v, a)`` only gives the case ``w = v``.
+    Slotine–Li control needs ``w = q̇_r ≠ v``. Because ``C`` is the Christoffel matrix,
+    ``C(q, v) w = Γ(v, w)`` is a symmetric bilinear form with ``Γ(x, x) = C(q, x) x``, so
+    by polarisation ``Γ(v, w) = [Γ(v + w, v + w) − Γ(v − w, v − w)] / 4`` and::
+
+        Y_π(q, v, w, a) = Y(q, 0, a) + [Y(q, v + w, 0) − Y(q, v − w, 0)] / 4
+
+    Args:
+        q: Configuration [rad]. v: Velocity in ``C(q, v)`` [rad/s].
+        w: Velocity multiplied by ``C`` [rad/s]. a: Acceleration [rad/s²].
+
+    Returns:
+        ``Y_π``, shape (nv, 10 (njoints − 1)).
+    """
+    zero = np.zeros(model.nv)
+    y = pin.computeJointTorqueRegressor(model, data, q, zero, a).copy()
+    y += 0.25 * pin.computeJointTorqueRegressor(model, data, q, v + w, zero)
+    y -= 0.25 * pin.computeJointTorqueRegressor(model, data, q, v - w, zero)
+    # Gravity is in all three calls; the difference cancels it, so it counts once.
+    return y
+
+
+@dataclass(frozen=True)
+class Friction:
+    """Joint friction ``f_i(q̇_i) = V_i q̇_i + C_i sgn(q̇_i)``.
+
+    Attributes:
+        viscous: ``V`` per joint [N·m·s/rad], >= 0.
+        coulomb: ``C`` per joint [N·m], >= 0.
+        smoothing: Velocity scale ε [rad/s] of the smooth sign ``tanh(q̇/ε)``; 0 (default)
+            uses the exact sign, right with a fixed-step integrator. A positive ε lets an
+            adaptive-step integrator pass through sticking without stalling.
+    """
+
+    viscous: tuple[float, ...]
+    coulomb: tuple[float, ...]
+    smoothing: float = 0.0
+
+    def __post_init__(self) -> None:
+        if len(self.viscous) != len(self.coulomb):
+            raise InvalidParameterError(
+                "coulomb", self.coulomb, f"one value per joint, like viscous (length {len(self.viscous)})"
+            )
+        for name, values in (("viscous", self.viscous), ("coulomb", self.coulomb)):
+            for x in values:
+                if not (math.isfinite(x) and x >= 0):
+                    raise InvalidParameterError(name, values, "finite values >= 0")
+        if not (math.isfinite(self.smoothing) and self.smoothing >= 0):
+            raise InvalidParameterError("smoothing", self.smoothing, "a finite velocity >= 0 rad/s")
+
+    @classmethod
+    def report(cls, smoothing: float = 0.0) -> Friction:
+        """The report's friction: V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m."""
+        return cls(viscous=(0.4, 0.2), coulomb=(0.2, 0.1), smoothing=smoothing)
+
+    @property
+    def parameters(self) -> np.ndarray:
+        """``(V_1..V_n, C_1..C_n)``, matching :func:`friction_regressor`'s columns."""
+        return np.array(self.viscous + self.coulomb)
+
+    def torque(self, v: np.ndarray) -> np.ndarray:
+        """Friction torque ``f(q̇)`` [N·m] at joint velocity ``v`` [rad/s]."""
+        return np.asarray(self.viscous) * v + np.asarray(self.coulomb) * smooth_sign(v, self.smoothing)
+
+
+def smooth_sign(v: np.ndarray, smoothing: float) -> np.ndarray:
+    """``sgn(v)`` if ``smoothing == 0`` else ``tanh(v / smoothing)``."""
+    return np.sign(v) if smoothing == 0 else np.tanh(v / smoothing)
+
+
+def friction_regressor(v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
+    """``[diag(q̇), diag(sgn q̇)]``, shape (nv, 2 nv): ``f(q̇) = Y_f (V, C)``."""
+    return np.hstack([np.diag(v), np.diag(smooth_sign(v, smoothing))])

@@ -1,0 +1,92 @@
+"""End-effector kinematics: forward kinematics and Jacobian from Pinocchio frames, and the
+analytic inverse kinematics of a planar 2R arm (both elbow branches).
+
+Angles [rad], positions [m]. The plane is the base frame's x-y plane.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.errors import InvalidParameterError, UnreachableTargetError
+from twolink_pin.model import RobotModel
+
+
+def _check_q(robot: RobotModel, q: np.ndarray) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.shape != (robot.nq,):
+        raise InvalidParameterError("q", q.tolist(), f"shape ({robot.nq},) but got {q.shape}")
+    if not np.all(np.isfinite(q)):
+        raise InvalidParameterError("q", q.tolist(), "finite joint angles [rad]")
+    return q
+
+
+def forward_kinematics(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    """End-effector position ``(x, y)`` [m] at configuration ``q`` [rad] (Pinocchio frames)."""
+    q = _check_q(robot, q)
+    data = data if data is not None else robot.create_data()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return data.oMf[robot.ee_frame_id].translation[:2].copy()
+
+
+def jacobian(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    """Planar end-effector Jacobian ``∂(x, y)/∂q`` [m/rad], shape (2, nv), world-aligned."""
+    q = _check_q(robot, q)
+    data = data if data is not None else robot.create_data()
+    J = pin.computeFrameJacobian(robot.model, data, q, robot.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+    return J[:2, :].copy()
+
+
+class Workspace(NamedTuple):
+    """Reachable annulus of a planar 2R arm."""
+
+    r_min: float
+    """Inner radius ``|L1 − L2|`` [m]."""
+    r_max: float
+    """Outer radius ``L1 + L2`` [m]."""
+
+
+def workspace(robot: RobotModel) -> Workspace:
+    """The annulus ``|L1 − L2| <= r <= L1 + L2`` of a planar 2R arm [m]."""
+    _require_2r(robot)
+    l1, l2 = robot.link_lengths
+    return Workspace(abs(l1 - l2), l1 + l2)
+
+
+def _require_2r(robot: RobotModel) -> None:
+    if robot.nv != 2:
+        raise InvalidParameterError("robot", robot.model.name, "a planar 2R arm (nv = 2) for analytic IK")
+
+
+def inverse_kinematics(robot: RobotModel, target: tuple[float, float] | np.ndarray, tol: float = 1e-12) -> np.ndarray:
+    """Both elbow branches reaching ``target = (x, y)`` [m] (report eqs. 2–3).
+
+    Returns:
+        Shape (2, 2): row 0 is the ``q2 >= 0`` branch (the report's "first pair"), row 1
+        the ``q2 <= 0`` branch [rad]. On the annulus boundary both rows coincide.
+
+    Raises:
+        UnreachableTargetError: if ``target`` lies outside the annulus (beyond ``tol`` [m]).
+        InvalidParameterError: if ``target`` is not two finite numbers.
+    """
+    _require_2r(robot)
+    xy = np.asarray(target, dtype=float)
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)):
+        raise InvalidParameterError("target", np.asarray(target).tolist(), "two finite coordinates (x, y) [m]")
+    x, y = float(xy[0]), float(xy[1])
+    l1, l2 = (float(v) for v in robot.link_lengths)
+    r_min, r_max = workspace(robot)
+    r = math.hypot(x, y)
+    if r < r_min - tol or r > r_max + tol:
+        raise UnreachableTargetError((x, y), r_min, r_max)
+    c2 = (x * x + y * y - l1 * l1 - l2 * l2) / (2 * l1 * l2)
+    q2 = math.acos(min(1.0, max(-1.0, c2)))
+    solutions = []
+    for elbow in (q2, -q2):
+        k1, k2 = l1 + l2 * math.cos(elbow), l2 * math.sin(elbow)
+        solutions.append((math.atan2(y, x) - math.atan2(k2, k1), elbow))
+    return np.array(solutions)
