@@ -62,7 +62,9 @@ def _require_2r(robot: RobotModel) -> None:
         raise InvalidParameterError("robot", robot.model.name, "a planar 2R arm (nv = 2) for analytic IK")
 
 
-def inverse_kinematics(robot: RobotModel, target: tuple[float, float] | np.ndarray, tol: float = 1e-12) -> np.ndarray:
+def inverse_kinematics(
+    robot: RobotModel, target: tuple[float, float] | np.ndarray, tol: float = 1e-12
+) -> np.ndarray:
     """Both elbow branches reaching ``target = (x, y)`` [m] (report eqs. 2–3).
 
     Returns:
@@ -76,7 +78,9 @@ def inverse_kinematics(robot: RobotModel, target: tuple[float, float] | np.ndarr
     _require_2r(robot)
     xy = np.asarray(target, dtype=float)
     if xy.shape != (2,) or not np.all(np.isfinite(xy)):
-        raise InvalidParameterError("target", np.asarray(target).tolist(), "two finite coordinates (x, y) [m]")
+        raise InvalidParameterError(
+            "target", np.asarray(target).tolist(), "two finite coordinates (x, y) [m]"
+        )
     x, y = float(xy[0]), float(xy[1])
     l1, l2 = (float(v) for v in robot.link_lengths)
     r_min, r_max = workspace(robot)

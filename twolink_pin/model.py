@@ -132,7 +132,9 @@ def load_robot(
         raise InvalidURDFError(str(path), "<robot>", "expected at least one moving joint, found none")
     if model.nq != model.nv:
         raise InvalidURDFError(
-            str(path), "<robot>", f"expected only 1-DoF joints (nq == nv), got nq = {model.nq}, nv = {model.nv}"
+            str(path),
+            "<robot>",
+            f"expected only 1-DoF joints (nq == nv), got nq = {model.nq}, nv = {model.nv}",
         )
     ee_id = _end_effector_frame(model, ee_frame, path)
     if payload > 0:

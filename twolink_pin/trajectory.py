@@ -13,6 +13,7 @@ coefficients in powers of ``t − t_0`` follow by scaling, ``a_k = c_k / T^k``.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -66,7 +67,7 @@ def _check_times(times: tuple[float, ...], n: int, what: str) -> None:
         raise InvalidParameterError("times", times, f"one time per via point ({n} from {what})")
     if n < 2:
         raise InvalidParameterError("times", times, "at least two via points")
-    if not all(math.isfinite(t) for t in times) or any(b <= a for a, b in zip(times, times[1:])):
+    if not all(math.isfinite(t) for t in times) or any(b <= a for a, b in itertools.pairwise(times)):
         raise InvalidParameterError("times", times, "finite, strictly increasing times [s]")
 
 

@@ -81,7 +81,9 @@ class TwoLinkLumpedMap(ParameterMap):
         body2 = pi[N_BODY_PARAMETERS:]
         if abs(body2[_MCY]) > 1e-12 * max(1.0, abs(body2[_MASS])):
             raise InvalidParameterError(
-                "link 2 first moment m*c_y", float(body2[_MCY]), "0 kg·m (centre of mass on the link's x axis)"
+                "link 2 first moment m*c_y",
+                float(body2[_MCY]),
+                "0 kg·m (centre of mass on the link's x axis)",
             )
         izz1, izz2, m2, mcx2 = pi[_IZZ], body2[_IZZ], body2[_MASS], body2[_MCX]
         return np.array([izz1 + self.l1**2 * m2 + izz2, izz2, self.l1 * mcx2])
