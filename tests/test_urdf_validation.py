@@ -254,6 +254,12 @@ def test_decimal_mass_spellings_pass(value: str) -> None:
     validate_urdf_string(arm(mass=f'<mass value="{value}"/>'))
 
 
+def test_explicitly_massless_link_passes() -> None:
+    """mass 0 with an all-zero inertia is a massless frame link (example-robot-data uses them)."""
+    zero = '<inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/>'
+    validate_urdf_string(arm(mass='<mass value="0"/>', inertia=zero))
+
+
 def test_missing_mass() -> None:
     assert_rejected(arm(mass=""), "link 'link2' <inertial><mass>", 'missing; expected <mass value="..."/>')
     assert_rejected(arm(mass="<mass/>"), "link 'link2' <inertial><mass>", "value is missing")

@@ -50,9 +50,30 @@ def _non_negative(text: str) -> float:
     return value
 
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number >= 1, got {text!r}")
+    return value
+
+
+def _jsonable(obj: Any) -> Any:
+    """``obj`` with non-finite floats (an absent torque limit is inf) as None."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    return obj
+
+
 def _emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
     if args.json:
-        print(json.dumps(payload, allow_nan=False))
+        print(json.dumps(_jsonable(payload), allow_nan=False))
     else:
         print(text)
 
@@ -95,6 +116,14 @@ def cmd_info(args: argparse.Namespace) -> int:
             f"parameters {p_text}",
         ]
     )
+    if args.write_urdf:
+        from twolink_pin.variants import write_payload_urdf
+
+        if robot.payload <= 0:
+            raise InvalidParameterError("--payload", robot.payload, "a mass > 0 kg to write a payload variant")
+        written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
+        payload["urdf_written"] = str(written)
+        text += f"\nwrote   {written}"
     _emit(args, payload, text)
     return 0
 
@@ -249,6 +278,32 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_report(args: argparse.Namespace) -> int:
+    import shlex
+
+    from twolink_pin.report import ReportOptions, build_report, terminal_progress
+    from twolink_pin.simulation import SimulationConfig
+
+    options = ReportOptions(
+        urdf=args.urdf,
+        payload=args.payload,
+        config=SimulationConfig(
+            duration=args.duration, dt=args.dt, method=args.method, q0_offset=tuple(args.q0_offset)
+        ),
+        lam=args.lam,
+        workers=args.workers,
+        animation=not args.no_animation,
+    )
+    command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
+    results = build_report(
+        args.out, options, progress=None if args.json else terminal_progress, command_line=command
+    )
+    index = Path(args.out) / "index.html"
+    payload = {"index": str(index), "total_seconds": results["total_seconds"]}
+    _emit(args, payload, f"report written to {index} in {results['total_seconds']:.1f} s")
+    return 0
+
+
 # -- parser -----------------------------------------------------------------------------
 
 
@@ -290,6 +345,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     p = sub.add_parser("info", help="model summary: sizes, link lengths, torque limits, parameters")
+    p.add_argument("--write-urdf", metavar="FILE", help="also write the payload variant as a URDF file")
     _add_robot_options(p)
     p.set_defaults(func=cmd_info)
 
@@ -325,6 +381,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_robot_options(p)
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("report", help="reproduce the whole course report as HTML (index.html) in DIR")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
+    _add_sim_options(p)
+    p.add_argument("--workers", type=_positive_int, default=2, help="processes for the five runs (default 2)")
+    p.add_argument("--no-animation", action="store_true", help="skip the 3-D animation")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_report)
     return parser
 
 
@@ -332,6 +396,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``twolink-pin`` console script."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)
     try:
         return int(args.func(args))
     except SimulationDivergedError as exc:

@@ -69,7 +69,8 @@ def inverse_kinematics(
 
     Returns:
         Shape (2, 2): row 0 is the ``q2 >= 0`` branch (the report's "first pair"), row 1
-        the ``q2 <= 0`` branch [rad]. On the annulus boundary both rows coincide.
+        the ``q2 <= 0`` branch [rad]. Within ``tol`` of the annulus boundary both rows are
+        the same pose: the straight arm (q2 = 0) outside, the folded arm (q2 = ±π) inside.
 
     Raises:
         UnreachableTargetError: if ``target`` lies outside the annulus (beyond ``tol`` [m]).
@@ -88,7 +89,13 @@ def inverse_kinematics(
     if r < r_min - tol or r > r_max + tol:
         raise UnreachableTargetError((x, y), r_min, r_max)
     c2 = (x * x + y * y - l1 * l1 - l2 * l2) / (2 * l1 * l2)
-    q2 = math.acos(min(1.0, max(-1.0, c2)))
+    # On the boundary (within tol) snap to the straight or folded arm, so both branches
+    # coincide exactly instead of differing by the rounding acos amplifies near ±1.
+    if r >= r_max - tol or c2 >= 1.0:
+        c2 = 1.0
+    elif r <= r_min + tol or c2 <= -1.0:
+        c2 = -1.0
+    q2 = math.acos(c2)
     solutions = []
     for elbow in (q2, -q2):
         k1, k2 = l1 + l2 * math.cos(elbow), l2 * math.sin(elbow)

@@ -56,7 +56,8 @@ class RobotModel:
     link_lengths: np.ndarray = field(repr=False)
     """Distance between successive joints, the last to the end effector [m], shape (nv,)."""
     torque_limits: np.ndarray = field(repr=False)
-    """Motor torque limit of each joint from the URDF ``<limit effort>`` [N·m], shape (nv,)."""
+    """Motor torque limit of each joint from the URDF ``<limit effort>`` [N·m], shape (nv,);
+    ``inf`` where the URDF gives none (effort 0 or absent)."""
     p: np.ndarray = field(repr=False)
     """True parameters of the map (for the twolink p1, p2, p3 [kg·m²])."""
 
@@ -151,6 +152,6 @@ def load_robot(
         payload=float(payload),
         parameter_map=pmap,
         link_lengths=_readonly(_link_lengths(model, ee_id)),
-        torque_limits=_readonly(model.effortLimit),
+        torque_limits=_readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
         p=_readonly(pmap.values(model)),
     )

@@ -6,9 +6,10 @@ acceleration, jerk for the default ``order = 3``) at ``t_0`` and ``t_n``: with t
 five via points that is 5 + 2·3 = 11 conditions and a 10th-order polynomial (report
 eqs. 4–7). Angles [rad], times [s].
 
-The linear system is solved in normalised time ``s = (t − t_0)/T`` (``T = t_n − t_0``),
-whose Vandermonde matrix is far better conditioned than the one in ``t``; the
-coefficients in powers of ``t − t_0`` follow by scaling, ``a_k = c_k / T^k``.
+The linear system is solved and evaluated in normalised time ``s = (t − t_0)/T``
+(``T = t_n − t_0``), which keeps the matrix's scale independent of the time unit and span
+(for the report's 4 s the condition number is 2e8 against 5e8 in ``t``); the coefficients
+in powers of ``t − t_0`` follow by scaling, ``a_k = c_k / T^k``.
 """
 
 from __future__ import annotations

@@ -29,7 +29,8 @@ Checks, in order:
 2. at least one ``<link>``, at most :data:`MAX_LINKS` links and joints (counted before
    any other work, so a huge file is rejected quickly);
 3. every link and joint has a unique, non-empty ``name``;
-4. every ``<inertial>`` (at most one per link): ``<mass value>`` finite and > 0 [kg];
+4. every ``<inertial>`` (at most one per link): ``<mass value>`` finite and > 0 [kg]
+   (or exactly 0 with an all-zero inertia: an explicitly massless frame link);
    ``<inertia>`` with the six attributes ``ixx ixy ixz iyy iyz izz`` finite [kg·m²], the
    matrix positive definite and its principal moments satisfying the triangle
    inequality; ``<origin xyz rpy>`` if present three finite numbers each [m], [rad];
@@ -231,11 +232,20 @@ def _check_link(link: ET.Element, where: str, path: str) -> None:
     if raw is None:
         raise InvalidURDFError(path, f"{where}<mass>", "value is missing; expected a finite number > 0 kg")
     value = _finite_float(raw)
+    if value == 0.0 and _is_zero_inertia(inertial.find("inertia")):
+        return  # An explicitly massless link (mass 0, inertia 0), common for frame links.
     if value is None or not value > 0.0:
         raise InvalidURDFError(path, f"{where}<mass>", f'mass value="{raw}" must be a finite number > 0 kg')
 
     _check_inertia(inertial.find("inertia"), f"{where}<inertia>", path)
     _check_origin(inertial.find("origin"), f"{where}<origin>", path)
+
+
+def _is_zero_inertia(inertia: ET.Element | None) -> bool:
+    """Whether ``<inertia>`` is absent or has all six entries exactly 0."""
+    if inertia is None:
+        return True
+    return all(_finite_float(inertia.get(name, "0")) == 0.0 for name in _INERTIA_ATTRIBUTES)
 
 
 def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
