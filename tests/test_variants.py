@@ -1,0 +1,48 @@
+"""Payload variants written as URDF (yourdfpy) agree with the in-Pinocchio payload."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from twolink_pin import InvalidParameterError, InvalidURDFError, load_robot, twolink_urdf_path
+from twolink_pin.closed_form import mass_matrix
+from twolink_pin.variants import POINT_MASS_INERTIA, payload_urdf, write_payload_urdf
+
+
+@settings(max_examples=10, deadline=None)
+@given(mass=st.floats(min_value=0.05, max_value=5.0))
+def test_written_payload_urdf_gives_the_same_p_as_load_robot(tmp_path_factory, mass: float) -> None:
+    """Second method: the yourdfpy-edited file and Pinocchio's added inertia give equal p."""
+    path = write_payload_urdf(twolink_urdf_path(), mass, tmp_path_factory.mktemp("v") / "pl.urdf")
+    from_file = load_robot(path)
+    in_memory = load_robot(payload=mass)
+    # The written point mass carries POINT_MASS_INERTIA about its centre (adds to p1, p2).
+    np.testing.assert_allclose(from_file.p, in_memory.p, atol=3 * POINT_MASS_INERTIA)
+    l1, l2 = 0.38, 0.24
+    expected = np.array([3.4 + mass * (l1**2 + l2**2), 0.4 + mass * l2**2, 0.3 + mass * l1 * l2])
+    np.testing.assert_allclose(from_file.p, expected, atol=1e-8)
+    q = np.array([0.3, -1.1])
+    data = from_file.create_data()
+    import pinocchio as pin
+
+    np.testing.assert_allclose(pin.crba(from_file.model, data, q), mass_matrix(q, expected), atol=1e-8)
+
+
+def test_payload_must_be_positive() -> None:
+    with pytest.raises(
+        InvalidParameterError, match=r"payload = -1\.0 is invalid: expected a finite mass > 0 kg"
+    ):
+        payload_urdf(twolink_urdf_path(), -1.0)
+
+
+def test_link_with_mass_is_refused() -> None:
+    with pytest.raises(InvalidURDFError, match="link 'link2' <inertial>: expected a massless link"):
+        payload_urdf(twolink_urdf_path(), 1.0, link="link2")
+
+
+def test_unknown_link_is_named() -> None:
+    with pytest.raises(InvalidURDFError, match="link 'gripper': no such link"):
+        payload_urdf(twolink_urdf_path(), 1.0, link="gripper")
