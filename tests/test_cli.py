@@ -1,0 +1,113 @@
+"""The command line: JSON outputs against the library and closed forms, exit codes, one-line errors."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from twolink_pin.cli import main
+from twolink_pin.closed_form import forward_kinematics
+
+
+def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_info_json_reads_p_from_the_urdf(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "info", "--json")
+    data = json.loads(out)
+    assert code == 0
+    assert (data["nq"], data["nv"]) == (2, 2)
+    np.testing.assert_allclose(data["link_lengths"], [0.38, 0.24], atol=1e-15)
+    np.testing.assert_allclose(data["torque_limits"], [240, 40])
+    np.testing.assert_allclose(data["p"], [3.4, 0.4, 0.3], atol=1e-12)
+
+
+def test_info_payload_changes_p_by_the_closed_form(capsys: pytest.CaptureFixture[str]) -> None:
+    m, l1, l2 = 2.0, 0.38, 0.24
+    _, out, _ = run(capsys, "info", "--payload", str(m), "--json")
+    expected = [3.4 + m * (l1**2 + l2**2), 0.4 + m * l2**2, 0.3 + m * l1 * l2]
+    np.testing.assert_allclose(json.loads(out)["p"], expected, atol=1e-12)
+
+
+@pytest.mark.parametrize("q", [(0.0, 0.0), (0.3, 0.5), (-2.0, 3.0)])
+def test_fk_json_equals_closed_form(capsys: pytest.CaptureFixture[str], q: tuple[float, float]) -> None:
+    _, out, _ = run(capsys, "fk", *map(str, q), "--json")
+    np.testing.assert_allclose(json.loads(out)["xy"], forward_kinematics(np.array(q), 0.38, 0.24), atol=1e-14)
+
+
+def test_ik_json_branches_reach_the_target(capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "ik", "0.48", "-0.1", "--json")
+    sols = np.array(json.loads(out)["solutions"])
+    assert sols[0, 1] > 0 > sols[1, 1]
+    np.testing.assert_allclose(sols.round(4), [[-0.7044, 1.3587], [0.2936, -1.3587]])  # report Table 1 row 3
+    for q in sols:
+        np.testing.assert_allclose(forward_kinematics(q, 0.38, 0.24), [0.48, -0.1], atol=1e-12)
+
+
+def test_trajectory_json_meets_the_via_points(capsys: pytest.CaptureFixture[str]) -> None:
+    _, out, _ = run(capsys, "trajectory", "--json")
+    data = json.loads(out)
+    coeffs = np.array(data["coefficients"])
+    assert coeffs.shape == (2, 11)
+    for t, q in zip(data["times"], data["via_q"]):
+        np.testing.assert_allclose([np.polynomial.polynomial.polyval(t, c) for c in coeffs], q, atol=1e-9)
+    assert data["within_limits"] is True
+    assert np.all(np.array(data["peak_torque"]) < np.array(data["torque_limits"]))
+
+
+def test_simulate_json_short_pd_run(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(capsys, "simulate", "pd", "--duration", "0.5", "--json")
+    data = json.loads(out)
+    assert code == 0 and data["controller"] == "pd"
+    assert data["p_hat_final"] is None
+    # At t = 0 the PD torque is Kp·e(0) with e(0) = (0.1, −0.1): max |tau| >= (35, 30) N·m.
+    assert data["metrics"]["max"]["tau"][0] >= 35 - 1e-9 and data["metrics"]["max"]["tau"][1] >= 30 - 1e-9
+    assert data["metrics"]["max"]["e"] == pytest.approx([0.1, 0.1], abs=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["ik", "1", "1"], "outside the reachable annulus 0.14 <= r <= 0.62 m"),
+        (["fk", "nan", "0"], "expected a finite number, got 'nan'"),
+        (["simulate", "pd", "--duration", "0"], "expected a number > 0, got '0'"),
+        (["simulate", "pid"], "invalid choice: 'pid'"),
+        (["info", "--payload", "-1"], "expected a number >= 0, got '-1'"),
+        (["info", "--urdf", "/nonexistent.urdf"], "file not found"),
+        (["simulate", "pd", "--duration", "1", "--dt", "2"], "dt = 2.0 is invalid"),
+    ],
+)
+def test_bad_input_exits_2_with_one_line(
+    capsys: pytest.CaptureFixture[str], argv: list[str], message: str
+) -> None:
+    try:
+        code = main(argv)  # library errors: main returns 2
+    except SystemExit as exc:  # usage errors: argparse exits 2
+        code = exc.code
+    _, err = capsys.readouterr()
+    assert code == 2
+    assert message in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_console_script_runs_as_a_process() -> None:
+    """The installed entry point works outside pytest (exit status and stdout)."""
+    proc = subprocess.run(
+        [sys.executable, "-m", "twolink_pin.cli", "fk", "0", "0", "--json"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert proc.returncode == 0
+    np.testing.assert_allclose(json.loads(proc.stdout)["xy"], [0.62, 0.0], atol=1e-15)
+    bad = subprocess.run(
+        [sys.executable, "-m", "twolink_pin.cli", "ik", "5", "5"], capture_output=True, text=True
+    )
+    assert bad.returncode == 2 and bad.stderr.count("\n") == 1
