@@ -120,7 +120,9 @@ def cmd_info(args: argparse.Namespace) -> int:
         from twolink_pin.variants import write_payload_urdf
 
         if robot.payload <= 0:
-            raise InvalidParameterError("--payload", robot.payload, "a mass > 0 kg to write a payload variant")
+            raise InvalidParameterError(
+                "--payload", robot.payload, "a mass > 0 kg to write a payload variant"
+            )
         written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
         payload["urdf_written"] = str(written)
         text += f"\nwrote   {written}"
@@ -278,6 +280,70 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_animate(args: argparse.Namespace) -> int:
+    from twolink_pin.trajectory import REPORT_VIA_XY
+
+    robot = _robot(args)
+    if args.from_file:
+        from twolink_pin.io import load_result
+
+        result = load_result(args.from_file)
+    elif args.controller is None:
+        raise InvalidParameterError("CONTROLLER", None, "a controller name, or --from FILE.npz")
+    else:
+        result = _run_one(args, args.controller, robot)
+    via = REPORT_VIA_XY if robot.nv == 2 else None
+    if args.html:
+        from twolink_pin.visualization import write_html
+
+        path = write_html(robot, result.t, result.q, result.q_des, path=args.html, via_xy=via, loop=args.loop)
+        _emit(args, {"html": str(path), "controller": result.controller}, f"animation written to {path}")
+        return 0
+    import signal
+    import threading
+
+    from twolink_pin.visualization import serve
+
+    def _stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, _stop)  # a service manager's stop shuts down as cleanly as Ctrl-C
+
+    with serve(
+        robot,
+        result.t,
+        result.q,
+        result.q_des,
+        via_xy=via,
+        host=args.host,
+        port=args.port,
+        loop=args.loop,
+        open_browser=not args.no_browser,
+        quiet=True,
+    ) as viewer:
+        _emit(
+            args,
+            {"url": viewer.url, "host": viewer.host, "port": viewer.port},
+            f"meshcat viewer at {viewer.url}",
+        )
+        print("press Ctrl-C to stop", file=sys.stderr, flush=True)
+        try:
+            threading.Event().wait()
+        except KeyboardInterrupt:
+            print("stopping the viewer", file=sys.stderr)
+    return 0
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"expected a port in 0..65535, got {text!r}")
+    return value
+
+
 def cmd_report(args: argparse.Namespace) -> int:
     import shlex
 
@@ -381,6 +447,24 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_robot_options(p)
     p.set_defaults(func=cmd_compare)
+
+    p = sub.add_parser("animate", help="the tracked motion in meshcat: live in the browser, or one HTML file")
+    p.add_argument("controller", nargs="?", choices=list(CONTROLLERS), help="controller to simulate")
+    _add_sim_options(p)
+    p.add_argument(
+        "--from", dest="from_file", metavar="FILE.npz", help="animate a saved result (simulate --save)"
+    )
+    p.add_argument(
+        "--html", metavar="FILE", help="write one self-contained HTML animation instead of serving"
+    )
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)"
+    )
+    p.add_argument("--port", type=_port, default=None, help="port of the viewer (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.add_argument("--loop", action="store_true", help="repeat the motion")
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_animate)
 
     p = sub.add_parser("report", help="reproduce the whole course report as HTML (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
