@@ -33,7 +33,7 @@ import numpy as np
 from twolink_pin import errata
 from twolink_pin.closed_form import coriolis_matrix as cf_coriolis
 from twolink_pin.closed_form import mass_matrix as cf_mass
-from twolink_pin.comparison import COLUMNS, REPORT_TABLE2, Table2
+from twolink_pin.comparison import COLUMNS, REPORT_TABLE2, UNITS, Table2
 from twolink_pin.controllers import CONTROLLERS
 from twolink_pin.dynamics import coriolis_matrix, mass_matrix
 from twolink_pin.errors import OutputError
@@ -376,6 +376,11 @@ def _write_pages(stage: Path, r: dict[str, Any]) -> None:
         f.write(_html(r))
 
 
+def _table2_headers(kind: str) -> list[str]:
+    units = UNITS[kind]
+    return ["controller", *(f"{c} [{units[i // 2]}]" for i, c in enumerate(COLUMNS))]
+
+
 def _table2_rows(r: dict[str, Any], kind: str) -> list[list[str]]:
     rows = []
     for name, entry in r["controllers"].items():
@@ -490,11 +495,11 @@ def _html(r: dict[str, Any]) -> str:
         "<h2 id='table2'>5. Table 2</h2>",
         "<p>The report does not say which norm its Table 2 shows. Ours, in three defined norms over 30 s:</p>",
         "<h3>RMS = sqrt((1/T)∫x² dt)</h3>",
-        _table(["controller", *COLUMNS], _table2_rows(r, "rms"), "table2-rms"),
+        _table(_table2_headers("rms"), _table2_rows(r, "rms"), "table2-rms"),
         "<h3>L2 = sqrt(∫x² dt)</h3>",
-        _table(["controller", *COLUMNS], _table2_rows(r, "l2"), "table2-l2"),
+        _table(_table2_headers("l2"), _table2_rows(r, "l2"), "table2-l2"),
         "<h3>max |x|</h3>",
-        _table(["controller", *COLUMNS], _table2_rows(r, "max"), "table2-max"),
+        _table(_table2_headers("max"), _table2_rows(r, "max"), "table2-max"),
         "<h3>The report's Table 2</h3>",
         _table(["controller", *COLUMNS], [[n, *v] for n, v in REPORT_TABLE2.items()], "table2-report"),
         f"<div class='note'>{_discussion(r)}</div>",
