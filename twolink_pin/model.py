@@ -30,6 +30,34 @@ def twolink_urdf_path() -> Path:
     return Path(str(resources.files("twolink_pin.robots").joinpath("twolink.urdf")))
 
 
+def example_robot_urdf(relative: str) -> Path:
+    """Path of a URDF shipped by ``example-robot-data``.
+
+    Args:
+        relative: Path below the package's ``robots/`` folder, e.g.
+            ``"double_pendulum_description/urdf/double_pendulum.urdf"`` or
+            ``"asr_twodof_description/urdf/TwoDofs.urdf"`` (a planar 2-DOF arm).
+
+    Raises:
+        InvalidURDFError: the distribution is not installed or has no such file.
+    """
+    import importlib.metadata
+
+    try:
+        files = importlib.metadata.files("example-robot-data") or []
+    except importlib.metadata.PackageNotFoundError:
+        raise InvalidURDFError(
+            relative, "example-robot-data", "not installed (pip install example-robot-data)"
+        ) from None
+    suffix = "robots/" + relative.lstrip("/")
+    for file in files:
+        if str(file).endswith(suffix):
+            return Path(str(file.locate()))
+    raise InvalidURDFError(
+        relative, "example-robot-data", f"no file ending in {suffix!r} in the installed distribution"
+    )
+
+
 def _readonly(array: np.ndarray) -> np.ndarray:
     array = np.array(array, dtype=float)
     array.setflags(write=False)

@@ -1,0 +1,100 @@
+"""Nothing but the twolink's parameter map assumes the twolink: other URDF arms from
+example-robot-data (with gravity) load, their dynamics identities hold, and the
+controllers track joint-space trajectories on them."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from twolink_pin import (
+    Adaptive,
+    AdaptiveGains,
+    ComputedTorque,
+    InertialParameterMap,
+    InvalidURDFError,
+    JointTrajectory,
+    Plant,
+    SimulationConfig,
+    SlotineLiGains,
+    inertial_parameters,
+    load_robot,
+    simulate,
+)
+from twolink_pin.dynamics import regressor
+from twolink_pin.model import example_robot_urdf
+
+ROBOTS = ["double_pendulum_description/urdf/double_pendulum.urdf", "asr_twodof_description/urdf/TwoDofs.urdf"]
+
+
+@pytest.fixture(scope="module", params=ROBOTS)
+def robot(request: pytest.FixtureRequest):
+    return load_robot(example_robot_urdf(request.param))
+
+
+def test_unknown_example_robot_is_named() -> None:
+    with pytest.raises(InvalidURDFError, match=r"no_such_robot\.urdf"):
+        example_robot_urdf("no_such_robot.urdf")
+
+
+def test_generic_robot_uses_all_inertial_parameters_and_has_gravity(robot) -> None:
+    assert isinstance(robot.parameter_map, InertialParameterMap)
+    np.testing.assert_allclose(robot.p, inertial_parameters(robot.model), rtol=0, atol=0)
+    data = robot.create_data()
+    rng = np.random.default_rng(1)
+    gravity = [
+        np.abs(pin.computeGeneralizedGravity(robot.model, data, rng.uniform(-3, 3, robot.nq))).max()
+        for _ in range(5)
+    ]
+    if "pendulum" in str(robot.urdf_path):
+        assert max(gravity) > 0.1  # joints about x under gravity along −z
+
+
+def test_polarised_regressor_includes_gravity_once(robot) -> None:
+    """Y_π(q, v, w, a) π = M a + C(q, v) w + g(q), checked with Pinocchio's separate terms."""
+    data = robot.create_data()
+    rng = np.random.default_rng(2)
+    pi = inertial_parameters(robot.model)
+    for _ in range(20):
+        q, v, w, a = rng.uniform(-2, 2, size=(4, robot.nv))
+        M = pin.crba(robot.model, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        C = pin.computeCoriolisMatrix(robot.model, data, q, v).copy()
+        g = pin.computeGeneralizedGravity(robot.model, data, q).copy()
+        np.testing.assert_allclose(
+            regressor(robot.model, data, q, v, w, a) @ pi, M @ a + C @ w + g, atol=1e-10
+        )
+
+
+def _trajectory(robot) -> JointTrajectory:
+    via = np.array([[0.0, 0.0], [0.6, -0.4], [0.2, 0.8], [0.0, 0.0]])[:, : robot.nv]
+    return JointTrajectory.from_via_q((0.0, 1.0, 2.0, 3.0), via)
+
+
+def test_computed_torque_tracks_on_another_robot(robot) -> None:
+    controller = ComputedTorque(robot, SlotineLiGains(k=(0.05, 0.05), lam=10.0))
+    result = simulate(
+        controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=6.0, q0_offset=(0.05, -0.05))
+    )
+    assert np.abs(result.e[result.t > 5.0]).max() < 1e-6  # from 0.05 rad: exponential convergence
+
+
+def test_adaptive_with_twenty_parameters_keeps_v_non_increasing(robot) -> None:
+    """V = ½ sᵀ M s + ½ p̃ᵀ Γ⁻¹ p̃ with all 20 of Pinocchio's parameters (gravity included)."""
+    gains = AdaptiveGains(k=(0.05, 0.05), gamma=(1.0,) * 20, lam=10.0, initial_estimate=0.8)
+    controller = Adaptive(robot, gains)
+    result = simulate(
+        controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=2.0, q0_offset=(0.05, -0.05))
+    )
+    data = robot.create_data()
+    s = result.edot + gains.lam * result.e
+    p_err = result.p_hat - result.p_true
+    V = np.array(
+        [
+            0.5 * s[k] @ pin.crba(robot.model, data, result.q[k]) @ s[k]
+            + 0.5 * p_err[k] @ (p_err[k] * gains.gamma)
+            for k in range(len(result.t))
+        ]
+    )
+    assert np.diff(V).max() < 1e-9 * V[0]
