@@ -75,9 +75,9 @@ def _trajectory(robot) -> JointTrajectory:
 def test_computed_torque_tracks_on_another_robot(robot) -> None:
     controller = ComputedTorque(robot, SlotineLiGains(k=(0.05, 0.05), lam=10.0))
     result = simulate(
-        controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=6.0, q0_offset=(0.05, -0.05))
+        controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=8.0, q0_offset=(0.05, -0.05))
     )
-    assert np.abs(result.e[result.t > 5.0]).max() < 1e-6  # from 0.05 rad: exponential convergence
+    assert np.abs(result.e[result.t > 7.0]).max() < 1e-6  # from 0.05 rad: exponential convergence
 
 
 def test_adaptive_with_twenty_parameters_keeps_v_non_increasing(robot) -> None:
