@@ -116,7 +116,7 @@ def test_absurd_gain_diverges_with_the_controller_and_time_named() -> None:
     """K = 1e9 makes RK4 at dt = 1 ms unstable: SimulationDivergedError at t = dt naming 'computed-torque'."""
     controller = ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9)))
     with pytest.raises(
-        SimulationDivergedError, match=r"controller 'computed-torque' diverged at t = 0\.0010 s"
+        SimulationDivergedError, match=r"controller 'computed-torque' diverged at t = 0\.001 s"
     ) as info:
         simulate(controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=1.0))
     assert info.value.controller == "computed-torque"
@@ -132,6 +132,15 @@ def test_huge_torque_diverges_with_either_method(method: str) -> None:
         simulate(controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=1.0, method=method))
     assert info.value.controller == "constant-torque"
     assert 0 < info.value.time <= 1e-3 + 1e-12
+
+
+def test_stiff_gain_with_the_adaptive_method_stops_instead_of_hanging() -> None:
+    """K = 1e9 makes DOP853's step collapse: the evaluation budget turns it into an error."""
+    controller = ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9)))
+    with pytest.raises(SimulationDivergedError, match=r"diverged at t = .* s: .*(collapsed|state)") as info:
+        simulate(controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.05, method="adaptive"))
+    assert info.value.controller == "computed-torque"
+    assert 0 < info.value.time <= 0.05
 
 
 # --- configuration errors -------------------------------------------------------------------

@@ -24,6 +24,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
 
 
 def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
@@ -94,6 +95,52 @@ def regressor(
     y -= 0.25 * pin.computeJointTorqueRegressor(model, data, q, v - w, zero)
     # Gravity is in all three calls; the difference cancels it, so it counts once.
     return y
+
+
+def without_gravity(model: pin.Model) -> pin.Model:
+    """A copy of ``model`` with zero gravity: its RNEA gives ``M(q) a + C(q, v) v`` only.
+
+    With it, two RNEA calls give the model term of every law (see :func:`model_torque`)::
+
+        M(q) a + C(q, v) w + g(q) = RNEA(q, (v + w)/2, a) − RNEA₀(q, (v − w)/2, 0)
+
+    (polarisation of the Christoffel form; the gravity of the first call is kept, the
+    second has none). The fast simulator and the batch engine use this identity.
+    """
+    copy = pin.Model(model)
+    copy.gravity = pin.Motion.Zero()
+    return copy
+
+
+def model_with_parameters(model: pin.Model, parameter_map: ParameterMap, p: np.ndarray) -> pin.Model:
+    """A copy of ``model`` whose dynamics has the parameters ``p`` of ``parameter_map``.
+
+    The inertial parameters become ``π' = π + P (p − p_model)``: since ``Y_π P = Y_p``,
+    ``Y_π π' = Y_p p`` — a controller built on this model "believes" ``p``. The kinematics
+    is unchanged. Used for parameter-estimate errors (``p = p_true ⊙ (1 + δ)``).
+
+    Raises:
+        InvalidParameterError: ``p`` has the wrong length or gives a body a non-finite
+            inertia (e.g. a zero mass with a first moment).
+    """
+    p = np.asarray(p, dtype=float)
+    if p.shape != (parameter_map.size,) or not np.all(np.isfinite(p)):
+        raise InvalidParameterError(
+            "p",
+            p.tolist(),
+            f"{parameter_map.size} finite values {parameter_map.names} but got shape {p.shape}",
+        )
+    pi = inertial_parameters(model) + parameter_map.matrix @ (p - parameter_map.values(model))
+    copy = pin.Model(model)
+    for j in range(1, model.njoints):
+        body = pi[N_BODY_PARAMETERS * (j - 1) : N_BODY_PARAMETERS * j].copy()
+        inertia = pin.Inertia.FromDynamicParameters(body)
+        if not (np.all(np.isfinite(inertia.toDynamicParameters())) and inertia.mass > 0):
+            raise InvalidParameterError(
+                "p", p.tolist(), f"parameters giving body {j} a finite inertia with a mass > 0 kg"
+            )
+        copy.inertias[j] = inertia
+    return copy
 
 
 @dataclass(frozen=True)

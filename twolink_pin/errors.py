@@ -80,7 +80,7 @@ class SimulationDivergedError(TwolinkPinError):
         self.controller = controller
         self.time = time
         self.detail = detail
-        super().__init__(f"simulation with controller '{controller}' diverged at t = {time:.4f} s: {detail}")
+        super().__init__(f"simulation with controller '{controller}' diverged at t = {time:.6g} s: {detail}")
 
 
 class OutputError(TwolinkPinError):

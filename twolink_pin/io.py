@@ -88,7 +88,7 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
             continue
         if name in ("controller", "method"):
             kwargs[name] = str(value)
-        elif name in ("dt", "reference_period"):
+        elif name in ("dt", "reference_period", "control_period"):
             kwargs[name] = float(value)
         elif name == "saturate":
             kwargs[name] = bool(value)

@@ -6,10 +6,19 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import pinocchio as pin
 
-from twolink_pin.controllers.base import Controller, diagonal_gain, positive_scalar
+from twolink_pin.controllers.base import (
+    Controller,
+    StageKernel,
+    data_view,
+    diagonal_gain,
+    input_buffers,
+    literal,
+    positive_scalar,
+)
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
-from twolink_pin.dynamics import regressor
+from twolink_pin.dynamics import regressor, without_gravity
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -78,6 +87,74 @@ class Adaptive(Controller):
     def regressor(self, q: np.ndarray, v: np.ndarray, v_r: np.ndarray, a_r: np.ndarray) -> np.ndarray:
         """``Y(q, q̇, q̇_r, q̈_r)``, shape (nv, len(p̂))."""
         return regressor(self.model, self.data, q, v, v_r, a_r) @ self.P
+
+    def _extra_columns(self) -> tuple[list[str], list[dict[int, str]]] | None:
+        """Kernel statements and sparse columns (joint -> expression) that :meth:`regressor`
+        appends after ``Y_π P``; None if this class's regressor has no kernel form."""
+        return ([], []) if type(self).regressor is Adaptive.regressor else None
+
+    def stage_kernel(self) -> StageKernel | None:
+        extra = self._extra_columns() if type(self).compute is Adaptive.compute else None
+        if extra is None:
+            return None
+        nv, lam = self.robot.nv, literal(self.lam)
+        model0 = without_gravity(self.model)
+        data0 = model0.createData()
+        (wp, wm, ab), namespace = input_buffers(nv, 3)
+        namespace.update(
+            {
+                "c_model": self.model,
+                "c_data": self.data,
+                "c_model0": model0,
+                "c_data0": data0,
+                "c_ya": data_view(self.data.jointTorqueRegressor),
+                "c_yb": data_view(data0.jointTorqueRegressor),
+                "c_wp": wp,
+                "c_wm": wm,
+                "c_ab": ab,
+                "c_zero": np.zeros(nv),
+                "c_reg": pin.computeJointTorqueRegressor,
+            }
+        )
+        lines = []
+        for j in range(nv):
+            lines.append(f"c_e{j} = q{j} - qd{j}")
+            lines.append(f"c_ed{j} = v{j} - vd{j}")
+            lines.append(f"c_s{j} = c_ed{j} + {lam} * c_e{j}")
+            lines.append(f"c_w{j} = vd{j} - {lam} * c_e{j}")
+        values = (
+            [f"0.5 * (v{j} + c_w{j})" for j in range(nv)]
+            + [f"0.5 * (v{j} - c_w{j})" for j in range(nv)]
+            + [f"ad{j} - {lam} * c_ed{j}" for j in range(nv)]
+        )
+        lines.append(f"c_pack(c_in, 0, {', '.join(values)})")
+        lines.append("c_reg(c_model, c_data, qb, c_wp, c_ab)")
+        lines.append("c_reg(c_model0, c_data0, qb, c_wm, c_zero)")
+        # Y_p = (Y_a − Y_b) P over P's non-zero entries only; Y_π[j, r] is at r * nv + j.
+        columns: list[dict[int, str]] = []
+        used = sorted({int(r) for r in np.flatnonzero(np.any(self.P != 0, axis=1))})
+        for j in range(nv):
+            lines += [f"c_d{j}_{r} = c_ya[{r * nv + j}] - c_yb[{r * nv + j}]" for r in used]
+        for i in range(self.P.shape[1]):
+            for j in range(nv):
+                terms = []
+                for r in np.flatnonzero(self.P[:, i]):
+                    factor = float(self.P[r, i])
+                    term = f"c_d{j}_{r}" if abs(factor) == 1.0 else f"c_d{j}_{r} * {literal(abs(factor))}"
+                    terms.append(("- " if factor < 0 else "+ ") + term)
+                expr = " ".join(terms).removeprefix("+ ") if terms else "0.0"
+                lines.append(f"c_y{j}_{i} = {expr}")
+            columns.append({j: f"c_y{j}_{i}" for j in range(nv)})
+        extra_lines, extra_columns = extra
+        lines += extra_lines
+        columns += extra_columns
+        for j in range(nv):
+            model = " + ".join(f"{col[j]} * z{i}" for i, col in enumerate(columns) if j in col) or "0.0"
+            lines.append(f"tau{j} = ({model}) - {literal(self.k[j])} * c_s{j}")
+        for i, col in enumerate(columns):
+            projection = " + ".join(f"{expr} * c_s{j}" for j, expr in col.items()) or "0.0"
+            lines.append(f"dz{i} = -{literal(self.Gamma[i])} * ({projection})")
+        return StageKernel(tuple(lines), namespace)
 
     def compute(
         self,

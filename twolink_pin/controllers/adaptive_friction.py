@@ -8,6 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from twolink_pin.controllers.adaptive import Adaptive, AdaptiveGains
+from twolink_pin.controllers.base import StageKernel, literal
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
 from twolink_pin.dynamics import Friction, friction_regressor
 from twolink_pin.errors import InvalidParameterError
@@ -58,6 +59,12 @@ class AdaptiveFriction(Adaptive):
             raise InvalidParameterError(
                 "friction", self.friction, f"viscous and coulomb of length nv = {robot.nv}"
             )
+        if gains is not None and not isinstance(gains, AdaptiveFrictionGains):
+            raise InvalidParameterError(
+                "gains",
+                type(gains).__name__,
+                "AdaptiveFrictionGains (it also sets the friction estimates' start)",
+            )
         super().__init__(robot, gains if gains is not None else AdaptiveFrictionGains())
 
     def _true_parameters(self) -> np.ndarray:
@@ -81,6 +88,23 @@ class AdaptiveFriction(Adaptive):
                 self.gains.friction_initial_estimate * self.p_true[n_inertial:],
             ]
         )
+
+    def _extra_columns(self) -> tuple[list[str], list[dict[int, str]]] | None:
+        if type(self).regressor is not AdaptiveFriction.regressor:
+            return None
+        nv, eps = self.robot.nv, self.friction.smoothing
+        if eps == 0:
+            lines = [f"c_sg{j} = (v{j} > 0.0) - (v{j} < 0.0)" for j in range(nv)]
+        else:
+            lines = [f"c_sg{j} = c_tanh(v{j} / {literal(eps)})" for j in range(nv)]
+        columns = [{j: f"v{j}"} for j in range(nv)] + [{j: f"c_sg{j}"} for j in range(nv)]
+        return lines, columns
+
+    def stage_kernel(self) -> StageKernel | None:
+        kernel = super().stage_kernel()
+        if kernel is None:
+            return None
+        return StageKernel(kernel.lines, {**kernel.namespace, "c_tanh": math.tanh})
 
     def regressor(self, q: np.ndarray, v: np.ndarray, v_r: np.ndarray, a_r: np.ndarray) -> np.ndarray:
         return np.hstack([super().regressor(q, v, v_r, a_r), friction_regressor(v, self.friction.smoothing)])

@@ -6,7 +6,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, diagonal_gain, positive_scalar
+from twolink_pin.controllers.base import (
+    Controller,
+    StageKernel,
+    diagonal_gain,
+    literal,
+    model_term_kernel,
+    positive_scalar,
+)
 from twolink_pin.dynamics import model_torque
 from twolink_pin.model import RobotModel
 
@@ -50,6 +57,28 @@ class ComputedTorque(Controller):
         self.gains = gains if gains is not None else SlotineLiGains()
         self.k = diagonal_gain("k", self.gains.k, robot.nv)
         self.lam = self.gains.lam
+
+    def stage_kernel(self) -> StageKernel | None:
+        if type(self).compute is not ComputedTorque.compute:
+            return None
+        nv, lam = self.robot.nv, literal(self.lam)
+        lines = []
+        for j in range(nv):
+            lines.append(f"c_e{j} = q{j} - qd{j}")
+            lines.append(f"c_ed{j} = v{j} - vd{j}")
+        model_lines, namespace = model_term_kernel(
+            self.model,
+            self.data,
+            nv,
+            [f"vd{j} - {lam} * c_e{j}" for j in range(nv)],
+            [f"ad{j} - {lam} * c_ed{j}" for j in range(nv)],
+        )
+        lines += model_lines
+        scale = "" if self.model_scale == 1.0 else f"{literal(self.model_scale)} * "
+        lines += [
+            f"tau{j} = {scale}c_m{j} - {literal(self.k[j])} * (c_ed{j} + {lam} * c_e{j})" for j in range(nv)
+        ]
+        return StageKernel(tuple(lines), namespace)
 
     def compute(
         self,

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, diagonal_gain
+from twolink_pin.controllers.base import Controller, StageKernel, diagonal_gain, literal, model_term_kernel
 from twolink_pin.dynamics import model_torque
 from twolink_pin.model import RobotModel
 
@@ -45,6 +45,19 @@ class PDFeedforward(Controller):
         self.gains = gains if gains is not None else PDGains()
         self.kp = diagonal_gain("kp", self.gains.kp, robot.nv)
         self.kd = diagonal_gain("kd", self.gains.kd, robot.nv)
+
+    def stage_kernel(self) -> StageKernel | None:
+        if type(self).compute is not PDFeedforward.compute:
+            return None
+        nv = self.robot.nv
+        lines, namespace = model_term_kernel(
+            self.model, self.data, nv, [f"vd{j}" for j in range(nv)], [f"ad{j}" for j in range(nv)]
+        )
+        lines += [
+            f"tau{j} = c_m{j} - ({literal(self.kp[j])} * (q{j} - qd{j}) + {literal(self.kd[j])} * (v{j} - vd{j}))"
+            for j in range(nv)
+        ]
+        return StageKernel(tuple(lines), namespace)
 
     def compute(
         self,
