@@ -199,6 +199,7 @@ def _run_one(args: argparse.Namespace, name: str, robot):  # type: ignore[no-unt
         dt=args.dt,
         method=args.method,
         q0_offset=tuple(args.q0_offset),
+        control_period=args.control_period,
     )
     smoothing = args.friction_smoothing
     if smoothing is None:
@@ -354,7 +355,11 @@ def cmd_report(args: argparse.Namespace) -> int:
         urdf=args.urdf,
         payload=args.payload,
         config=SimulationConfig(
-            duration=args.duration, dt=args.dt, method=args.method, q0_offset=tuple(args.q0_offset)
+            duration=args.duration,
+            dt=args.dt,
+            method=args.method,
+            q0_offset=tuple(args.q0_offset),
+            control_period=args.control_period,
         ),
         lam=args.lam,
         workers=args.workers,
@@ -395,6 +400,13 @@ def _add_sim_options(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--saturate", action="store_true", help="clip torques at the URDF limits")
     p.add_argument("--method", choices=("rk4", "adaptive"), default="rk4", help="integrator (default rk4)")
+    p.add_argument(
+        "--control-period",
+        type=_positive,
+        default=None,
+        metavar="T",
+        help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
+    )
     p.add_argument(
         "--friction-smoothing",
         type=_non_negative,
@@ -473,6 +485,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--no-animation", action="store_true", help="skip the 3-D animation")
     _add_robot_options(p)
     p.set_defaults(func=cmd_report)
+
+    from twolink_pin.sweep import add_sweep_parser
+
+    add_sweep_parser(sub, _add_sim_options, _add_robot_options)
     return parser
 
 

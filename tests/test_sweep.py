@@ -1,0 +1,225 @@
+"""Tests of twolink_pin.sweep: reproducibility bit for bit, the summary against numpy on the
+written rows, divergent cases counted rather than fatal, each row being the run it
+describes, and the ``sweep`` command's parser and output.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from twolink_pin.batch import robot_with_parameters
+from twolink_pin.controllers import PDFeedforward, PDGains, WrongModel
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.metrics import compute_metrics
+from twolink_pin.model import load_robot
+from twolink_pin.plant import Plant
+from twolink_pin.simulation import SimulationConfig, simulate
+from twolink_pin.sweep import (
+    PERCENTILES,
+    Cases,
+    GainRange,
+    SweepConfig,
+    _controller,
+    add_sweep_parser,
+    cmd_sweep,
+    run_sweep,
+)
+from twolink_pin.trajectory import build_trajectory
+
+ROBOT = load_robot()
+TRAJECTORY = build_trajectory(ROBOT)
+SHORT = SimulationConfig(duration=0.05)
+
+
+def _rows(path: Path) -> list[dict[str, str]]:
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def _study(**changes) -> SweepConfig:  # type: ignore[no-untyped-def]
+    base = SweepConfig(
+        "pd",
+        samples=12,
+        seed=7,
+        q0_spread=0.1,
+        param_error=0.2,
+        gains=(GainRange("kp", 100.0, 400.0), GainRange("kd2", 20.0, 80.0)),
+        simulation=SHORT,
+        chunk=5,
+    )
+    return replace(base, **changes)
+
+
+def test_seeded_sweeps_are_reproducible_bit_for_bit_whatever_the_chunks_and_threads(tmp_path: Path) -> None:
+    run_sweep(_study(), ROBOT, TRAJECTORY, tmp_path / "a", plot=False)
+    run_sweep(_study(chunk=12, threads=1), ROBOT, TRAJECTORY, tmp_path / "b", plot=False)
+    for name in ("runs.csv", "runs.json", "summary.json"):
+        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+    run_sweep(_study(seed=8), ROBOT, TRAJECTORY, tmp_path / "c", plot=False)
+    assert (tmp_path / "a" / "runs.csv").read_bytes() != (tmp_path / "c" / "runs.csv").read_bytes()
+
+
+def test_summary_statistics_are_numpy_percentiles_of_the_rows(tmp_path: Path) -> None:
+    output = run_sweep(_study(), ROBOT, TRAJECTORY, tmp_path, plot=False)
+    rows = _rows(tmp_path / "runs.csv")
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert summary == output.summary
+    assert summary["runs"] == len(rows) == 12
+    assert summary["diverged"] == sum(r["diverged"] == "1" for r in rows) == 0
+    assert summary["limit_exceeded"] == sum(r["limit_exceeded"] == "1" for r in rows)
+    for name, stat in summary["metrics"].items():
+        column = np.array([float(r[name]) for r in rows])
+        p5, p50, p95 = np.percentile(column, PERCENTILES)
+        assert (stat["p5"], stat["median"], stat["p95"]) == (p5, p50, p95), name
+    json_rows = json.loads((tmp_path / "runs.json").read_text())
+    assert [r["rms_e1"] for r in json_rows] == [float(r["rms_e1"]) for r in rows]
+
+
+def test_divergent_cases_are_counted_not_fatal(tmp_path: Path) -> None:
+    """Kd up to 600 with dt = 5 ms: RK4 goes unstable above Kd ≈ 300, for those cases only."""
+    study = _study(
+        samples=10,
+        gains=(GainRange("kd", 40.0, 600.0),),
+        simulation=SimulationConfig(duration=0.5, dt=5e-3),
+        param_error=0.0,
+    )
+    output = run_sweep(study, ROBOT, TRAJECTORY, tmp_path, plot=True)
+    rows = _rows(tmp_path / "runs.csv")
+    diverged = [r for r in rows if r["diverged"] == "1"]
+    assert 0 < output.summary["diverged"] == len(diverged) < 10
+    assert all(float(r["gain_kd"]) > 200 for r in diverged)
+    assert all(r["rms_e1"] == "nan" and float(r["diverged_at"]) > 0 for r in diverged)
+    kept = np.array([float(r["rms_e1"]) for r in rows if r["diverged"] == "0"])
+    assert output.summary["metrics"]["rms_e1"]["median"] == np.median(kept)
+    assert (tmp_path / "distributions.png").stat().st_size > 10_000
+
+
+def test_a_row_is_the_run_it_describes(tmp_path: Path) -> None:
+    """Rebuild case 3 by hand (offset, parameter error, gains) and simulate it alone."""
+    study = _study()
+    run_sweep(study, ROBOT, TRAJECTORY, tmp_path, plot=False)
+    row = _rows(tmp_path / "runs.csv")[3]
+    factors = np.array([float(row[f"param_factor_{n}"]) for n in ("p1", "p2", "p3")])
+    kp, kd2 = float(row["gain_kp"]), float(row["gain_kd2"])
+    controller = PDFeedforward(
+        robot_with_parameters(ROBOT, ROBOT.p * factors), PDGains(kp=(kp, kp), kd=(40.0, kd2))
+    )
+    q0 = (float(row["q0_offset1"]), float(row["q0_offset2"]))
+    result = simulate(controller, Plant(ROBOT), TRAJECTORY, replace(SHORT, q0_offset=q0))
+    metrics = compute_metrics(result)
+    np.testing.assert_allclose([float(row["rms_e1"]), float(row["rms_e2"])], metrics.rms.e, rtol=1e-9)
+    np.testing.assert_allclose(
+        [float(row["peak_command2"])], np.abs(result.tau_command[:, 1]).max(), rtol=1e-9
+    )
+
+
+def test_cases_are_drawn_in_the_documented_ranges() -> None:
+    cases = Cases(_study(samples=200), ROBOT)
+    assert np.all(np.abs(cases.q0_offset - np.array([0.1, -0.1])) <= 0.1)
+    assert np.all(np.abs(cases.param_factor - 1) <= 0.2)
+    assert np.all((cases.gains["kp"] >= 100) & (cases.gains["kp"] <= 400))
+
+
+def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None:
+    study = _study(param_error=0.0)
+    cases = Cases(study, ROBOT)
+    controller = _controller(study, ROBOT, cases, 0, None)
+    assert controller.gains.kp == (cases.gains["kp"][0],) * 2
+    assert controller.gains.kd == (40.0, cases.gains["kd2"][0])
+    robust = replace(study, controller="robust", gains=(GainRange("model_scale", 0.2, 0.3),))
+    built = _controller(robust, ROBOT, Cases(robust, ROBOT), 0, None)
+    assert isinstance(built, WrongModel) and 0.2 <= built.model_scale <= 0.3
+
+
+@pytest.mark.parametrize(
+    ("changes", "text"),
+    [
+        ({"gains": (GainRange("kq", 1.0, 2.0),)}, "gain = 'kq' is invalid: expected one of kp, kd"),
+        ({"param_error": 1.0}, r"a fraction in \[0, 1\)"),
+        ({"simulation": SimulationConfig(method="adaptive")}, "'rk4'"),
+        ({"controller": "lqr"}, "one of pd, computed-torque"),
+    ],
+)
+def test_bad_studies_are_refused_naming_the_value(changes: dict, text: str) -> None:  # type: ignore[type-arg]
+    with pytest.raises(InvalidParameterError, match=text):
+        _study(**changes)
+
+
+def test_gain_range_text_is_parsed_or_refused_with_an_example() -> None:
+    assert GainRange.parse("kp=100:400") == GainRange("kp", 100.0, 400.0)
+    for bad in ("kp", "kp=1", "kp=4:1", "=1:2", "kp=a:b"):
+        with pytest.raises(InvalidParameterError, match="NAME=LO:HI"):
+            GainRange.parse(bad)
+
+
+def test_trajectories_are_kept_only_when_asked(tmp_path: Path) -> None:
+    output = run_sweep(_study(samples=6), ROBOT, TRAJECTORY, tmp_path, keep_trajectories=True, plot=False)
+    kept = sorted(tmp_path.glob("trajectories-*.npz"))
+    assert [p.name for p in kept] == ["trajectories-0000000.npz", "trajectories-0000005.npz"]
+    assert set(kept) <= set(output.files)
+    with np.load(kept[0]) as data:
+        assert data["q"].shape == (5, SHORT.steps + 1, 2)
+
+
+# --- the command --------------------------------------------------------------------------------------
+
+
+def _parser() -> argparse.ArgumentParser:
+    """A stand-in for the CLI: the sim and robot options ``simulate`` has, plus ``sweep``."""
+
+    def sim(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--duration", type=float, default=30.0)
+        p.add_argument("--dt", type=float, default=1e-3)
+        p.add_argument("--lambda", dest="lam", type=float, default=None)
+        p.add_argument("--q0-offset", nargs=2, type=float, default=(0.1, -0.1))
+        p.add_argument("--saturate", action="store_true")
+        p.add_argument("--method", choices=("rk4", "adaptive"), default="rk4")
+        p.add_argument("--friction-smoothing", type=float, default=None)
+
+    def robot(p: argparse.ArgumentParser) -> None:
+        p.add_argument("--urdf")
+        p.add_argument("--payload", type=float, default=0.0)
+        p.add_argument("--json", action="store_true")
+
+    parser = argparse.ArgumentParser(prog="twolink-pin")
+    add_sweep_parser(parser.add_subparsers(dest="command"), sim, robot)
+    return parser
+
+
+def test_sweep_command_prints_json_and_a_progress_bar(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    argv = ["sweep", "computed-torque", "--samples", "4", "--duration", "0.05", "--q0-spread", "0.2"]
+    argv += ["--gain", "lam=2:8", "--out", str(tmp_path), "--json", "--no-plot"]
+    args = _parser().parse_args(argv)
+    assert args.func is cmd_sweep
+    assert cmd_sweep(args) == 0
+    captured = capsys.readouterr()
+    payload = json.loads(captured.out)
+    assert payload["runs"] == 4 and payload["diverged"] == 0 and payload["gains"] == {"lam": [2.0, 8.0]}
+    assert "100.0%" in captured.err and "4/4 runs" in captured.err
+    assert len(_rows(tmp_path / "runs.csv")) == 4
+
+
+def test_sweep_command_text_summary(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    argv = ["sweep", "adaptive", "--samples", "3", "--duration", "0.05", "--param-error", "0.3"]
+    args = _parser().parse_args([*argv, "--out", str(tmp_path), "--no-plot"])
+    assert cmd_sweep(args) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("sweep adaptive: 3 runs in ")
+    assert "p_hat_final_p3" in out and f"wrote {tmp_path / 'summary.json'}" in out
+
+
+@pytest.mark.parametrize("bad", [["--gain", "kp"], ["--param-error", "1.5"], ["--samples", "0"]])
+def test_sweep_command_refuses_bad_options(bad: list[str], capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as info:
+        _parser().parse_args(["sweep", "pd", "--samples", "3", *bad])
+    assert info.value.code == 2
+    assert "error" in capsys.readouterr().err
