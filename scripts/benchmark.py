@@ -1,0 +1,317 @@
+"""Benchmark of the simulators against a pure-Python closed-form baseline, measured in one run.
+
+For each controller: seconds per 30-s simulation (RK4, dt = 1 ms; median of several runs)
+of the single run with the law at every stage, the single run with the law sampled at
+1 kHz (zero-order hold), and the batch engine per simulation at N = 1000; each also as a
+ratio ``Nx`` to the baseline — the report's PD job as a plain Python loop over floats
+with the closed-form M and C (no Pinocchio, no numpy per stage), timed in the same run.
+Then the batch engine's scaling from N = 1 to 10 000 runs with 1 and 2 threads, and the
+peak memory of sweeps of 1 000 and 10 000 runs (each in a fresh process).
+
+Batch and sweep timings use shorter simulations where N is large (noted in the output):
+the cost per step is constant, so seconds per 30-s simulation = elapsed × 30 / duration / N.
+
+Usage::
+
+    .venv/bin/python scripts/benchmark.py            # full: a few minutes
+    .venv/bin/python scripts/benchmark.py --quick    # smoke test: seconds, numbers rough
+    .venv/bin/python scripts/benchmark.py --json     # also a JSON line at the end
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin import CONTROLLERS, SimulationConfig, build_trajectory, load_robot, make_scenario, simulate
+from twolink_pin.batch import default_threads, simulate_batch
+from twolink_pin.controllers import PDGains
+from twolink_pin.trajectory import JointTrajectory
+
+FULL = 30.0
+"""The job's simulated time [s]."""
+DT = 1.0e-3
+"""RK4 step [s]."""
+
+
+def baseline_pd(
+    trajectory: JointTrajectory,
+    p: np.ndarray,
+    gains: PDGains,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    dt: float,
+    n: int,
+) -> tuple[list[float], list[float], list[float]]:
+    """The PD job as a pure-Python loop on floats with the report's closed-form model.
+
+    ``M = [[p1 + 2 p3 c2, p2 + p3 c2], [p2 + p3 c2, p2]]``, ``C = p3 s2 [[−q̇2, −(q̇1 + q̇2)], [q̇1, 0]]``;
+    law ``τ = M q̈_d + C q̇_d − Kp e − Kd ė`` at every RK4 stage; ``q̈ = M⁻¹ (τ − C q̇)`` by the
+    2×2 inverse. The reference is precomputed on the half-step grid (vectorised), as in
+    the simulators. Returns the flat q, q̇, τ histories.
+    """
+    half = trajectory.sample(np.arange(2 * n + 1) * (dt / 2))
+    rq1, rq2 = half.q[:, 0].tolist(), half.q[:, 1].tolist()
+    rv1, rv2 = half.v[:, 0].tolist(), half.v[:, 1].tolist()
+    ra1, ra2 = half.a[:, 0].tolist(), half.a[:, 1].tolist()
+    p1, p2, p3 = (float(x) for x in p)
+    kp1, kp2 = gains.kp
+    kd1, kd2 = gains.kd
+    cos, sin = math.cos, math.sin
+
+    def f(q1: float, q2: float, v1: float, v2: float, i: int) -> tuple[float, float, float, float]:
+        c2, s2 = cos(q2), sin(q2)
+        m11, m12, h = p1 + 2 * p3 * c2, p2 + p3 * c2, p3 * s2
+        wd1, wd2, ad1, ad2 = rv1[i], rv2[i], ra1[i], ra2[i]
+        t1 = m11 * ad1 + m12 * ad2 - h * (v2 * wd1 + (v1 + v2) * wd2) - kp1 * (q1 - rq1[i]) - kd1 * (v1 - wd1)
+        t2 = m12 * ad1 + p2 * ad2 + h * v1 * wd1 - kp2 * (q2 - rq2[i]) - kd2 * (v2 - wd2)
+        b1, b2 = t1 + h * (v2 * v1 + (v1 + v2) * v2), t2 - h * v1 * v1
+        det = m11 * p2 - m12 * m12
+        return (p2 * b1 - m12 * b2) / det, (m11 * b2 - m12 * b1) / det, t1, t2
+
+    q1, q2 = float(q0[0]), float(q0[1])
+    v1, v2 = float(v0[0]), float(v0[1])
+    Q: list[float] = []
+    V: list[float] = []
+    T: list[float] = []
+    h2, h6 = dt / 2, dt / 6
+    for k in range(n):
+        i = 2 * k
+        a11, a12, t1, t2 = f(q1, q2, v1, v2, i)
+        Q += (q1, q2)
+        V += (v1, v2)
+        T += (t1, t2)
+        x1, x2, y1, y2 = q1 + h2 * v1, q2 + h2 * v2, v1 + h2 * a11, v2 + h2 * a12
+        a21, a22, _, _ = f(x1, x2, y1, y2, i + 1)
+        x1b, x2b, y1b, y2b = q1 + h2 * y1, q2 + h2 * y2, v1 + h2 * a21, v2 + h2 * a22
+        a31, a32, _, _ = f(x1b, x2b, y1b, y2b, i + 1)
+        x1c, x2c, y1c, y2c = q1 + dt * y1b, q2 + dt * y2b, v1 + dt * a31, v2 + dt * a32
+        a41, a42, _, _ = f(x1c, x2c, y1c, y2c, i + 2)
+        q1, q2 = q1 + h6 * (v1 + 2 * (y1 + y1b) + y1c), q2 + h6 * (v2 + 2 * (y2 + y2b) + y2c)
+        v1, v2 = v1 + h6 * (a11 + 2 * (a21 + a31) + a41), v2 + h6 * (a12 + 2 * (a22 + a32) + a42)
+    Q += (q1, q2)
+    V += (v1, v2)
+    return Q, V, T
+
+
+def _timed(run: Callable[[], Any]) -> float:
+    start = time.perf_counter()
+    run()
+    return time.perf_counter() - start
+
+
+def _machine() -> dict[str, Any]:
+    cpu = platform.processor() or "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            names = [line.split(":", 1)[1].strip() for line in f if line.startswith("model name")]
+        cpu = names[0] if names else cpu
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": default_threads(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pinocchio": pin.__version__,
+        "system": f"{platform.system()} {platform.release()}",
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+    }
+
+
+_SWEEP_CHILD = """
+import sys, tracemalloc
+from twolink_pin import build_trajectory, load_robot
+from twolink_pin.simulation import SimulationConfig
+from twolink_pin.sweep import SweepConfig, GainRange, run_sweep
+
+def high_water_mib():  # VmHWM: this process's peak RSS (ru_maxrss would carry the parent's over exec)
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("VmHWM")) / 1024
+
+robot = load_robot(); trajectory = build_trajectory(robot)
+samples, duration, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+config = SweepConfig("pd", samples, seed=1, q0_spread=0.1, param_error=0.2,
+                     gains=(GainRange("kp", 100.0, 400.0),), simulation=SimulationConfig(duration=duration))
+before = high_water_mib()
+tracemalloc.start()
+output = run_sweep(config, robot, trajectory, out, plot=False)
+traced = tracemalloc.get_traced_memory()[1]
+print(before, high_water_mib(), traced / 2**20, output.seconds)
+"""
+
+
+def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
+    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations."""
+    done = subprocess.run(
+        [sys.executable, "-c", _SWEEP_CHILD, str(samples), str(duration), out],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    before, peak, traced, seconds = (float(x) for x in done.stdout.split())
+    return {
+        "samples": samples,
+        "rss_before_mib": before,
+        "rss_peak_mib": peak,
+        "python_peak_mib": traced,
+        "seconds": seconds,
+    }
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="short runs and few repeats (smoke test)")
+    parser.add_argument(
+        "--repeats", type=int, default=None, help="repeats per single-run timing (default 7; quick 1)"
+    )
+    parser.add_argument("--json", action="store_true", help="also print the results as one JSON line")
+    args = parser.parse_args(argv)
+    quick = args.quick
+    repeats = args.repeats or (1 if quick else 7)
+    single_duration = 0.5 if quick else FULL
+    robot = load_robot()
+    trajectory = build_trajectory(robot)
+    results: dict[str, Any] = {"machine": _machine(), "quick": quick}
+    m = results["machine"]
+    print(
+        f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
+        f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
+    )
+
+    # -- the baseline ----------------------------------------------------------------------
+    n = round(single_duration / DT)
+    ref0 = trajectory.sample(0.0)
+    q0, v0 = ref0.q + np.array([0.1, -0.1]), ref0.v
+
+    def baseline() -> Any:
+        return baseline_pd(trajectory, robot.p, PDGains(), q0, v0, DT, n)
+
+    scale = FULL / single_duration
+    Q, _, _ = baseline()
+    controller, plant = make_scenario("pd", robot)
+    check = simulate(controller, plant, trajectory, SimulationConfig(duration=single_duration, dt=DT))
+    agreement = float(np.abs(np.array(Q).reshape(-1, 2) - check.q).max())
+    print(
+        f"\nbaseline: pure-Python floats, closed-form PD job ({single_duration:g} s simulated, x{scale:g}); "
+        f"agrees with simulate('pd') to {agreement:.1e} rad"
+    )
+
+    # -- single runs, round-robin with the baseline so that load drift hits all alike ------------
+    cases = {}
+    for name in CONTROLLERS:
+        for label, period in (("per_stage", None), ("sampled_1khz", DT)):
+            config = SimulationConfig(duration=single_duration, dt=DT, control_period=period)
+
+            def run(name: str = name, config: SimulationConfig = config) -> None:
+                c, p = make_scenario(name, robot)
+                simulate(c, p, trajectory, config)
+
+            cases[name, label] = run
+    timings: dict[Any, list[float]] = {key: [] for key in cases}
+    base_times = []
+    for _ in range(repeats):
+        base_times.append(_timed(baseline))
+        for key, run in cases.items():
+            timings[key].append(_timed(run))
+    single: dict[str, dict[str, float]] = {name: {} for name in CONTROLLERS}
+    for (name, label), times in timings.items():
+        single[name][label] = statistics.median(times) * scale
+    base = statistics.median(base_times) * scale
+    results["baseline_seconds"] = base
+    print(
+        f"baseline {base:.3f} s per 30-s simulation (median of {len(base_times)}; "
+        f"spread {min(base_times) * scale:.3f}–{max(base_times) * scale:.3f} s)"
+    )
+
+    # -- batch at N = 1000, per simulation -----------------------------------------------------------
+    batch_n = 100 if quick else 1000
+    batch_duration = 0.05 if quick else 1.0
+    batch: dict[str, float] = {}
+    for name in CONTROLLERS:
+        controllers = [make_scenario(name, robot)[0] for _ in range(batch_n)]
+        _, plant = make_scenario(name, robot)
+        config = SimulationConfig(duration=batch_duration, dt=DT)
+        start = time.perf_counter()
+        simulate_batch(controllers, plant, trajectory, config)
+        batch[name] = (time.perf_counter() - start) * FULL / batch_duration / batch_n
+    threads = max(1, min(default_threads(), batch_n // 256))
+    print(
+        f"\nseconds per 30-s simulation and ratio to the baseline (single: median of {repeats}, "
+        "interleaved with the baseline; "
+        f"batch: N = {batch_n}, {batch_duration:g} s simulated, {threads} thread(s), per simulation)"
+    )
+    print(f"  {'controller':18s} {'per-stage law':>20s} {'sampled 1 kHz':>20s} {'batch per sim':>20s}")
+    for name in CONTROLLERS:
+        cells = [single[name]["per_stage"], single[name]["sampled_1khz"], batch[name]]
+        print(f"  {name:18s} " + " ".join(f"{x:10.3f} s {x / base:6.2f}x" for x in cells))
+    results["single"] = single
+    results["batch_per_sim"] = {"n": batch_n, "duration": batch_duration, "seconds": batch}
+
+    # -- batch scaling ------------------------------------------------------------------------------
+    sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)
+    budget = 5.0 if quick else 2000.0  # simulated run-seconds per measurement
+    print("\nbatch scaling, pd: seconds per 30-s simulation (ratio to the baseline)")
+    print(f"  {'N':>6s} {'simulated':>10s} {'1 thread':>20s} {'2 threads':>20s}")
+    scaling = []
+    for size in sizes:
+        duration = min(FULL, max(0.02 if quick else 0.2, budget / size))
+        controllers = [make_scenario("pd", robot)[0] for _ in range(size)]
+        _, plant = make_scenario("pd", robot)
+        config = SimulationConfig(duration=duration, dt=DT)
+        row = {"n": size, "duration": duration}
+        for count in (1, 2):
+            start = time.perf_counter()
+            simulate_batch(controllers, plant, trajectory, config, threads=count)
+            row[f"threads_{count}"] = (time.perf_counter() - start) * FULL / duration / size
+        scaling.append(row)
+        used = max(1, min(2, size // 256))
+        note = "" if used == 2 else "  (2 requested, 1 used: N < 512)"
+        print(
+            f"  {size:6d} {duration:8.2f} s "
+            + " ".join(f"{row[f'threads_{c}']:10.4f} s {row[f'threads_{c}'] / base:6.3f}x" for c in (1, 2))
+            + note
+        )
+    results["batch_scaling"] = scaling
+
+    # -- sweep memory ---------------------------------------------------------------------------------
+    sweep_sizes = (100, 1000) if quick else (1000, 10000)
+    sweep_duration = 0.02 if quick else 0.5
+    print(
+        f"\npeak memory of a pd sweep (±0.1 rad, ±20 % parameters, kp range; {sweep_duration:g} s simulated "
+        "per run; chunks of 1000; fresh process; plot off)"
+    )
+    import tempfile
+
+    memory = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for samples in sweep_sizes:
+            row = _sweep_memory(samples, sweep_duration, os.path.join(tmp, str(samples)))
+            memory.append(row)
+            print(
+                f"  {samples:6d} runs: peak RSS {row['rss_peak_mib']:7.1f} MiB (after imports and setup "
+                f"{row['rss_before_mib']:6.1f} MiB), Python allocations peak {row['python_peak_mib']:6.1f} MiB, "
+                f"{row['seconds']:.1f} s"
+            )
+    results["sweep_memory"] = memory
+    results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
+    print(f"\nload average at the end {results['machine']['load_average_end']}")
+    if args.json:
+        print(json.dumps(results))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

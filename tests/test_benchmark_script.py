@@ -1,0 +1,45 @@
+"""Smoke test of scripts/benchmark.py: ``--quick`` runs and prints positive ratios.
+
+No timing is asserted (the benchmark is how the targets are judged, on a quiet machine);
+this only checks that every section runs and its ratios parse as positive numbers.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+SCRIPT = Path(__file__).resolve().parents[1] / "scripts" / "benchmark.py"
+RATIO = re.compile(r"(\S+)x\b")
+
+
+def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
+    lines = done.stdout.splitlines()
+    table = lines[lines.index(next(x for x in lines if x.lstrip().startswith("controller"))) + 1 :][:5]
+    assert [row.split()[0] for row in table] == [
+        "pd",
+        "computed-torque",
+        "robust",
+        "adaptive",
+        "adaptive-friction",
+    ]
+    for row in table:
+        ratios = [float(x) for x in RATIO.findall(row)]
+        assert len(ratios) == 3 and all(r > 0 for r in ratios), row
+    scaling = [x for x in lines if re.match(r"\s+\d+\s+[\d.]+ s ", x)]
+    assert len(scaling) == 3
+    assert all(float(r) > 0 for row in scaling for r in RATIO.findall(row))
+    assert any("peak RSS" in x for x in lines)
+    results = json.loads(lines[-1])
+    assert results["baseline_seconds"] > 0 and results["quick"] is True
+    assert set(results["single"]) == {"pd", "computed-torque", "robust", "adaptive", "adaptive-friction"}
