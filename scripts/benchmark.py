@@ -6,7 +6,8 @@ of the single run with the law at every stage, the single run with the law sampl
 ratio ``Nx`` to the baseline — the report's PD job as a plain Python loop over floats
 with the closed-form M and C (no Pinocchio, no numpy per stage), timed in the same run.
 Then the batch engine's scaling from N = 1 to 10 000 runs with 1 and 2 threads, and the
-peak memory of sweeps of 1 000 and 10 000 runs (each in a fresh process).
+peak memory of sweeps of 1 000 and 10 000 runs (each in a fresh process), and the wall
+time of ``twolink-pin report`` (full mode only).
 
 Batch and sweep timings use shorter simulations where N is large (noted in the output):
 the cost per step is constant, so seconds per 30-s simulation = elapsed × 30 / duration / N.
@@ -306,6 +307,21 @@ def main(argv: list[str] | None = None) -> int:
                 f"{row['seconds']:.1f} s"
             )
     results["sweep_memory"] = memory
+
+    # -- the one-command report (issue target: <= 10 s on a 2-core machine) ---------------------------
+    if quick:
+        print("\nreport: skipped with --quick (it renders 33 figures)")
+    else:
+        with tempfile.TemporaryDirectory() as tmp:
+            start = time.perf_counter()
+            subprocess.run(
+                [sys.executable, "-m", "twolink_pin.cli", "report", "--out", os.path.join(tmp, "out"), "--json"],
+                check=True,
+                capture_output=True,
+            )
+            seconds = time.perf_counter() - start
+        results["report_seconds"] = seconds
+        print(f"\nreport: `twolink-pin report` in a fresh process {seconds:.1f} s (target 10 s)")
     results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
     print(f"\nload average at the end {results['machine']['load_average_end']}")
     if args.json:

@@ -12,6 +12,7 @@ simulation → metrics → plotting / visualization / report. Quick use::
     print(compute_metrics(result).rms.e)       # RMS tracking error per joint [rad]
 """
 
+from twolink_pin.batch import BatchResult, robot_with_parameters, simulate_batch
 from twolink_pin.controllers import (
     CONTROLLERS,
     Adaptive,
@@ -45,11 +46,12 @@ from twolink_pin.errors import (
 from twolink_pin.feasibility import TorqueCheck, check_torques
 from twolink_pin.kinematics import forward_kinematics, inverse_kinematics, jacobian, workspace
 from twolink_pin.metrics import Metrics, compute_metrics
-from twolink_pin.model import RobotModel, load_robot, twolink_urdf_path
+from twolink_pin.model import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
 from twolink_pin.parameters import InertialParameterMap, ParameterMap, inertial_parameters
 from twolink_pin.plant import Plant
 from twolink_pin.scenarios import Scenario, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
+from twolink_pin.sweep import SweepConfig, run_sweep
 from twolink_pin.trajectory import JointTrajectory, TrajectorySample, ViaPoints, build_trajectory
 from twolink_pin.twolink import TwoLinkLumpedMap
 
@@ -61,6 +63,7 @@ __all__ = [
     "AdaptiveFriction",
     "AdaptiveFrictionGains",
     "AdaptiveGains",
+    "BatchResult",
     "ComputedTorque",
     "Controller",
     "Friction",
@@ -80,6 +83,7 @@ __all__ = [
     "SimulationDivergedError",
     "SimulationResult",
     "SlotineLiGains",
+    "SweepConfig",
     "TorqueCheck",
     "TrajectorySample",
     "TwoLinkLumpedMap",
@@ -91,6 +95,7 @@ __all__ = [
     "check_torques",
     "compute_metrics",
     "coriolis_matrix",
+    "example_robot_urdf",
     "forward_dynamics",
     "forward_kinematics",
     "inertial_parameters",
@@ -102,7 +107,10 @@ __all__ = [
     "mass_matrix",
     "model_torque",
     "regressor",
+    "robot_with_parameters",
+    "run_sweep",
     "simulate",
+    "simulate_batch",
     "twolink_urdf_path",
     "workspace",
 ]

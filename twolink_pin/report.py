@@ -23,7 +23,7 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -102,6 +102,24 @@ def _run(
     return result, metrics, figures, time.perf_counter() - start
 
 
+class _InProcess:
+    """A stand-in for ProcessPoolExecutor that runs each task at submit (workers = 1)."""
+
+    def __enter__(self) -> _InProcess:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
+        future: Future[Any] = Future()
+        try:
+            future.set_result(fn(*args))
+        except Exception as exc:
+            future.set_exception(exc)
+        return future
+
+
 def build_report(
     out_dir: str | os.PathLike[str],
     options: ReportOptions | None = None,
@@ -152,43 +170,50 @@ def _swap_into_place(stage: Path, out: Path) -> None:
         shutil.rmtree(old, ignore_errors=True)
 
 
-def _build(stage: Path, options: ReportOptions, tick: Callable[[str], None]) -> dict[str, Any]:
+def _trajectory_figures(urdf: str | None, payload: float, fig_dir: str) -> list[str]:
+    """Worker: Figures 3–6 (picklable arguments only)."""
     from twolink_pin.plotting import save_trajectory_figures
 
+    robot = load_robot(urdf, payload=payload)
+    trajectory = build_trajectory(robot)
+    check = check_torques(robot, trajectory)
+    return [p.name for p in save_trajectory_figures(robot, trajectory, check, Path(fig_dir))]
+
+
+def _build(stage: Path, options: ReportOptions, tick: Callable[[str], None]) -> dict[str, Any]:
     fig_dir = stage / "figures"
     robot = load_robot(options.urdf, payload=options.payload)
     via = ViaPoints()
     trajectory = build_trajectory(robot, via)
     check = check_torques(robot, trajectory)
-    tick("model and trajectory")
-    model_section = _model_facts(robot)
-    traj_figs = [p.name for p in save_trajectory_figures(robot, trajectory, check, fig_dir)]
-    tick("trajectory figures")
-
+    # The animated run first (the animation is written here while the workers plot),
+    # the trajectory figures last; this process meanwhile checks the model.
+    order = [ANIMATED_CONTROLLER, *(n for n in CONTROLLERS if n != ANIMATED_CONTROLLER)]
+    run_args = {
+        n: (n, options.urdf, options.payload, options.config, options.lam, str(fig_dir)) for n in order
+    }
+    traj_args = (options.urdf, options.payload, str(fig_dir))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
-    args = [
-        (n, options.urdf, options.payload, options.config, options.lam, str(fig_dir)) for n in CONTROLLERS
-    ]
-    if options.workers > 1:
-        with ProcessPoolExecutor(max_workers=options.workers) as pool:
-            futures = {a[0]: pool.submit(_run, *a) for a in args}
-            for name, future in futures.items():
-                runs[name] = future.result()
-                tick(f"controller {name}")
-    else:
-        for a in args:
-            runs[a[0]] = _run(*a)
-            tick(f"controller {a[0]}")
-    table = Table2({n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()})
-
     animation = None
-    if options.animation:
-        from twolink_pin.visualization import write_html
+    with ProcessPoolExecutor(max_workers=options.workers) if options.workers > 1 else _InProcess() as pool:
+        futures = {n: pool.submit(_run, *a) for n, a in run_args.items()}
+        traj_future = pool.submit(_trajectory_figures, *traj_args)
+        model_section = _model_facts(robot)
+        tick("model and trajectory")
+        for name in order:
+            runs[name] = futures[name].result()
+            tick(f"controller {name}")
+            if name == ANIMATED_CONTROLLER and options.animation:
+                from twolink_pin.visualization import write_html
 
-        res = runs[ANIMATED_CONTROLLER][0]
-        write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_xy=via.xy)
-        animation = "animation.html"
-        tick("animation")
+                res = runs[name][0]
+                write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_xy=via.xy)
+                animation = "animation.html"
+                tick("animation")
+        traj_figs = traj_future.result()
+        tick("trajectory figures")
+    runs = {n: runs[n] for n in CONTROLLERS}  # the report's order
+    table = Table2({n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()})
 
     cfg = options.config
     lam = options.lam if options.lam is not None else 5.0
