@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from twolink_pin.batch import robot_with_parameters
+from twolink_pin.cli import build_parser, cmd_sweep
 from twolink_pin.controllers import PDFeedforward, PDGains, WrongModel
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.metrics import compute_metrics
@@ -27,8 +28,6 @@ from twolink_pin.sweep import (
     GainRange,
     SweepConfig,
     _controller,
-    add_sweep_parser,
-    cmd_sweep,
     run_sweep,
 )
 from twolink_pin.trajectory import build_trajectory
@@ -172,25 +171,8 @@ def test_trajectories_are_kept_only_when_asked(tmp_path: Path) -> None:
 
 
 def _parser() -> argparse.ArgumentParser:
-    """A stand-in for the CLI: the sim and robot options ``simulate`` has, plus ``sweep``."""
-
-    def sim(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--duration", type=float, default=30.0)
-        p.add_argument("--dt", type=float, default=1e-3)
-        p.add_argument("--lambda", dest="lam", type=float, default=None)
-        p.add_argument("--q0-offset", nargs=2, type=float, default=(0.1, -0.1))
-        p.add_argument("--saturate", action="store_true")
-        p.add_argument("--method", choices=("rk4", "adaptive"), default="rk4")
-        p.add_argument("--friction-smoothing", type=float, default=None)
-
-    def robot(p: argparse.ArgumentParser) -> None:
-        p.add_argument("--urdf")
-        p.add_argument("--payload", type=float, default=0.0)
-        p.add_argument("--json", action="store_true")
-
-    parser = argparse.ArgumentParser(prog="twolink-pin")
-    add_sweep_parser(parser.add_subparsers(dest="command"), sim, robot)
-    return parser
+    """The real CLI parser: the sweep command is wired as users run it."""
+    return build_parser()
 
 
 def test_sweep_command_prints_json_and_a_progress_bar(

@@ -10,9 +10,10 @@ import argparse
 import json
 import math
 import sys
+import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import IO, Any, NoReturn
 
 import numpy as np
 
@@ -375,6 +376,160 @@ def cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
+def _number(low: float, high: float, closed_high: bool) -> Callable[[str], float]:
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        if not (math.isfinite(value) and low <= value and (value <= high if closed_high else value < high)):
+            bound = "]" if closed_high else ")"
+            raise argparse.ArgumentTypeError(f"expected a number in [{low:g}, {high:g}{bound}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _gain(text: str) -> Any:
+    from twolink_pin.sweep import GainRange
+
+    try:
+        return GainRange.parse(text)
+    except InvalidParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _add_sweep_parser(subparsers: Any, controllers: list[str]) -> None:
+    """The ``sweep`` command (``func`` is :func:`cmd_sweep`)."""
+    p = subparsers.add_parser(
+        "sweep", help="Monte Carlo study of one controller on the batch engine: table, summary, histograms"
+    )
+    p.add_argument("controller", choices=controllers)
+    p.add_argument("--samples", type=_positive_int, required=True, metavar="N", help="number of runs")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0): same seed, same files")
+    p.add_argument(
+        "--q0-spread",
+        type=_number(0.0, math.inf, False),
+        default=0.0,
+        metavar="RAD",
+        help="initial error q0-offset ± U(RAD) per joint [rad] (default 0)",
+    )
+    p.add_argument(
+        "--param-error",
+        type=_number(0.0, 1.0, False),
+        default=0.0,
+        metavar="FRAC",
+        help="controller's parameters p·(1 + U(±FRAC)) per parameter (default 0)",
+    )
+    p.add_argument(
+        "--gain",
+        type=_gain,
+        action="append",
+        default=[],
+        metavar="NAME=LO:HI",
+        help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
+    )
+    p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
+    p.add_argument(
+        "--threads", type=_positive_int, default=None, help="threads of the batch engine (default all cores)"
+    )
+    p.add_argument(
+        "--chunk", type=_positive_int, default=1000, metavar="N", help="runs per batch (default 1000)"
+    )
+    p.add_argument(
+        "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
+    )
+    p.add_argument("--no-plot", action="store_true", help="skip distributions.png")
+    _add_sim_options(p)
+    _add_robot_options(p)
+    p.set_defaults(func=cmd_sweep)
+
+
+class _ProgressBar:
+    """A one-line progress bar on stderr (redrawn on a terminal, every 10 % otherwise)."""
+
+    def __init__(self, stream: IO[str] | None = None, width: int = 30) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.width = width
+        self.tty = bool(getattr(self.stream, "isatty", lambda: False)())
+        self.started = time.perf_counter()
+        self.shown = -1
+
+    def __call__(self, done: int, total: int) -> None:
+        fraction = done / total if total else 1.0
+        step = int(fraction * 100) if self.tty else int(fraction * 10) * 10
+        if step == self.shown:
+            return
+        self.shown = step
+        elapsed = time.perf_counter() - self.started
+        eta = elapsed * (1 - fraction) / fraction if fraction > 0 else math.nan
+        filled = round(self.width * fraction)
+        line = (
+            f"[{'#' * filled}{'.' * (self.width - filled)}] {100 * fraction:5.1f}%  {done}/{total} runs  "
+            f"{elapsed:6.1f} s" + (f"  ETA {eta:5.0f} s" if math.isfinite(eta) and done < total else "")
+        )
+        self.stream.write(("\r" + line) if self.tty else line + "\n")
+        if self.tty and done >= total:
+            self.stream.write("\n")
+        self.stream.flush()
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    """``twolink-pin sweep``: run the study, print its summary (text or ``--json``)."""
+    from twolink_pin.simulation import SimulationConfig
+    from twolink_pin.sweep import SweepConfig, run_sweep
+    from twolink_pin.trajectory import build_trajectory
+
+    robot = _robot(args)
+    smoothing = getattr(args, "friction_smoothing", None)
+    simulation = SimulationConfig(
+        duration=args.duration,
+        dt=args.dt,
+        method=getattr(args, "method", "rk4"),
+        q0_offset=tuple(args.q0_offset),
+        control_period=getattr(args, "control_period", None),
+    )
+    config = SweepConfig(
+        controller=args.controller,
+        samples=args.samples,
+        seed=args.seed,
+        q0_spread=args.q0_spread,
+        param_error=args.param_error,
+        gains=tuple(args.gain),
+        simulation=simulation,
+        lam=getattr(args, "lam", None),
+        saturate=getattr(args, "saturate", False),
+        friction_smoothing=0.0 if smoothing is None else smoothing,
+        chunk=args.chunk,
+        threads=args.threads,
+    )
+    output = run_sweep(
+        config,
+        robot,
+        build_trajectory(robot),
+        args.out,
+        progress=_ProgressBar(),
+        keep_trajectories=args.keep_trajectories,
+        plot=not args.no_plot,
+    )
+    summary = output.summary
+    if getattr(args, "json", False):
+        payload = {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}
+        print(json.dumps(payload, allow_nan=False))
+        return 0
+    lines = [
+        f"sweep {config.controller}: {summary['runs']} runs in {output.seconds:.1f} s "
+        f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
+        f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
+    ]
+    for name, stat in summary["metrics"].items():
+        cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
+        lines.append(f"  {name:28s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
+    lines += [f"  wrote {f}" for f in output.files]
+    print("\n".join(lines))
+    return 0
+
+
 # -- parser -----------------------------------------------------------------------------
 
 
@@ -486,9 +641,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_robot_options(p)
     p.set_defaults(func=cmd_report)
 
-    from twolink_pin.sweep import add_sweep_parser
-
-    add_sweep_parser(sub, _add_sim_options, _add_robot_options)
+    _add_sweep_parser(sub, list(CONTROLLERS))
     return parser
 
 
