@@ -29,8 +29,10 @@ test: $(VENV)/.installed-test
 	$(BIN)/python -m pytest
 
 lint: $(VENV)/.installed-test
+	$(BIN)/python -m pip install -q -e '.[dev]'
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
+	$(BIN)/mypy twolink_pin
 
 bench: $(VENV)/.installed
 	$(BIN)/python scripts/benchmark.py

@@ -13,11 +13,16 @@ import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import IO, Any, NoReturn
+from typing import IO, TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError, SimulationDivergedError, TwolinkPinError
+
+if TYPE_CHECKING:  # the commands import the library lazily, to keep `--help` fast
+    from twolink_pin.metrics import Metrics
+    from twolink_pin.model import RobotModel
+    from twolink_pin.simulation import SimulationResult
 
 
 class _Parser(argparse.ArgumentParser):
@@ -79,11 +84,11 @@ def _emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
         print(text)
 
 
-def _fmt(values: Sequence[float], digits: int = 4) -> str:
+def _fmt(values: Sequence[float] | np.ndarray, digits: int = 4) -> str:
     return "(" + ", ".join(f"{x:.{digits}f}" for x in values) + ")"
 
 
-def _robot(args: argparse.Namespace):  # type: ignore[no-untyped-def]  # returns RobotModel
+def _robot(args: argparse.Namespace) -> RobotModel:
     from twolink_pin.model import load_robot
 
     return load_robot(getattr(args, "urdf", None), payload=getattr(args, "payload", 0.0))
@@ -190,7 +195,7 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     return 0
 
 
-def _run_one(args: argparse.Namespace, name: str, robot):  # type: ignore[no-untyped-def]
+def _run_one(args: argparse.Namespace, name: str, robot: RobotModel) -> SimulationResult:
     from twolink_pin.scenarios import make_scenario
     from twolink_pin.simulation import SimulationConfig, simulate
     from twolink_pin.trajectory import build_trajectory
@@ -211,7 +216,7 @@ def _run_one(args: argparse.Namespace, name: str, robot):  # type: ignore[no-unt
     return simulate(controller, plant, build_trajectory(robot), config)
 
 
-def _result_payload(result, metrics, robot) -> dict[str, Any]:  # type: ignore[no-untyped-def]
+def _result_payload(result: SimulationResult, metrics: Metrics, robot: RobotModel) -> dict[str, Any]:
     return {
         "controller": result.controller,
         "duration": result.duration,
@@ -256,7 +261,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                 f"  joint {j + 1}: commanded torque exceeded its {result.torque_limits[j]:g} N·m limit "
                 f"(first at t = {at:.3f} s, by up to {result.limit_excess[j]:.2f} N·m)"
             )
-    if result.p_hat is not None:
+    if result.p_hat is not None and result.p_true is not None:
         lines.append(f"  p_hat(end) {_fmt(result.p_hat[-1])}  true {_fmt(result.p_true)}")
     lines += [f"  figure {f}" for f in figures]
     if args.save:

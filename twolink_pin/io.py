@@ -55,11 +55,11 @@ def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
 def save_result(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
     """Save a :class:`SimulationResult` as a compressed ``.npz``, atomically."""
     arrays: dict[str, Any] = {}
-    for f in fields(result):
-        value = getattr(result, f.name)
+    for entry in fields(result):
+        value = getattr(result, entry.name)
         if value is None:
             continue
-        arrays[f.name] = np.asarray(value)
+        arrays[entry.name] = np.asarray(value)
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)
     with atomic_write(path, "wb") as f:

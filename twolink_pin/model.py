@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
@@ -133,7 +134,7 @@ def load_robot(
     urdf: str | os.PathLike[str] | None = None,
     payload: float = 0.0,
     ee_frame: str | None = None,
-    parameter_map: type[ParameterMap] | None = None,
+    parameter_map: Callable[[pin.Model], ParameterMap] | None = None,
 ) -> RobotModel:
     """Load an arm from URDF.
 
@@ -142,7 +143,7 @@ def load_robot(
         payload: Point mass at the end-effector frame's origin [kg], >= 0.
         ee_frame: Name of the end-effector frame; default ``ee_link`` if present, else the
             last frame on the last joint.
-        parameter_map: Class of the parameter map; default :class:`TwoLinkLumpedMap` for a
+        parameter_map: Parameter-map class (called with the model); default :class:`TwoLinkLumpedMap` for a
             planar 2R arm, else :class:`InertialParameterMap` (all of Pinocchio's π).
 
     Raises:
@@ -171,8 +172,11 @@ def load_robot(
         point = pin.Inertia(float(payload), np.zeros(3), np.zeros((3, 3)))
         model.inertias[frame.parentJoint] = model.inertias[frame.parentJoint] + frame.placement.act(point)
     if parameter_map is None:
-        parameter_map = TwoLinkLumpedMap if TwoLinkLumpedMap.applies_to(model) else InertialParameterMap
-    pmap = parameter_map(model)
+        pmap: ParameterMap = (
+            TwoLinkLumpedMap(model) if TwoLinkLumpedMap.applies_to(model) else InertialParameterMap(model)
+        )
+    else:
+        pmap = parameter_map(model)
     return RobotModel(
         model=model,
         urdf_path=path,

@@ -266,7 +266,7 @@ def _gains(result: SimulationResult) -> str:
     # The runner builds each controller from make_scenario's defaults; show those.
     from twolink_pin.controllers import AdaptiveFrictionGains, AdaptiveGains, PDGains, SlotineLiGains
 
-    gains = {
+    gains: Any = {
         "pd": PDGains(),
         "computed-torque": SlotineLiGains(),
         "robust": SlotineLiGains(),
@@ -330,7 +330,8 @@ def _torque_facts(check: TorqueCheck) -> dict[str, Any]:
 
 
 def _versions() -> dict[str, str]:
-    import matplotlib
+    import importlib.metadata
+
     import pinocchio
 
     import twolink_pin
@@ -339,7 +340,7 @@ def _versions() -> dict[str, str]:
         "twolink_pin": twolink_pin.__version__,
         "pinocchio": pinocchio.__version__,
         "numpy": np.__version__,
-        "matplotlib": matplotlib.__version__,
+        "matplotlib": importlib.metadata.version("matplotlib"),  # plotting.py is the only importer
         "python": platform.python_version(),
         "platform": platform.platform(),
         "cpus": str(os.cpu_count()),

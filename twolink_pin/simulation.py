@@ -134,12 +134,14 @@ class SimulationConfig:
         return max(1, round(self.duration / self.dt))
 
 
-def _readonly(array: np.ndarray | None) -> np.ndarray | None:
-    if array is None:
-        return None
+def _readonly(array: np.ndarray) -> np.ndarray:
     array = np.array(array, dtype=float)
     array.setflags(write=False)
     return array
+
+
+def _readonly_or_none(array: np.ndarray | None) -> np.ndarray | None:
+    return None if array is None else _readonly(array)
 
 
 @dataclass(frozen=True)
@@ -290,14 +292,14 @@ def simulate(
         torque_limits=_readonly(plant.limits),
         saturate=plant.saturate,
         reference_period=trajectory.period,
-        p_hat=_readonly(p_hat),
-        p_true=_readonly(true) if p_hat is not None else None,
+        p_hat=_readonly_or_none(p_hat),
+        p_true=_readonly_or_none(true) if p_hat is not None else None,
         parameter_names=controller.parameter_names if p_hat is not None else (),
         control_period=None if config.hold_steps is None else config.hold_steps * dt,
     )
 
 
-def _rk4(controller, plant, trajectory, q, v, z, dt, n, hold=None):  # type: ignore[no-untyped-def]  # internal
+def _rk4(controller, plant, trajectory, q, v, z, dt, n, hold=None):  # internal
     """RK4 through ``controller.compute``; ``hold``: steps per control period, or None."""
     half = trajectory.sample(np.arange(2 * n + 1) * (dt / 2))
     rq, rv, ra = half.q, half.v, half.a
@@ -565,7 +567,7 @@ def _fast_rk4(
     return Q, V, Z, T, grid
 
 
-def _adaptive(controller, plant, trajectory, q0, v0, z0, t, config):  # type: ignore[no-untyped-def]  # internal
+def _adaptive(controller, plant, trajectory, q0, v0, z0, t, config):  # internal
     nv = q0.shape[0]
     law, accel, name = controller.compute, plant.acceleration, controller.name
 
