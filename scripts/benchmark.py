@@ -315,7 +315,15 @@ def main(argv: list[str] | None = None) -> int:
         with tempfile.TemporaryDirectory() as tmp:
             start = time.perf_counter()
             subprocess.run(
-                [sys.executable, "-m", "twolink_pin.cli", "report", "--out", os.path.join(tmp, "out"), "--json"],
+                [
+                    sys.executable,
+                    "-m",
+                    "twolink_pin.cli",
+                    "report",
+                    "--out",
+                    os.path.join(tmp, "out"),
+                    "--json",
+                ],
                 check=True,
                 capture_output=True,
             )
