@@ -111,3 +111,31 @@ def test_console_script_runs_as_a_process() -> None:
         [sys.executable, "-m", "twolink_pin.cli", "ik", "5", "5"], capture_output=True, text=True
     )
     assert bad.returncode == 2 and bad.stderr.count("\n") == 1
+
+
+def test_animate_live_serves_on_loopback_and_stops_cleanly_on_ctrl_c(tmp_path) -> None:
+    """The README's live command: prints a 127.0.0.1 URL that serves the viewer; SIGINT exits 0."""
+    import signal
+    import urllib.request
+
+    saved = tmp_path / "run.npz"
+    assert main(["simulate", "pd", "--duration", "0.2", "--save", str(saved)]) == 0
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "twolink_pin.cli", "animate", "--from", str(saved), "--no-browser", "--json"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        line = proc.stdout.readline()  # type: ignore[union-attr]
+        info = json.loads(line)
+        assert info["host"] == "127.0.0.1" and info["url"].startswith(f"http://127.0.0.1:{info['port']}/")
+        with urllib.request.urlopen(info["url"], timeout=10) as response:
+            assert response.status == 200
+            assert b"<html" in response.read().lower()
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()

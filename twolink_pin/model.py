@@ -150,7 +150,12 @@ def load_robot(
         InvalidURDFError: the file is missing or describes no sound model.
         InvalidParameterError: ``payload`` is negative or not finite.
     """
-    if not (isinstance(payload, (int, float)) and math.isfinite(payload) and payload >= 0):
+    if not (
+        isinstance(payload, (int, float))
+        and not isinstance(payload, bool)
+        and math.isfinite(payload)
+        and payload >= 0
+    ):
         raise InvalidParameterError("payload", payload, "a finite mass >= 0 kg")
     path = Path(urdf) if urdf is not None else twolink_urdf_path()
     validate_urdf_file(path)
