@@ -32,6 +32,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.arrays import readonly, readonly_or_none
 from twolink_pin.controllers import (
     Adaptive,
     AdaptiveFriction,
@@ -116,16 +117,6 @@ class BatchMetrics(NamedTuple):
         """Run ``i``'s metrics as a :class:`~twolink_pin.metrics.Metrics`."""
         pick = lambda n: Norms(n.e[i], n.edot[i], n.tau[i])  # noqa: E731
         return Metrics(pick(self.rms), pick(self.l2), pick(self.max), self.final_period_max_abs_e[i])
-
-
-def _frozen(array: np.ndarray) -> np.ndarray:
-    array = np.array(array, dtype=float)
-    array.setflags(write=False)
-    return array
-
-
-def _readonly(array: np.ndarray | None) -> np.ndarray | None:
-    return None if array is None else _frozen(array)
 
 
 @dataclass(frozen=True)
@@ -706,22 +697,22 @@ def simulate_batch(
     return BatchResult(
         controller=controllers[0].name,
         dt=dt,
-        t=_frozen(t),
-        q0_offset=_frozen(q0_off),
-        v0_offset=_frozen(v0_off),
+        t=readonly(t),
+        q0_offset=readonly(q0_off),
+        v0_offset=readonly(v0_off),
         metrics=acc.metrics(dead),
-        diverged_at=_frozen(diverged_at),
-        torque_limits=_frozen(limits),
+        diverged_at=readonly(diverged_at),
+        torque_limits=readonly(limits),
         saturate=plant.saturate,
         threads=threads,
         control_period=None if hold is None else hold * dt,
-        p_hat_final=_readonly(p_hat_final),
-        p_true=_readonly(p_true),
+        p_hat_final=readonly_or_none(p_hat_final),
+        p_true=readonly_or_none(p_true),
         parameter_names=tuple(names),
-        q=_readonly(Q) if record else None,
-        v=_readonly(V) if record else None,
-        tau_command=_readonly(T) if record else None,
-        p_hat=_readonly(Z) if record and law.nz and p_hat_final is not None else None,
+        q=readonly_or_none(Q) if record else None,
+        v=readonly_or_none(V) if record else None,
+        tau_command=readonly_or_none(T) if record else None,
+        p_hat=readonly_or_none(Z) if record and law.nz and p_hat_final is not None else None,
     )
 
 

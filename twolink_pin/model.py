@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.parameters import InertialParameterMap, ParameterMap
 from twolink_pin.twolink import TwoLinkLumpedMap
@@ -57,12 +58,6 @@ def example_robot_urdf(relative: str) -> Path:
     raise InvalidURDFError(
         relative, "example-robot-data", f"no file ending in {suffix!r} in the installed distribution"
     )
-
-
-def _readonly(array: np.ndarray) -> np.ndarray:
-    array = np.array(array, dtype=float)
-    array.setflags(write=False)
-    return array
 
 
 @dataclass(frozen=True)
@@ -188,7 +183,7 @@ def load_robot(
         ee_frame_id=ee_id,
         payload=float(payload),
         parameter_map=pmap,
-        link_lengths=_readonly(_link_lengths(model, ee_id)),
-        torque_limits=_readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
-        p=_readonly(pmap.values(model)),
+        link_lengths=readonly(_link_lengths(model, ee_id)),
+        torque_limits=readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
+        p=readonly(pmap.values(model)),
     )

@@ -42,6 +42,7 @@ import numpy as np
 import pinocchio as pin
 from scipy.integrate import solve_ivp
 
+from twolink_pin.arrays import readonly, readonly_or_none
 from twolink_pin.controllers.base import Controller, data_view
 from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
 from twolink_pin.plant import Plant
@@ -132,16 +133,6 @@ class SimulationConfig:
     def steps(self) -> int:
         """Number of steps ``round(duration / dt)``."""
         return max(1, round(self.duration / self.dt))
-
-
-def _readonly(array: np.ndarray) -> np.ndarray:
-    array = np.array(array, dtype=float)
-    array.setflags(write=False)
-    return array
-
-
-def _readonly_or_none(array: np.ndarray | None) -> np.ndarray | None:
-    return None if array is None else _readonly(array)
 
 
 @dataclass(frozen=True)
@@ -281,19 +272,19 @@ def simulate(
         controller=controller.name,
         method=config.method,
         dt=dt,
-        t=_readonly(t),
-        q=_readonly(q),
-        v=_readonly(v),
-        tau_command=_readonly(tau_cmd),
-        tau=_readonly(np.array([plant.applied_torque(x) for x in tau_cmd]) if plant.saturate else tau_cmd),
-        q_des=_readonly(ref.q),
-        v_des=_readonly(ref.v),
-        a_des=_readonly(ref.a),
-        torque_limits=_readonly(plant.limits),
+        t=readonly(t),
+        q=readonly(q),
+        v=readonly(v),
+        tau_command=readonly(tau_cmd),
+        tau=readonly(np.array([plant.applied_torque(x) for x in tau_cmd]) if plant.saturate else tau_cmd),
+        q_des=readonly(ref.q),
+        v_des=readonly(ref.v),
+        a_des=readonly(ref.a),
+        torque_limits=readonly(plant.limits),
         saturate=plant.saturate,
         reference_period=trajectory.period,
-        p_hat=_readonly_or_none(p_hat),
-        p_true=_readonly_or_none(true) if p_hat is not None else None,
+        p_hat=readonly_or_none(p_hat),
+        p_true=readonly_or_none(true) if p_hat is not None else None,
         parameter_names=controller.parameter_names if p_hat is not None else (),
         control_period=None if config.hold_steps is None else config.hold_steps * dt,
     )

@@ -22,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 from numpy.polynomial import polynomial as P
 
+from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
@@ -101,9 +102,9 @@ class JointTrajectory:
     """
 
     def __init__(self, times: np.ndarray, via_q: np.ndarray, period: float, boundary_order: int) -> None:
-        self.times = _readonly(times)
+        self.times = readonly(times)
         """Via-point times [s], shape (n + 1,)."""
-        self.via_q = _readonly(via_q)
+        self.via_q = readonly(via_q)
         """Via points [rad], shape (n + 1, nv)."""
         self.period = float(period)
         """Repetition period [s]."""
@@ -129,7 +130,7 @@ class JointTrajectory:
         for _ in range(3):
             self._c.append(P.polyder(self._c[-1]))
         scale = self.span ** -powers.astype(float)
-        self.coefficients = _readonly((self._c[0] * scale[:, None]).T)
+        self.coefficients = readonly((self._c[0] * scale[:, None]).T)
         """Coefficients [rad/s^k], shape (nv, degree + 1), ascending powers of ``t − t0``."""
 
     @classmethod
@@ -177,12 +178,6 @@ class JointTrajectory:
 
     def __call__(self, t: float | np.ndarray) -> TrajectorySample:
         return self.sample(t)
-
-
-def _readonly(array: np.ndarray) -> np.ndarray:
-    array = np.array(array, dtype=float)
-    array.setflags(write=False)
-    return array
 
 
 def build_trajectory(robot: RobotModel, via: ViaPoints | None = None) -> JointTrajectory:
