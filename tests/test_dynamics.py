@@ -13,6 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from twolink_pin import closed_form
+from twolink_pin.controllers.base import gather
 from twolink_pin.dynamics import (
     Friction,
     coriolis_matrix,
@@ -20,10 +21,12 @@ from twolink_pin.dynamics import (
     friction_regressor,
     inverse_dynamics,
     mass_matrix,
+    model_torque,
+    polarisation_pair,
     regressor,
 )
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.model import RobotModel, load_robot
+from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
 from twolink_pin.parameters import inertial_parameters
 
 ROBOT: RobotModel = load_robot()
@@ -206,3 +209,59 @@ def test_friction_rejects_negative_values_naming_them(kwargs: dict, text: str) -
     with pytest.raises(InvalidParameterError) as info:
         Friction(**kwargs)
     assert str(info.value) == text
+
+
+# -- the polarisation pair of the fast simulator ------------------------------------------------
+
+PAIR_ROBOTS = [
+    None,  # the twolink: gravity along the joint axes, so no gravity torque
+    "double_pendulum_description/urdf/double_pendulum.urdf",  # gravity torque
+    "asr_twodof_description/urdf/TwoDofs.urdf",
+]
+
+
+@pytest.mark.parametrize("relative", PAIR_ROBOTS)
+@pytest.mark.parametrize("armature", [0.0, 0.3])
+def test_polarisation_pair_gives_the_model_term_in_one_call(relative: str | None, armature: float) -> None:
+    """One RNEA / regressor call on the pair (copy B upside down, half gravity) equals the
+    two-call model term ``M a + C(q, v) w + g`` (RNEA + Coriolis matrix) and the polarised
+    regressor, including gravity and armature, to 1e-12 relative."""
+    robot = load_robot(example_robot_urdf(relative)) if relative else load_robot()
+    model = pin.Model(robot.model)
+    model.armature = np.full(model.nv, armature)
+    data = model.createData()
+    pair = polarisation_pair(model)
+    pair_data = pair.createData()
+    nv, n_pi = model.nv, 10 * (model.njoints - 1)
+    rng = np.random.default_rng(7)
+    gravity_seen = 0.0
+    for _ in range(100):
+        q, v, w, a = (rng.uniform(-3.0, 3.0, nv) for _ in range(4))
+        Q, V, A = np.r_[q, q], np.r_[(v + w) / 2, (v - w) / 2], np.r_[a, np.zeros(nv)]
+        expected = model_torque(model, data, q, v, w, a)
+        tau = pin.rnea(pair, pair_data, Q, V, A)
+        scale = max(1.0, float(np.abs(expected).max()))
+        assert np.abs(tau[:nv] - tau[nv:] - expected).max() <= 1e-12 * scale
+        Y = pin.computeJointTorqueRegressor(pair, pair_data, Q, V, A)
+        expected_y = regressor(model, data, q, v, w, a)
+        scale = max(1.0, float(np.abs(expected_y).max()))
+        assert np.abs(Y[:nv, :n_pi] - Y[nv:, n_pi:] - expected_y).max() <= 1e-12 * scale
+        gravity_seen = max(gravity_seen, float(np.abs(pin.computeGeneralizedGravity(model, data, q)).max()))
+    if relative and "double_pendulum" in relative:
+        assert gravity_seen > 0.1  # the identity was really exercised with gravity
+
+
+def test_polarisation_pair_refuses_nq_different_from_nv() -> None:
+    """A free-flyer model (nq = nv + 1) is refused with both sizes in the message."""
+    model = pin.buildSampleModelHumanoidRandom()
+    with pytest.raises(ValueError, match=rf"nq = {model.nq}, nv = {model.nv}"):
+        polarisation_pair(model)
+
+
+def test_gather_reads_the_items_at_the_offsets() -> None:
+    """``gather`` returns exactly ``buffer[offsets]``, also with gaps and adjacent offsets."""
+    values = np.random.default_rng(3).normal(size=40)
+    offsets = [0, 1, 5, 6, 17, 39]
+    assert gather(offsets)(memoryview(values)) == tuple(values[offsets])
+    with pytest.raises(ValueError, match="increasing"):
+        gather([3, 2])

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.dynamics import Friction
+from twolink_pin.dynamics import ABA_CONVENTION, Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -40,7 +40,7 @@ class Plant:
         tau = self.applied_torque(tau)
         if self.friction is not None:
             tau = tau - self.friction.torque(v)
-        return pin.aba(self.model, self.data, q, v, tau)
+        return pin.aba(self.model, self.data, q, v, tau, ABA_CONVENTION)
 
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
         """Mechanical energy ``½ q̇ᵀ M q̇ + U(q)`` [J]."""

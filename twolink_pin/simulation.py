@@ -44,6 +44,7 @@ from scipy.integrate import solve_ivp
 
 from twolink_pin.arrays import readonly, readonly_or_none
 from twolink_pin.controllers.base import Controller, data_view
+from twolink_pin.dynamics import ABA_CONVENTION
 from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
 from twolink_pin.plant import Plant
 from twolink_pin.trajectory import JointTrajectory, TrajectorySample
@@ -341,9 +342,9 @@ def _rk4(controller, plant, trajectory, q, v, z, dt, n, hold=None):  # internal
 def _plant_lines(plant: Plant, nv: int) -> tuple[list[str], list[str]]:
     """Statements of ``plant.acceleration`` on floats: (torque part, acceleration part).
 
-    The torque part writes the applied torque for ``tau{j}`` into the buffer ``p_t``
-    (saturation, then friction, which reads ``v{j}``); the acceleration part calls ABA on
-    ``qb``, ``p_v`` (written with ``q`` before the law) and ``p_t``, and binds ``a{j}``.
+    The torque part binds the applied torque ``p_f{j}`` for ``tau{j}`` (saturation, then
+    friction, which reads ``v{j}``); the acceleration part writes ``q``, ``v`` and ``p_f`` into
+    ABA's input buffer in one ``struct.pack_into``, calls ABA and binds ``a{j}``.
     """
     torque: list[str] = []
     for j in range(nv):
@@ -361,8 +362,10 @@ def _plant_lines(plant: Plant, nv: int) -> tuple[list[str], list[str]]:
             else:
                 sign = f"p_tanh(v{j} / {float(friction.smoothing)!r})"
             expr = f"{expr} - ({viscous} * v{j} + {coulomb} * {sign})"
-        torque.append(f"p_in[{2 * nv + j}] = {expr}")
-    accel = ["p_aba(p_model, p_data, qb, p_v, p_t)"]  # result read from data.ddq
+        torque.append(f"p_f{j} = {expr}")
+    values = [f"q{j}" for j in range(nv)] + [f"v{j}" for j in range(nv)] + [f"p_f{j}" for j in range(nv)]
+    accel = [f"p_pack(p_in, 0, {', '.join(values)})"]
+    accel.append("p_aba(p_model, p_data, p_q, p_v, p_t, p_world)")  # result read from data.ddq
     accel += [f"a{j} = p_ddq[{j}]" for j in range(nv)]
     return torque, accel
 
@@ -409,10 +412,6 @@ def _rk4_source(
     def reference(index: str) -> list[str]:
         return [f"qd{j} = rq{j}[{index}]; vd{j} = rv{j}[{index}]; ad{j} = ra{j}[{index}]" for j in J]
 
-    def set_q(stage: int) -> list[str]:  # q into qb (for the law and ABA), v into p_v (ABA)
-        prefix = ("x_q", "x_v") if stage == 1 else (f"q{stage}_", f"v{stage}_")
-        return ["p_pack(p_in, 0, " + ", ".join(f"{x}{j}" for x in prefix for j in J) + ")"]
-
     def law_at(stage: int) -> list[str]:
         lines = _at_stage(law, stage, held=False)
         return lines + (_at_stage(torque, 1, held=True) if torque_at_sample else [])
@@ -447,17 +446,15 @@ def _rk4_source(
         emit(1, reference("0"))
     emit(1, ["for k in range(n):", f"    o = {width} * k"])
     if hold == 1:  # a sample at every step
-        emit(2, reference("2 * k") + set_q(1) + law_at(1))
+        emit(2, reference("2 * k") + law_at(1))
     elif held:
         emit(2, ["if k % m == 0:"])
-        emit(3, reference("2 * k") + set_q(1) + law_at(1))
-        emit(2, ["else:"])
-        emit(3, set_q(1))
+        emit(3, reference("2 * k") + law_at(1))
     else:
-        emit(2, ["r = 2 * k", *set_q(1), *law_at(1)])
+        emit(2, ["r = 2 * k", *law_at(1)])
     emit(2, records + plant_at(1))
     for stage, step, previous in ((2, "h2", 1), (3, "h2", 2), (4, "h", 3)):
-        emit(2, stage_state(stage, step, previous) + set_q(stage))
+        emit(2, stage_state(stage, step, previous))
         if not held:
             if stage in (2, 4):
                 emit(2, reference("r + 1" if stage == 2 else "r + 2"))
@@ -478,9 +475,9 @@ def _rk4_source(
     # the last sample: the law at t_n (held: only if t_n is a sampling instant)
     if held:
         emit(1, ["if n % m == 0:"])
-        emit(2, reference("2 * n") + set_q(1) + law_at(1))
+        emit(2, reference("2 * n") + law_at(1))
     else:
-        emit(1, reference("2 * n") + set_q(1) + law_at(1))
+        emit(1, reference("2 * n") + law_at(1))
     emit(1, [f"o = {width} * n", *records, "return 0, None"])
     return "\n".join(out).replace("LIMIT", repr(DIVERGENCE_LIMIT)) + "\n"
 
@@ -521,17 +518,18 @@ def _fast_rk4(
     nv, nz = q0.shape[0], z0.shape[0]
     if any(not key.startswith("c_") for key in kernel.namespace):
         raise AssertionError(f"kernel names must start with 'c_': {sorted(kernel.namespace)}")
-    buffer = np.zeros(3 * nv)  # [q, v, τ]: ABA's inputs, q also the law's
+    buffer = np.zeros(3 * nv)  # [q, v, τ]: ABA's inputs
     namespace = {
         **kernel.namespace,
-        "qb": buffer[:nv],
+        "p_q": buffer[:nv],
         "p_v": buffer[nv : 2 * nv],
         "p_t": buffer[2 * nv :],
         "p_in": _floats(buffer),
-        "p_pack": struct.Struct(f"{2 * nv}d").pack_into,
+        "p_pack": struct.Struct(f"{3 * nv}d").pack_into,
         "p_model": plant.model,
         "p_data": plant.data,
         "p_aba": pin.aba,
+        "p_world": ABA_CONVENTION,
         "p_ddq": data_view(plant.data.ddq),
         "p_tanh": math.tanh,
     }

@@ -13,12 +13,14 @@ from twolink_pin.controllers.base import (
     StageKernel,
     data_view,
     diagonal_gain,
-    input_buffers,
+    gather,
     literal,
+    pair_inputs,
+    pair_values,
     positive_scalar,
 )
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
-from twolink_pin.dynamics import regressor, without_gravity
+from twolink_pin.dynamics import polarisation_pair, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -98,43 +100,41 @@ class Adaptive(Controller):
         if extra is None:
             return None
         nv, lam = self.robot.nv, literal(self.lam)
-        model0 = without_gravity(self.model)
-        data0 = model0.createData()
-        (wp, wm, ab), namespace = input_buffers(nv, 3)
-        namespace.update(
-            {
-                "c_model": self.model,
-                "c_data": self.data,
-                "c_model0": model0,
-                "c_data0": data0,
-                "c_ya": data_view(self.data.jointTorqueRegressor),
-                "c_yb": data_view(data0.jointTorqueRegressor),
-                "c_wp": wp,
-                "c_wm": wm,
-                "c_ab": ab,
-                "c_zero": np.zeros(nv),
-                "c_reg": pin.computeJointTorqueRegressor,
-            }
-        )
+        pair = polarisation_pair(self.model)
+        data = pair.createData()
+        (Q, V, A), namespace = pair_inputs(nv)
         lines = []
         for j in range(nv):
             lines.append(f"c_e{j} = q{j} - qd{j}")
             lines.append(f"c_ed{j} = v{j} - vd{j}")
             lines.append(f"c_s{j} = c_ed{j} + {lam} * c_e{j}")
             lines.append(f"c_w{j} = vd{j} - {lam} * c_e{j}")
-        values = (
-            [f"0.5 * (v{j} + c_w{j})" for j in range(nv)]
-            + [f"0.5 * (v{j} - c_w{j})" for j in range(nv)]
-            + [f"ad{j} - {lam} * c_ed{j}" for j in range(nv)]
-        )
-        lines.append(f"c_pack(c_in, 0, {', '.join(values)})")
-        lines.append("c_reg(c_model, c_data, qb, c_wp, c_ab)")
-        lines.append("c_reg(c_model0, c_data0, qb, c_wm, c_zero)")
-        # Y_p = (Y_a − Y_b) P over P's non-zero entries only; Y_π[j, r] is at r * nv + j.
-        columns: list[dict[int, str]] = []
+        lines.append(f"c_pack(c_in, 0, {pair_values(nv, [f'ad{j} - {lam} * c_ed{j}' for j in range(nv)])})")
+        lines.append("c_reg(c_pair, c_pdata, c_Q, c_V, c_A)")
+        # Y_π = Y_A − Y_B (diagonal blocks of the pair's regressor), read only where P is
+        # non-zero. The pair's regressor is (2 nv) × (2 n_π), column-major.
+        n_pi, rows = self.P.shape[0], 2 * nv
         used = sorted({int(r) for r in np.flatnonzero(np.any(self.P != 0, axis=1))})
+        entries = {r * rows + j: f"c_a{j}_{r}" for j in range(nv) for r in used}
+        entries |= {(n_pi + r) * rows + nv + j: f"c_b{j}_{r}" for j in range(nv) for r in used}
+        offsets = sorted(entries)
+        if offsets:
+            lines.append(f"{', '.join(entries[o] for o in offsets)}, = c_gather(c_y)")
         for j in range(nv):
-            lines += [f"c_d{j}_{r} = c_ya[{r * nv + j}] - c_yb[{r * nv + j}]" for r in used]
+            lines += [f"c_d{j}_{r} = c_a{j}_{r} - c_b{j}_{r}" for r in used]
+        namespace.update(
+            {
+                "c_pair": pair,
+                "c_pdata": data,
+                "c_y": data_view(data.jointTorqueRegressor),
+                "c_gather": gather(offsets),
+                "c_Q": Q,
+                "c_V": V,
+                "c_A": A,
+                "c_reg": pin.computeJointTorqueRegressor,
+            }
+        )
+        columns: list[dict[int, str]] = []  # Y_p = Y_π P, column by column
         for i in range(self.P.shape[1]):
             for j in range(nv):
                 terms = []

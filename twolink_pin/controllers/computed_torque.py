@@ -68,7 +68,6 @@ class ComputedTorque(Controller):
             lines.append(f"c_ed{j} = v{j} - vd{j}")
         model_lines, namespace = model_term_kernel(
             self.model,
-            self.data,
             nv,
             [f"vd{j} - {lam} * c_e{j}" for j in range(nv)],
             [f"ad{j} - {lam} * c_ed{j}" for j in range(nv)],

@@ -51,7 +51,7 @@ class PDFeedforward(Controller):
             return None
         nv = self.robot.nv
         lines, namespace = model_term_kernel(
-            self.model, self.data, nv, [f"vd{j}" for j in range(nv)], [f"ad{j}" for j in range(nv)]
+            self.model, nv, [f"vd{j}" for j in range(nv)], [f"ad{j}" for j in range(nv)]
         )
         lines += [
             f"tau{j} = c_m{j} - ({literal(self.kp[j])} * (q{j} - qd{j}) + {literal(self.kd[j])} * (v{j} - vd{j}))"
