@@ -36,6 +36,7 @@ from twolink_pin.dynamics import Friction, model_with_parameters, regressor, wit
 from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import RobotModel, load_robot
+from twolink_pin.parameters import ParameterMap
 from twolink_pin.plant import Plant
 from twolink_pin.scenarios import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
@@ -183,15 +184,36 @@ def test_a_diverging_run_is_flagged_at_simulates_time_and_the_others_finish() ->
 # --- the batch's Pinocchio terms -----------------------------------------------------------------------
 
 
-def test_regressor_columns_from_rnea_equal_pinocchios_regressor_times_p() -> None:
-    """``τ(π₀ + P_j) − τ(π₀)`` (non-physical column inertias) is column j of ``Y_π P``."""
+class _FirstTwoLumped(ParameterMap):
+    """p1, p2 only: p3's dynamics is outside the map, so ``τ(π₀) ≠ Y_p p₀``."""
+
+    names = ("p1", "p2")
+
+    @property
+    def matrix(self) -> np.ndarray:
+        return ROBOT.parameter_map.matrix[:, :2]
+
+    def values(self, model: pin.Model) -> np.ndarray:
+        return ROBOT.parameter_map.values(model)[:2]
+
+
+@pytest.mark.parametrize(
+    ("parameter_map", "needs_base"), [(ROBOT.parameter_map, False), (_FirstTwoLumped(), True)]
+)
+def test_regressor_columns_from_rnea_equal_pinocchios_regressor_times_p(
+    parameter_map: ParameterMap, needs_base: bool
+) -> None:
+    """``τ(π₀ + P_j) − τ(π₀)`` (non-physical column inertias) is column j of ``Y_π P``, both
+    with τ(π₀) recovered from the columns (a complete map) and computed on a base model."""
     rng = np.random.default_rng(0)
     n = 5
     q, v, w, a = (rng.uniform(-2, 2, (n, 2)) for _ in range(4))
-    columns = batch_module._Regressor(ROBOT.model, ROBOT.parameter_map, 1, n)(q, v, w, a)
+    engine = batch_module._Regressor(ROBOT.model, parameter_map, 1, n)
+    assert (engine.weights is None) == needs_base
+    columns = engine(q, v, w, a)
     data = ROBOT.create_data()
     for i in range(n):
-        expected = regressor(ROBOT.model, data, q[i], v[i], w[i], a[i]) @ ROBOT.parameter_map.matrix
+        expected = regressor(ROBOT.model, data, q[i], v[i], w[i], a[i]) @ parameter_map.matrix
         got = np.stack([c[i] for c in columns], axis=1)
         np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12)
 

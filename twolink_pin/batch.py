@@ -7,11 +7,12 @@ law of ``control_period``), with the N states as the columns of ``(nv, N)`` arra
 
 * the plant's accelerations come from ``pin.abaInParallel`` over a ``pin.ModelPool``;
 * the controllers' Pinocchio terms from ``pin.rneaInParallel``: the model term
-  ``M(q) a + C(q, q̇) w + g(q)`` by the polarisation identity (two RNEA, see
-  :func:`twolink_pin.dynamics.without_gravity`) and, for the adaptive laws or when the
+  ``M(q) a + C(q, q̇) w + g(q)`` by the polarisation identity, both terms in one call on
+  :func:`twolink_pin.dynamics.polarisation_forest`, and, for the adaptive laws or when the
   controllers' models differ, the regressor ``Y_p`` column by column: RNEA is linear in
-  the inertial parameters π, so ``Y_p[:, j] = τ(π₀ + P[:, j]) − τ(π₀)`` on two models
-  that differ by the map's column ``P[:, j]`` (π₀: the plant's parameters);
+  the inertial parameters π, so ``Y_p[:, j] = τ(π₀ + P[:, j]) − τ(π₀)`` on models that
+  differ by the map's column ``P[:, j]`` (π₀: the plant's parameters; see
+  :class:`_Regressor`), all columns in one call;
 * the laws themselves in numpy over the batch, written as explicit per-column sums so a
   run's numbers do not depend on N or on which runs share its batch.
 
@@ -41,7 +42,7 @@ from twolink_pin.controllers import (
     PDFeedforward,
     WrongModel,
 )
-from twolink_pin.dynamics import model_with_parameters, without_gravity
+from twolink_pin.dynamics import model_torque, model_with_parameters, polarisation_forest
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.metrics import Metrics, Norms
 from twolink_pin.model import RobotModel
@@ -186,37 +187,55 @@ def _check_parallel() -> None:
         raise BatchUnavailableError(missing)
 
 
-class _Rnea:
-    """``rneaInParallel`` on one model: ``(N, nv)`` arrays in, ``(N, nv)`` out (own buffer)."""
+class _PolarisedTerms:
+    """``M_i(q) a + C_i(q, v) w + g_i(q)`` [N·m] of several models over the batch, in one call.
 
-    def __init__(self, model: pin.Model, threads: int, n: int) -> None:
-        self.pool = pin.ModelPool(model, threads)
+    One ``rneaInParallel`` on the :func:`~twolink_pin.dynamics.polarisation_forest` of the
+    models (same kinematics): the two terms of the polarisation identity of every model in
+    one parallel region instead of two per model.
+    """
+
+    def __init__(self, models: Sequence[pin.Model], threads: int, n: int) -> None:
+        forest = polarisation_forest(models)
+        self.pool = pin.ModelPool(forest, threads)
         self.threads = threads
-        self.out = np.empty((n, model.nv))
+        self.k, self.nv = len(models), models[0].nv
+        size = 2 * self.k * self.nv
+        self.q, self.v, self.a = np.empty((n, size)), np.empty((n, size)), np.zeros((n, size))
+        self.out = np.empty((n, size))
 
-    def __call__(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> np.ndarray:
-        pin.rneaInParallel(self.threads, self.pool, q.T, v.T, a.T, self.out.T)
-        return self.out
+    def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
+        n, k, nv = q.shape[0], self.k, self.nv
+        self.q.reshape(n, 2 * k, nv)[:] = q[:, None, :]
+        velocities = self.v.reshape(n, k, 2, nv)
+        velocities[:, :, 0, :] = (0.5 * (v + w))[:, None, :]
+        velocities[:, :, 1, :] = (0.5 * (v - w))[:, None, :]
+        self.a.reshape(n, k, 2, nv)[:, :, 0, :] = a[:, None, :]  # copies B keep a = 0
+        pin.rneaInParallel(self.threads, self.pool, self.q.T, self.v.T, self.a.T, self.out.T)
+        out = self.out.reshape(n, k, 2, nv)
+        return [out[:, i, 0, :] - out[:, i, 1, :] for i in range(k)]
 
 
 class _ModelTerm:
-    """``M(q) a + C(q, v) w + g(q)`` [N·m] of one model over the batch (two RNEA)."""
+    """``M(q) a + C(q, v) w + g(q)`` [N·m] of one model over the batch (one RNEA call)."""
 
     def __init__(self, model: pin.Model, threads: int, n: int) -> None:
-        self.rnea = _Rnea(model, threads, n)
-        self.rnea0 = _Rnea(without_gravity(model), threads, n)
-        self.zero = np.zeros((n, model.nv))
+        self.terms = _PolarisedTerms([model], threads, n)
 
     def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        return self.rnea(q, 0.5 * (v + w), a) - self.rnea0(q, 0.5 * (v - w), self.zero)
+        return self.terms(q, v, w, a)[0]
 
 
 class _Regressor:
     """``Y_p(q, v, w, a)`` with ``Y_p p = M a + C(q, v) w + g`` over the batch, shape (N, nv, n_p).
 
-    Column ``j`` is ``τ(π₀ + P_j) − τ(π₀)``, each τ a :class:`_ModelTerm` (RNEA is linear in π,
-    also for the non-physical π of a column). π₀ is ``model``'s parameters, with any zero
-    mass set to 1 kg so that every column model has a finite inertia.
+    RNEA is linear in the inertial parameters π (also for the non-physical π of a column),
+    so on the column models ``π₀ + P_j`` it gives ``T_j = τ(π₀) + Y_j``. π₀ is ``model``'s
+    parameters, with any zero mass set to 1 kg so that every column model has a finite
+    inertia. When the map describes π₀'s dynamics completely, ``τ(π₀) = Y p₀``
+    (``p₀ = values(π₀)``), so ``τ(π₀) = Σ_k p₀_k T_k / (1 + Σ p₀)`` and no base model is
+    needed: n_p models, not n_p + 1 (checked numerically at construction; otherwise the base
+    is computed). All models go through one :class:`_PolarisedTerms` call.
     """
 
     def __init__(self, model: pin.Model, parameter_map: ParameterMap, threads: int, n: int) -> None:
@@ -224,16 +243,39 @@ class _Regressor:
         masses = pi0[::N_BODY_PARAMETERS]
         masses[masses <= 0] = 1.0
         pi0[::N_BODY_PARAMETERS] = masses
-        self.base = _ModelTerm(_with_inertial_parameters(model, pi0), threads, n)
+        base = _with_inertial_parameters(model, pi0)
         P = parameter_map.matrix
-        self.columns = [
-            _ModelTerm(_with_inertial_parameters(model, pi0 + P[:, j]), threads, n) for j in range(P.shape[1])
-        ]
+        columns = [_with_inertial_parameters(model, pi0 + P[:, j]) for j in range(P.shape[1])]
         self.size = P.shape[1]
+        p0 = parameter_map.values(base)
+        denominator = 1.0 + float(np.sum(p0))
+        self.weights: np.ndarray | None = None
+        if abs(denominator) > 1e-6 and _complete(base, columns, p0 / denominator):
+            self.weights = p0 / denominator
+            self.terms = _PolarisedTerms(columns, threads, n)
+        else:
+            self.terms = _PolarisedTerms([base, *columns], threads, n)
 
     def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
-        base = self.base(q, v, w, a)
-        return [column(q, v, w, a) - base for column in self.columns]
+        terms = self.terms(q, v, w, a)
+        if self.weights is None:
+            return [column - terms[0] for column in terms[1:]]
+        base = terms[0] * self.weights[0]
+        for weight, term in zip(self.weights[1:], terms[1:], strict=True):
+            base = base + term * weight
+        return [term - base for term in terms]
+
+
+def _complete(base: pin.Model, columns: Sequence[pin.Model], weights: np.ndarray) -> bool:
+    """Whether ``τ(π₀) = Σ_k weights_k T_k`` at random states, to 1e-10 relative."""
+    rng = np.random.default_rng(0)
+    q, v, w, a = (rng.uniform(-2.0, 2.0, (8, base.nv)) for _ in range(4))
+    direct = _PolarisedTerms([base], 1, 8)(q, v, w, a)[0]
+    terms = _PolarisedTerms(columns, 1, 8)(q, v, w, a)
+    combined = sum(
+        (weight * term for weight, term in zip(weights, terms, strict=True)), np.zeros_like(direct)
+    )
+    return bool(np.abs(combined - direct).max() <= 1e-10 * max(1.0, float(np.abs(direct).max())))
 
 
 def _with_inertial_parameters(model: pin.Model, pi: np.ndarray) -> pin.Model:
@@ -305,11 +347,7 @@ def _check_representable(controllers: Sequence[Controller], p: np.ndarray, regre
     columns = regressor(q, v, w, a)
     predicted = sum(columns[j] * p[:, j : j + 1] for j in range(len(columns)))
     for i, c in enumerate(controllers):
-        data = c.model.createData()
-        model0 = without_gravity(c.model)
-        exact = pin.rnea(c.model, data, q[i], 0.5 * (v[i] + w[i]), a[i]) - pin.rnea(
-            model0, model0.createData(), q[i], 0.5 * (v[i] - w[i]), np.zeros(nv)
-        )
+        exact = model_torque(c.model, c.model.createData(), q[i], v[i], w[i], a[i])
         if not np.allclose(predicted[i], exact, rtol=1e-9, atol=1e-9 * max(1.0, float(np.abs(exact).max()))):
             raise InvalidParameterError(
                 f"controllers[{i}].model",

@@ -18,6 +18,7 @@ All functions take the model and a ``pin.Data`` the caller owns (one per user).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -136,19 +137,39 @@ def polarisation_pair(model: pin.Model) -> pin.Model:
     Raises:
         ValueError: ``nq != nv`` (the input layout above needs one coordinate per joint).
     """
-    if model.nq != model.nv:
-        raise ValueError(f"expected a model with nq == nv, got nq = {model.nq}, nv = {model.nv}")
-    g = np.array(model.gravity.linear, dtype=float)
+    return polarisation_forest([model])
+
+
+def polarisation_forest(models: Sequence[pin.Model]) -> pin.Model:
+    """The :func:`polarisation_pair` of each of ``models``, all in one model: copies
+    ``A_0, B_0, A_1, B_1, ...`` (joints ``2 i nv ..`` and ``(2 i + 1) nv ..``).
+
+    The models must share their kinematics and gravity (e.g. differ only in inertias, as
+    the batch engine's regressor columns do); the first one's gravity is used.
+
+    Raises:
+        ValueError: no model, or ``nq != nv``.
+    """
+    if not models:
+        raise ValueError("expected at least one model, got none")
+    first = models[0]
+    if first.nq != first.nv:
+        raise ValueError(f"expected a model with nq == nv, got nq = {first.nq}, nv = {first.nv}")
+    g = np.array(first.gravity.linear, dtype=float)
     axis = np.cross(g, [1.0, 0.0, 0.0])
     if np.linalg.norm(axis) < 1e-9 * max(1.0, float(np.linalg.norm(g))):
         axis = np.cross(g, [0.0, 1.0, 0.0])
     norm = float(np.linalg.norm(axis))
     u = axis / norm if norm > 0 else np.array([1.0, 0.0, 0.0])
     flipped = pin.SE3(2.0 * np.outer(u, u) - np.eye(3), np.zeros(3))  # rotation by π about u
-    pair = pin.appendModel(_renamed(model, "a/"), _renamed(model, "b/"), 0, flipped)
-    pair.gravity = pin.Motion(0.5 * model.gravity.vector)
-    pair.armature = np.concatenate([model.armature, model.armature])
-    return pair
+    forest = _renamed(models[0], "0a/")
+    for i, model in enumerate(models):
+        if i > 0:
+            forest = pin.appendModel(forest, _renamed(model, f"{i}a/"), 0, pin.SE3.Identity())
+        forest = pin.appendModel(forest, _renamed(model, f"{i}b/"), 0, flipped)
+    forest.gravity = pin.Motion(0.5 * first.gravity.vector)
+    forest.armature = np.concatenate([m.armature for m in models for _ in range(2)])
+    return forest
 
 
 def _renamed(model: pin.Model, prefix: str) -> pin.Model:
