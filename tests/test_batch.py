@@ -105,6 +105,7 @@ def _assert_run_equals(single: SimulationResult, batch, i: int) -> None:  # type
     if single.p_hat is not None:
         np.testing.assert_allclose(batch.p_hat[i], single.p_hat, rtol=0, atol=TOL)
         np.testing.assert_allclose(batch.p_hat_final[i], single.p_hat[-1], rtol=0, atol=TOL)
+        np.testing.assert_array_equal(batch.p_true, single.p_true)
     metrics, mine = compute_metrics(single), batch.metrics.run(i)
     for kind in ("rms", "l2", "max"):
         for ours, theirs in zip(getattr(mine, kind), getattr(metrics, kind)):
@@ -117,6 +118,24 @@ def _assert_run_equals(single: SimulationResult, batch, i: int) -> None:  # type
     )
     first = [np.nan if x is None else x for x in single.first_exceeded_at]
     np.testing.assert_array_equal(batch.metrics.first_exceeded_at[i], first)
+
+
+@pytest.mark.parametrize("name", ["adaptive", "adaptive-friction"])
+def test_a_run_judges_the_estimates_against_the_plant_not_the_believed_model(name: str) -> None:
+    """An adaptive law built on a model with parameter errors starts from its belief, but
+    ``p_true`` (and so ``p_error``) is the plant's p and friction."""
+    robot = load_robot()
+    believed = robot_with_parameters(robot, np.asarray(robot.p) * np.array([1.2, 0.8, 1.1]))
+    controller, plant = make_scenario(name, robot)
+    wrong = type(controller)(believed, controller.gains)
+    result = simulate(wrong, plant, TRAJECTORY, replace(SHORT, duration=0.01))
+    n_p = len(robot.p)
+    np.testing.assert_allclose(result.p_true[:n_p], robot.p, rtol=1e-12)
+    np.testing.assert_allclose(wrong.true_parameters()[:n_p], believed.p, rtol=1e-12)
+    assert np.abs(believed.p - np.asarray(robot.p)).max() > 0.05  # the two really differ
+    if name == "adaptive-friction":
+        np.testing.assert_array_equal(result.p_true[n_p:], plant.friction.parameters)
+    np.testing.assert_allclose(result.p_error[0], result.p_hat[0] - result.p_true, rtol=0, atol=0)
 
 
 # --- the batch equals the single runs -----------------------------------------------------------

@@ -83,7 +83,7 @@ def robot_with_parameters(robot: RobotModel, p: np.ndarray) -> RobotModel:
     are unchanged. Build a controller on it to give it a parameter error: PD and
     Slotine–Li use ``p`` in their model terms, the adaptive laws start from
     ``p̂(0) = initial_estimate × p`` (their regressor does not depend on the inertias).
-    Note that an adaptive controller built this way reports ``p`` as its "true" values.
+    Runs judge ``p̂`` against the plant's values (:meth:`Controller.parameters_of`).
     """
     model = model_with_parameters(robot.model, robot.parameter_map, p)
     values = np.array(robot.parameter_map.values(model), dtype=float)
@@ -727,10 +727,7 @@ def simulate_batch(
     if isinstance(controllers[0], Adaptive):
         p_hat_final = z.copy()
         p_hat_final[dead] = np.nan
-        p_true = np.array(plant.robot.parameter_map.values(plant.model), dtype=float)
-        if isinstance(controllers[0], AdaptiveFriction):
-            friction = np.zeros(2 * nv) if plant.friction is None else plant.friction.parameters
-            p_true = np.concatenate([p_true, friction])
+        p_true = controllers[0].parameters_of(plant)
         names = controllers[0].parameter_names
     return BatchResult(
         controller=controllers[0].name,

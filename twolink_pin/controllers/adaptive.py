@@ -23,6 +23,7 @@ from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
 from twolink_pin.dynamics import polarisation_pair, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
+from twolink_pin.plant import Plant
 
 
 @dataclass(frozen=True)
@@ -82,6 +83,9 @@ class Adaptive(Controller):
 
     def true_parameters(self) -> np.ndarray:
         return self.p_true.copy()
+
+    def parameters_of(self, plant: Plant) -> np.ndarray:
+        return np.array(plant.robot.parameter_map.values(plant.model), dtype=float)
 
     def initial_state(self) -> np.ndarray:
         return self.gains.initial_estimate * self.p_true

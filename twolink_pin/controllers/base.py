@@ -16,13 +16,16 @@ import abc
 import math
 import struct
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, ClassVar, NamedTuple
+from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
+
+if TYPE_CHECKING:  # only for annotations: the plant is built beside the controller
+    from twolink_pin.plant import Plant
 
 EMPTY = np.zeros(0)
 EMPTY.setflags(write=False)
@@ -165,7 +168,19 @@ class Controller(abc.ABC):
         return ()
 
     def true_parameters(self) -> np.ndarray | None:
-        """The plant's true values of the estimated parameters, or None."""
+        """The estimated parameters' values on the controller's own model, or None.
+
+        These are the values ``p̂(0)`` is scaled from. The values a run is judged against
+        are the plant's: :meth:`parameters_of`.
+        """
+        return None
+
+    def parameters_of(self, plant: Plant) -> np.ndarray | None:
+        """The estimated parameters' actual values on ``plant``, or None if none are estimated.
+
+        They differ from :meth:`true_parameters` when the controller was built on a model
+        with parameter errors (:func:`twolink_pin.batch.robot_with_parameters`).
+        """
         return None
 
     def stage_kernel(self) -> StageKernel | None:
