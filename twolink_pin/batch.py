@@ -727,7 +727,7 @@ def simulate_batch(
     if isinstance(controllers[0], Adaptive):
         p_hat_final = z.copy()
         p_hat_final[dead] = np.nan
-        p_true = controllers[0].parameters_of(plant)
+        p_true = controllers[0].parameters_of(plant.robot, plant.friction)
         names = controllers[0].parameter_names
     return BatchResult(
         controller=controllers[0].name,

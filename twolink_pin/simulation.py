@@ -268,7 +268,7 @@ def simulate(
             )
         q, v, z, tau_cmd, ref = _adaptive(controller, plant, trajectory, q0, v0, z0, t, config)
     p_hat = z if z.shape[1] else None
-    true = controller.parameters_of(plant)
+    true = controller.parameters_of(plant.robot, plant.friction)
     return SimulationResult(
         controller=controller.name,
         method=config.method,

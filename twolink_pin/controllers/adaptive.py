@@ -20,10 +20,9 @@ from twolink_pin.controllers.base import (
     positive_scalar,
 )
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
-from twolink_pin.dynamics import polarisation_pair, regressor
+from twolink_pin.dynamics import Friction, polarisation_pair, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.plant import Plant
 
 
 @dataclass(frozen=True)
@@ -84,8 +83,8 @@ class Adaptive(Controller):
     def true_parameters(self) -> np.ndarray:
         return self.p_true.copy()
 
-    def parameters_of(self, plant: Plant) -> np.ndarray:
-        return np.array(plant.robot.parameter_map.values(plant.model), dtype=float)
+    def parameters_of(self, robot: RobotModel, friction: Friction | None) -> np.ndarray:
+        return np.array(robot.parameter_map.values(robot.model), dtype=float)
 
     def initial_state(self) -> np.ndarray:
         return self.gains.initial_estimate * self.p_true

@@ -13,7 +13,6 @@ from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
 from twolink_pin.dynamics import Friction, friction_regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.plant import Plant
 
 
 @dataclass(frozen=True)
@@ -71,11 +70,10 @@ class AdaptiveFriction(Adaptive):
     def _true_parameters(self) -> np.ndarray:
         return np.concatenate([self.robot.p, self.friction.parameters])
 
-    def parameters_of(self, plant: Plant) -> np.ndarray:
+    def parameters_of(self, robot: RobotModel, friction: Friction | None) -> np.ndarray:
         """The plant's p and friction ``(V, C)``; zeros for a plant without friction."""
-        nv = self.robot.nv
-        friction = np.zeros(2 * nv) if plant.friction is None else plant.friction.parameters
-        return np.concatenate([super().parameters_of(plant), friction])
+        values = np.zeros(2 * robot.nv) if friction is None else friction.parameters
+        return np.concatenate([super().parameters_of(robot, friction), values])
 
     @property
     def parameter_names(self) -> tuple[str, ...]:

@@ -24,8 +24,8 @@ import pinocchio as pin
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
-if TYPE_CHECKING:  # only for annotations: the plant is built beside the controller
-    from twolink_pin.plant import Plant
+if TYPE_CHECKING:
+    from twolink_pin.dynamics import Friction
 
 EMPTY = np.zeros(0)
 EMPTY.setflags(write=False)
@@ -175,8 +175,9 @@ class Controller(abc.ABC):
         """
         return None
 
-    def parameters_of(self, plant: Plant) -> np.ndarray | None:
-        """The estimated parameters' actual values on ``plant``, or None if none are estimated.
+    def parameters_of(self, robot: RobotModel, friction: Friction | None) -> np.ndarray | None:
+        """The estimated parameters' actual values on a plant (its arm and joint friction),
+        or None if none are estimated.
 
         They differ from :meth:`true_parameters` when the controller was built on a model
         with parameter errors (:func:`twolink_pin.batch.robot_with_parameters`).
