@@ -15,12 +15,12 @@ from twolink_pin.controllers.base import (
     diagonal_gain,
     gather,
     literal,
-    pair_inputs,
+    pair_namespace,
     pair_values,
     positive_scalar,
 )
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
-from twolink_pin.dynamics import Friction, polarisation_pair, regressor
+from twolink_pin.dynamics import Friction, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -103,9 +103,7 @@ class Adaptive(Controller):
         if extra is None:
             return None
         nv, lam = self.robot.nv, literal(self.lam)
-        pair = polarisation_pair(self.model)
-        data = pair.createData()
-        (Q, V, A), namespace = pair_inputs(nv)
+        data, namespace = pair_namespace(self.model)
         lines = []
         for j in range(nv):
             lines.append(f"c_e{j} = q{j} - qd{j}")
@@ -127,13 +125,8 @@ class Adaptive(Controller):
             lines += [f"c_d{j}_{r} = c_a{j}_{r} - c_b{j}_{r}" for r in used]
         namespace.update(
             {
-                "c_pair": pair,
-                "c_pdata": data,
                 "c_y": data_view(data.jointTorqueRegressor),
                 "c_gather": gather(offsets),
-                "c_Q": Q,
-                "c_V": V,
-                "c_A": A,
                 "c_reg": pin.computeJointTorqueRegressor,
             }
         )

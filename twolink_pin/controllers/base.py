@@ -64,22 +64,36 @@ def data_view(array: np.ndarray) -> memoryview:
     return memoryview(flat)  # type: ignore[arg-type]  # numpy's stubs lack __buffer__ before 3.12
 
 
-def pair_inputs(nv: int) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray], dict[str, Any]]:
-    """Input buffers ``(Q, V, A)`` of a :func:`~twolink_pin.dynamics.polarisation_pair`.
+def pair_namespace(model: pin.Model) -> tuple[pin.Data, dict[str, Any]]:
+    """The :func:`~twolink_pin.dynamics.polarisation_pair` of ``model``, its Data and inputs.
 
-    They are consecutive slices of one buffer of ``6 nv`` floats, so one kernel line
-    ``c_pack(c_in, 0, q.., q.., u⁺.., u⁻.., a..)`` (``struct.pack_into`` on a memoryview,
-    ~20 ns a float against ~50 ns for a numpy item assignment) writes ``Q = (q, q)``,
-    ``V = (u⁺, u⁻)`` and copy A's half of ``A``; copy B's half of ``A`` stays zero.
+    Returns the pair's Data and a kernel namespace with ``c_pair``, ``c_pdata`` and the input
+    buffers ``c_Q``, ``c_V``, ``c_A``: consecutive slices of one buffer of ``6 nv`` floats,
+    so one kernel line ``c_pack(c_in, 0, q.., q.., u⁺.., u⁻.., a..)`` (``struct.pack_into``
+    on a memoryview, ~20 ns a float against ~50 ns for a numpy item assignment) writes
+    ``Q = (q, q)``, ``V = (u⁺, u⁻)`` and copy A's half of ``A``; copy B's half stays zero.
     """
+    from twolink_pin.dynamics import polarisation_pair
+
+    pair = polarisation_pair(model)
+    data = pair.createData()
+    nv = model.nv
     buffer = np.zeros(6 * nv)
     view = memoryview(buffer)  # type: ignore[arg-type]  # numpy's stubs lack __buffer__ before 3.12
-    namespace = {"c_in": view, "c_pack": struct.Struct(f"{5 * nv}d").pack_into}
-    return (buffer[: 2 * nv], buffer[2 * nv : 4 * nv], buffer[4 * nv :]), namespace
+    namespace = {
+        "c_in": view,
+        "c_pack": struct.Struct(f"{5 * nv}d").pack_into,
+        "c_pair": pair,
+        "c_pdata": data,
+        "c_Q": buffer[: 2 * nv],
+        "c_V": buffer[2 * nv : 4 * nv],
+        "c_A": buffer[4 * nv :],
+    }
+    return data, namespace
 
 
 def pair_values(nv: int, a: Sequence[str]) -> str:
-    """The arguments of the ``c_pack`` line of :func:`pair_inputs`: ``(q, q, u⁺, u⁻, a)``.
+    """The arguments of the ``c_pack`` line of :func:`pair_namespace`: ``(q, q, u⁺, u⁻, a)``.
 
     ``u^± = (v ± w)/2``; expects statements binding ``c_w{j}`` (``w``) to have run.
     """
@@ -117,23 +131,14 @@ def model_term_kernel(
     the polarisation identity; ``c_m{j} = τ_A[j] − τ_B[j]`` is read from its Data
     (:func:`data_view`).
     """
-    from twolink_pin.dynamics import polarisation_pair
-
-    pair = polarisation_pair(model)
-    data = pair.createData()
-    (Q, V, A), namespace = pair_inputs(nv)
+    data, namespace = pair_namespace(model)
     lines = [f"c_w{j} = {w[j]}" for j in range(nv)]
     lines.append(f"c_pack(c_in, 0, {pair_values(nv, a)})")
     lines.append("c_rnea(c_pair, c_pdata, c_Q, c_V, c_A)")
     lines += [f"c_m{j} = c_tau[{j}] - c_tau[{nv + j}]" for j in range(nv)]
     namespace.update(
         {
-            "c_pair": pair,
-            "c_pdata": data,
             "c_tau": data_view(data.tau),
-            "c_Q": Q,
-            "c_V": V,
-            "c_A": A,
             "c_rnea": pin.rnea,
         }
     )
