@@ -103,26 +103,13 @@ def regressor(
     return y
 
 
-def without_gravity(model: pin.Model) -> pin.Model:
-    """A copy of ``model`` with zero gravity: its RNEA gives ``M(q) a + C(q, v) v`` only.
-
-    With it, two RNEA calls give the model term of every law (see :func:`model_torque`)::
-
-        M(q) a + C(q, v) w + g(q) = RNEA(q, (v + w)/2, a) − RNEA₀(q, (v − w)/2, 0)
-
-    (polarisation of the Christoffel form; the gravity of the first call is kept, the
-    second has none). The fast simulator and the batch engine use this identity.
-    """
-    copy = pin.Model(model)
-    copy.gravity = pin.Motion.Zero()
-    return copy
-
-
 def polarisation_pair(model: pin.Model) -> pin.Model:
     """Two copies of ``model`` side by side, so that one call evaluates the polarisation.
 
-    The identity of :func:`without_gravity` needs RNEA (or the regressor) at two inputs,
-    ``A = (q, (v+w)/2, a)`` with gravity and ``B = (q, (v−w)/2, 0)`` without. Each call from
+    By polarisation of the Christoffel form (see :func:`regressor`), the model term of
+    every law is ``M(q) a + C(q, v) w + g(q) = RNEA(q, (v+w)/2, a) − RNEA₀(q, (v−w)/2, 0)``,
+    RNEA₀ without gravity: RNEA (or the regressor) at two inputs, ``A = (q, (v+w)/2, a)``
+    with gravity and ``B = (q, (v−w)/2, 0)`` without. Each call from
     Python costs ~0.6 µs of binding overhead, more than RNEA's own work on a small arm, so
     the fast simulator makes one call on a model holding both: copy A (joints ``0..nv−1``)
     and copy B (joints ``nv..2nv−1``), both attached to the universe. Gravity is shared by

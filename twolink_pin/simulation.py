@@ -342,11 +342,13 @@ def _rk4(controller, plant, trajectory, q, v, z, dt, n, hold=None):  # internal
 def _plant_lines(plant: Plant, nv: int) -> tuple[list[str], list[str]]:
     """Statements of ``plant.acceleration`` on floats: (torque part, acceleration part).
 
-    The torque part binds the applied torque ``p_f{j}`` for ``tau{j}`` (saturation, then
-    friction, which reads ``v{j}``); the acceleration part writes ``q``, ``v`` and ``p_f`` into
-    ABA's input buffer in one ``struct.pack_into``, calls ABA and binds ``a{j}``.
+    The torque part binds the applied torque for ``tau{j}`` (saturation ``p_u{j}``, then
+    friction, which reads ``v{j}``, into ``p_f{j}``); the acceleration part writes ``q``, ``v``
+    and the applied torque into ABA's input buffer in one ``struct.pack_into``, calls ABA and
+    binds ``a{j}``.
     """
     torque: list[str] = []
+    applied: list[str] = []
     for j in range(nv):
         expr = f"tau{j}"
         limit = float(plant.limits[j])
@@ -362,8 +364,12 @@ def _plant_lines(plant: Plant, nv: int) -> tuple[list[str], list[str]]:
             else:
                 sign = f"p_tanh(v{j} / {float(friction.smoothing)!r})"
             expr = f"{expr} - ({viscous} * v{j} + {coulomb} * {sign})"
-        torque.append(f"p_f{j} = {expr}")
-    values = [f"q{j}" for j in range(nv)] + [f"v{j}" for j in range(nv)] + [f"p_f{j}" for j in range(nv)]
+        if expr.isidentifier():  # the command or its saturation: pack it, no copy per stage
+            applied.append(expr)
+        else:
+            torque.append(f"p_f{j} = {expr}")
+            applied.append(f"p_f{j}")
+    values = [f"q{j}" for j in range(nv)] + [f"v{j}" for j in range(nv)] + applied
     accel = [f"p_pack(p_in, 0, {', '.join(values)})"]
     accel.append("p_aba(p_model, p_data, p_q, p_v, p_t, p_world)")  # result read from data.ddq
     accel += [f"a{j} = p_ddq[{j}]" for j in range(nv)]

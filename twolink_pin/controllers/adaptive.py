@@ -132,6 +132,7 @@ class Adaptive(Controller):
         )
         columns: list[dict[int, str]] = []  # Y_p = Y_π P, column by column
         for i in range(self.P.shape[1]):
+            column: dict[int, str] = {}
             for j in range(nv):
                 terms = []
                 for r in np.flatnonzero(self.P[:, i]):
@@ -139,8 +140,12 @@ class Adaptive(Controller):
                     term = f"c_d{j}_{r}" if abs(factor) == 1.0 else f"c_d{j}_{r} * {literal(abs(factor))}"
                     terms.append(("- " if factor < 0 else "+ ") + term)
                 expr = " ".join(terms).removeprefix("+ ") if terms else "0.0"
-                lines.append(f"c_y{j}_{i} = {expr}")
-            columns.append({j: f"c_y{j}_{i}" for j in range(nv)})
+                if expr.isidentifier():  # a single unit term: use it, no copy per stage
+                    column[j] = expr
+                else:
+                    lines.append(f"c_y{j}_{i} = {expr}")
+                    column[j] = f"c_y{j}_{i}"
+            columns.append(column)
         extra_lines, extra_columns = extra
         lines += extra_lines
         columns += extra_columns

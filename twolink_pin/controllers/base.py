@@ -16,16 +16,14 @@ import abc
 import math
 import struct
 from collections.abc import Callable, Mapping, Sequence
-from typing import TYPE_CHECKING, Any, ClassVar, NamedTuple
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.dynamics import Friction, polarisation_pair
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-
-if TYPE_CHECKING:
-    from twolink_pin.dynamics import Friction
 
 EMPTY = np.zeros(0)
 EMPTY.setflags(write=False)
@@ -73,8 +71,6 @@ def pair_namespace(model: pin.Model) -> tuple[pin.Data, dict[str, Any]]:
     on a memoryview, ~20 ns a float against ~50 ns for a numpy item assignment) writes
     ``Q = (q, q)``, ``V = (u⁺, u⁻)`` and copy A's half of ``A``; copy B's half stays zero.
     """
-    from twolink_pin.dynamics import polarisation_pair
-
     pair = polarisation_pair(model)
     data = pair.createData()
     nv = model.nv
