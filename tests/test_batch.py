@@ -36,7 +36,7 @@ from twolink_pin.dynamics import Friction, model_with_parameters, polarisation_f
 from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import RobotModel, load_robot
-from twolink_pin.parameters import ParameterMap
+from twolink_pin.model.parameters import ParameterMap
 from twolink_pin.plant import Plant
 from twolink_pin.scenarios import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate

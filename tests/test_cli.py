@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from twolink_pin.cli import main
-from twolink_pin.closed_form import forward_kinematics
+from twolink_pin.twolink.closed_form import forward_kinematics
 
 
 def run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:

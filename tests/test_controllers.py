@@ -16,7 +16,6 @@ from conftest_sim import ROBOT, adaptive_lyapunov, run, slotine_li_s
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin import closed_form
 from twolink_pin.controllers import (
     CONTROLLERS,
     DEFAULT_LAMBDA,
@@ -32,8 +31,9 @@ from twolink_pin.controllers import (
 )
 from twolink_pin.dynamics import Friction, regressor
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.parameters import inertial_parameters
+from twolink_pin.model.parameters import inertial_parameters
 from twolink_pin.scenarios import make_scenario
+from twolink_pin.twolink import closed_form
 
 MODEL = ROBOT.model
 P_TRUE = np.asarray(ROBOT.p)

@@ -12,7 +12,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin import closed_form
 from twolink_pin.controllers.base import gather
 from twolink_pin.dynamics import (
     Friction,
@@ -27,7 +26,8 @@ from twolink_pin.dynamics import (
 )
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
-from twolink_pin.parameters import inertial_parameters
+from twolink_pin.model.parameters import inertial_parameters
+from twolink_pin.twolink import closed_form
 
 ROBOT: RobotModel = load_robot()
 MODEL = ROBOT.model

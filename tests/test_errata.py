@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from twolink_pin import build_trajectory, load_robot, make_scenario, simulate
-from twolink_pin.errata import (
+from twolink_pin.twolink.errata import (
     REPORT_COEFFICIENTS,
     parameter_convergence,
     printed_coefficients,

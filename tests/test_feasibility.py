@@ -9,11 +9,11 @@ import dataclasses
 import numpy as np
 import pytest
 
-from twolink_pin import closed_form
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.feasibility import TorqueCheck, check_torques
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.trajectory import JointTrajectory, build_trajectory
+from twolink_pin.twolink import closed_form
 
 ROBOT: RobotModel = load_robot()
 TRAJ: JointTrajectory = build_trajectory(ROBOT)

@@ -12,10 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin import closed_form
 from twolink_pin.errors import UnreachableTargetError
 from twolink_pin.kinematics import forward_kinematics, inverse_kinematics, jacobian, workspace
 from twolink_pin.model import RobotModel, load_robot
+from twolink_pin.twolink import closed_form
 
 ROBOT: RobotModel = load_robot()
 L1, L2 = 0.38, 0.24

@@ -17,12 +17,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin import closed_form
 from twolink_pin.dynamics import mass_matrix
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel, load_robot, twolink_urdf_path
-from twolink_pin.parameters import InertialParameterMap, inertial_parameters
-from twolink_pin.twolink import TwoLinkLumpedMap
+from twolink_pin.model.parameters import InertialParameterMap, inertial_parameters
+from twolink_pin.twolink import closed_form
+from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 L1, L2 = 0.38, 0.24
 REPORT_P = np.array([3.4, 0.4, 0.3])

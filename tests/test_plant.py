@@ -13,12 +13,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import cumulative_trapezoid
 
-from twolink_pin import closed_form
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
 from twolink_pin.scenarios import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
+from twolink_pin.twolink import closed_form
 
 P_TRUE = np.asarray(ROBOT.p)
 LIMITS = np.array([240.0, 40.0])

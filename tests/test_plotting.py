@@ -18,13 +18,14 @@ from matplotlib.figure import Figure
 from matplotlib.image import imread
 from matplotlib.lines import Line2D
 
-from twolink_pin import closed_form, plotting
+from twolink_pin import plotting
 from twolink_pin.errors import InvalidParameterError, OutputError
 from twolink_pin.feasibility import TorqueCheck, check_torques
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.scenarios import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.trajectory import JointTrajectory, build_trajectory
+from twolink_pin.twolink import closed_form
 
 ROBOT: RobotModel = load_robot()
 TRAJ: JointTrajectory = build_trajectory(ROBOT)

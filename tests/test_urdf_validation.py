@@ -18,7 +18,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from twolink_pin.errors import InvalidURDFError, TwolinkPinError
-from twolink_pin.urdf_validation import MAX_LINKS, validate_urdf_file, validate_urdf_string
+from twolink_pin.model.urdf_validation import MAX_LINKS, validate_urdf_file, validate_urdf_string
 
 SHIPPED_URDF = Path(__file__).resolve().parents[1] / "robots" / "twolink.urdf"
 

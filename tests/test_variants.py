@@ -8,8 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from twolink_pin import InvalidParameterError, InvalidURDFError, load_robot, twolink_urdf_path
-from twolink_pin.closed_form import mass_matrix
-from twolink_pin.variants import POINT_MASS_INERTIA, payload_urdf, write_payload_urdf
+from twolink_pin.model.payload import POINT_MASS_INERTIA, payload_urdf, write_payload_urdf
+from twolink_pin.twolink.closed_form import mass_matrix
 
 
 @settings(max_examples=10, deadline=None)

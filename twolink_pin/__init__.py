@@ -47,13 +47,13 @@ from twolink_pin.feasibility import TorqueCheck, check_torques
 from twolink_pin.kinematics import forward_kinematics, inverse_kinematics, jacobian, workspace
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
-from twolink_pin.parameters import InertialParameterMap, ParameterMap, inertial_parameters
+from twolink_pin.model.parameters import InertialParameterMap, ParameterMap, inertial_parameters
 from twolink_pin.plant import Plant
 from twolink_pin.scenarios import Scenario, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.sweep import SweepConfig, run_sweep
 from twolink_pin.trajectory import JointTrajectory, TrajectorySample, ViaPoints, build_trajectory
-from twolink_pin.twolink import TwoLinkLumpedMap
+from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 __version__ = "0.1.0"
 

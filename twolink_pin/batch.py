@@ -46,7 +46,7 @@ from twolink_pin.dynamics import model_torque, model_with_parameters, polarisati
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.metrics import Metrics, Norms
 from twolink_pin.model import RobotModel
-from twolink_pin.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
+from twolink_pin.model.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.trajectory import JointTrajectory

@@ -123,7 +123,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         ]
     )
     if args.write_urdf:
-        from twolink_pin.variants import write_payload_urdf
+        from twolink_pin.model.payload import write_payload_urdf
 
         if robot.payload <= 0:
             raise InvalidParameterError(
@@ -243,7 +243,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
         figures = [str(p) for p in save_simulation_figures(result, Path(args.plot))]
     if args.save:
-        from twolink_pin.io import save_result
+        from twolink_pin.storage import save_result
 
         save_result(result, args.save)
     payload["figures"] = figures
@@ -292,7 +292,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
 
     robot = _robot(args)
     if args.from_file:
-        from twolink_pin.io import load_result
+        from twolink_pin.storage import load_result
 
         result = load_result(args.from_file)
     elif args.controller is None:

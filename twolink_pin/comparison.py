@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from twolink_pin.controllers import CONTROLLERS
-from twolink_pin.io import atomic_write, write_json
+from twolink_pin.files import atomic_write, write_json
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.simulation import SimulationResult
 

@@ -25,7 +25,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
+from twolink_pin.model.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
 
 
 def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:

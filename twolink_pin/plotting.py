@@ -36,7 +36,7 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.feasibility import TorqueCheck
-from twolink_pin.io import atomic_write
+from twolink_pin.files import atomic_write
 from twolink_pin.kinematics import workspace
 from twolink_pin.model import RobotModel
 from twolink_pin.simulation import SimulationResult

@@ -30,21 +30,21 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin import errata
-from twolink_pin.closed_form import coriolis_matrix as cf_coriolis
-from twolink_pin.closed_form import mass_matrix as cf_mass
 from twolink_pin.comparison import COLUMNS, REPORT_TABLE2, UNITS, Table2
 from twolink_pin.controllers import CONTROLLERS
 from twolink_pin.dynamics import coriolis_matrix, mass_matrix
 from twolink_pin.errors import OutputError
 from twolink_pin.feasibility import TorqueCheck, check_torques
-from twolink_pin.io import atomic_write, write_json
+from twolink_pin.files import atomic_write, write_json
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.scenarios import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.trajectory import ViaPoints, build_trajectory
+from twolink_pin.twolink import errata
+from twolink_pin.twolink.closed_form import coriolis_matrix as cf_coriolis
+from twolink_pin.twolink.closed_form import mass_matrix as cf_mass
 
 MARKER = ".twolink-pin-report"
 """File that marks a directory as written by this command (safe to replace)."""

@@ -48,7 +48,7 @@ from twolink_pin.controllers import (
 )
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.io import atomic_write, write_json
+from twolink_pin.files import atomic_write, write_json
 from twolink_pin.model import RobotModel
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import SimulationConfig

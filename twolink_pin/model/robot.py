@@ -20,9 +20,9 @@ import pinocchio as pin
 
 from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
-from twolink_pin.parameters import InertialParameterMap, ParameterMap
-from twolink_pin.twolink import TwoLinkLumpedMap
-from twolink_pin.urdf_validation import validate_urdf_file
+from twolink_pin.model.parameters import InertialParameterMap, ParameterMap
+from twolink_pin.model.urdf_validation import validate_urdf_file
+from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 DEFAULT_EE_FRAME = "ee_link"
 

@@ -15,8 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
-from twolink_pin.io import atomic_write
-from twolink_pin.urdf_validation import validate_urdf_file
+from twolink_pin.files import atomic_write
+from twolink_pin.model.urdf_validation import validate_urdf_file
 
 POINT_MASS_INERTIA = 1e-9
 """Tiny isotropic inertia [kg·m²] that keeps the point mass's inertia positive definite."""

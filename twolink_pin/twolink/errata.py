@@ -11,12 +11,12 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from twolink_pin.closed_form import coriolis_matrix, mass_matrix
 from twolink_pin.controllers.adaptive import Adaptive
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.twolink.closed_form import coriolis_matrix, mass_matrix
 
 REPORT_TABLE1 = {
     (0.48, 0.1): ((-0.2936, 1.3587), (0.7044, -1.3587)),

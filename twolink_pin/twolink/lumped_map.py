@@ -21,7 +21,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
+from twolink_pin.model.parameters import N_BODY_PARAMETERS, ParameterMap, inertial_parameters
 
 _MASS, _MCX, _MCY, _IZZ = 0, 1, 2, 9
 

@@ -1,0 +1,12 @@
+"""Everything specific to the course report's 2-link planar arm, in one place.
+
+=====================  ==================================================================
+``lumped_map.py``      the report's parameters (p1, p2, p3) as a parameter map
+``closed_form.py``     the report's closed-form model: an independent cross-check
+``errata.py``          where the report is wrong or silent, with the evidence
+=====================  ==================================================================
+
+Nothing outside this package depends on the twolink; the package imports only the generic
+modules it builds on. (This docstring imports nothing, so any of its modules can be
+imported alone.)
+"""
