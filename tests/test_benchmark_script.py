@@ -25,13 +25,14 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
         timeout=300,
     )
     lines = done.stdout.splitlines()
-    table = lines[lines.index(next(x for x in lines if x.lstrip().startswith("controller"))) + 1 :][:5]
+    table = lines[lines.index(next(x for x in lines if x.lstrip().startswith("law"))) + 1 :][:6]
     assert [row.split()[0] for row in table] == [
         "pd",
         "computed-torque",
         "robust",
         "adaptive",
         "adaptive-friction",
+        "sliding-mode",
     ]
     for row in table:
         ratios = [float(x) for x in RATIO.findall(row)]
@@ -42,4 +43,12 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
     assert any("peak RSS" in x for x in lines)
     results = json.loads(lines[-1])
     assert results["baseline_seconds"] > 0 and results["quick"] is True
-    assert set(results["single"]) == {"pd", "computed-torque", "robust", "adaptive", "adaptive-friction"}
+    assert set(results["single"]) == {
+        "pd",
+        "computed-torque",
+        "robust",
+        "adaptive",
+        "adaptive-friction",
+        "sliding-mode (example)",
+    }
+    assert any("targets" in x for x in lines)

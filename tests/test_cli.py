@@ -36,7 +36,7 @@ def test_info_payload_changes_p_by_the_closed_form(capsys: pytest.CaptureFixture
     np.testing.assert_allclose(json.loads(out)["p"], expected, atol=1e-12)
 
 
-@pytest.mark.parametrize("q", [(0.0, 0.0), (0.3, 0.5), (-2.0, 3.0)])
+@pytest.mark.parametrize("q", [(0.0, 0.0), (0.3, 0.5), (-2.0, 3.0), (0.1, -1e-3)])
 def test_fk_json_equals_closed_form(capsys: pytest.CaptureFixture[str], q: tuple[float, float]) -> None:
     _, out, _ = run(capsys, "fk", *map(str, q), "--json")
     np.testing.assert_allclose(json.loads(out)["xy"], forward_kinematics(np.array(q), 0.38, 0.24), atol=1e-14)
@@ -62,6 +62,24 @@ def test_trajectory_json_meets_the_via_points(capsys: pytest.CaptureFixture[str]
     assert np.all(np.array(data["peak_torque"]) < np.array(data["torque_limits"]))
 
 
+def test_simulate_takes_a_law_from_a_users_file(capsys: pytest.CaptureFixture[str]) -> None:
+    """``simulate examples/sliding_mode.py:SlidingMode`` runs the tutorial's law: it tracks."""
+    code, out, _ = run(
+        capsys, "simulate", "examples/sliding_mode.py:SlidingMode", "--duration", "8", "--json"
+    )
+    data = json.loads(out)
+    assert code == 0 and data["controller"] == "sliding-mode"
+    assert max(data["metrics"]["final_period_max_abs_e"]) < 1e-3
+
+
+def test_simulate_gain_option_sets_one_value_or_one_per_joint(capsys: pytest.CaptureFixture[str]) -> None:
+    """--gain kp=0 is refused (> 0); --gain kd=30,40 gives the first torque −Kp e(0) − Kd ė(0) = −(350, −300)·0.1."""
+    code, out, _ = run(capsys, "simulate", "pd", "--duration", "0.01", "--gain", "kd=30,40", "--json")
+    assert code == 0
+    # At t = 0 the feedforward and ė vanish at the via point; −Kp e(0) = (−35, 30) N·m dominates.
+    assert json.loads(out)["metrics"]["max"]["tau"][0] >= 35 - 1e-9
+
+
 def test_simulate_json_short_pd_run(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "simulate", "pd", "--duration", "0.5", "--json")
     data = json.loads(out)
@@ -77,11 +95,31 @@ def test_simulate_json_short_pd_run(capsys: pytest.CaptureFixture[str]) -> None:
     [
         (["ik", "1", "1"], "outside the reachable annulus 0.14 <= r <= 0.62 m"),
         (["fk", "nan", "0"], "expected a finite number, got 'nan'"),
-        (["simulate", "pd", "--duration", "0"], "expected a number > 0, got '0'"),
-        (["simulate", "pid"], "invalid choice: 'pid'"),
-        (["info", "--payload", "-1"], "expected a number >= 0, got '-1'"),
+        (["simulate", "pd", "--duration", "0"], "expected a number in (0, 1e+06] s, got '0'"),
+        (
+            ["simulate", "pid"],
+            "controller 'pid': no law of that name; registered laws are pd, computed-torque",
+        ),
+        (
+            ["simulate", "pd", "--lambda", "3"],
+            "lambda = 3.0 is invalid: expected a law with a λ gain; 'pd' has none",
+        ),
+        (
+            ["simulate", "pd", "--gain", "kq=1"],
+            "gain = 'kq' is invalid: expected one of the gains of 'pd': kp, kd",
+        ),
+        (["info", "--payload", "-1"], "expected a number in [0, 10000] kg, got '-1'"),
         (["info", "--urdf", "/nonexistent.urdf"], "file not found"),
-        (["simulate", "pd", "--duration", "1", "--dt", "2"], "dt = 2.0 is invalid"),
+        (["info", "--robot", "ur55"], "no robot of that name; named robots are twolink"),
+        (["fk", "0.1"], "Q = [0.1] is invalid: expected 2 joint angles [rad] for twolink (nq = 2)"),
+        (
+            ["simulate", "pd", "--duration", "1", "--dt", "0.5", "--control-period", "0.7"],
+            "control_period = 0.7 is invalid",
+        ),
+        (
+            ["simulate", "pd", "--q0-offset", "0.1", "0.2", "0.3"],
+            "q0_offset = (0.1, 0.2, 0.3) is invalid: expected one value, or 2 values",
+        ),
     ],
 )
 def test_bad_input_exits_2_with_one_line(

@@ -12,7 +12,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin.controllers.base import gather
 from twolink_pin.dynamics import (
     Friction,
     coriolis_matrix,
@@ -173,15 +172,15 @@ def test_coriolis_bilinear_form_is_symmetric(q: np.ndarray, v: np.ndarray, w: np
 @given(v=rates, smoothing=st.sampled_from([0.0, 0.01, 0.5]))
 def test_friction_torque_equals_regressor_times_parameters(v: np.ndarray, smoothing: float) -> None:
     """Friction.torque(v) = friction_regressor(v) (V1, V2, C1, C2) for exact and smooth sign."""
-    friction = Friction.report(smoothing=smoothing)
+    friction = Friction((0.4, 0.2), (0.2, 0.1), smoothing=smoothing)
     np.testing.assert_allclose(
         friction.torque(v), friction_regressor(v, smoothing) @ friction.parameters, rtol=0, atol=1e-14
     )
 
 
 def test_report_friction_values() -> None:
-    """The report's friction: V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m, exact sign."""
-    friction = Friction.report()
+    """The twolink profile's friction is the report's: V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m."""
+    friction = Friction(*ROBOT.profile.friction)
     np.testing.assert_array_equal(friction.parameters, [0.4, 0.2, 0.2, 0.1])
     np.testing.assert_allclose(friction.torque(np.array([2.0, -1.0])), [1.0, -0.3], rtol=0, atol=1e-15)
 
@@ -226,7 +225,7 @@ def test_polarisation_pair_gives_the_model_term_in_one_call(relative: str | None
     """One RNEA / regressor call on the pair (copy B upside down, half gravity) equals the
     two-call model term ``M a + C(q, v) w + g`` (RNEA + Coriolis matrix) and the polarised
     regressor, including gravity and armature, to 1e-12 relative."""
-    robot = load_robot(example_robot_urdf(relative)) if relative else load_robot()
+    robot = load_robot(str(example_robot_urdf(relative))) if relative else load_robot()
     model = pin.Model(robot.model)
     model.armature = np.full(model.nv, armature)
     data = model.createData()
@@ -258,10 +257,9 @@ def test_polarisation_pair_refuses_nq_different_from_nv() -> None:
         polarisation_pair(model)
 
 
-def test_gather_reads_the_items_at_the_offsets() -> None:
-    """``gather`` returns exactly ``buffer[offsets]``, also with gaps and adjacent offsets."""
-    values = np.random.default_rng(3).normal(size=40)
-    offsets = [0, 1, 5, 6, 17, 39]
-    assert gather(offsets)(memoryview(values)) == tuple(values[offsets])
-    with pytest.raises(ValueError, match="increasing"):
-        gather([3, 2])
+def test_friction_regressor_of_a_batch_is_the_regressor_of_each_row() -> None:
+    """friction_regressor on (N, nv) velocities stacks the (nv, 2 nv) regressors of the rows."""
+    v = np.array([[0.3, -2.0], [0.0, 1e-4], [-1.0, 0.5]])
+    batch = friction_regressor(v, 1e-3)
+    for i in range(3):
+        np.testing.assert_array_equal(batch[i], friction_regressor(v[i], 1e-3))

@@ -55,7 +55,7 @@ def test_parameter_drift_matches_the_averaged_adaptation_rates(robot) -> None:
     traj = build_trajectory(robot)
     controller, plant = make_scenario("adaptive", robot)
     result = simulate(controller, plant, traj)
-    e = parameter_convergence(result, robot, traj)
+    e = parameter_convergence(result, controller, traj)
     r1, r2 = e.evidence["averaged_adaptation_rates_per_s"][:2]
     norms = e.evidence["p_error_norm_at_t"]
     ratio = norms["30"] / norms["10"]

@@ -12,25 +12,24 @@ from twolink_pin import (
     Adaptive,
     AdaptiveGains,
     ComputedTorque,
-    InertialParameterMap,
     InvalidURDFError,
     JointTrajectory,
     Plant,
     SimulationConfig,
     SlotineLiGains,
-    inertial_parameters,
     load_robot,
     simulate,
 )
 from twolink_pin.dynamics import regressor
 from twolink_pin.model import example_robot_urdf
+from twolink_pin.model.parameters import InertialParameterMap, inertial_parameters
 
 ROBOTS = ["double_pendulum_description/urdf/double_pendulum.urdf", "asr_twodof_description/urdf/TwoDofs.urdf"]
 
 
 @pytest.fixture(scope="module", params=ROBOTS)
 def robot(request: pytest.FixtureRequest):
-    return load_robot(example_robot_urdf(request.param))
+    return load_robot(str(example_robot_urdf(request.param)))
 
 
 def test_unknown_example_robot_is_named() -> None:
@@ -38,17 +37,27 @@ def test_unknown_example_robot_is_named() -> None:
         example_robot_urdf("no_such_robot.urdf")
 
 
-def test_generic_robot_uses_all_inertial_parameters_and_has_gravity(robot) -> None:
+def test_a_generic_urdf_gets_the_generic_profile_and_all_inertial_parameters(robot) -> None:
+    """A URDF outside the catalog: named after its file, no presets, the map p = π."""
+    assert robot.name == robot.urdf_path.stem and robot.gain_presets == {}
     assert isinstance(robot.parameter_map, InertialParameterMap)
-    np.testing.assert_allclose(robot.p, inertial_parameters(robot.model), rtol=0, atol=0)
-    data = robot.create_data()
+    assert robot.parameter_map.size == 10 * robot.nv
+
+
+def test_the_double_pendulum_feels_gravity_and_the_planar_arm_does_not() -> None:
+    """Joints about x under gravity along −z (pendulum): |g(q)| > 0.1 N·m; the asr arm's joint axes
+    are vertical: g(q) = 0 (to 1e-12)."""
     rng = np.random.default_rng(1)
-    gravity = [
-        np.abs(pin.computeGeneralizedGravity(robot.model, data, rng.uniform(-3, 3, robot.nq))).max()
-        for _ in range(5)
-    ]
-    if "pendulum" in str(robot.urdf_path):
-        assert max(gravity) > 0.1  # joints about x under gravity along −z
+    for relative, felt in zip(ROBOTS, (True, False)):
+        robot = load_robot(str(example_robot_urdf(relative)))
+        data = robot.create_data()
+        worst = max(
+            float(
+                np.abs(pin.computeGeneralizedGravity(robot.model, data, rng.uniform(-3, 3, robot.nq))).max()
+            )
+            for _ in range(5)
+        )
+        assert (worst > 0.1) if felt else (worst < 1e-9), (relative, worst)
 
 
 def test_polarised_regressor_includes_gravity_once(robot) -> None:
@@ -73,7 +82,7 @@ def _trajectory(robot) -> JointTrajectory:
 
 
 def test_computed_torque_tracks_on_another_robot(robot) -> None:
-    controller = ComputedTorque(robot, SlotineLiGains(k=(0.05, 0.05), lam=10.0))
+    controller = ComputedTorque(robot, SlotineLiGains(k=0.05, lam=10.0))
     result = simulate(
         controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=8.0, q0_offset=(0.05, -0.05))
     )
@@ -82,7 +91,7 @@ def test_computed_torque_tracks_on_another_robot(robot) -> None:
 
 def test_adaptive_with_twenty_parameters_keeps_v_non_increasing(robot) -> None:
     """V = ½ sᵀ M s + ½ p̃ᵀ Γ⁻¹ p̃ with all 20 of Pinocchio's parameters (gravity included)."""
-    gains = AdaptiveGains(k=(0.05, 0.05), gamma=(1.0,) * 20, lam=10.0, initial_estimate=0.8)
+    gains = AdaptiveGains(k=0.05, gamma=1.0, lam=10.0, initial_estimate=0.8)
     controller = Adaptive(robot, gains)
     result = simulate(
         controller, Plant(robot), _trajectory(robot), SimulationConfig(duration=2.0, q0_offset=(0.05, -0.05))

@@ -139,8 +139,9 @@ def test_urdf_copied_outside_the_package_loads(tmp_path: Path) -> None:
     copy = tmp_path / "elsewhere" / "arm.urdf"
     copy.parent.mkdir()
     shutil.copyfile(twolink_urdf_path(), copy)
-    loaded = load_robot(copy)
+    loaded = load_robot(copy, parameter_map=TwoLinkLumpedMap)
     assert loaded.urdf_path == copy
+    assert loaded.name == "arm" and loaded.gain_presets == {}  # not the catalog's file: generic profile
     np.testing.assert_allclose(loaded.p, REPORT_P, rtol=0, atol=1e-12)
     np.testing.assert_allclose(loaded.link_lengths, [L1, L2], rtol=0, atol=1e-15)
 

@@ -16,7 +16,7 @@ from scipy.integrate import cumulative_trapezoid
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
-from twolink_pin.scenarios import make_scenario
+from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.twolink import closed_form
 
@@ -53,7 +53,7 @@ def test_friction_is_subtracted_from_the_applied_torque(
     q: np.ndarray, v: np.ndarray, tau: np.ndarray
 ) -> None:
     """With the report's friction: q̈ = M⁻¹ (τ − C q̇ − V q̇ − C_c sgn q̇)."""
-    friction = Friction.report()
+    friction = Friction((0.4, 0.2), (0.2, 0.1))
     expected = _closed_form_acceleration(q, v, tau - friction.torque(v))
     np.testing.assert_allclose(
         Plant(ROBOT, friction=friction).acceleration(q, v, tau), expected, rtol=1e-10, atol=1e-9
@@ -118,7 +118,7 @@ def test_unforced_arm_with_friction_loses_energy_to_friction() -> None:
     Measured: E falls from 6.0 to 2.3 J; the trapezoid balance residual is 3.5e-7 J,
     tested at 1e-5 J (joint 2 reverses once, where sgn jumps).
     """
-    friction = Friction.report()
+    friction = Friction((0.4, 0.2), (0.2, 0.1))
     plant = Plant(ROBOT, friction=friction)
     result = simulate(ConstantTorque(ROBOT), plant, TRAJECTORY, FREE_MOTION)
     energy = _energy(plant, result)

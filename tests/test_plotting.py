@@ -1,14 +1,21 @@
 """Tests of twolink_pin.plotting: the figures show the data they are given (lines equal
-the trajectory, the run's errors, torques and estimates; limit lines at the motor limits),
-the PNGs have the stated pixel size and are not blank, every write is atomic, and no
-figure outlives its save.
+the trajectory, its forward kinematics, the run's errors, torques and estimates; limit
+lines at the motor limits), parameters go to the figure and panel their result declares
+(kind and unit, never the name), report figure numbers appear only when the caller passes
+them, every figure works for any number of joints, the PNGs decode at the stated pixel
+size and are not blank, every write is atomic, no pyplot state is touched, and no figure
+outlives its save.
 
-Simulations are short (2 s) so the module runs in seconds.
+Simulations are short (0.3–2 s) so the module runs in seconds.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import gc
+import subprocess
+import sys
+import types
 import weakref
 from pathlib import Path
 
@@ -21,22 +28,30 @@ from matplotlib.lines import Line2D
 from twolink_pin import plotting
 from twolink_pin.errors import InvalidParameterError, OutputError
 from twolink_pin.feasibility import TorqueCheck, check_torques
-from twolink_pin.model import RobotModel, load_robot
-from twolink_pin.scenarios import make_scenario
+from twolink_pin.kinematics import joint_positions
+from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
+from twolink_pin.plotting import _style
+from twolink_pin.plotting.distribution import _distribution_figure
+from twolink_pin.plotting.run import _simulation_figures, _torque_figure
+from twolink_pin.plotting.trajectory import _trajectory_figures
+from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
-from twolink_pin.trajectory import JointTrajectory, build_trajectory
+from twolink_pin.trajectory import JointTrajectory, default_trajectory
 from twolink_pin.twolink import closed_form
+from twolink_pin.twolink.reference import REPORT_FIGURES
 
 ROBOT: RobotModel = load_robot()
-TRAJ: JointTrajectory = build_trajectory(ROBOT)
+TRAJ: JointTrajectory = default_trajectory(ROBOT)
 LIMITS = (240.0, 40.0)
-TRAJECTORY_FILES = ["fig03_theta1.png", "fig04_theta2.png", "fig05_workspace.png", "fig06_desired_torque.png"]
+TRAJECTORY_KEYS = ["theta1", "theta2", "workspace", "desired_torque"]
 RUN_SUFFIXES = ["theta1", "theta2", "theta1dot", "theta2dot", "torque"]
 
 
-def _run(name: str, duration: float = 2.0, saturate: bool = False) -> SimulationResult:
-    controller, plant = make_scenario(name, ROBOT, saturate=saturate)
-    return simulate(controller, plant, TRAJ, SimulationConfig(duration=duration))
+def _run(
+    name: str, duration: float = 2.0, saturate: bool = False, robot: RobotModel = ROBOT
+) -> SimulationResult:
+    controller, plant = make_scenario(name, robot, saturate=saturate)
+    return simulate(controller, plant, default_trajectory(robot), SimulationConfig(duration=duration))
 
 
 @pytest.fixture(scope="module")
@@ -46,7 +61,7 @@ def check() -> TorqueCheck:
 
 @pytest.fixture(scope="module")
 def trajectory_figures(check: TorqueCheck) -> dict[str, Figure]:
-    return plotting._trajectory_figures(ROBOT, TRAJ, check)
+    return _trajectory_figures(ROBOT, TRAJ, check)
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +71,7 @@ def pd() -> SimulationResult:
 
 @pytest.fixture(scope="module")
 def pd_figures(pd: SimulationResult) -> dict[str, Figure]:
-    return plotting._simulation_figures(pd)
+    return _simulation_figures(pd)
 
 
 @pytest.fixture(scope="module")
@@ -86,24 +101,52 @@ def _line(ax, label: str) -> Line2D:  # type: ignore[no-untyped-def]
     return found[0]
 
 
+def _data_lines(ax) -> list[Line2D]:  # type: ignore[no-untyped-def]
+    """The labelled lines of an axes (not the zero line or limit lines)."""
+    return [ln for ln in ax.get_lines() if not str(ln.get_label()).startswith("_")]
+
+
 def _limit_levels(ax) -> list[float]:  # type: ignore[no-untyped-def]
     """y of the dashed horizontal limit lines of an axes."""
     levels = []
     for ln in ax.get_lines():
         y = np.asarray(ln.get_ydata(), dtype=float)
-        if ln.get_linestyle() == "--" and ln.get_color() == plotting.LIMIT_COLOR and np.ptp(y) == 0:
+        if ln.get_linestyle() == "--" and ln.get_color() == _style.LIMIT_COLOR and np.ptp(y) == 0:
             levels.append(float(y[0]))
     return sorted(levels)
 
 
 def _assert_png(path: Path, figsize: tuple[float, float]) -> None:
-    """The PNG's pixel size is figsize × DPI and it is not a blank canvas."""
+    """The file is a PNG that decodes at figsize × DPI pixels and is not a blank canvas."""
+    assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n", path.name
     image = imread(path)
     w, h = figsize
-    assert image.shape[:2] == (round(h * plotting.DPI), round(w * plotting.DPI)), path.name
+    expected = (h * _style.DPI, w * _style.DPI)  # matplotlib truncates a fractional pixel
+    assert all(abs(n - x) < 1 for n, x in zip(image.shape[:2], expected)), (path.name, image.shape, expected)
     gray = image[..., :3].mean(axis=2)
     assert gray.std() > 0.05, f"{path.name} looks blank (std {gray.std():.4f})"
     assert (gray < 0.5).mean() > 0.005, f"{path.name} has almost no dark pixels (no text or lines)"
+
+
+def _chain_urdf(path: Path, n: int, effort: float = 200.0) -> Path:
+    """An n-joint arm in gravity: a yaw joint, then pitch joints 0.3 m apart, and an
+    ``ee_link`` 0.25 m beyond the last joint (so nothing is planar for n >= 2)."""
+    parts = ['<?xml version="1.0"?>\n<robot name="chain"><link name="l0"/>']
+    for i in range(1, n + 1):
+        axis, xyz = ("0 0 1", "0 0 0.1") if i == 1 else ("0 1 0", "0.3 0 0")
+        parts.append(
+            f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/>'
+            f'<origin xyz="{xyz}"/><axis xyz="{axis}"/>'
+            f'<limit lower="-3.14" upper="3.14" effort="{effort}" velocity="10"/></joint>'
+            f'<link name="l{i}"><inertial><origin xyz="0.1 0.01 0.02"/><mass value="{2.0 / i}"/>'
+            f'<inertia ixx="0.05" ixy="0.001" ixz="0" iyy="0.04" iyz="0" izz="0.03"/></inertial></link>'
+        )
+    parts.append(
+        f'<joint name="ee" type="fixed"><parent link="l{n}"/><child link="ee_link"/>'
+        '<origin xyz="0.25 0 0"/></joint><link name="ee_link"/></robot>\n'
+    )
+    path.write_text("".join(parts))
+    return path
 
 
 # --------------------------------------------------------------------- trajectory
@@ -112,23 +155,26 @@ def _assert_png(path: Path, figsize: tuple[float, float]) -> None:
 def test_trajectory_figures_written_with_size_and_content(
     tmp_path: Path, check: TorqueCheck, trajectory_figures: dict[str, Figure]
 ) -> None:
-    """Figures 3–6 land in a new nested directory, in order, at figsize × DPI pixels, not
-    blank, and nothing else (no temporary file) is left in the directory."""
+    """trajectory_<key>.png land in a new nested directory, in order (no report figure
+    number in a name), at figsize × DPI pixels, not blank, and nothing else (no temporary
+    file) is left in the directory."""
+    assert list(trajectory_figures) == TRAJECTORY_KEYS
     out = tmp_path / "new" / "figs"
-    sizes = {f"{k}.png": tuple(fig.get_size_inches()) for k, fig in trajectory_figures.items()}
+    sizes = {f"trajectory_{k}.png": tuple(fig.get_size_inches()) for k, fig in trajectory_figures.items()}
     paths = plotting.save_trajectory_figures(ROBOT, TRAJ, check, out)
-    assert [p.name for p in paths] == TRAJECTORY_FILES
-    assert sorted(p.name for p in out.iterdir()) == sorted(TRAJECTORY_FILES)
-    assert sizes["fig03_theta1.png"] == plotting.JOINT_FIGSIZE
-    assert sizes["fig05_workspace.png"] == plotting.WORKSPACE_FIGSIZE
+    assert [p.name for p in paths] == [f"trajectory_{k}.png" for k in TRAJECTORY_KEYS]
+    assert sorted(p.name for p in out.iterdir()) == sorted(sizes)
+    assert sizes["trajectory_theta1.png"] == _style.JOINT_FIGSIZE
+    assert sizes["trajectory_workspace.png"] == _style.WORKSPACE_FIGSIZE
+    assert sizes["trajectory_desired_torque.png"] == _style.TORQUE_FIGSIZE
     for path in paths:
         _assert_png(path, sizes[path.name])
 
 
 def test_joint_figure_plots_the_trajectory_and_its_via_points(trajectory_figures: dict[str, Figure]) -> None:
-    """Each panel of Figure 3/4 is the trajectory's q, q̇, q̈, jerk over exactly one period,
-    and the via-point markers sit at (times, via_q)."""
-    for j, key in enumerate(("fig03_theta1", "fig04_theta2")):
+    """Each panel of a joint figure is the trajectory's q, q̇, q̈, jerk over exactly one
+    period, and the via-point markers sit at (times, via_q)."""
+    for j, key in enumerate(("theta1", "theta2")):
         fig = trajectory_figures[key]
         for label, field in (("position", "q"), ("velocity", "v"), ("acceleration", "a"), ("jerk", "jerk")):
             line = _line(_axes(fig, label), label)
@@ -142,10 +188,11 @@ def test_joint_figure_plots_the_trajectory_and_its_via_points(trajectory_figures
 
 
 def test_workspace_figure_path_annulus_and_labels(trajectory_figures: dict[str, Figure]) -> None:
-    """The end-effector path equals the closed-form FK of the trajectory, the annulus
-    circles have radii |L1 − L2| and L1 + L2, the axes are equal-aspect, and the via points
-    are labelled with their times (the start and end point share one label)."""
-    fig = trajectory_figures["fig05_workspace"]
+    """The end-effector path equals the closed-form FK of the trajectory (a second method
+    beside Pinocchio's), the annulus circles have radii |L1 − L2| and L1 + L2, the axes are
+    equal-aspect x-y, and the via points are labelled with their times (the start and end
+    point share one label)."""
+    fig = trajectory_figures["workspace"]
     full, zoom = _axes(fig, "workspace"), _axes(fig, "path")
     path = _line(zoom, "end-effector path")
     xy = np.column_stack([path.get_xdata(), path.get_ydata()])
@@ -157,22 +204,35 @@ def test_workspace_figure_path_annulus_and_labels(trajectory_figures: dict[str, 
     radii = sorted(
         float(np.hypot(ln.get_xdata(), ln.get_ydata()).mean())
         for ln in full.get_lines()
-        if ln.get_color() == "tab:green"
+        if ln.get_color() == _style.REACH_COLOR
     )
     np.testing.assert_allclose(radii, [abs(l1 - l2), l1 + l2], rtol=0, atol=1e-12)
     assert full.get_aspect() == 1.0 and zoom.get_aspect() == 1.0
+    assert (zoom.get_xlabel(), zoom.get_ylabel()) == ("x [m]", "y [m]")
     labels = [text.get_text() for text in zoom.texts]
     assert any(s.startswith("t = 0, 4 s") for s in labels), labels
     for tv in ("1", "2", "3"):
         assert any(s.startswith(f"t = {tv} s") for s in labels), labels
 
 
+def test_workspace_arms_come_from_joint_positions(trajectory_figures: dict[str, Figure]) -> None:
+    """The blue arms are the x-y of kinematics.joint_positions at the via points: joint
+    origins, then the end effector."""
+    full = _axes(trajectory_figures["workspace"], "workspace")
+    arms = [ln for ln in full.get_lines() if ln.get_color() == "tab:blue"]
+    assert len(arms) == len(TRAJ.times)
+    expected = joint_positions(ROBOT, TRAJ.via_q)[:, :, :2]
+    for line, arm in zip(arms, expected):
+        np.testing.assert_allclose(np.column_stack([line.get_xdata(), line.get_ydata()]), arm, rtol=0, atol=0)
+
+
 def test_desired_torque_figure_data_limits_and_peaks(
     check: TorqueCheck, trajectory_figures: dict[str, Figure]
 ) -> None:
-    """Figure 6 plots check.tau, dashed lines at ±240 and ±40 N·m, a marker at each peak,
-    and (the peaks being a few % of the limits) a note that the limit is off scale."""
-    fig = trajectory_figures["fig06_desired_torque"]
+    """The desired-torque figure plots check.tau, dashed lines at ±240 and ±40 N·m, a
+    marker at each peak, and (the peaks being a few % of the limits) a note that the limit
+    is off scale."""
+    fig = trajectory_figures["desired_torque"]
     for j, limit in enumerate(LIMITS):
         ax = _axes(fig, f"tau{j + 1}")
         line = _line(ax, "desired")
@@ -188,12 +248,82 @@ def test_desired_torque_figure_data_limits_and_peaks(
         )
         assert any(f"±{limit:g} N·m limit off scale" in t.get_text() for t in ax.texts)
         assert ax.get_ylim()[1] < limit  # the curve is not squashed against a far-away limit
+        assert "[N·m]" in ax.get_ylabel()
 
 
 def test_trajectory_figures_reject_a_mismatched_trajectory(check: TorqueCheck) -> None:
     three = JointTrajectory.from_via_q((0.0, 1.0), np.zeros((2, 3)))
     with pytest.raises(InvalidParameterError, match="trajectory"):
-        plotting._trajectory_figures(ROBOT, three, check)
+        _trajectory_figures(ROBOT, three, check)
+
+
+def test_arm_without_torque_limits_and_in_another_plane() -> None:
+    """The double pendulum swings in the y-z plane and its URDF gives no effort limits:
+    the workspace figure is drawn in y-z (its path is joint_positions' y-z, no annulus),
+    and the torque figures draw no limit line and say there is no limit."""
+    robot = load_robot(str(example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf")))
+    trajectory = default_trajectory(robot)
+    check = check_torques(robot, trajectory, samples=201)
+    assert not np.isfinite(check.limits).any()
+    figures = _trajectory_figures(robot, trajectory, check, samples=201)
+    zoom = _axes(figures["workspace"], "path")
+    assert (zoom.get_xlabel(), zoom.get_ylabel()) == ("y [m]", "z [m]")
+    path = _line(zoom, "end-effector path")
+    t = trajectory.t0 + np.linspace(0.0, trajectory.span, 201)
+    expected = joint_positions(robot, trajectory.sample(t).q)[:, -1, 1:]
+    np.testing.assert_allclose(np.column_stack([path.get_xdata(), path.get_ydata()]), expected, atol=0)
+    full = _axes(figures["workspace"], "workspace")
+    assert [ln for ln in full.get_lines() if ln.get_color() == _style.REACH_COLOR] == []
+    assert "y-z plane" in figures["workspace"].get_suptitle()
+    for j in range(2):
+        ax = _axes(figures["desired_torque"], f"tau{j + 1}")
+        assert _limit_levels(ax) == []
+        assert any("no limit in the URDF" in text.get_text() for text in ax.texts)
+    assert "no motor limits" in figures["desired_torque"].get_suptitle()
+    torque = _torque_figure(_run("pd", duration=0.3, robot=robot))
+    assert all(_limit_levels(_axes(torque, f"tau{j + 1}")) == [] for j in range(2))
+
+
+# ----------------------------------------------------------------------- titles
+
+
+def test_report_figure_numbers_only_when_given(
+    check: TorqueCheck, pd: SimulationResult, trajectory_figures: dict[str, Figure]
+) -> None:
+    """With figure_numbers every title cites its own number ("cf. report Fig. N"), with a
+    partial mapping only the figures it names do, and without none does; ``title`` goes
+    beside the controller's name. A read-only mapping is accepted and left as it was."""
+    assert all("cf. report" not in fig.get_suptitle() for fig in trajectory_figures.values())
+    numbers = REPORT_FIGURES["trajectory"]
+    cited = _trajectory_figures(ROBOT, TRAJ, check, samples=201, figure_numbers=numbers)
+    for key, fig in cited.items():
+        assert f"cf. report Fig. {numbers[key]}" in fig.get_suptitle(), key
+
+    run_numbers = types.MappingProxyType(dict(REPORT_FIGURES["pd"]))
+    figs = _simulation_figures(pd, run_numbers, "PD + model feedforward")
+    assert dict(run_numbers) == REPORT_FIGURES["pd"]
+    for key, fig in figs.items():
+        title = fig.get_suptitle()
+        assert title.startswith("controller pd (PD + model feedforward) — cf. report Fig. "), title
+        assert title.splitlines()[0].endswith(f"Fig. {run_numbers[key]}"), title
+    partial = _simulation_figures(pd, {"torque": 11, "friction_error": 33})
+    assert "cf. report Fig. 11" in partial["torque"].get_suptitle()
+    assert all("cf. report" not in f.get_suptitle() for k, f in partial.items() if k != "torque")
+    assert all(f.get_suptitle().startswith("controller pd\n") for k, f in partial.items() if k != "torque")
+
+
+@pytest.mark.parametrize(
+    ("numbers", "match"),
+    [
+        ([("torque", 11)], "figure_numbers.*a mapping"),
+        ({"torque": 0}, r"figure_numbers\['torque'\].*positive integer"),
+        ({"torque": True}, r"figure_numbers\['torque'\].*positive integer"),
+        ({"torque": "11"}, r"figure_numbers\['torque'\].*positive integer"),
+    ],
+)
+def test_bad_figure_numbers_are_refused(pd: SimulationResult, numbers: object, match: str) -> None:
+    with pytest.raises(InvalidParameterError, match=match):
+        _simulation_figures(pd, numbers)  # type: ignore[arg-type]
 
 
 # --------------------------------------------------------------------- simulation
@@ -204,13 +334,13 @@ def test_state_figures_plot_actual_desired_and_error(
 ) -> None:
     """Position and velocity figures: top panel q (v) and q_d (v_d); both error panels hold
     e (ė) exactly; the log panel is the window-wise max |e|, so it bounds |e| from above
-    and reaches max |e|."""
+    and reaches max |e|; every y label has its unit."""
     figures = pd_figures
     assert list(figures) == RUN_SUFFIXES
     for j in range(2):
-        for key, actual, desired, error in (
-            (f"theta{j + 1}", pd.q, pd.q_des, pd.e),
-            (f"theta{j + 1}dot", pd.v, pd.v_des, pd.edot),
+        for key, actual, desired, error, unit in (
+            (f"theta{j + 1}", pd.q, pd.q_des, pd.e, "[rad]"),
+            (f"theta{j + 1}dot", pd.v, pd.v_des, pd.edot, "[rad/s]"),
         ):
             fig = figures[key]
             top = _axes(fig, "signal")
@@ -226,7 +356,9 @@ def test_state_figures_plot_actual_desired_and_error(
             assert np.all(ye[window] >= np.abs(error[:, j]))
             np.testing.assert_allclose(ye.max(), np.abs(error[:, j]).max(), rtol=0, atol=0)
             assert _axes(fig, "error-log").get_yscale() == "log"
-            assert "pd" in fig.get_suptitle()
+            for label in ("signal", "error", "error-log"):
+                assert _axes(fig, label).get_ylabel().endswith(unit), (key, label)
+            assert fig.get_suptitle().startswith("controller pd")
 
 
 def test_torque_figure_data_and_limit_lines(pd: SimulationResult, pd_figures: dict[str, Figure]) -> None:
@@ -243,6 +375,7 @@ def test_torque_figure_data_and_limit_lines(pd: SimulationResult, pd_figures: di
         for ax in (whole, last):
             assert _limit_levels(ax) == [-limit, limit]
             assert [ln for ln in ax.get_lines() if "commanded" in str(ln.get_label())] == []
+        assert whole.get_ylabel() == rf"$\tau_{{{j + 1}}}$ [N·m]"
 
 
 def test_saturated_run_shows_commanded_and_applied_torque() -> None:
@@ -250,42 +383,170 @@ def test_saturated_run_shows_commanded_and_applied_torque() -> None:
     one and says the plant clipped it; without, it flags the excess as unsaturated."""
     sat = _run("adaptive", duration=0.3, saturate=True)
     assert sat.limit_exceeded[1], "the adaptive run's initial τ2 should exceed 40 N·m"
-    ax = _axes(plotting._torque_figure(sat), "tau2")
+    ax = _axes(_torque_figure(sat), "tau2")
     np.testing.assert_array_equal(_line(ax, "commanded").get_ydata(), sat.tau_command[:, 1])
     np.testing.assert_array_equal(_line(ax, "applied").get_ydata(), sat.tau[:, 1])
     assert np.abs(_line(ax, "applied").get_ydata()).max() <= 40.0
     assert any("clipped by the plant" in t.get_text() for t in ax.texts)
     free = _run("adaptive", duration=0.3)
-    ax = _axes(plotting._torque_figure(free), "tau2")
+    ax = _axes(_torque_figure(free), "tau2")
     assert any("not saturated" in t.get_text() for t in ax.texts)
+
+
+# --------------------------------------------------------------------- parameters
 
 
 def test_parameter_figures_only_for_adaptive_runs(
     pd_figures: dict[str, Figure], adaptive: SimulationResult, friction: SimulationResult
 ) -> None:
     """pd has no parameter figure, adaptive has param_error only, adaptive-friction has both;
-    the lines are p̂ − p (absolute) and 100 (p̂ − p)/p (relative)."""
+    the lines are p̂ − p (absolute, one panel per unit: kg·m²; N·m·s/rad and N·m) and
+    100 (p̂ − p)/p (relative), with the units on the y axes."""
     assert "param_error" not in pd_figures
-    figs = plotting._simulation_figures(adaptive)
+    figs = _simulation_figures(adaptive)
     assert list(figs) == [*RUN_SUFFIXES, "param_error"]
     assert adaptive.p_error is not None and adaptive.p_true is not None
-    absolute = _axes(figs["param_error"], "absolute")
-    for i in range(3):
-        np.testing.assert_array_equal(absolute.get_lines()[i].get_ydata(), adaptive.p_error[:, i])
+    absolute = _axes(figs["param_error"], "absolute [kg·m²]")
+    assert absolute.get_ylabel() == "estimate − true [kg·m²]"
+    for i, line in enumerate(_data_lines(absolute)):
+        np.testing.assert_array_equal(line.get_ydata(), adaptive.p_error[:, i])
+    assert len(absolute.get_lines()) == 3 + 1  # p1..p3 and the zero line
     relative = _axes(figs["param_error"], "relative")
+    assert relative.get_ylabel().endswith("[%]")
     np.testing.assert_allclose(
-        relative.get_lines()[0].get_ydata(), 100 * adaptive.p_error[:, 0] / adaptive.p_true[0], rtol=1e-12
+        _data_lines(relative)[0].get_ydata(), 100 * adaptive.p_error[:, 0] / adaptive.p_true[0], rtol=1e-12
     )
-    figs = plotting._simulation_figures(friction)
+    figs = _simulation_figures(friction)
     assert list(figs) == [*RUN_SUFFIXES, "param_error", "friction_error"]
     assert friction.p_error is not None
     names = list(friction.parameter_names)
-    viscous = _axes(figs["friction_error"], "V")
-    coulomb = _axes(figs["friction_error"], "C")
-    for ax, group in ((viscous, ("V1", "V2")), (coulomb, ("C1", "C2"))):
-        for line, name in zip(ax.get_lines(), group):
+    for unit, group in (("N·m·s/rad", ("V1", "V2")), ("N·m", ("C1", "C2"))):
+        ax = _axes(figs["friction_error"], f"absolute [{unit}]")
+        assert ax.get_ylabel() == f"estimate − true [{unit}]"
+        lines = _data_lines(ax)
+        assert len(lines) == len(group)
+        for line, name in zip(lines, group):
             np.testing.assert_array_equal(line.get_ydata(), friction.p_error[:, names.index(name)])
-    assert len(_axes(figs["param_error"], "absolute").get_lines()) == 3 + 1  # p1..p3 and the zero line
+    assert len(_data_lines(_axes(figs["param_error"], "absolute [kg·m²]"))) == 3
+
+
+def test_parameters_go_where_their_kind_says_not_their_name(friction: SimulationResult) -> None:
+    """Renamed so that an inertial parameter is called "Vz" and a friction one "Cx" or
+    "p9", each still lands in the figure of its declared kind; re-declaring p3 as friction
+    moves it (with its own unit panel) to friction_error; declaring all friction leaves no
+    param_error figure."""
+    assert friction.p_error is not None
+    names = ("Vz", "p2", "p3", "Cx", "p9", "C1", "C2")
+    renamed = dataclasses.replace(friction, parameter_names=names)
+    figs = _simulation_figures(renamed)
+    inertial = _data_lines(_axes(figs["param_error"], "absolute [kg·m²]"))
+    assert [str(ln.get_label()).split(" (")[0] for ln in inertial] == [
+        "Vz",
+        r"$\hat{p}_{2} - p_{2}$",
+        r"$\hat{p}_{3} - p_{3}$",
+    ]
+    np.testing.assert_array_equal(inertial[0].get_ydata(), friction.p_error[:, 0])
+    viscous = _data_lines(_axes(figs["friction_error"], "absolute [N·m·s/rad]"))
+    assert [str(ln.get_label()).split(" (")[0] for ln in viscous] == ["Cx", r"$\hat{p}_{9} - p_{9}$"]
+    np.testing.assert_array_equal(viscous[1].get_ydata(), friction.p_error[:, 4])
+
+    kinds = ("inertial", "inertial", "friction", "friction", "friction", "friction", "friction")
+    moved = _simulation_figures(dataclasses.replace(friction, parameter_kinds=kinds))
+    assert len(_data_lines(_axes(moved["param_error"], "absolute [kg·m²]"))) == 2
+    p3 = _data_lines(_axes(moved["friction_error"], "absolute [kg·m²]"))
+    assert len(p3) == 1
+    np.testing.assert_array_equal(p3[0].get_ydata(), friction.p_error[:, 2])
+
+    only = _simulation_figures(dataclasses.replace(friction, parameter_kinds=("friction",) * 7))
+    assert list(only) == [*RUN_SUFFIXES, "friction_error"]
+
+
+def test_parameter_panels_follow_the_declared_units(adaptive: SimulationResult) -> None:
+    """The absolute panels group the parameters by ``parameter_units`` (in order of first
+    use) and each y axis names that unit."""
+    assert adaptive.p_error is not None
+    result = dataclasses.replace(adaptive, parameter_units=("kg", "kg·m", "kg"))
+    fig = _simulation_figures(result)["param_error"]
+    assert [ax.get_label() for ax in fig.axes] == ["absolute [kg]", "absolute [kg·m]", "relative"]
+    kg = _data_lines(_axes(fig, "absolute [kg]"))
+    np.testing.assert_array_equal(kg[0].get_ydata(), adaptive.p_error[:, 0])
+    np.testing.assert_array_equal(kg[1].get_ydata(), adaptive.p_error[:, 2])
+    assert _axes(fig, "absolute [kg·m]").get_ylabel() == "estimate − true [kg·m]"
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        (
+            {"parameter_kinds": ()},
+            r"result\.parameter_kinds.*one entry per estimated parameter \(3\) but got 0",
+        ),
+        ({"parameter_units": ("kg·m²",)}, r"result\.parameter_units.*\(3\) but got 1"),
+        ({"parameter_kinds": ("inertial", "payload", "inertial")}, r"parameter_kinds.*not \['payload'\]"),
+    ],
+)
+def test_undeclared_parameters_are_refused(adaptive: SimulationResult, change: dict, match: str) -> None:  # type: ignore[type-arg]
+    with pytest.raises(InvalidParameterError, match=match):
+        _simulation_figures(dataclasses.replace(adaptive, **change))
+
+
+# ------------------------------------------------------------------ generality in nv
+
+
+@pytest.mark.parametrize("nv", [1, 3, 6])
+def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, nv: int) -> None:
+    """An nv-joint arm gets one trajectory figure and two state figures per joint, a torque
+    panel pair per joint at least 1.5 in tall (the figure grows with nv), the workspace
+    without an annulus (no closed form for nv != 2), and its inertial parameters in one
+    panel per unit (kg, kg·m, kg·m²); every file is written."""
+    robot = load_robot(_chain_urdf(tmp_path / f"chain{nv}.urdf", nv))
+    assert robot.nv == nv
+    trajectory = default_trajectory(robot)
+    check = check_torques(robot, trajectory, samples=201)
+    figures = _trajectory_figures(robot, trajectory, check, samples=201)
+    assert list(figures) == [*(f"theta{j + 1}" for j in range(nv)), "workspace", "desired_torque"]
+    full = _axes(figures["workspace"], "workspace")
+    assert [ln for ln in full.get_lines() if ln.get_color() == _style.REACH_COLOR] == []
+    assert len([ax for ax in figures["desired_torque"].axes if ax.get_label().startswith("tau")]) == nv
+
+    result = _run("adaptive", duration=0.2, robot=robot)
+    assert set(result.parameter_units) == {"kg", "kg·m", "kg·m²"}
+    run = _simulation_figures(result)
+    suffixes = [f"theta{j + 1}" for j in range(nv)] + [f"theta{j + 1}dot" for j in range(nv)]
+    assert list(run) == [*suffixes, "torque", "param_error"]
+    torque = run["torque"]
+    torque.canvas.draw()
+    height = torque.get_size_inches()[1]
+    for j in range(nv):
+        for label in (f"tau{j + 1}", f"tau{j + 1}-last"):
+            ax = _axes(torque, label)
+            assert ax.get_position().height * height >= 1.5, (label, ax.get_position().height * height)
+        np.testing.assert_array_equal(
+            _line(_axes(torque, f"tau{j + 1}"), "applied").get_ydata(), result.tau[:, j]
+        )
+    param = run["param_error"]
+    assert [ax.get_label() for ax in param.axes] == [
+        "absolute [kg]",
+        "absolute [kg·m]",
+        "absolute [kg·m²]",
+        "relative",
+    ]
+    assert sum(len(_data_lines(ax)) for ax in param.axes[:3]) == len(result.parameter_names)
+
+    real_save = _style._save
+    rendered = ("trajectory_workspace.png", "adaptive_torque.png", "adaptive_param_error.png")
+    monkeypatch.setattr(  # render the three largest figures, only name the others (speed)
+        _style, "_save", lambda fig, path: real_save(fig, path) if path.name in rendered else path
+    )
+    paths = plotting.save_trajectory_figures(robot, trajectory, check, tmp_path)
+    paths += plotting.save_simulation_figures(result, tmp_path)
+    expected = [f"trajectory_{k}.png" for k in figures] + [f"adaptive_{k}.png" for k in run]
+    assert [p.name for p in paths] == expected
+    for name in rendered:
+        _assert_png(tmp_path / name, tuple((figures | run)[name.split("_", 1)[1][:-4]].get_size_inches()))
+
+
+# ---------------------------------------------------------------------- saving
 
 
 def test_save_simulation_figures_sizes_and_no_leftovers(
@@ -294,7 +555,7 @@ def test_save_simulation_figures_sizes_and_no_leftovers(
     """Files are <controller>_<suffix>.png by default, at figsize × DPI, not blank, and
     nothing else (no temporary file) is left in the directory."""
     sizes = {k: tuple(f.get_size_inches()) for k, f in pd_figures.items()}
-    assert sizes["theta1"] == plotting.STATE_FIGSIZE and sizes["torque"] == plotting.SIM_TORQUE_FIGSIZE
+    assert sizes["theta1"] == _style.STATE_FIGSIZE and sizes["torque"] == _style.SIM_TORQUE_FIGSIZE
     paths = plotting.save_simulation_figures(pd, tmp_path / "a")
     assert [p.name for p in paths] == [f"pd_{k}.png" for k in RUN_SUFFIXES]
     for path, key in zip(paths, RUN_SUFFIXES):
@@ -305,13 +566,21 @@ def test_save_simulation_figures_sizes_and_no_leftovers(
 def test_custom_prefix_and_every_friction_figure(
     tmp_path: Path, friction: SimulationResult, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """A given prefix replaces the controller's name (the default, see the test above) and
-    every figure of an adaptive-friction run is saved."""
+    """A given prefix replaces the controller's name (the default, see the test above),
+    every figure of an adaptive-friction run is saved, and the friction figure decodes."""
     written: list[str] = []
-    monkeypatch.setattr(plotting, "_save", lambda fig, path: written.append(path.name) or path)
+    real_save = _style._save
+
+    def record(fig: Figure, path: Path) -> Path:
+        written.append(path.name)
+        return real_save(fig, path) if path.name.endswith("friction_error.png") else path
+
+    monkeypatch.setattr(_style, "_save", record)
     suffixes = [*RUN_SUFFIXES, "param_error", "friction_error"]
     paths = plotting.save_simulation_figures(friction, tmp_path, prefix="run7")
     assert written == [p.name for p in paths] == [f"run7_{k}.png" for k in suffixes]
+    figure = _simulation_figures(friction)["friction_error"]
+    _assert_png(tmp_path / "run7_friction_error.png", tuple(figure.get_size_inches()))
 
 
 # -------------------------------------------------------------------- distribution
@@ -319,21 +588,24 @@ def test_custom_prefix_and_every_friction_figure(
 
 def test_distribution_figure_histograms(tmp_path: Path) -> None:
     """One histogram per metric whose counts add up to the finite values; the title counts
-    the non-finite ones; the PNG has the figure's pixel size."""
+    the non-finite ones; the PNG has the figure's pixel size; the input is left as it was."""
     rng = np.random.default_rng(0)
     a = rng.normal(size=200)
     a[:3] = np.nan
+    a.setflags(write=False)
     rows = {"RMS e1 [rad]": a, "RMS e2 [rad]": rng.lognormal(size=50), "peak τ1 [N·m]": np.full(10, 3.0)}
-    fig = plotting._distribution_figure(rows)
+    fig = _distribution_figure(rows)
     visible = [ax for ax in fig.axes if ax.get_visible()]
     assert len(visible) == 3
     heights = sum(p.get_height() for p in visible[0].patches)
     assert heights == 197
     assert "3 non-finite" in visible[0].get_title()
     assert sum(p.get_height() for p in visible[2].patches) == 10
+    assert visible[2].get_xlabel() == "peak τ1 [N·m]"
     path = plotting.save_distribution_figure(rows, tmp_path / "mc" / "dist.png")
     assert path == tmp_path / "mc" / "dist.png"
     _assert_png(path, tuple(fig.get_size_inches()))
+    assert int(np.isnan(a).sum()) == 3
 
 
 def test_distribution_figure_rejects_empty_input(tmp_path: Path) -> None:
@@ -366,19 +638,43 @@ def test_failed_write_keeps_the_old_file_and_leaves_no_temp(
 
 
 def test_output_directory_that_is_a_file_is_reported(tmp_path: Path, pd: SimulationResult) -> None:
+    """A file where the output folder should go is an OutputError naming a path under it
+    (the wording is twolink_pin.files'), and the file is left as it was."""
     blocker = tmp_path / "file"
     blocker.write_text("x")
-    with pytest.raises(OutputError, match="cannot create the directory"):
+    with pytest.raises(OutputError) as caught:
         plotting.save_simulation_figures(pd, blocker / "figs")
+    assert caught.value.path.startswith(str(blocker))
+    assert blocker.read_text() == "x"
 
 
 def test_figures_are_freed_after_saving(
-    tmp_path: Path, check: TorqueCheck, monkeypatch: pytest.MonkeyPatch
+    tmp_path: Path, check: TorqueCheck, pd: SimulationResult, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """No figure survives a save (no pyplot registry, nothing cached)."""
     refs: list[weakref.ref[Figure]] = []
-    monkeypatch.setattr(plotting, "_save", lambda fig, path: refs.append(weakref.ref(fig)) or path)
+    monkeypatch.setattr(_style, "_save", lambda fig, path: refs.append(weakref.ref(fig)) or path)
     plotting.save_trajectory_figures(ROBOT, TRAJ, check, tmp_path)
+    plotting.save_simulation_figures(pd, tmp_path)
     gc.collect()
-    assert len(refs) == 4
+    assert len(refs) == 4 + 5
     assert all(ref() is None for ref in refs)
+
+
+def test_no_pyplot_and_only_the_public_names() -> None:
+    """Building and saving figures never imports pyplot (checked in a fresh interpreter),
+    and the package exports exactly its three save functions (no report tables)."""
+    code = (
+        "import sys, tempfile, numpy as np\n"
+        "import twolink_pin.plotting as p\n"
+        "p.save_distribution_figure({'x [m]': np.arange(5.0)}, tempfile.mkdtemp() + '/d.png')\n"
+        "assert 'matplotlib.pyplot' not in sys.modules, 'pyplot imported'\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert done.returncode == 0, done.stderr
+    assert sorted(plotting.__all__) == [
+        "save_distribution_figure",
+        "save_simulation_figures",
+        "save_trajectory_figures",
+    ]
+    assert not hasattr(plotting, "REPORT_FIGURES") and not hasattr(plotting, "CONTROLLER_TITLES")

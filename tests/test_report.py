@@ -1,16 +1,19 @@
-"""``twolink-pin report``: the page a student opens, checked in headless Chromium."""
+"""``twolink-pin report``: the page a student opens, checked in headless Chromium; its numbers
+against the library; a sixth law, a non-twolink robot, and failures that leave nothing behind."""
 
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
 from browser import network_requests, require_chromium, start_chromium
 
 from twolink_pin import OutputError, SimulationConfig
-from twolink_pin.controllers import CONTROLLERS
+from twolink_pin.errors import SimulationDivergedError
 from twolink_pin.report import MARKER, ReportOptions, build_report
+from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
 SHORT = ReportOptions(config=SimulationConfig(duration=4.0), workers=1)
 
@@ -24,35 +27,51 @@ def report_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> None:
     results = json.loads((report_dir / "results.json").read_text())
-    assert list(results["controllers"]) == list(CONTROLLERS)
-    assert results["model"]["closed_form_check"]["max_abs_dM"] < 1e-12
-    assert results["model"]["p"]["p1"] == pytest.approx(3.4, abs=1e-12)
-    csv_rows = (report_dir / "table2.csv").read_text().strip().splitlines()
-    assert len(csv_rows) == 1 + 4 * len(CONTROLLERS) + len(CONTROLLERS)  # header, 4 rows each, report rows
+    assert list(results["controllers"]) == list(REPORT_CONTROLLERS)
+    assert results["twolink"]["closed_form_check"]["max_abs_dM"] < 1e-12
+    assert results["robot"]["parameters"]["p1"] == pytest.approx(3.4, abs=1e-12)
+    assert results["simulation"]["lambda"] == {
+        "computed-torque": 5.0,
+        "robust": 5.0,
+        "adaptive": 5.0,
+        "adaptive-friction": 5.0,
+    }
+    csv_rows = (report_dir / "comparison.csv").read_text().strip().splitlines()
+    assert len(csv_rows) == 1 + 4 * len(REPORT_CONTROLLERS)  # header, 3 norms + last-period row each
+    errata = [e["topic"] for e in results["errata"]]
+    assert len(errata) == 6 and "Unstated λ, initial state and norm" in errata
+
+
+def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:
+    """No float printed with 15+ digits (e.g. "Peaks [4.093301855416829, ...]")."""
+    text = (report_dir / "index.html").read_text()
+    body = text[text.index("<body>") :]
+    assert not re.findall(r"\d\.\d{9,}", body)
 
 
 @pytest.mark.browser
 def test_index_html_images_tables_and_animation_in_chromium(report_dir: Path) -> None:
     """Every image decodes, the tables have their rows, the animation link opens a scene."""
     require_chromium()
+    n = len(REPORT_CONTROLLERS)
     with start_chromium(1280, 900) as driver:
         driver.get((report_dir / "index.html").as_uri())
         images = driver.execute_script(
             "return Array.from(document.images).map(i => [i.getAttribute('src'), i.complete, i.naturalWidth]);"
         )
-        assert len(images) >= 4 + 5 * len(CONTROLLERS)
+        assert len(images) >= 4 + 5 * n
         broken = [src for src, complete, width in images if not (complete and width > 0)]
         assert broken == []
         rows = driver.execute_script(
             "const n = id => document.querySelectorAll('#' + id + ' tbody tr').length;"
             "return {t1: n('table1'), rms: n('table2-rms'), rep: n('table2-report'), coef: n('coefficients')};"
         )
-        assert rows == {"t1": 4, "rms": len(CONTROLLERS), "rep": 5, "coef": 11}
+        assert rows == {"t1": 4, "rms": n, "rep": 5, "coef": 11}
         first_cells = driver.execute_script(
             "return Array.from(document.querySelectorAll('#table2-rms tbody tr td:first-child'))"
             ".map(td => td.textContent);"
         )
-        assert first_cells == list(CONTROLLERS)
+        assert first_cells == list(REPORT_CONTROLLERS)
         external = [u for u in network_requests(driver) if not u.startswith(("file:", "data:"))]
         assert external == []
         href = driver.find_element("id", "animation-link").get_attribute("href")
@@ -63,6 +82,39 @@ def test_index_html_images_tables_and_animation_in_chromium(report_dir: Path) ->
             " if (window.sceneLoaded || Date.now() - t0 > 20000) done(); else setTimeout(poll, 100); })();"
         )
         assert driver.execute_script("return !!window.sceneLoaded && !!window.viewer;")
+
+
+def test_a_sixth_law_gets_its_own_section_and_the_errata_use_the_runs_lambda(tmp_path: Path) -> None:
+    """--controller adds the tutorial's law beside pd and adaptive; λ = 3 appears in the errata
+    text (the page may not contradict the run's settings)."""
+    options = ReportOptions(
+        config=SimulationConfig(duration=1.0),
+        lam=3.0,
+        workers=1,
+        animation=False,
+        controllers=("pd", "adaptive", "examples/sliding_mode.py:SlidingMode"),
+    )
+    results = build_report(tmp_path / "r", options)
+    assert list(results["controllers"]) == ["pd", "adaptive", "sliding-mode"]
+    settings = next(e for e in results["errata"] if e["topic"].startswith("Unstated"))
+    assert "λ = 3 1/s" in settings["correct"]
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "id='ctrl-sliding-mode'" in html or 'id="ctrl-sliding-mode"' in html
+    assert results["controllers"]["sliding-mode"]["figures"]
+
+
+def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: Path) -> None:
+    """On the double pendulum: no Table 1, no report Table 2, no closed-form check, no errata."""
+    from twolink_pin.model import example_robot_urdf
+
+    urdf = str(example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf"))
+    options = ReportOptions(
+        robot=urdf, config=SimulationConfig(duration=1.0), workers=1, animation=False, controllers=("pd",)
+    )
+    results = build_report(tmp_path / "r", options)
+    assert results["twolink"] is None and results["errata"] == []
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "table1" not in html and "table2-report" not in html and "Errata" not in html
 
 
 def test_refuses_a_directory_that_is_not_a_report(tmp_path: Path) -> None:
@@ -82,13 +134,24 @@ def test_failure_midway_leaves_the_previous_report_whole(
     (out / MARKER).write_text("")
     (out / "index.html").write_text("previous report")
 
-    import twolink_pin.report as report
+    import twolink_pin.report.pages as pages
 
     def boom(*args: object, **kwargs: object) -> None:
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(report, "_write_pages", boom)
+    monkeypatch.setattr(pages, "write_pages", boom)
     with pytest.raises(RuntimeError, match="disk full"):
         build_report(out, ReportOptions(config=SimulationConfig(duration=0.5), workers=1, animation=False))
     assert (out / "index.html").read_text() == "previous report"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging directory left behind
+
+
+def test_a_diverging_run_in_a_worker_arrives_whole_and_nothing_is_written(tmp_path: Path) -> None:
+    """λ = 1e6 makes the Slotine–Li laws diverge in the worker processes: the parent gets the
+    SimulationDivergedError with its controller and time (the exception pickles), and the
+    output folder is not created."""
+    options = ReportOptions(config=SimulationConfig(duration=0.5), lam=1e6, workers=2, animation=False)
+    with pytest.raises(SimulationDivergedError) as info:
+        build_report(tmp_path / "out", options)
+    assert info.value.controller in REPORT_CONTROLLERS and info.value.time > 0
+    assert list(tmp_path.iterdir()) == []

@@ -1,6 +1,6 @@
 """Tests of twolink_pin.simulation: RK4 against the adaptive-step integrator, convergence in
-dt, divergence detection, configuration errors, and the read-only result with its
-torque-limit bookkeeping.
+dt, divergence detection, a law that misbehaves (raises, wrong shape, NaN), configuration
+errors, and the read-only result with its torque-limit bookkeeping.
 """
 
 from __future__ import annotations
@@ -9,13 +9,21 @@ import re
 
 import numpy as np
 import pytest
-from conftest_sim import ROBOT, TRAJECTORY, ConstantTorque, run
+from conftest_sim import ROBOT, TRAJECTORY, ConstantTorque, ConstantTorqueGains, run
 
-from twolink_pin.controllers import ComputedTorque, PDFeedforward, SlotineLiGains
-from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
+from twolink_pin.controllers import (
+    ComputedTorque,
+    LawInput,
+    LawOutput,
+    PDFeedforward,
+    PDGains,
+    SlotineLiGains,
+    Terms,
+)
+from twolink_pin.errors import ControllerError, InvalidParameterError, SimulationDivergedError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.plant import Plant
-from twolink_pin.scenarios import make_scenario
+from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import DIVERGENCE_LIMIT, SimulationConfig, simulate
 
 COMPARISON_DURATION = 3.0
@@ -127,10 +135,10 @@ def test_absurd_gain_diverges_with_the_controller_and_time_named() -> None:
 @pytest.mark.parametrize("method", ["rk4", "adaptive"])
 def test_huge_torque_diverges_with_either_method(method: str) -> None:
     """τ = 1e9 N·m drives |q̇| past DIVERGENCE_LIMIT: SimulationDivergedError at some 0 < t <= 1 ms."""
-    controller = ConstantTorque(ROBOT, (1e9, 1e9))
-    with pytest.raises(SimulationDivergedError, match="controller 'constant-torque' diverged") as info:
+    controller = ConstantTorque(ROBOT, ConstantTorqueGains(torque=1e9))
+    with pytest.raises(SimulationDivergedError, match="controller 'test-constant-torque' diverged") as info:
         simulate(controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=1.0, method=method))
-    assert info.value.controller == "constant-torque"
+    assert info.value.controller == "test-constant-torque"
     assert 0 < info.value.time <= 1e-3 + 1e-12
 
 
@@ -158,7 +166,14 @@ def test_stiff_gain_with_the_adaptive_method_stops_instead_of_hanging() -> None:
         ({"duration": 1.0, "dt": 2.0}, "dt", "dt = 2.0 is invalid: expected a step <= duration (1.0 s)"),
         ({"method": "euler"}, "method", "method = 'euler' is invalid: expected 'rk4' or 'adaptive'"),
         ({"rtol": 0.0}, "rtol", "rtol = 0.0 is invalid: expected a finite value > 0"),
-        ({"q0_offset": (0.1, float("nan"))}, "q0_offset", "q0_offset = (0.1, nan) is invalid"),
+        (
+            {"q0_offset": (0.1, float("nan"))},
+            "q0_offset",
+            "q0_offset = (0.1, nan) is invalid: expected finite offsets",
+        ),
+        ({"q0_offset": "big"}, "q0_offset", "q0_offset = 'big' is invalid: expected finite offsets"),
+        ({"control_period": 1.5e-3}, "control_period", "expected a whole multiple of dt = 0.001 s"),
+        ({"control_period": 1e-3, "method": "adaptive"}, "control_period", "None with the adaptive method"),
     ],
 )
 def test_bad_config_is_refused_naming_the_value(kwargs: dict, name: str, text: str) -> None:
@@ -173,9 +188,84 @@ def test_offset_of_the_wrong_length_is_refused_by_simulate(name: str) -> None:
     """An offset with 3 values for a 2-joint arm: InvalidParameterError naming it and its value."""
     config = SimulationConfig(duration=1.0, **{name: (0.1, 0.1, 0.1)})
     with pytest.raises(
-        InvalidParameterError, match=re.escape(f"{name} = (0.1, 0.1, 0.1) is invalid: expected 2 values")
+        InvalidParameterError,
+        match=re.escape(f"{name} = (0.1, 0.1, 0.1) is invalid: expected one value, or 2 values"),
     ):
         simulate(PDFeedforward(ROBOT), Plant(ROBOT), TRAJECTORY, config)
+
+
+def test_one_offset_value_applies_to_every_joint() -> None:
+    """q0_offset = 0.05 (a number) gives q(0) − q_d(0) = (0.05, 0.05) rad."""
+    result = run("pd", duration=0.01, q0_offset=0.05)  # type: ignore[arg-type]
+    np.testing.assert_allclose(result.e[0], (0.05, 0.05), rtol=0, atol=1e-15)
+
+
+# --- a law that misbehaves ----------------------------------------------------------------------
+
+
+class _Faulty(PDFeedforward, register=False):
+    """PD that fails in a chosen way from t = 0.25 s."""
+
+    mode = "raise"
+
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        out = super().compute(x, terms)
+        if x.t < 0.25:
+            return out
+        if self.mode == "raise":
+            raise ZeroDivisionError("the law divided by zero")
+        if self.mode == "nan":
+            return LawOutput(out.tau * np.nan)
+        return LawOutput(out.tau[:, :1])
+
+
+@pytest.mark.parametrize(
+    ("mode", "error", "text"),
+    [
+        (
+            "raise",
+            ControllerError,
+            "controller 'pd' failed at t = 0.25 s: ZeroDivisionError: the law divided by zero",
+        ),
+        ("shape", ControllerError, "LawOutput.tau must have shape (1, 2), got shape (1, 1)"),
+    ],
+)
+def test_a_misbehaving_law_is_named_with_the_simulated_time(mode: str, error: type, text: str) -> None:
+    """A law that raises, returns NaN or the wrong shape stops the run with ControllerError naming
+    the law and the time of the evaluation (the shape is checked at the first evaluation it changes:
+    the engine validates the first output, then trusts the shapes, so a later change surfaces as
+    numpy's broadcast error or a non-finite state — here the torque of shape (1, 1) broadcasts)."""
+    law = _Faulty(ROBOT, PDGains(kp=(350.0, 300.0), kd=(40.0, 50.0)))
+    law.mode = mode
+    if mode == "shape":  # wrong from the start: caught by the first-output check
+        law.compute = lambda x, terms: LawOutput(np.zeros((1, 1)))  # type: ignore[method-assign]
+        text = text.replace("0.25", "0")
+    with pytest.raises(error, match=re.escape(text)) as info:
+        simulate(law, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.5))
+    assert info.value.controller == "pd"
+
+
+def test_a_law_returning_nan_stops_the_run_naming_the_law_and_the_time() -> None:
+    """NaN torques from t = 0.25 s: the run stops at t = 0.25 s (the first sample whose state or
+    torque is not finite), naming the law; the message says the law's torque is the likely cause."""
+    law = _Faulty(ROBOT, PDGains(kp=(350.0, 300.0), kd=(40.0, 50.0)))
+    law.mode = "nan"
+    with pytest.raises((ControllerError, SimulationDivergedError)) as info:
+        simulate(law, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.5))
+    assert info.value.controller == "pd"  # type: ignore[union-attr]
+    assert info.value.time == pytest.approx(0.25, abs=1.5e-3)  # type: ignore[union-attr]
+    assert "torque" in str(info.value)
+
+
+def test_a_law_returning_a_bare_array_is_told_to_return_law_output() -> None:
+    """compute must return LawOutput; a bare ndarray is refused at the first evaluation, t = 0."""
+    law = PDFeedforward(ROBOT)
+    law.compute = lambda x, terms: np.zeros((1, 2))  # type: ignore[method-assign,assignment,return-value]
+    with pytest.raises(
+        ControllerError, match=re.escape("compute returned ndarray; return LawOutput(tau)")
+    ) as info:
+        simulate(law, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.1))
+    assert info.value.time == 0.0
 
 
 # --- the result -------------------------------------------------------------------------------
@@ -193,7 +283,7 @@ def test_result_arrays_have_the_documented_shapes(name: str) -> None:
     for attr in ("q", "v", "tau_command", "tau", "q_des", "v_des", "a_des", "e", "edot"):
         assert getattr(result, attr).shape == (n, 2), attr
     assert result.torque_limits.shape == (2,)
-    assert result.controller == name and result.reference_period == 4.0
+    assert result.controller == name and result.reference_period == 4.0 and result.robot == "twolink"
     if name == "pd":
         assert result.p_hat is None and result.p_true is None and result.p_error is None
         assert result.parameter_names == ()

@@ -1,6 +1,7 @@
-"""Tests of twolink_pin.sweep: reproducibility bit for bit, the summary against numpy on the
-written rows, divergent cases counted rather than fatal, each row being the run it
-describes, and the ``sweep`` command's parser and output.
+"""Tests of twolink_pin.studies.sweep: reproducibility bit for bit (whatever the chunks and
+threads; each run's case from its own seed), the summary against numpy on the written rows,
+divergent cases counted rather than fatal, each row being the run it describes, a user's law
+by file, a user's folder never overwritten, and the ``sweep`` command's parser and output.
 """
 
 from __future__ import annotations
@@ -14,22 +15,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from twolink_pin.batch import robot_with_parameters
-from twolink_pin.cli import build_parser, cmd_sweep
+from twolink_pin.cli import build_parser
+from twolink_pin.cli.commands import cmd_sweep
 from twolink_pin.controllers import PDFeedforward, PDGains, WrongModel
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import ControllerSpecError, InvalidParameterError, OutputError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
+from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
-from twolink_pin.sweep import (
-    PERCENTILES,
-    Cases,
-    GainRange,
-    SweepConfig,
-    _controller,
-    run_sweep,
-)
+from twolink_pin.studies.sweep import PERCENTILES, Cases, GainRange, SweepConfig, _chunk_law, run_sweep
 from twolink_pin.trajectory import build_trajectory
 
 ROBOT = load_robot()
@@ -63,6 +58,15 @@ def test_seeded_sweeps_are_reproducible_bit_for_bit_whatever_the_chunks_and_thre
         assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
     run_sweep(_study(seed=8), ROBOT, TRAJECTORY, tmp_path / "c", plot=False)
     assert (tmp_path / "a" / "runs.csv").read_bytes() != (tmp_path / "c" / "runs.csv").read_bytes()
+
+
+def test_a_runs_case_depends_only_on_the_seed_and_its_index(tmp_path: Path) -> None:
+    """The first 5 rows of a 12-run sweep equal a 5-run sweep's rows, byte for byte."""
+    run_sweep(_study(), ROBOT, TRAJECTORY, tmp_path / "a", plot=False)
+    run_sweep(_study(samples=5), ROBOT, TRAJECTORY, tmp_path / "b", plot=False)
+    a = (tmp_path / "a" / "runs.csv").read_text().splitlines()
+    b = (tmp_path / "b" / "runs.csv").read_text().splitlines()
+    assert a[:6] == b
 
 
 def test_summary_statistics_are_numpy_percentiles_of_the_rows(tmp_path: Path) -> None:
@@ -108,7 +112,7 @@ def test_a_row_is_the_run_it_describes(tmp_path: Path) -> None:
     factors = np.array([float(row[f"param_factor_{n}"]) for n in ("p1", "p2", "p3")])
     kp, kd2 = float(row["gain_kp"]), float(row["gain_kd2"])
     controller = PDFeedforward(
-        robot_with_parameters(ROBOT, ROBOT.p * factors), PDGains(kp=(kp, kp), kd=(40.0, kd2))
+        ROBOT, PDGains(kp=(kp, kp), kd=(40.0, kd2)), model_parameters=ROBOT.p * factors
     )
     q0 = (float(row["q0_offset1"]), float(row["q0_offset2"]))
     result = simulate(controller, Plant(ROBOT), TRAJECTORY, replace(SHORT, q0_offset=q0))
@@ -120,35 +124,77 @@ def test_a_row_is_the_run_it_describes(tmp_path: Path) -> None:
 
 
 def test_cases_are_drawn_in_the_documented_ranges() -> None:
-    cases = Cases(_study(samples=200), ROBOT)
+    cases = Cases(_study(samples=200), ROBOT, 0, 200)
     assert np.all(np.abs(cases.q0_offset - np.array([0.1, -0.1])) <= 0.1)
     assert np.all(np.abs(cases.param_factor - 1) <= 0.2)
     assert np.all((cases.gains["kp"] >= 100) & (cases.gains["kp"] <= 400))
 
 
 def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None:
+    """kp=LO:HI sets both joints' Kp per run; kd2 only the second Kd; model_scale is robust's β."""
     study = _study(param_error=0.0)
-    cases = Cases(study, ROBOT)
-    controller = _controller(study, ROBOT, cases, 0, None)
-    assert controller.gains.kp == (cases.gains["kp"][0],) * 2
-    assert controller.gains.kd == (40.0, cases.gains["kd2"][0])
+    cases = Cases(study, ROBOT, 0, 12)
+    law = _chunk_law(study, ROBOT, cases, make_scenario("pd", ROBOT).controller)
+    np.testing.assert_array_equal(
+        np.broadcast_to(law.gains.kp, (12, 2)), np.repeat(cases.gains["kp"][:, None], 2, axis=1)
+    )
+    np.testing.assert_array_equal(law.gains.kd[:, 0], 40.0)
+    np.testing.assert_array_equal(law.gains.kd[:, 1], cases.gains["kd2"])
     robust = replace(study, controller="robust", gains=(GainRange("model_scale", 0.2, 0.3),))
-    built = _controller(robust, ROBOT, Cases(robust, ROBOT), 0, None)
-    assert isinstance(built, WrongModel) and 0.2 <= built.model_scale <= 0.3
+    built = _chunk_law(robust, ROBOT, Cases(robust, ROBOT, 0, 12), make_scenario("robust", ROBOT).controller)
+    assert isinstance(built, WrongModel) and np.all(
+        (built.gains.model_scale >= 0.2) & (built.gains.model_scale <= 0.3)
+    )
+
+
+def test_a_users_law_from_a_file_sweeps_like_a_built_in_one(tmp_path: Path) -> None:
+    """The tutorial's sliding-mode law by path, with its own gains drawn (ks, phi): no divergence,
+    every row tracked to a small error."""
+    study = _study(
+        controller="examples/sliding_mode.py:SlidingMode",
+        gains=(GainRange("ks", 1.0, 5.0), GainRange("phi", 0.02, 0.1)),
+    )
+    output = run_sweep(
+        replace(study, simulation=SimulationConfig(duration=0.3)), ROBOT, TRAJECTORY, tmp_path, plot=False
+    )
+    assert output.summary["controller"] == "sliding-mode" and output.summary["diverged"] == 0
+    rows = _rows(tmp_path / "runs.csv")
+    assert [float(r["gain_ks"]) for r in rows] and all(1.0 <= float(r["gain_ks"]) <= 5.0 for r in rows)
+
+
+def test_a_users_folder_is_never_overwritten(tmp_path: Path) -> None:
+    """--out into a non-empty folder the sweep did not write: OutputError, the folder untouched."""
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(OutputError, match="refusing to overwrite"):
+        run_sweep(_study(samples=2), ROBOT, TRAJECTORY, tmp_path, plot=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+    run_sweep(_study(samples=2), ROBOT, TRAJECTORY, tmp_path / "s", plot=False)
+    run_sweep(_study(samples=3), ROBOT, TRAJECTORY, tmp_path / "s", plot=False)  # its own: replaced
+    assert len(_rows(tmp_path / "s" / "runs.csv")) == 3
 
 
 @pytest.mark.parametrize(
     ("changes", "text"),
     [
-        ({"gains": (GainRange("kq", 1.0, 2.0),)}, "gain = 'kq' is invalid: expected one of kp, kd"),
+        (
+            {"gains": (GainRange("kq", 1.0, 2.0),)},
+            "gain = 'kq' is invalid: expected one of the gains of 'pd': kp, kd",
+        ),
         ({"param_error": 1.0}, r"a fraction in \[0, 1\)"),
         ({"simulation": SimulationConfig(method="adaptive")}, "'rk4'"),
-        ({"controller": "lqr"}, "one of pd, computed-torque"),
+        ({"seed": -1}, "seed = -1 is invalid: expected a whole number >= 0"),
+        ({"samples": 10**9}, "samples = 1000000000 is invalid: expected a whole number from 1 to 10000000"),
+        ({"lam": 3.0}, "lambda = 3.0 is invalid"),
     ],
 )
 def test_bad_studies_are_refused_naming_the_value(changes: dict, text: str) -> None:  # type: ignore[type-arg]
     with pytest.raises(InvalidParameterError, match=text):
         _study(**changes)
+
+
+def test_an_unknown_law_is_refused_listing_the_registered_ones() -> None:
+    with pytest.raises(ControllerSpecError, match="registered laws are pd, computed-torque, robust"):
+        _study(controller="lqr")
 
 
 def test_gain_range_text_is_parsed_or_refused_with_an_example() -> None:
@@ -186,7 +232,7 @@ def test_sweep_command_prints_json_and_a_progress_bar(
     captured = capsys.readouterr()
     payload = json.loads(captured.out)
     assert payload["runs"] == 4 and payload["diverged"] == 0 and payload["gains"] == {"lam": [2.0, 8.0]}
-    assert "100.0%" in captured.err and "4/4 runs" in captured.err
+    assert "100%" in captured.err and "4/4" in captured.err  # the progress display, on stderr
     assert len(_rows(tmp_path / "runs.csv")) == 4
 
 
@@ -195,7 +241,7 @@ def test_sweep_command_text_summary(tmp_path: Path, capsys: pytest.CaptureFixtur
     args = _parser().parse_args([*argv, "--out", str(tmp_path), "--no-plot"])
     assert cmd_sweep(args) == 0
     out = capsys.readouterr().out
-    assert out.startswith("sweep adaptive: 3 runs in ")
+    assert out.startswith("sweep adaptive on twolink: 3 runs in ")
     assert "p_hat_final_p3" in out and f"wrote {tmp_path / 'summary.json'}" in out
 
 

@@ -16,7 +16,8 @@ from numpy.polynomial import polynomial as P
 from twolink_pin.errors import InvalidParameterError, UnreachableTargetError
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel, load_robot
-from twolink_pin.trajectory import REPORT_TIMES, REPORT_VIA_XY, JointTrajectory, ViaPoints, build_trajectory
+from twolink_pin.trajectory import JointTrajectory, ViaPoints, build_trajectory, default_via_points
+from twolink_pin.twolink.reference import REPORT_TIMES, REPORT_VIA_XY
 
 ROBOT: RobotModel = load_robot()
 TRAJ: JointTrajectory = build_trajectory(ROBOT)
@@ -37,9 +38,10 @@ def _ik_via_points() -> np.ndarray:
 
 
 def test_report_defaults() -> None:
-    """ViaPoints() is the report's set: (0.48, 0.1), (0.38, 0), (0.48, −0.1), (0.58, 0), back
+    """The twolink's default via points are the report's set: (0.48, 0.1), (0.38, 0), (0.48, −0.1), (0.58, 0), back
     to the start, at 0, 1, 2, 3, 4 s, branch 0, jerk-free ends; the period is 4 s."""
-    via = ViaPoints()
+    via = default_via_points(ROBOT)
+    assert via is not None
     assert via.xy == ((0.48, 0.1), (0.38, 0.0), (0.48, -0.1), (0.58, 0.0), (0.48, 0.1))
     assert via.times == REPORT_TIMES == (0.0, 1.0, 2.0, 3.0, 4.0)
     assert (via.branch, via.period, via.boundary_order) == (0, None, 3)
@@ -213,7 +215,7 @@ def test_invalid_via_points_raise_with_clear_messages(kwargs: dict, text: str) -
     """Non-increasing times, a time count that differs from the points, a bad branch or a
     period shorter than the via-point span raise InvalidParameterError with that text."""
     with pytest.raises(InvalidParameterError) as info:
-        ViaPoints(**kwargs)
+        ViaPoints(**{"xy": REPORT_VIA_XY, "times": REPORT_TIMES, **kwargs})
     assert str(info.value) == text
 
 
@@ -226,7 +228,7 @@ def test_unreachable_via_point_raises_when_building() -> None:
 
 def test_branch_1_uses_the_other_elbow() -> None:
     """With branch = 1 every via point is the q2 <= 0 IK solution (Table 1's second pair)."""
-    traj = build_trajectory(ROBOT, ViaPoints(branch=1))
+    traj = build_trajectory(ROBOT, ViaPoints(xy=REPORT_VIA_XY, times=REPORT_TIMES, branch=1))
     expected = np.array([inverse_kinematics(ROBOT, xy)[1] for xy in REPORT_VIA_XY])
     np.testing.assert_allclose(traj.via_q, expected, rtol=0, atol=0)
     assert np.all(traj.via_q[:, 1] <= 0)
@@ -235,7 +237,7 @@ def test_branch_1_uses_the_other_elbow() -> None:
 def test_longer_period_rests_at_the_last_via_point() -> None:
     """With period 5 s > span 4 s the arm rests at the last via point from 4 s to 5 s
     (q = last via point, v = a = jerk = 0), then repeats the motion."""
-    traj = build_trajectory(ROBOT, ViaPoints(period=5.0))
+    traj = build_trajectory(ROBOT, ViaPoints(xy=REPORT_VIA_XY, times=REPORT_TIMES, period=5.0))
     assert traj.period == 5.0
     rest = traj.sample(np.array([4.0, 4.25, 4.5, 4.999]))
     np.testing.assert_allclose(rest.q, np.tile(traj.via_q[-1], (4, 1)), rtol=0, atol=1e-9)

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from twolink_pin import InvalidParameterError, InvalidURDFError, load_robot, twolink_urdf_path
 from twolink_pin.model.payload import POINT_MASS_INERTIA, payload_urdf, write_payload_urdf
 from twolink_pin.twolink.closed_form import mass_matrix
+from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 
 @settings(max_examples=10, deadline=None)
@@ -17,7 +18,9 @@ from twolink_pin.twolink.closed_form import mass_matrix
 def test_written_payload_urdf_gives_the_same_p_as_load_robot(tmp_path_factory, mass: float) -> None:
     """Second method: the yourdfpy-edited file and Pinocchio's added inertia give equal p."""
     path = write_payload_urdf(twolink_urdf_path(), mass, tmp_path_factory.mktemp("v") / "pl.urdf")
-    from_file = load_robot(path)
+    from_file = load_robot(
+        path, parameter_map=TwoLinkLumpedMap
+    )  # a file outside the catalog: generic profile
     in_memory = load_robot(payload=mass)
     # The written point mass carries POINT_MASS_INERTIA about its centre (adds to p1, p2).
     np.testing.assert_allclose(from_file.p, in_memory.p, atol=3 * POINT_MASS_INERTIA)

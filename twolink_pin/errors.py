@@ -3,7 +3,11 @@
 Every error the package raises on bad input derives from :class:`TwolinkPinError`.
 Each subclass keeps the offending value(s) as attributes and its message says what was
 expected, so a caller can both show it and act on it. The CLI turns any of them into one
-line on stderr and exit status 2.
+line on stderr: exit status 2 for bad input, 1 for a run that failed
+(:class:`SimulationDivergedError`, :class:`ControllerError`).
+
+Every exception pickles with its attributes (``__reduce__``), so an error raised in a
+worker process (the report's pool, a Dask worker) arrives whole in the parent.
 """
 
 from __future__ import annotations
@@ -14,6 +18,13 @@ from typing import Any
 class TwolinkPinError(Exception):
     """Base class of every error twolink-pin raises on bad input or a failed run."""
 
+    _fields: tuple[str, ...] = ()
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        if not self._fields:
+            return super().__reduce__()
+        return (type(self), tuple(getattr(self, name) for name in self._fields))
+
 
 class InvalidURDFError(TwolinkPinError):
     """A robot description that cannot give a sound model.
@@ -23,6 +34,8 @@ class InvalidURDFError(TwolinkPinError):
         element: The offending element, e.g. ``link 'link2' <mass>``.
         reason: What is wrong and what was expected.
     """
+
+    _fields = ("path", "element", "reason")
 
     def __init__(self, path: str, element: str, reason: str) -> None:
         self.path = path
@@ -40,6 +53,8 @@ class InvalidParameterError(TwolinkPinError, ValueError):
         expected: A description of the valid values.
     """
 
+    _fields = ("name", "value", "expected")
+
     def __init__(self, name: str, value: Any, expected: str) -> None:
         self.name = name
         self.value = value
@@ -55,6 +70,8 @@ class UnreachableTargetError(TwolinkPinError, ValueError):
         r_min: Inner radius of the reachable annulus [m].
         r_max: Outer radius of the reachable annulus [m].
     """
+
+    _fields = ("target", "r_min", "r_max")
 
     def __init__(self, target: tuple[float, float], r_min: float, r_max: float) -> None:
         self.target = target
@@ -76,11 +93,48 @@ class SimulationDivergedError(TwolinkPinError):
         detail: What was detected.
     """
 
+    _fields = ("controller", "time", "detail")
+
     def __init__(self, controller: str, time: float, detail: str) -> None:
         self.controller = controller
         self.time = time
         self.detail = detail
         super().__init__(f"simulation with controller '{controller}' diverged at t = {time:.6g} s: {detail}")
+
+
+class ControllerError(TwolinkPinError):
+    """A control law that raised, or returned something other than it must, during a run.
+
+    Attributes:
+        controller: The law's name.
+        time: Simulated time [s] of the evaluation.
+        detail: What went wrong (the law's own exception, or the bad shape).
+    """
+
+    _fields = ("controller", "time", "detail")
+
+    def __init__(self, controller: str, time: float, detail: str) -> None:
+        self.controller = controller
+        self.time = time
+        self.detail = detail
+        super().__init__(f"controller '{controller}' failed at t = {time:.6g} s: {detail}")
+
+
+class ControllerSpecError(TwolinkPinError):
+    """A reference to a control law (``name``, ``file.py:Class``, ``module:Class``) that
+    does not lead to one.
+
+    Attributes:
+        spec: The reference as given.
+        reason: What is wrong and what was expected.
+    """
+
+    _fields = ("spec", "reason")
+
+    def __init__(self, spec: str, reason: str) -> None:
+        self.spec = spec
+        self.reason = reason
+        super().__init__(f"controller {spec!r}: {reason}")
 
 
 class OutputError(TwolinkPinError):
@@ -90,6 +144,8 @@ class OutputError(TwolinkPinError):
         path: The offending path.
         reason: Why it cannot be used.
     """
+
+    _fields = ("path", "reason")
 
     def __init__(self, path: str, reason: str) -> None:
         self.path = path

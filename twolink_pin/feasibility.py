@@ -36,13 +36,21 @@ class TorqueCheck(NamedTuple):
     """Whether every joint stays within its limit."""
 
     def verdict(self) -> str:
-        """One line: feasible or not, with the tightest joint's peak and limit."""
-        ratio = self.peak / self.limits
-        j = int(np.argmax(ratio))
+        """One line: feasible or not, with the tightest joint's peak and limit (a joint
+        without an effort limit in its model has limit inf: "no limit")."""
         state = "FEASIBLE" if self.within_limits else "NOT FEASIBLE"
+        limited = np.isfinite(self.limits)
+        if not limited.any():
+            j = int(np.argmax(self.peak))
+            return (
+                f"{state}: no joint has an effort limit in the model; the largest peak is "
+                f"|tau{j + 1}| = {self.peak[j]:.3g} N·m at t = {self.peak_time[j]:.3f} s"
+            )
+        ratio = np.where(limited, self.peak / np.where(limited, self.limits, 1.0), -1.0)
+        j = int(np.argmax(ratio))
         return (
-            f"{state}: peak |tau{j + 1}| = {self.peak[j]:.2f} N·m at t = {self.peak_time[j]:.3f} s "
-            f"is {100 * ratio[j]:.1f}% of its {self.limits[j]:.0f} N·m limit"
+            f"{state}: peak |tau{j + 1}| = {self.peak[j]:.3g} N·m at t = {self.peak_time[j]:.3f} s "
+            f"is {100 * ratio[j]:.1f}% of its {self.limits[j]:.4g} N·m limit"
         )
 
 

@@ -1,15 +1,27 @@
-"""Writing files safely: atomic writes and JSON.
+"""Writing files safely: the one writer every output goes through.
 
-Every file the toolkit writes goes through :func:`atomic_write`: the content goes to a
-temporary file in the target's directory, which then replaces the target in one
-``os.replace``, so an error midway never leaves a half-written file.
+* :func:`atomic_write` — a file: the content goes to a temporary file in the target's
+  directory, flushed to disk, which then replaces the target in one ``os.replace``. An
+  error midway never leaves a half-written file; an existing target is replaced only if it
+  is a regular file (never a device, a pipe or a directory).
+* :func:`output_directory` — a folder of outputs: built in a staging folder beside it and
+  moved into place only when complete. An existing folder is replaced only if it is empty
+  or was written by the same command (its marker file), so a user's folder is never
+  overwritten.
+* :func:`write_json` — JSON through :func:`atomic_write` (no NaN or inf: they are not JSON).
+
+Every OS failure (read-only folder, full disk, a file where a folder is expected) becomes
+an :class:`~twolink_pin.errors.OutputError` naming the path and the reason.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
+import shutil
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -18,21 +30,77 @@ from typing import IO, Any
 from twolink_pin.errors import OutputError
 
 
-@contextlib.contextmanager
-def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
-    """Open a temporary file beside ``path``; on success move it onto ``path``."""
+def _reason(exc: OSError) -> str:
+    return exc.strerror or type(exc).__name__
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _make_parent(target: Path) -> None:
+    parent = target.parent
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise OutputError(str(parent), "exists and is not a directory") from None
+    except OSError as exc:
+        raise OutputError(str(parent), f"cannot create the directory ({_reason(exc)})") from exc
+    if not parent.is_dir():
+        raise OutputError(str(parent), "exists and is not a directory")
+
+
+def check_replaceable(path: str | os.PathLike[str]) -> Path:
+    """``path`` (symbolic links followed) if a file may be written there: absent or a
+    regular file. Raises :class:`OutputError` for a directory, a device, a pipe, a socket."""
     target = Path(path)
     try:
-        target.parent.mkdir(parents=True, exist_ok=True)
+        info = os.stat(target)
+    except FileNotFoundError:
+        return target
+    except NotADirectoryError:
+        parent = next((p for p in target.parents if p.exists()), None)
+        raise OutputError(str(parent or target), "exists and is not a directory") from None
     except OSError as exc:
-        raise OutputError(str(target.parent), f"cannot create the directory ({exc.strerror})") from exc
-    if target.is_dir():
+        raise OutputError(str(target), f"cannot be examined ({_reason(exc)})") from exc
+    if stat.S_ISDIR(info.st_mode):
         raise OutputError(str(target), "is a directory; expected a file path")
-    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    if not stat.S_ISREG(info.st_mode):
+        raise OutputError(
+            str(target), "is not a regular file (a device, pipe or socket); refusing to replace it"
+        )
+    return Path(os.path.realpath(target))
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
+    """Open a temporary file beside ``path``; on success flush it and move it onto ``path``.
+
+    Raises:
+        OutputError: ``path`` is a directory or not a regular file, or the folder cannot be
+            created or written (read-only, full, a file in the way).
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+    target = check_replaceable(path)
+    _make_parent(target)
     try:
-        with os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8") as f:
-            yield f
-        os.replace(tmp, target)
+        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise OutputError(str(target), f"cannot write in {target.parent} ({_reason(exc)})") from exc
+    try:
+        try:
+            with os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8") as f:
+                yield f
+                f.flush()
+                os.fsync(f.fileno())
+            os.chmod(tmp, 0o666 & ~_umask())
+            check_replaceable(target)  # nothing else took the name meanwhile
+            os.replace(tmp, target)
+        except OSError as exc:
+            raise OutputError(str(target), f"cannot write the file ({_reason(exc)})") from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -41,7 +109,103 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
 
 def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
     """Write ``obj`` as indented JSON, atomically."""
+    text = json.dumps(obj, indent=2, allow_nan=False)
     with atomic_write(path) as f:
-        json.dump(obj, f, indent=2, allow_nan=False)
+        f.write(text)
         f.write("\n")
     return Path(path)
+
+
+def _is_ours(folder: Path, marker: str) -> bool:
+    try:
+        entries = list(folder.iterdir())
+    except OSError as exc:
+        raise OutputError(str(folder), f"cannot be listed ({_reason(exc)})") from exc
+    return not entries or (folder / marker).is_file()
+
+
+def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
+    """``path`` if an output folder may be written there: absent, empty, or holding
+    ``marker`` (written by the same command before). Raises :class:`OutputError` otherwise."""
+    out = Path(path)
+    if out.is_symlink() or (out.exists() and not out.is_dir()):
+        raise OutputError(str(out), "exists and is not a directory")
+    if out.exists() and not _is_ours(out, marker):
+        raise OutputError(
+            str(out),
+            f"is a non-empty directory this command did not write ({marker} missing); refusing to overwrite it "
+            "— give a new or empty directory",
+        )
+    return out
+
+
+@contextlib.contextmanager
+def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") -> Iterator[Path]:
+    """A staging folder that replaces ``path`` when the block succeeds.
+
+    The folder ``path`` must be absent, empty, or one this command wrote (holding
+    ``marker``). The block writes into the yielded staging folder (beside ``path``, hidden);
+    on success ``marker`` is written into it and it is swapped into place (the old folder
+    removed); on failure or interruption it is removed and ``path`` is left as it was.
+
+    Raises:
+        OutputError: ``path`` is someone else's folder, a file, or its parent cannot be
+            written.
+    """
+    out = check_output_directory(path, marker)
+    _make_parent(out)
+    try:
+        stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
+    except OSError as exc:
+        raise OutputError(str(out.parent), f"cannot create a folder there ({_reason(exc)})") from exc
+    try:
+        os.chmod(stage, 0o777 & ~_umask())
+        yield stage
+        (stage / marker).write_text(note or f"written by twolink-pin ({marker})\n", encoding="utf-8")
+        check_output_directory(out, marker)  # still ours after the work
+        old = None
+        if out.exists():
+            old = out.parent / f".{out.name}.old-{os.getpid()}"
+            os.replace(out, old)
+        os.replace(stage, out)
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+    except OSError as exc:
+        shutil.rmtree(stage, ignore_errors=True)
+        code = errno.errorcode.get(exc.errno or 0, "")
+        raise OutputError(
+            str(out), f"cannot write the outputs ({_reason(exc)}{', ' + code if code else ''})"
+        ) from exc
+    except BaseException:
+        shutil.rmtree(stage, ignore_errors=True)
+        raise
+
+
+def check_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> Path:
+    """``path`` if it is a regular file of at most ``max_bytes`` that this process can read.
+
+    Reading a FIFO, a device (``/dev/zero``) or a directory would block, never end, or fail
+    obscurely: they are refused before any read.
+
+    Raises:
+        OutputError: missing, not a regular file, unreadable, or larger than ``max_bytes``
+            (the message names the bound).
+    """
+    file = Path(path)
+    try:
+        info = os.stat(file)
+    except FileNotFoundError:
+        raise OutputError(str(file), f"no such file (expected {what})") from None
+    except OSError as exc:
+        raise OutputError(str(file), f"cannot be examined ({_reason(exc)})") from exc
+    if stat.S_ISDIR(info.st_mode):
+        raise OutputError(str(file), f"is a directory (expected {what})")
+    if not stat.S_ISREG(info.st_mode):
+        raise OutputError(str(file), f"is not a regular file (a device, pipe or socket; expected {what})")
+    if info.st_size > max_bytes:
+        raise OutputError(
+            str(file), f"is {info.st_size} bytes, more than the {max_bytes} bytes accepted for {what}"
+        )
+    if not os.access(file, os.R_OK):
+        raise OutputError(str(file), "cannot be read (permission denied)")
+    return file

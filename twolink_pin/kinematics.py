@@ -1,7 +1,12 @@
-"""End-effector kinematics: forward kinematics and Jacobian from Pinocchio frames, and the
-analytic inverse kinematics of a planar 2R arm (both elbow branches).
+"""Kinematics from Pinocchio frames, and the analytic inverse kinematics of a planar 2R arm.
 
-Angles [rad], positions [m]. The plane is the base frame's x-y plane.
+* :func:`forward_kinematics` / :func:`jacobian`: the end effector's planar ``(x, y)`` [m]
+  and ``∂(x, y)/∂q`` (the base frame's x-y plane);
+* :func:`joint_positions`: every joint origin and the end effector in 3-D, for many
+  configurations (what figures and the 3-D view draw);
+* :func:`inverse_kinematics` / :func:`workspace`: both elbow branches of a planar 2R arm.
+
+Angles [rad], positions [m].
 """
 
 from __future__ import annotations
@@ -39,6 +44,34 @@ def jacobian(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> 
     data = data if data is not None else robot.create_data()
     J = pin.computeFrameJacobian(robot.model, data, q, robot.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
     return J[:2, :].copy()
+
+
+def joint_positions(robot: RobotModel, q: np.ndarray) -> np.ndarray:
+    """Origins of every joint and of the end-effector frame [m] at each configuration.
+
+    Args:
+        q: Configurations [rad], shape (F, nq) (or (nq,) for one).
+
+    Returns:
+        Shape (F, njoints, 3): the ``njoints − 1`` moving joints in order, then the end
+        effector (shape (njoints, 3) for a single configuration).
+    """
+    configurations = np.asarray(q, dtype=float)
+    single = configurations.ndim == 1
+    configurations = np.atleast_2d(configurations)
+    if configurations.shape[1] != robot.nq or not np.all(np.isfinite(configurations)):
+        raise InvalidParameterError(
+            "q", f"array of shape {configurations.shape}", f"finite configurations of shape (F, {robot.nq})"
+        )
+    data = robot.create_data()
+    model = robot.model
+    out = np.empty((len(configurations), model.njoints, 3))
+    for k, qk in enumerate(configurations):
+        pin.framesForwardKinematics(model, data, qk)
+        for j in range(1, model.njoints):
+            out[k, j - 1] = data.oMi[j].translation
+        out[k, -1] = data.oMf[robot.ee_frame_id].translation
+    return out[0] if single else out
 
 
 class Workspace(NamedTuple):

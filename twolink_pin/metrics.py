@@ -1,28 +1,35 @@
-"""Tracking metrics of a run: the norms behind our Table 2.
+"""Tracking metrics of runs: the norms behind our Table 2, accumulated block by block.
 
 The report's Table 2 gives "norms" of errors and torques without saying which. We define
 three, each per joint over the whole run ``[0, T]`` with the trapezoidal rule on the
-output grid:
+uniform output grid (spacing ``dt``):
 
 * RMS: ``sqrt((1/T) ∫ x² dt)`` — same unit as ``x``;
-* L2: ``sqrt(∫ x² dt)`` — unit of ``x`` times √s;
+* L2: ``sqrt(∫ x² dt) = sqrt(dt (Σ x_k² − ½ (x_0² + x_K²)))`` — unit of ``x`` times √s;
 * max: ``max |x|``;
 
 for ``x`` in ``e`` [rad], ``ė`` [rad/s], ``τ`` [N·m] (the torque applied to the arm),
-plus ``max |e|`` over the last reference period (the steady-state tracking error).
+plus ``max |e|`` over the last reference period (the steady-state tracking error), the peak
+commanded torque and the first time it exceeded each joint's limit.
+
+One implementation: :class:`RunningMetrics` takes samples block by block (the engine hands
+it each block of N runs, so a batch's memory stays O(N)); :func:`compute_metrics` feeds it
+a recorded run in one block.
 """
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from twolink_pin.simulation import SimulationResult
+if TYPE_CHECKING:
+    from twolink_pin.simulation import Samples, SimulationResult
 
 
 class Norms(NamedTuple):
-    """One norm of each signal, per joint, shape (nv,) each."""
+    """One norm of each signal, per joint: shape (nv,) for a run, (N, nv) for a batch."""
 
     e: np.ndarray
     """Of the position error [rad] (L2: [rad·√s])."""
@@ -33,7 +40,7 @@ class Norms(NamedTuple):
 
 
 class Metrics(NamedTuple):
-    """Norms of one run (see module docstring)."""
+    """Norms of one run (see module docstring); arrays of shape (nv,)."""
 
     rms: Norms
     """Root mean square over the run."""
@@ -54,17 +61,135 @@ class Metrics(NamedTuple):
         return out
 
 
-def _l2(t: np.ndarray, x: np.ndarray) -> np.ndarray:
-    return np.sqrt(np.trapezoid(x * x, t, axis=0))
+class BatchMetrics(NamedTuple):
+    """Each run's metrics; arrays of shape (N, nv). Rows of diverged runs are NaN."""
+
+    rms: Norms
+    """Root mean square of ``e`` [rad], ``ė`` [rad/s], applied ``τ`` [N·m]."""
+    l2: Norms
+    """``sqrt(∫ x² dt)`` of the same signals."""
+    max: Norms
+    """``max |x|`` of the same signals."""
+    final_period_max_abs_e: np.ndarray
+    """``max |e|`` over the last reference period [rad]."""
+    peak_command: np.ndarray
+    """``max |τ_command|`` [N·m] (before saturation)."""
+    first_exceeded_at: np.ndarray
+    """First time [s] ``|τ_command|`` exceeded the joint's limit; NaN if never."""
+
+    def run(self, i: int) -> Metrics:
+        """Run ``i``'s metrics as a :class:`Metrics`."""
+
+        def pick(n: Norms) -> Norms:
+            return Norms(n.e[i], n.edot[i], n.tau[i])
+
+        return Metrics(pick(self.rms), pick(self.l2), pick(self.max), self.final_period_max_abs_e[i])
+
+
+_SIGNALS = Norms._fields
+
+
+class RunningMetrics:
+    """Running sums and maxima of N runs' signals, fed block by block (an engine observer).
+
+    Args:
+        runs: N.
+        nv: Joints.
+        dt: Output grid spacing [s].
+        samples: Total number of samples K (sample K − 1 ends the run).
+        period: Reference period [s] (the "last period" window).
+        limits: Torque limits [N·m], shape (nv,).
+        applied: Maps commanded to applied torque (the plant's saturation).
+    """
+
+    def __init__(
+        self,
+        runs: int,
+        nv: int,
+        dt: float,
+        samples: int,
+        period: float,
+        limits: np.ndarray,
+        applied: Callable[[np.ndarray], np.ndarray] | None = None,
+    ) -> None:
+        self.dt, self.samples = dt, samples
+        self.duration = (samples - 1) * dt
+        self.last_start = self.duration - period - 1e-12
+        self.limits = np.asarray(limits, dtype=float)
+        self.applied = applied if applied is not None else (lambda tau: tau)
+        self.square = {name: np.zeros((runs, nv)) for name in _SIGNALS}
+        self.ends = {name: np.zeros((runs, nv)) for name in _SIGNALS}
+        self.peak = {name: np.zeros((runs, nv)) for name in _SIGNALS}
+        self.final_e = np.zeros((runs, nv))
+        self.peak_command = np.zeros((runs, nv))
+        self.first_exceeded = np.full((runs, nv), np.nan)
+
+    def add(self, samples: Samples) -> None:
+        """Add a block of samples (arrays (B, N, nv))."""
+        e = samples.q - samples.q_des
+        signals = {"e": e, "edot": samples.v - samples.v_des, "tau": self.applied(samples.tau_command)}
+        stop = samples.start + len(samples.t)
+        for name, x in signals.items():
+            x2 = x * x
+            self.square[name] += x2.sum(axis=0)
+            if samples.start == 0:
+                self.ends[name] += x2[0]
+            if stop == self.samples:
+                self.ends[name] += x2[-1]
+            np.maximum(self.peak[name], np.abs(x).max(axis=0), out=self.peak[name])
+        late = samples.t >= self.last_start
+        if late.any():
+            np.maximum(self.final_e, np.abs(e[late]).max(axis=0), out=self.final_e)
+        magnitude = np.abs(samples.tau_command)
+        np.maximum(self.peak_command, magnitude.max(axis=0), out=self.peak_command)
+        over = magnitude > self.limits
+        newly = over.any(axis=0) & np.isnan(self.first_exceeded)
+        if newly.any():
+            first = np.argmax(over, axis=0)
+            self.first_exceeded[newly] = samples.t[first[newly]]
+
+    def result(self, dead: np.ndarray | None = None) -> BatchMetrics:
+        """The metrics so far; rows of ``dead`` runs (mask, shape (N,)) are NaN."""
+        l2 = Norms(*(np.sqrt(self.dt * (self.square[k] - 0.5 * self.ends[k])) for k in _SIGNALS))
+        rms = Norms(*(x / np.sqrt(self.duration) for x in l2))
+        mx = Norms(*(self.peak[k] for k in _SIGNALS))
+
+        def clean(x: np.ndarray) -> np.ndarray:
+            x = np.array(x, dtype=float)
+            if dead is not None:
+                x[dead] = np.nan
+            x.setflags(write=False)
+            return x
+
+        return BatchMetrics(
+            Norms(*(clean(x) for x in rms)),
+            Norms(*(clean(x) for x in l2)),
+            Norms(*(clean(x) for x in mx)),
+            clean(self.final_e),
+            clean(self.peak_command),
+            clean(self.first_exceeded),
+        )
 
 
 def compute_metrics(result: SimulationResult) -> Metrics:
     """RMS, L2 and max of ``e``, ``ė``, ``τ`` and the last-period max ``|e|`` of ``result``."""
-    t = result.t
-    signals = {"e": result.e, "edot": result.edot, "tau": result.tau}
-    duration = t[-1] - t[0]
-    l2 = Norms(**{k: _l2(t, x) for k, x in signals.items()})
-    rms = Norms(**{k: x / np.sqrt(duration) for k, x in l2._asdict().items()})
-    mx = Norms(**{k: np.abs(x).max(axis=0) for k, x in signals.items()})
-    last = t >= t[-1] - result.reference_period - 1e-12
-    return Metrics(rms, l2, mx, np.abs(result.e[last]).max(axis=0))
+    from twolink_pin.simulation import Samples
+
+    nv = result.q.shape[1]
+    running = RunningMetrics(1, nv, result.dt, len(result.t), result.reference_period, result.torque_limits)
+    column = lambda x: x[:, None, :]  # noqa: E731  # (K, nv) -> (K, 1, nv)
+    zeros = np.zeros((len(result.t), 1, 0))
+    running.add(
+        Samples(
+            0,
+            result.t,
+            column(result.q),
+            column(result.v),
+            zeros,
+            column(result.tau),
+            column(result.q_des),
+            column(result.v_des),
+            column(result.a_des),
+        )
+    )
+    return running.result().run(0)

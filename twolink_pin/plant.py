@@ -3,7 +3,9 @@
 ``q̈ = ABA(q, q̇, sat(τ) − f(q̇))`` where ``f`` is the optional joint friction
 (:class:`twolink_pin.dynamics.Friction`; Pinocchio ignores URDF friction) and ``sat``
 clips to the URDF torque limits when ``saturate`` is on (off by default, as in the report).
-The plant owns its own ``pin.Data``, separate from the controller's.
+:meth:`Plant.applied_torque` and :meth:`Plant.motor_torque` work on one state ``(nv,)`` or
+on N runs ``(N, nv)``; the engine evaluates ABA itself for all runs at once
+(:mod:`twolink_pin.simulation.forward`).
 """
 
 from __future__ import annotations
@@ -17,33 +19,46 @@ from twolink_pin.model import RobotModel
 
 
 class Plant:
-    """Forward dynamics of ``robot`` with optional friction and torque saturation."""
+    """Forward dynamics of ``robot`` with optional friction and torque saturation.
+
+    Args:
+        robot: The arm.
+        friction: Joint friction; None for none.
+        saturate: Clip commanded torques at the URDF effort limits (joints without a
+            limit are never clipped).
+    """
 
     def __init__(self, robot: RobotModel, friction: Friction | None = None, saturate: bool = False) -> None:
         if friction is not None and len(friction.viscous) != robot.nv:
             raise InvalidParameterError(
                 "friction", friction, f"viscous and coulomb of length nv = {robot.nv}"
             )
+        if not isinstance(saturate, bool):
+            raise InvalidParameterError("saturate", saturate, "True or False")
         self.robot = robot
         self.model = robot.model
-        self.data = robot.create_data()
         self.friction = friction
-        self.saturate = bool(saturate)
+        self.saturate = saturate
         self.limits = np.array(robot.torque_limits, dtype=float)
+        self.limits.setflags(write=False)
 
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
         """Motor torque actually applied [N·m]: ``tau`` clipped to the limits if saturating."""
         return np.clip(tau, -self.limits, self.limits) if self.saturate else tau
 
+    def motor_torque(self, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """What drives the rigid bodies [N·m]: ``sat(τ) − f(q̇)``."""
+        u = self.applied_torque(tau)
+        return u if self.friction is None else u - self.friction.torque(v)
+
     def acceleration(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """Joint acceleration [rad/s²] under commanded torque ``tau`` [N·m]."""
-        tau = self.applied_torque(tau)
-        if self.friction is not None:
-            tau = tau - self.friction.torque(v)
-        return pin.aba(self.model, self.data, q, v, tau, ABA_CONVENTION)
+        """Joint acceleration [rad/s²] of one state under commanded torque ``tau`` [N·m]."""
+        data = self.model.createData()
+        return pin.aba(self.model, data, q, v, self.motor_torque(v, tau), ABA_CONVENTION).copy()
 
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
-        """Mechanical energy ``½ q̇ᵀ M q̇ + U(q)`` [J]."""
-        return float(pin.computeKineticEnergy(self.model, self.data, q, v)) + float(
-            pin.computePotentialEnergy(self.model, self.data, q)
+        """Mechanical energy ``½ q̇ᵀ M q̇ + U(q)`` [J] of one state."""
+        data = self.model.createData()
+        return float(pin.computeKineticEnergy(self.model, data, q, v)) + float(
+            pin.computePotentialEnergy(self.model, data, q)
         )

@@ -27,11 +27,6 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
 
-REPORT_VIA_XY = ((0.48, 0.1), (0.38, 0.0), (0.48, -0.1), (0.58, 0.0), (0.48, 0.1))
-"""The report's end-effector via points [m] (its text misprints the third as (0.48, 0.1))."""
-REPORT_TIMES = (0.0, 1.0, 2.0, 3.0, 4.0)
-"""The report's via-point times [s]."""
-
 
 @dataclass(frozen=True)
 class ViaPoints:
@@ -46,8 +41,8 @@ class ViaPoints:
         boundary_order: Highest derivative set to zero at both ends (3: up to jerk).
     """
 
-    xy: tuple[tuple[float, float], ...] = REPORT_VIA_XY
-    times: tuple[float, ...] = REPORT_TIMES
+    xy: tuple[tuple[float, float], ...]
+    times: tuple[float, ...]
     branch: int = 0
     period: float | None = None
     boundary_order: int = 3
@@ -181,11 +176,57 @@ class JointTrajectory:
 
 
 def build_trajectory(robot: RobotModel, via: ViaPoints | None = None) -> JointTrajectory:
-    """Trajectory of a planar 2R arm through end-effector via points (IK branch ``via.branch``).
+    """Trajectory through end-effector via points of a planar 2R arm (IK branch
+    ``via.branch``); default: the robot's own trajectory (:func:`default_via_points`).
 
     Raises:
         UnreachableTargetError: a via point is outside the reachable annulus.
+        InvalidParameterError: no via points given and the robot's profile has none.
     """
-    via = via if via is not None else ViaPoints()
+    if via is None:
+        return default_trajectory(robot)
     via_q = np.array([inverse_kinematics(robot, xy)[via.branch] for xy in via.xy])
     return JointTrajectory.from_via_q(via.times, via_q, via.period, via.boundary_order)
+
+
+def default_via_points(robot: RobotModel) -> ViaPoints | None:
+    """The robot profile's end-effector via points as :class:`ViaPoints` (planar), or None."""
+    spec = robot.profile.trajectory
+    if spec is None or spec.cartesian_points is None:
+        return None
+    xy = tuple((float(p[0]), float(p[1])) for p in spec.cartesian_points)
+    return ViaPoints(xy=xy, times=tuple(spec.times), branch=spec.branch, period=spec.period)
+
+
+def default_trajectory(robot: RobotModel) -> JointTrajectory:
+    """The robot's default reference: its profile's via points (joint or end-effector), else
+    a periodic motion through the middle of each joint's range (see :func:`neutral_motion`)."""
+    spec = robot.profile.trajectory
+    if spec is None:
+        return neutral_motion(robot)
+    if spec.joint_points is not None:
+        return JointTrajectory.from_via_q(spec.times, np.array(spec.joint_points, dtype=float), spec.period)
+    via = default_via_points(robot)
+    assert via is not None
+    return build_trajectory(robot, via)
+
+
+NEUTRAL_AMPLITUDE = 0.4
+"""Largest excursion [rad] of :func:`neutral_motion` from the middle of a joint's range."""
+
+
+def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
+    """A periodic reference for any arm: each joint leaves the middle of its range
+    (0 rad for an unlimited joint), swings ``±a_j`` and comes back, with
+    ``a_j = min(NEUTRAL_AMPLITUDE, 25 % of the range)``, the joints out of phase.
+    """
+    model = robot.model
+    lower, upper = np.array(model.lowerPositionLimit), np.array(model.upperPositionLimit)
+    finite = np.isfinite(lower) & np.isfinite(upper) & (upper > lower) & (upper - lower < 1e3)
+    middle = np.where(finite, 0.5 * (lower + upper), 0.0)
+    amplitude = np.where(finite, np.minimum(NEUTRAL_AMPLITUDE, 0.25 * (upper - lower)), NEUTRAL_AMPLITUDE)
+    signs = np.where(np.arange(robot.nv) % 2 == 0, 1.0, -1.0)
+    times = tuple(period * k / 4 for k in range(5))
+    shape = np.array([0.0, 1.0, 0.0, -1.0, 0.0])
+    via_q = middle + np.outer(shape, signs * amplitude)
+    return JointTrajectory.from_via_q(times, via_q)

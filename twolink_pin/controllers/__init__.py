@@ -1,29 +1,30 @@
-"""Tracking controllers: one law per module, registered by name.
+"""Tracking controllers: one law per file, registered by name when its class is defined.
 
-=====================  =====================================================
-name                   law
-=====================  =====================================================
-``pd``                 :class:`PDFeedforward` (report eq. 8)
-``computed-torque``    :class:`ComputedTorque` (Slotine–Li)
-``robust``             :class:`WrongModel` (Slotine–Li on 0.5 × the model)
-``adaptive``           :class:`Adaptive` (Slotine–Li adaptive)
-``adaptive-friction``  :class:`AdaptiveFriction` (with friction estimates)
-=====================  =====================================================
+=====================  ============================================================
+``base.py``            :class:`Controller` (the contract), ``LawInput``/``LawOutput``,
+                       the ``Terms`` protocol, the registry :data:`CONTROLLERS`
+``gains.py``           :class:`Gains` and :func:`gain`: validated gains with units
+``loading.py``         :func:`load_controller`: a name, ``file.py:Class``, ``module:Class``
+``pd.py``              ``pd`` — :class:`PDFeedforward` (report eq. 8)
+``computed_torque.py`` ``computed-torque`` — :class:`ComputedTorque` (Slotine–Li)
+``wrong_model.py``     ``robust`` — :class:`WrongModel` (Slotine–Li on β × the model)
+``adaptive.py``        ``adaptive`` — :class:`Adaptive` (Slotine–Li adaptive)
+``adaptive_friction``  ``adaptive-friction`` — :class:`AdaptiveFriction` (+ friction)
+=====================  ============================================================
 """
+
+# ruff: noqa: I001  # the laws register in import order: the report's order, kept by hand
 
 from __future__ import annotations
 
+from twolink_pin.controllers.base import CONTROLLERS, Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.pd import PDFeedforward, PDGains
+from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
+from twolink_pin.controllers.wrong_model import WrongModel, WrongModelGains
 from twolink_pin.controllers.adaptive import Adaptive, AdaptiveGains
 from twolink_pin.controllers.adaptive_friction import AdaptiveFriction, AdaptiveFrictionGains
-from twolink_pin.controllers.base import Controller
-from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
-from twolink_pin.controllers.pd import PDFeedforward, PDGains
-from twolink_pin.controllers.wrong_model import WrongModel
-
-CONTROLLERS: dict[str, type[Controller]] = {
-    cls.name: cls for cls in (PDFeedforward, ComputedTorque, WrongModel, Adaptive, AdaptiveFriction)
-}
-"""Controller classes by registry name, in the report's order."""
+from twolink_pin.controllers.loading import available_controllers, load_controller
 
 __all__ = [
     "CONTROLLERS",
@@ -34,8 +35,16 @@ __all__ = [
     "AdaptiveGains",
     "ComputedTorque",
     "Controller",
+    "Gains",
+    "LawInput",
+    "LawOutput",
     "PDFeedforward",
     "PDGains",
     "SlotineLiGains",
+    "Terms",
     "WrongModel",
+    "WrongModelGains",
+    "available_controllers",
+    "gain",
+    "load_controller",
 ]

@@ -1,10 +1,24 @@
-"""The controller interface: a small object with a stated law.
+"""The control-law contract: one class, one file, one method on batch-first arrays.
 
-A controller maps time, state and the reference sample to joint torques. Its internal
-state (parameter estimates of an adaptive law) is an explicit vector ``z`` that the
-simulator integrates beside the plant's, so a run is reproducible and resettable:
-:meth:`Controller.initial_state` gives ``z(0)`` and :meth:`Controller.compute` returns
-``(τ, ż)``. Stateless laws use an empty ``z``.
+A law subclasses :class:`Controller`, states its law in the class docstring, declares
+
+* ``name`` — the registry name (``twolink-pin simulate NAME``); defining the class
+  registers it in :data:`CONTROLLERS`;
+* ``title`` — a short display title;
+* ``Gains`` — its gains class (:mod:`twolink_pin.controllers.gains`: defaults and units);
+* ``estimates`` — which parameters its internal state ``z`` estimates, in order:
+  ``"inertial"`` (the robot's parameter map ``p``) and/or ``"friction"`` (viscous then
+  Coulomb coefficient per joint); empty for a law without state;
+
+and implements **one** method, :meth:`Controller.compute`, that maps a :class:`LawInput`
+(time, state, reference) to a :class:`LawOutput` (torque τ and, for a law with state, ż).
+Every array has a leading run axis: ``q`` is ``(N, nv)`` for N runs advanced together
+(N = 1 for a single run); the reference sample is ``(1, nv)`` (the same for every run).
+Write the law with numpy broadcasting and it never needs to know N.
+
+The Pinocchio quantities a law needs are asked of the :class:`Terms` object the engine
+passes in — it evaluates them for all N runs at once (one ``pin.rnea`` for a single run,
+``rneaInParallel`` over a ``ModelPool`` for a batch). A law never calls Pinocchio itself.
 
 Notation (report): ``e = q − q_d``, ``ė = q̇ − q̇_d``, ``s = ė + λ e``,
 ``q̇_r = q̇_d − λ e``, ``q̈_r = q̈_d − λ ė``.
@@ -13,230 +27,290 @@ Notation (report): ``e = q − q_d``, ``ė = q̇ − q̇_d``, ``s = ė + λ e``,
 from __future__ import annotations
 
 import abc
-import math
-import struct
-from collections.abc import Callable, Mapping, Sequence
-from typing import Any, ClassVar, NamedTuple
+import dataclasses
+from typing import Any, ClassVar, NamedTuple, Protocol
 
 import numpy as np
-import pinocchio as pin
 
-from twolink_pin.dynamics import Friction, polarisation_pair
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.controllers.gains import Gains, _spec, check_width, runs_of
+from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 
-EMPTY = np.zeros(0)
-EMPTY.setflags(write=False)
+ESTIMATES = ("inertial", "friction")
+"""Kinds of parameters a law may estimate, in the order they appear in ``z``."""
+FRICTION_UNITS = {"viscous": "N·m·s/rad", "coulomb": "N·m"}
+"""Units of the friction coefficients."""
 
 
-class StageKernel(NamedTuple):
-    """A law written out as Python statements on floats, for the fast RK4 loop (internal).
+class LawInput(NamedTuple):
+    """What a law sees at one evaluation, for N runs (arrays batch-first)."""
 
-    :mod:`twolink_pin.simulation` inlines ``lines`` wherever the law is evaluated. Before
-    they run, these floats are bound: ``q{j}``, ``v{j}`` (state, j = 0..nv−1), ``z{i}``
-    (controller state), ``qd{j}``, ``vd{j}``, ``ad{j}`` (reference sample). The lines must
-    bind the floats ``tau{j}`` [N·m] and ``dz{i}``, and name every temporary ``c_...``.
-    Each entry of ``namespace`` (keys ``c_...``: models, Data, buffers, functions) becomes
-    a local.
-    The result must equal :meth:`Controller.compute` to rounding (tested).
+    t: float
+    """Simulated time [s] (the same for every run)."""
+    q: np.ndarray
+    """Joint positions [rad], shape (N, nv)."""
+    v: np.ndarray
+    """Joint velocities [rad/s], shape (N, nv)."""
+    z: np.ndarray
+    """The law's internal state (e.g. parameter estimates), shape (N, nz); nz may be 0."""
+    q_des: np.ndarray
+    """Reference position [rad], shape (1, nv)."""
+    v_des: np.ndarray
+    """Reference velocity [rad/s], shape (1, nv)."""
+    a_des: np.ndarray
+    """Reference acceleration [rad/s²], shape (1, nv)."""
+
+
+class LawOutput(NamedTuple):
+    """What a law returns: the torque and, for a law with state, the state's derivative."""
+
+    tau: np.ndarray
+    """Commanded joint torque [N·m], shape (N, nv)."""
+    dz: np.ndarray | None = None
+    """``ż``, shape (N, nz); ``None`` for a law without state."""
+
+
+class Terms(Protocol):
+    """The Pinocchio quantities a law may ask for, evaluated by the engine for all N runs.
+
+    Arguments broadcast: each is ``(N, nv)`` or ``(1, nv)``. Implementations live in
+    :mod:`twolink_pin.simulation.terms` (:func:`~twolink_pin.simulation.terms.terms_for`
+    builds the one the engine would use, e.g. to test a law by itself).
     """
 
-    lines: tuple[str, ...]
-    """Statements, one per entry, no indentation."""
-    namespace: Mapping[str, Any]
-    """Objects the statements use, by name."""
+    def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``M̂(q) a + Ĉ(q, v) w + ĝ(q)`` [N·m], shape (N, nv), on the controller's model
+        (its robot, or its ``model_parameters``); ``C`` is the Christoffel form."""
+        ...
+
+    def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``Y`` with ``Y p = M(q) a + C(q, v) w + g(q)`` for the robot's parameter map
+        (whatever the inertias), shape (N, nv, n_p)."""
+        ...
+
+    def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
+        """``[diag(q̇), diag(sgn q̇)]`` per run, shape (N, nv, 2 nv): ``f(q̇) = Y_f (V, C)``;
+        ``tanh(q̇/smoothing)`` for the sign when ``smoothing > 0`` [rad/s]."""
+        ...
 
 
-def data_view(array: np.ndarray) -> memoryview:
-    """A flat ``memoryview`` on a ``pin.Data`` member (``data.tau``, ``data.ddq``, ...).
-
-    Pinocchio's Python functions return a fresh copy of their result, but the member they
-    also write (e.g. ``data.tau`` for RNEA) is exposed as a live view of the Data's memory.
-    Reading two floats through a memoryview costs ~60 ns, against ~300 ns for converting
-    the returned array, which matters when the call itself is ~1 µs. Element ``(i, j)`` of
-    a matrix member is at ``j * rows + i`` (column-major).
-    """
-    flat = array.T.reshape(-1) if array.ndim == 2 else array.reshape(-1)
-    if not np.shares_memory(flat, array):  # pragma: no cover  # a copy would go stale
-        raise AssertionError("expected a view of the Data member, got a copy")
-    return memoryview(flat)  # type: ignore[arg-type]  # numpy's stubs lack __buffer__ before 3.12
+CONTROLLERS: dict[str, type[Controller]] = {}
+"""Every registered law by name: the built-in ones, then those defined later (a user's
+file, a package's entry point ``twolink_pin.controllers``), in definition order."""
 
 
-def pair_namespace(model: pin.Model) -> tuple[pin.Data, dict[str, Any]]:
-    """The :func:`~twolink_pin.dynamics.polarisation_pair` of ``model``, its Data and inputs.
-
-    Returns the pair's Data and a kernel namespace with ``c_pair``, ``c_pdata`` and the input
-    buffers ``c_Q``, ``c_V``, ``c_A``: consecutive slices of one buffer of ``6 nv`` floats,
-    so one kernel line ``c_pack(c_in, 0, q.., q.., u⁺.., u⁻.., a..)`` (``struct.pack_into``
-    on a memoryview, ~20 ns a float against ~50 ns for a numpy item assignment) writes
-    ``Q = (q, q)``, ``V = (u⁺, u⁻)`` and copy A's half of ``A``; copy B's half stays zero.
-    """
-    pair = polarisation_pair(model)
-    data = pair.createData()
-    nv = model.nv
-    buffer = np.zeros(6 * nv)
-    view = memoryview(buffer)  # type: ignore[arg-type]  # numpy's stubs lack __buffer__ before 3.12
-    namespace = {
-        "c_in": view,
-        "c_pack": struct.Struct(f"{5 * nv}d").pack_into,
-        "c_pair": pair,
-        "c_pdata": data,
-        "c_Q": buffer[: 2 * nv],
-        "c_V": buffer[2 * nv : 4 * nv],
-        "c_A": buffer[4 * nv :],
-    }
-    return data, namespace
-
-
-def pair_values(nv: int, a: Sequence[str]) -> str:
-    """The arguments of the ``c_pack`` line of :func:`pair_namespace`: ``(q, q, u⁺, u⁻, a)``.
-
-    ``u^± = (v ± w)/2``; expects statements binding ``c_w{j}`` (``w``) to have run.
-    """
-    values = (
-        [f"q{j}" for j in range(nv)] * 2
-        + [f"0.5 * (v{j} + c_w{j})" for j in range(nv)]
-        + [f"0.5 * (v{j} - c_w{j})" for j in range(nv)]
-        + [a[j] for j in range(nv)]
-    )
-    return ", ".join(values)
-
-
-def gather(offsets: Sequence[int]) -> Callable[[memoryview], tuple[float, ...]]:
-    """A function reading the float64 items at ``offsets`` (increasing) of a buffer, in one call.
-
-    ``struct.unpack_from`` with pad bytes between the items: reading 12 regressor entries
-    this way costs ~0.25 µs against ~0.5 µs item by item through a memoryview.
-    """
-    fmt, position = "", 0
-    for offset in offsets:
-        if offset < position:
-            raise ValueError(f"expected increasing offsets, got {list(offsets)}")
-        fmt += f"{8 * (offset - position)}xd" if offset > position else "d"
-        position = offset + 1
-    return struct.Struct(fmt).unpack_from
-
-
-def model_term_kernel(
-    model: pin.Model, nv: int, w: Sequence[str], a: Sequence[str]
-) -> tuple[list[str], dict[str, Any]]:
-    """Statements binding ``c_m{j}`` = ``M(q) a + C(q, v) w + g(q)`` [N·m] by one RNEA call.
-
-    ``w`` and ``a`` are per-joint expressions (e.g. ``"vd0"``). RNEA runs once on the
-    :func:`~twolink_pin.dynamics.polarisation_pair` of ``model``, which holds both terms of
-    the polarisation identity; ``c_m{j} = τ_A[j] − τ_B[j]`` is read from its Data
-    (:func:`data_view`).
-    """
-    data, namespace = pair_namespace(model)
-    lines = [f"c_w{j} = {w[j]}" for j in range(nv)]
-    lines.append(f"c_pack(c_in, 0, {pair_values(nv, a)})")
-    lines.append("c_rnea(c_pair, c_pdata, c_Q, c_V, c_A)")
-    lines += [f"c_m{j} = c_tau[{j}] - c_tau[{nv + j}]" for j in range(nv)]
-    namespace.update(
-        {
-            "c_tau": data_view(data.tau),
-            "c_rnea": pin.rnea,
-        }
-    )
-    return lines, namespace
-
-
-def literal(x: float) -> str:
-    """``x`` as Python source that evaluates to exactly ``x`` (``repr`` round-trips)."""
-    if not math.isfinite(x):
-        raise ValueError(f"expected a finite float, got {x!r}")
-    return repr(float(x))
+def _register(cls: type[Controller]) -> None:
+    name = cls.__dict__["name"]
+    if not isinstance(name, str) or not name or name.strip() != name or " " in name:
+        raise ControllerSpecError(
+            repr(name), f"{cls.__qualname__}.name must be a non-empty name without spaces"
+        )
+    for attr in ("title", "Gains"):
+        if not hasattr(cls, attr):
+            raise ControllerSpecError(name, f"{cls.__qualname__} must declare {attr!r}")
+    if not (
+        isinstance(cls.Gains, type) and issubclass(cls.Gains, Gains) and dataclasses.is_dataclass(cls.Gains)
+    ):
+        raise ControllerSpecError(name, f"{cls.__qualname__}.Gains must be a dataclass subclassing Gains")
+    unknown = [e for e in cls.estimates if e not in ESTIMATES]
+    if unknown or len(set(cls.estimates)) != len(cls.estimates):
+        raise ControllerSpecError(
+            name, f"estimates must be distinct entries of {ESTIMATES}, got {cls.estimates}"
+        )
+    existing = CONTROLLERS.get(name)
+    if existing is not None and (existing.__module__, existing.__qualname__) != (
+        cls.__module__,
+        cls.__qualname__,
+    ):
+        raise ControllerSpecError(
+            name,
+            f"the name is taken by {existing.__module__}.{existing.__qualname__}; give the class another name",
+        )
+    CONTROLLERS[name] = cls
 
 
 class Controller(abc.ABC):
-    """Base class: one law, one ``pin.Data`` of its own, explicit state ``z``."""
+    """Base class of every control law (see the module docstring for the contract).
+
+    Args:
+        robot: The arm the law is designed for: its model gives the model term and the
+            regressor's parameter map; its profile may preset the gains.
+        gains: The law's gains; default: the robot's preset for this law, else the
+            ``Gains`` defaults, per-joint values derived from the robot where ``None``.
+        model_parameters: The parameters ``p`` (the robot's map) the law's model uses,
+            shape (n_p,) or one row per run (N, n_p); default: the robot's own. A
+            controller with a parameter error believes ``p ⊙ (1 + δ)``.
+    """
 
     name: ClassVar[str]
     """Registry name, e.g. ``"pd"``."""
+    title: ClassVar[str]
+    """Display title, e.g. ``"PD + model feedforward"``."""
+    Gains: ClassVar[type[Gains]]
+    """The law's gains class."""
+    estimates: ClassVar[tuple[str, ...]] = ()
+    """Parameters held in ``z``: a subsequence of :data:`ESTIMATES`."""
 
-    def __init__(self, robot: RobotModel) -> None:
+    def __init_subclass__(cls, register: bool = True, **kwargs: Any) -> None:
+        """Register the class under its ``name`` (``class X(Controller, register=False)``
+        for a law that is used directly but never named, e.g. in a test)."""
+        super().__init_subclass__(**kwargs)
+        if register and "name" in cls.__dict__ and not getattr(cls.compute, "__isabstractmethod__", False):
+            _register(cls)
+
+    def __init__(
+        self,
+        robot: RobotModel,
+        gains: Gains | None = None,
+        *,
+        model_parameters: np.ndarray | None = None,
+    ) -> None:
+        if not isinstance(robot, RobotModel):
+            raise InvalidParameterError(
+                "robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)"
+            )
         self.robot = robot
-        self.model = robot.model
-        self.data = robot.create_data()
+        if gains is None:
+            presets = dict(robot.gain_presets.get(self.name, {}))
+            valid = set(self.Gains.field_names())
+            presets = {k: v for k, v in presets.items() if k in valid}
+            gains = self.Gains(**presets)
+        if not isinstance(gains, self.Gains):
+            raise InvalidParameterError(
+                "gains", type(gains).__name__, f"an instance of {self.Gains.__name__}"
+            )
+        self.gains = self._resolve(gains)
+        self.model_parameters = self._check_parameters(model_parameters)
 
-    def initial_state(self) -> np.ndarray:
-        """``z(0)``: the controller's internal state at the start of a run (a copy)."""
-        return EMPTY
+    # -- declarations derived from the class and the robot -----------------------------
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
-        """Names of the estimated parameters held in ``z`` (empty if none)."""
-        return ()
+        """Names of the estimated parameters, in the order of ``z``."""
+        names: list[str] = []
+        for kind in self.estimates:
+            if kind == "inertial":
+                names += self.robot.parameter_map.names
+            else:
+                n = self.robot.nv
+                names += [f"V{j + 1}" for j in range(n)] + [f"C{j + 1}" for j in range(n)]
+        return tuple(names)
 
-    def true_parameters(self) -> np.ndarray | None:
-        """The estimated parameters' values on the controller's own model, or None.
+    @property
+    def parameter_units(self) -> tuple[str, ...]:
+        """SI unit of each estimated parameter."""
+        units: list[str] = []
+        for kind in self.estimates:
+            if kind == "inertial":
+                units += self.robot.parameter_map.units
+            else:
+                units += [FRICTION_UNITS["viscous"]] * self.robot.nv + [
+                    FRICTION_UNITS["coulomb"]
+                ] * self.robot.nv
+        return tuple(units)
 
-        These are the values ``p̂(0)`` is scaled from. The values a run is judged against
-        are the plant's: :meth:`parameters_of`.
-        """
-        return None
+    @property
+    def parameter_kinds(self) -> tuple[str, ...]:
+        """``"inertial"`` or ``"friction"`` for each estimated parameter."""
+        kinds: list[str] = []
+        for kind in self.estimates:
+            size = self.robot.parameter_map.size if kind == "inertial" else 2 * self.robot.nv
+            kinds += [kind] * size
+        return tuple(kinds)
 
-    def parameters_of(self, robot: RobotModel, friction: Friction | None) -> np.ndarray | None:
-        """The estimated parameters' actual values on a plant (its arm and joint friction),
-        or None if none are estimated.
+    @property
+    def state_size(self) -> int:
+        """``nz``: size of the law's internal state."""
+        return len(self.parameter_names)
 
-        They differ from :meth:`true_parameters` when the controller was built on a model
-        with parameter errors (:func:`twolink_pin.batch.robot_with_parameters`).
-        """
-        return None
+    @property
+    def runs(self) -> int | None:
+        """Number of runs this object's per-run gains or parameters describe (their leading
+        axis), or None when it holds one value set for every run."""
+        counts = {runs_of(v) for v in self.gains.values().values()}
+        if isinstance(self.model_parameters, np.ndarray) and self.model_parameters.ndim == 2:
+            counts.add(int(self.model_parameters.shape[0]))
+        counts.discard(None)
+        if len(counts) > 1:
+            raise InvalidParameterError(
+                "gains", sorted(counts), "per-run values with one number of runs N (the leading axis)"
+            )
+        return counts.pop() if counts else None
 
-    def stage_kernel(self) -> StageKernel | None:
-        """The law as float statements for the fast simulator, or None (use :meth:`compute`).
+    @classmethod
+    def takes(cls, gain_name: str) -> bool:
+        """Whether the law's gains have a field ``gain_name`` (e.g. ``"lam"``)."""
+        return gain_name in cls.Gains.field_names()
 
-        Subclasses that override :meth:`compute` get None unless they also provide their own
-        kernel, so the fast path never runs a law other than the one ``compute`` states.
-        """
-        return None
+    def believed_parameters(self) -> np.ndarray:
+        """The parameters ``p`` of the law's model: ``model_parameters`` or the robot's."""
+        return self.model_parameters if self.model_parameters is not None else np.asarray(self.robot.p)
+
+    def initial_state(self) -> np.ndarray:
+        """``z(0)``, shape (nz,) or one row per run (N, nz); zeros unless overridden."""
+        return np.zeros(self.state_size)
+
+    def scaled_gains(self) -> dict[str, Any]:
+        """Values for the per-joint or per-estimate gains left ``None``, derived from the
+        robot (override in a law whose gains default to ``None``)."""
+        return {}
+
+    # -- the law ------------------------------------------------------------------------
 
     @abc.abstractmethod
-    def compute(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        q_des: np.ndarray,
-        v_des: np.ndarray,
-        a_des: np.ndarray,
-        z: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Torque and state derivative.
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        """The law: torque [N·m] (and ż) for every run.
 
         Args:
-            q: Joint positions [rad]. v: Joint velocities [rad/s].
-            q_des, v_des, a_des: Reference position [rad], velocity [rad/s], acceleration [rad/s²].
-            z: Controller state (see :meth:`initial_state`).
+            x: Time, state and reference sample, batch-first (see :class:`LawInput`).
+            terms: The engine's Pinocchio terms for the N runs (see :class:`Terms`).
 
         Returns:
-            ``(τ [N·m], ż)``.
+            ``LawOutput(tau)`` with ``tau`` of shape (N, nv), plus ``dz`` of shape
+            (N, nz) for a law with state.
         """
 
+    # -- internals ----------------------------------------------------------------------
 
-def diagonal_gain(
-    name: str, values: Sequence[float], nv: int | None = None, positive: bool = True
-) -> np.ndarray:
-    """Validate a diagonal gain and return it as an array.
+    def _resolve(self, gains: Gains) -> Gains:
+        missing = [name for name, value in gains.values().items() if value is None]
+        if missing:
+            derived = self.scaled_gains()
+            absent = [name for name in missing if name not in derived]
+            if absent:
+                raise InvalidParameterError(
+                    f"gains.{absent[0]}", None, f"a value: {type(self).__name__} derives no default for it"
+                )
+            gains = dataclasses.replace(gains, **{name: derived[name] for name in missing})
+        for f in dataclasses.fields(gains):
+            spec = _spec(f)
+            value = getattr(gains, f.name)
+            if spec.per == "joint":
+                check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")
+            elif spec.per == "estimate":
+                check_width(
+                    f.name, value, self.state_size, f"per estimated parameter: {self.parameter_names}"
+                )
+        return gains
 
-    Raises:
-        InvalidParameterError: wrong length, non-finite, or not strictly positive.
-    """
-    array = np.asarray(values, dtype=float)
-    if array.ndim != 1 or (nv is not None and array.shape != (nv,)):
-        expected = f"shape ({nv},)" if nv is not None else "a 1-D sequence"
-        raise InvalidParameterError(name, tuple(values), f"{expected} but got shape {array.shape}")
-    for x in array:
-        if not math.isfinite(x) or (positive and x <= 0):
-            raise InvalidParameterError(name, tuple(values), "finite values > 0")
-    return array
+    def _check_parameters(self, p: Any) -> np.ndarray | None:
+        if p is None:
+            return None
+        size = self.robot.parameter_map.size
+        try:
+            array = np.array(p, dtype=float)
+        except (TypeError, ValueError):
+            raise InvalidParameterError(
+                "model_parameters", p, f"{size} numbers {self.robot.parameter_map.names}"
+            ) from None
+        if array.shape[-1:] != (size,) or array.ndim not in (1, 2) or not np.all(np.isfinite(array)):
+            raise InvalidParameterError(
+                "model_parameters",
+                array.tolist() if array.size <= 24 else f"shape {array.shape}",
+                f"{size} finite values {self.robot.parameter_map.names}, or one row of them per run",
+            )
+        array.setflags(write=False)
+        return array
 
-
-def positive_scalar(name: str, value: float, unit: str) -> float:
-    """Validate a finite, strictly positive scalar."""
-    if not (
-        isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value) and value > 0
-    ):
-        raise InvalidParameterError(name, value, f"a finite value > 0 {unit}")
-    return float(value)
+    def __repr__(self) -> str:
+        return f"<{type(self).__name__} {self.name!r} on {self.robot.name}: {self.gains.describe()}>"

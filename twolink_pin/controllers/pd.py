@@ -3,29 +3,28 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
-import numpy as np
+from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.dynamics import joint_inertia
 
-from twolink_pin.controllers.base import Controller, StageKernel, diagonal_gain, literal, model_term_kernel
-from twolink_pin.dynamics import model_torque
-from twolink_pin.model import RobotModel
+NATURAL_FREQUENCY = 10.0
+"""ω [rad/s] of the robot-derived default gains ``Kp = ω² I``, ``Kd = 2 ω I`` (critical
+damping of each joint's inertia ``I = diag M(q₀)`` alone)."""
 
 
-@dataclass(frozen=True)
-class PDGains:
-    """Gains of :class:`PDFeedforward` (the report's values).
+@dataclass(frozen=True, eq=False)
+class PDGains(Gains):
+    """Gains of :class:`PDFeedforward` (report: Kp = diag(350, 300), Kd = diag(40, 50)).
 
     Attributes:
-        kp: Position gains ``Kp`` [N·m/rad], diagonal.
-        kd: Velocity gains ``Kd`` [N·m·s/rad], diagonal.
+        kp: Position gains ``Kp`` [N·m/rad], diagonal; default ``ω² diag M(q₀)``.
+        kd: Velocity gains ``Kd`` [N·m·s/rad], diagonal; default ``2 ω diag M(q₀)``.
     """
 
-    kp: tuple[float, ...] = (350.0, 300.0)
-    kd: tuple[float, ...] = (40.0, 50.0)
-
-    def __post_init__(self) -> None:
-        diagonal_gain("kp", self.kp)
-        diagonal_gain("kd", self.kd, len(self.kp))
+    kp: Any = gain(None, per="joint", unit="N·m/rad", doc="position gain Kp")
+    kd: Any = gain(None, per="joint", unit="N·m·s/rad", doc="velocity gain Kd")
 
 
 class PDFeedforward(Controller):
@@ -34,40 +33,18 @@ class PDFeedforward(Controller):
         τ = M(q) q̈_d + C(q, q̇) q̇_d + g(q) − Kp e − Kd ė
 
     (``g = 0`` for the horizontal twolink.) With ``V = ½ ėᵀ M ė + ½ eᵀ Kp e`` the report
-    shows ``V̇ = −ėᵀ Kd ė`` (eqs. 9–10). ``M``, ``C``, ``g`` come from Pinocchio on the
-    controller's own Data.
+    shows ``V̇ = −ėᵀ Kd ė`` (eqs. 9–10).
     """
 
     name = "pd"
+    title = "PD + model feedforward"
+    Gains = PDGains
 
-    def __init__(self, robot: RobotModel, gains: PDGains | None = None) -> None:
-        super().__init__(robot)
-        self.gains = gains if gains is not None else PDGains()
-        self.kp = diagonal_gain("kp", self.gains.kp, robot.nv)
-        self.kd = diagonal_gain("kd", self.gains.kd, robot.nv)
+    def scaled_gains(self) -> dict[str, Any]:
+        inertia = joint_inertia(self.robot.model)
+        return {"kp": NATURAL_FREQUENCY**2 * inertia, "kd": 2.0 * NATURAL_FREQUENCY * inertia}
 
-    def stage_kernel(self) -> StageKernel | None:
-        if type(self).compute is not PDFeedforward.compute:
-            return None
-        nv = self.robot.nv
-        lines, namespace = model_term_kernel(
-            self.model, nv, [f"vd{j}" for j in range(nv)], [f"ad{j}" for j in range(nv)]
-        )
-        lines += [
-            f"tau{j} = c_m{j} - ({literal(self.kp[j])} * (q{j} - qd{j}) + {literal(self.kd[j])} * (v{j} - vd{j}))"
-            for j in range(nv)
-        ]
-        return StageKernel(tuple(lines), namespace)
-
-    def compute(
-        self,
-        q: np.ndarray,
-        v: np.ndarray,
-        q_des: np.ndarray,
-        v_des: np.ndarray,
-        a_des: np.ndarray,
-        z: np.ndarray,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        tau = model_torque(self.model, self.data, q, v, v_des, a_des)
-        tau -= self.kp * (q - q_des) + self.kd * (v - v_des)
-        return tau, z
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        g = self.gains
+        tau = terms.model(x.q, x.v, x.v_des, x.a_des)
+        return LawOutput(tau - (g.kp * (x.q - x.q_des) + g.kd * (x.v - x.v_des)))

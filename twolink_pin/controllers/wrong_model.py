@@ -2,14 +2,31 @@
 
 from __future__ import annotations
 
-import math
+from dataclasses import dataclass
+from typing import Any
 
-from twolink_pin.controllers.computed_torque import ComputedTorque, SlotineLiGains
-from twolink_pin.errors import InvalidParameterError
-from twolink_pin.model import RobotModel
+from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, SLIDING_RATE
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.dynamics import joint_inertia
 
 
-class WrongModel(ComputedTorque):
+@dataclass(frozen=True, eq=False)
+class WrongModelGains(Gains):
+    """Gains of :class:`WrongModel` (report: K = diag(40, 50), β = 0.5).
+
+    Attributes:
+        k: Sliding gain ``K`` [N·m·s/rad], diagonal; default ``κ diag M(q₀)``.
+        lam: ``λ`` [1/s] in ``s = ė + λ e``.
+        model_scale: ``β``, the factor on the model terms (report: 0.5), >= 0.
+    """
+
+    k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
+    lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
+    model_scale: Any = gain(0.5, bound="nonnegative", doc="β: M̂ = β M, Ĉ = β C, ĝ = β g")
+
+
+class WrongModel(Controller):
     r"""Slotine–Li control on a scaled model ``M̂ = β M``, ``Ĉ = β C``, ``ĝ = β g``::
 
         τ = β [M(q) q̈_r + C(q, q̇) q̇_r + g(q)] − K s      (report: β = 0.5)
@@ -21,11 +38,14 @@ class WrongModel(ComputedTorque):
     """
 
     name = "robust"
+    title = "Slotine–Li law with M̂ = β M, Ĉ = β C (report: β = 0.5)"
+    Gains = WrongModelGains
 
-    def __init__(
-        self, robot: RobotModel, gains: SlotineLiGains | None = None, model_scale: float = 0.5
-    ) -> None:
-        super().__init__(robot, gains)
-        if not (isinstance(model_scale, (int, float)) and math.isfinite(model_scale) and model_scale >= 0):
-            raise InvalidParameterError("model_scale", model_scale, "a finite factor >= 0 on M, C and g")
-        self.model_scale = float(model_scale)
+    def scaled_gains(self) -> dict[str, Any]:
+        return {"k": SLIDING_RATE * joint_inertia(self.robot.model)}
+
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        g = self.gains
+        e, edot = x.q - x.q_des, x.v - x.v_des
+        tau = terms.model(x.q, x.v, x.v_des - g.lam * e, x.a_des - g.lam * edot)
+        return LawOutput(g.model_scale * tau - g.k * (edot + g.lam * e))

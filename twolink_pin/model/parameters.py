@@ -7,7 +7,9 @@ and inertia about the body frame's origin, SI units), and
 ``Y_π π = M(q) a + C(q, v) v + g(q)``. Controllers work with a smaller vector ``p``:
 a :class:`ParameterMap` gives the constant matrix ``P`` with ``Y_p = Y_π P`` and reads
 ``p`` from a model. This module holds the base class and the robot-independent map
-(``p = π``); a robot's own lumped map lives in its own module (``twolink.py``).
+(``p = π``); a robot's own map lives with that robot (the twolink's lumped p1, p2, p3 in
+:mod:`twolink_pin.twolink.lumped_map`), and :func:`model_with_parameters` builds a model
+whose dynamics has given parameters ``p``.
 """
 
 from __future__ import annotations
@@ -21,6 +23,9 @@ N_BODY_PARAMETERS = 10
 """Inertial parameters per body in Pinocchio's ordering."""
 
 BODY_PARAMETER_NAMES = ("m", "mcx", "mcy", "mcz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+"""Pinocchio's order of a body's ten inertial parameters."""
+BODY_PARAMETER_UNITS = ("kg", "kg·m", "kg·m", "kg·m", "kg·m²", "kg·m²", "kg·m²", "kg·m²", "kg·m²", "kg·m²")
+"""Their SI units."""
 
 
 def inertial_parameters(model: pin.Model) -> np.ndarray:
@@ -37,6 +42,8 @@ class ParameterMap(abc.ABC):
 
     names: tuple[str, ...]
     """Name of each entry of ``p``."""
+    units: tuple[str, ...]
+    """SI unit of each entry of ``p``."""
 
     @property
     @abc.abstractmethod
@@ -61,6 +68,7 @@ class InertialParameterMap(ParameterMap):
         self.names = tuple(
             f"{model.names[j]}.{name}" for j in range(1, model.njoints) for name in BODY_PARAMETER_NAMES
         )
+        self.units = BODY_PARAMETER_UNITS * (model.njoints - 1)
         self._matrix = np.eye(n)
         self._matrix.setflags(write=False)
 
@@ -70,3 +78,46 @@ class InertialParameterMap(ParameterMap):
 
     def values(self, model: pin.Model) -> np.ndarray:
         return inertial_parameters(model)
+
+
+def model_with_parameters(model: pin.Model, parameter_map: ParameterMap, p: np.ndarray) -> pin.Model:
+    """A copy of ``model`` whose dynamics has the parameters ``p`` of ``parameter_map``.
+
+    The inertial parameters become ``π' = π + P (p − p_model)``: since ``Y_π P = Y_p``,
+    ``Y_π π' = Y_p p`` — a controller built on this model "believes" ``p``. The kinematics
+    is unchanged. Used for parameter-estimate errors (``p = p_true ⊙ (1 + δ)``).
+
+    Raises:
+        InvalidParameterError: ``p`` has the wrong length or gives a body a non-finite
+            inertia (e.g. a zero mass with a first moment).
+    """
+    from twolink_pin.errors import InvalidParameterError
+
+    p = np.asarray(p, dtype=float)
+    if p.shape != (parameter_map.size,) or not np.all(np.isfinite(p)):
+        raise InvalidParameterError(
+            "p",
+            p.tolist(),
+            f"{parameter_map.size} finite values {parameter_map.names} but got shape {p.shape}",
+        )
+    pi = inertial_parameters(model) + parameter_map.matrix @ (p - parameter_map.values(model))
+    copy = pin.Model(model)
+    for j in range(1, model.njoints):
+        body = pi[N_BODY_PARAMETERS * (j - 1) : N_BODY_PARAMETERS * j].copy()
+        inertia = pin.Inertia.FromDynamicParameters(body)
+        if not (np.all(np.isfinite(inertia.toDynamicParameters())) and inertia.mass > 0):
+            raise InvalidParameterError(
+                "p", p.tolist(), f"parameters giving body {j} a finite inertia with a mass > 0 kg"
+            )
+        copy.inertias[j] = inertia
+    return copy
+
+
+def with_inertial_parameters(model: pin.Model, pi: np.ndarray) -> pin.Model:
+    """A copy of ``model`` with every body's inertia set from ``pi`` (shape (10 nb,))."""
+    copy = pin.Model(model)
+    for j in range(1, model.njoints):
+        copy.inertias[j] = pin.Inertia.FromDynamicParameters(
+            np.array(pi[N_BODY_PARAMETERS * (j - 1) : N_BODY_PARAMETERS * j])
+        )
+    return copy

@@ -1,63 +1,40 @@
 """Loading a robot arm from URDF into Pinocchio.
 
-:func:`load_robot` validates the file (:mod:`twolink_pin.urdf_validation`), builds the
-Pinocchio model, optionally adds a point-mass payload at the end effector, and reads
-everything else the toolkit needs from the model: link lengths, torque limits and the
-parameters ``p`` of the model's parameter map.
+:func:`load_robot` resolves a robot name or a URDF path (:mod:`twolink_pin.model.catalog`),
+validates the file (:mod:`twolink_pin.model.urdf_validation`), builds the Pinocchio model,
+optionally adds a point-mass payload at the end effector, and reads everything else the
+toolkit needs from the model: link lengths, torque limits and the parameters ``p`` of the
+robot's parameter map. The robot's :class:`~twolink_pin.model.profile.RobotProfile` rides
+along (its gain presets, default trajectory, plant friction).
 """
 
 from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from importlib import resources
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
 
 from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
+from twolink_pin.model.catalog import example_robot_urdf, resolve
 from twolink_pin.model.parameters import InertialParameterMap, ParameterMap
+from twolink_pin.model.profile import RobotProfile
 from twolink_pin.model.urdf_validation import validate_urdf_file
-from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 DEFAULT_EE_FRAME = "ee_link"
+
+__all__ = ["DEFAULT_EE_FRAME", "RobotModel", "example_robot_urdf", "load_robot", "twolink_urdf_path"]
 
 
 def twolink_urdf_path() -> Path:
     """Path of the shipped ``twolink.urdf`` (works from a checkout and an installed wheel)."""
-    return Path(str(resources.files("twolink_pin.robots").joinpath("twolink.urdf")))
-
-
-def example_robot_urdf(relative: str) -> Path:
-    """Path of a URDF shipped by ``example-robot-data``.
-
-    Args:
-        relative: Path below the package's ``robots/`` folder, e.g.
-            ``"double_pendulum_description/urdf/double_pendulum.urdf"`` or
-            ``"asr_twodof_description/urdf/TwoDofs.urdf"`` (a planar 2-DOF arm).
-
-    Raises:
-        InvalidURDFError: the distribution is not installed or has no such file.
-    """
-    import importlib.metadata
-
-    try:
-        files = importlib.metadata.files("example-robot-data") or []
-    except importlib.metadata.PackageNotFoundError:
-        raise InvalidURDFError(
-            relative, "example-robot-data", "not installed (pip install example-robot-data)"
-        ) from None
-    suffix = "robots/" + relative.lstrip("/")
-    for file in files:
-        if str(file).endswith(suffix):
-            return Path(str(file.locate()))
-    raise InvalidURDFError(
-        relative, "example-robot-data", f"no file ending in {suffix!r} in the installed distribution"
-    )
+    return resolve("twolink")[0]
 
 
 @dataclass(frozen=True)
@@ -84,6 +61,18 @@ class RobotModel:
     ``inf`` where the URDF gives none (effort 0 or absent)."""
     p: np.ndarray = field(repr=False)
     """True parameters of the map (for the twolink p1, p2, p3 [kg·m²])."""
+    profile: RobotProfile = field(repr=False, default_factory=lambda: RobotProfile("robot"))
+    """The robot's name and defaults (gain presets, trajectory, plant friction)."""
+
+    @property
+    def name(self) -> str:
+        """The robot's short name (catalog name or URDF file stem)."""
+        return self.profile.name
+
+    @property
+    def gain_presets(self) -> Mapping[str, Mapping[str, Any]]:
+        """Gains per law name that laws built on this robot use by default."""
+        return self.profile.gain_presets
 
     @property
     def nq(self) -> int:
@@ -126,23 +115,23 @@ def _link_lengths(model: pin.Model, ee_frame_id: int) -> np.ndarray:
 
 
 def load_robot(
-    urdf: str | os.PathLike[str] | None = None,
+    robot: str | os.PathLike[str] | None = None,
     payload: float = 0.0,
     ee_frame: str | None = None,
     parameter_map: Callable[[pin.Model], ParameterMap] | None = None,
 ) -> RobotModel:
-    """Load an arm from URDF.
+    """Load an arm by name or from a URDF file.
 
     Args:
-        urdf: URDF file; default the shipped ``twolink.urdf``.
+        robot: A catalog name (``"twolink"``, the default) or a path to a URDF file.
         payload: Point mass at the end-effector frame's origin [kg], >= 0.
-        ee_frame: Name of the end-effector frame; default ``ee_link`` if present, else the
-            last frame on the last joint.
-        parameter_map: Parameter-map class (called with the model); default :class:`TwoLinkLumpedMap` for a
-            planar 2R arm, else :class:`InertialParameterMap` (all of Pinocchio's π).
+        ee_frame: Name of the end-effector frame; default the profile's, else ``ee_link``
+            if present, else the last frame on the last joint.
+        parameter_map: Parameter-map class (called with the model); default the profile's
+            (the twolink's lumped p1..p3), else :class:`InertialParameterMap` (all π).
 
     Raises:
-        InvalidURDFError: the file is missing or describes no sound model.
+        InvalidURDFError: unknown name, missing file, or a file that gives no sound model.
         InvalidParameterError: ``payload`` is negative or not finite.
     """
     if not (
@@ -152,7 +141,7 @@ def load_robot(
         and payload >= 0
     ):
         raise InvalidParameterError("payload", payload, "a finite mass >= 0 kg")
-    path = Path(urdf) if urdf is not None else twolink_urdf_path()
+    path, profile = resolve(robot)
     validate_urdf_file(path)
     try:
         model = pin.buildModelFromUrdf(str(path))
@@ -166,17 +155,13 @@ def load_robot(
             "<robot>",
             f"expected only 1-DoF joints (nq == nv), got nq = {model.nq}, nv = {model.nv}",
         )
-    ee_id = _end_effector_frame(model, ee_frame, path)
+    ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
     if payload > 0:
         frame = model.frames[ee_id]
         point = pin.Inertia(float(payload), np.zeros(3), np.zeros((3, 3)))
         model.inertias[frame.parentJoint] = model.inertias[frame.parentJoint] + frame.placement.act(point)
-    if parameter_map is None:
-        pmap: ParameterMap = (
-            TwoLinkLumpedMap(model) if TwoLinkLumpedMap.applies_to(model) else InertialParameterMap(model)
-        )
-    else:
-        pmap = parameter_map(model)
+    factory = parameter_map if parameter_map is not None else profile.parameter_map
+    pmap: ParameterMap = factory(model) if factory is not None else InertialParameterMap(model)
     return RobotModel(
         model=model,
         urdf_path=path,
@@ -186,4 +171,5 @@ def load_robot(
         link_lengths=readonly(_link_lengths(model, ee_id)),
         torque_limits=readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
         p=readonly(pmap.values(model)),
+        profile=profile,
     )

@@ -11,26 +11,15 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from twolink_pin.controllers.adaptive import Adaptive
+from twolink_pin.controllers import Adaptive
+from twolink_pin.dynamics import regressor
+from twolink_pin.errors import InvalidParameterError
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.trajectory import JointTrajectory
 from twolink_pin.twolink.closed_form import coriolis_matrix, mass_matrix
-
-REPORT_TABLE1 = {
-    (0.48, 0.1): ((-0.2936, 1.3587), (0.7044, -1.3587)),
-    (0.38, 0.0): ((-0.6426, 1.8921), (0.6426, -1.8921)),
-    "third": ((-0.7044, 1.3587), (0.2936, -1.3587)),
-    (0.58, 0.0): ((-0.2835, 0.7424), (0.2835, -0.7424)),
-}
-"""The report's Table 1 (the third row's coordinates are lost in the text conversion)."""
-
-REPORT_COEFFICIENTS = (
-    (-0.2936, 0, 0, 0, -2.04, 3.11, 1.95, 0.65, -0.12, 0.01, -0.00048),
-    (1.3587, 0, 0, 0, 3.19, -4.4, 2.32, -0.54, 0.04, 0.003, -0.00051),
-)
-"""The report's eqs. 6–7, ascending powers of t [s]."""
+from twolink_pin.twolink.reference import REPORT_COEFFICIENTS, REPORT_TABLE1
 
 
 class Erratum(NamedTuple):
@@ -94,13 +83,14 @@ def printed_coefficients(trajectory: JointTrajectory) -> Erratum:
 def y3_sign(robot: RobotModel, seed: int = 0, samples: int = 200) -> Erratum:
     """Y3's lower-left Coriolis entry: printed −q̇1 sin q2, correct +q̇1 sin q2."""
     rng = np.random.default_rng(seed)
-    controller = Adaptive(robot)
     p = np.asarray(robot.p)
+    P = robot.parameter_map.matrix
+    data = robot.create_data()
     err_ours, err_printed = 0.0, 0.0
     for _ in range(samples):
         q, v, w, a = rng.uniform(-np.pi, np.pi, size=(4, 2))
         exact = mass_matrix(q, p) @ a + coriolis_matrix(q, v, p) @ w
-        ours = controller.regressor(q, v, w, a) @ p
+        ours = regressor(robot.model, data, q, v, w, a) @ P @ p
         printed = ours.copy()
         printed[1] -= 2 * p[2] * v[0] * np.sin(q[1]) * w[0]
         err_ours = max(err_ours, float(np.abs(ours - exact).max()))
@@ -118,11 +108,13 @@ def y3_sign(robot: RobotModel, seed: int = 0, samples: int = 200) -> Erratum:
 
 
 def unstated_settings(lam: float, q0_offset: tuple[float, ...]) -> Erratum:
-    """λ, the initial state and the Table 2 norm are not in the report."""
+    """λ, the initial state and the Table 2 norm are not in the report (the text states the
+    values this run used)."""
+    offset = ", ".join(f"{x:g}" for x in q0_offset)
     return Erratum(
         "Unstated λ, initial state and norm",
         "The report never gives λ, the initial state of its runs, nor which norm Table 2 shows.",
-        "We use λ = 5 1/s, q(0) = q_d(0) + (0.1, −0.1) rad, q̇(0) = 0, and report RMS, L2 and max.",
+        f"We use λ = {lam:g} 1/s, q(0) = q_d(0) + ({offset}) rad, q̇(0) = 0, and report RMS, L2 and max.",
         {"lambda_per_s": lam, "q0_offset_rad": list(q0_offset)},
     )
 
@@ -140,26 +132,37 @@ def robust_naming(result: SimulationResult) -> Erratum:
 
 
 def parameter_convergence(
-    result: SimulationResult, robot: RobotModel, trajectory: JointTrajectory
+    result: SimulationResult, controller: Adaptive, trajectory: JointTrajectory
 ) -> Erratum:
     """Do the adaptive estimates approach the true values, and how fast?
 
     Evidence: ``|p̃|`` at several times; the excitation Gram matrix
     ``G = (1/T) ∫ Yᵀ K⁻¹ Y dt`` along one period of the desired motion (positive
     definite = persistently exciting) and the slowest rate of the averaged adaptation
-    ``dp̃/dt ≈ −Γ G p̃`` (valid once ``s`` is small: ``s ≈ K⁻¹ Y p̃``).
+    ``dp̃/dt ≈ −Γ G p̃`` (valid once ``s`` is small: ``s ≈ K⁻¹ Y p̃``), with the run's own
+    gains ``K`` and ``Γ = diag(1/γ)`` (``controller``).
+
+    Raises:
+        InvalidParameterError: ``result`` holds no parameter estimates.
     """
-    assert result.p_hat is not None and result.p_true is not None
-    controller = Adaptive(robot)
-    n_p = len(controller.p_true)
+    if result.p_hat is None or result.p_true is None:
+        raise InvalidParameterError("result", result.controller, "a run of an adaptive law (with p̂)")
+    robot = controller.robot
+    n_p = robot.parameter_map.size
+    P = robot.parameter_map.matrix
+    data = robot.create_data()
+    k = np.broadcast_to(np.asarray(controller.gains.k, dtype=float), (robot.nv,))
+    rate = (
+        1.0 / np.broadcast_to(np.asarray(controller.gains.gamma, dtype=float), (controller.state_size,))[:n_p]
+    )
     t = trajectory.t0 + np.linspace(0.0, trajectory.period, 2001)
     ref = trajectory.sample(t)
     gram = np.zeros((n_p, n_p))
-    for k in range(len(t)):
-        Y = controller.regressor(ref.q[k], ref.v[k], ref.v[k], ref.a[k])
-        gram += Y.T @ (Y / controller.k[:, None])
+    for i in range(len(t)):
+        Y = regressor(robot.model, data, ref.q[i], ref.v[i], ref.v[i], ref.a[i]) @ P
+        gram += Y.T @ (Y / k[:, None])
     gram /= len(t)
-    rates = np.linalg.eigvals(controller.Gamma[:, None] * gram).real
+    rates = np.linalg.eigvals(rate[:, None] * gram).real
     p_err = result.p_hat[:, :n_p] - result.p_true[:n_p]
     checkpoints = [tc for tc in (0.0, 10.0, 20.0, 30.0) if tc <= result.t[-1] + 1e-9]
     norms = {

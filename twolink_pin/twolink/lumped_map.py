@@ -12,7 +12,6 @@ link frame) and ``L1`` the distance joint 1 -> joint 2 [m]::
 
 The regressor columns follow from which π direction produces each ``Y_i``:
 ``Y1 = Y_π e(Izz1)``, ``Y2 = Y_π (e(Izz2) - e(Izz1))``, ``Y3 = Y_π e(mcx2) / L1``.
-This is the only module that assumes two joints.
 """
 
 from __future__ import annotations
@@ -45,6 +44,7 @@ class TwoLinkLumpedMap(ParameterMap):
     """Lumped parameters ``p = (p1, p2, p3)`` [kg·m²] of a planar 2R arm about z."""
 
     names = ("p1", "p2", "p3")
+    units = ("kg·m²", "kg·m²", "kg·m²")
 
     def __init__(self, model: pin.Model) -> None:
         if not self.applies_to(model):

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+import zipfile
 from dataclasses import fields
 from pathlib import Path
 from typing import Any
@@ -11,8 +12,11 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.errors import OutputError
-from twolink_pin.files import atomic_write
-from twolink_pin.simulation import SimulationResult
+from twolink_pin.files import atomic_write, check_input_file
+from twolink_pin.simulation.result import SimulationResult
+
+MAX_RESULT_BYTES = 2**31
+"""Largest result file :func:`load_result` reads (2 GiB)."""
 
 
 def save_result(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
@@ -36,11 +40,14 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
     Raises:
         OutputError: the file is missing or is not a saved simulation result.
     """
+    check_input_file(path, MAX_RESULT_BYTES, "a saved simulation result (.npz)")
     try:
         with np.load(path, allow_pickle=False) as data:
             raw = {k: data[k] for k in data.files}
-    except (OSError, ValueError) as exc:
-        raise OutputError(str(path), f"cannot read a saved simulation result ({exc})") from exc
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
+        raise OutputError(
+            str(path), f"cannot read a saved simulation result ({type(exc).__name__}: {exc})"
+        ) from exc
     names = {f.name for f in fields(SimulationResult)}
     missing = {"controller", "t", "q", "v", "q_des"} - raw.keys()
     if missing:
@@ -49,13 +56,13 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
     for name, value in raw.items():
         if name not in names:
             continue
-        if name in ("controller", "method"):
+        if name in ("controller", "method", "robot"):
             kwargs[name] = str(value)
         elif name in ("dt", "reference_period", "control_period"):
             kwargs[name] = float(value)
         elif name == "saturate":
             kwargs[name] = bool(value)
-        elif name == "parameter_names":
+        elif name in ("parameter_names", "parameter_units", "parameter_kinds"):
             kwargs[name] = tuple(str(x) for x in value)
         else:
             array = np.array(value, dtype=float)

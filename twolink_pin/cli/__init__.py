@@ -1,0 +1,63 @@
+"""``twolink-pin``: the command-line shell over the library.
+
+==============  ===================================================================
+``parser.py``   commands, options, and the argument types that check numbers
+``commands.py`` one function per command, each a thin shell over the library
+``output.py``   text or JSON on stdout, the progress display on stderr
+==============  ===================================================================
+
+Bad input gives one line on stderr and exit status 2; a failed run (a diverged
+simulation, a law that raised) exit status 1; Ctrl-C exit status 130.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Sequence
+
+from twolink_pin.cli.parser import build_parser
+from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``twolink-pin`` console script."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    args.argv = list(sys.argv[1:] if argv is None else argv)
+    try:
+        return int(args.func(args))
+    except (SimulationDivergedError, ControllerError) as exc:
+        _say(f"twolink-pin: {exc}")
+        return 1
+    except TwolinkPinError as exc:
+        _say(f"twolink-pin: error: {exc}")
+        return 2
+    except KeyboardInterrupt:
+        _say("twolink-pin: interrupted")
+        return 130
+    except BrokenPipeError:  # stdout closed by the reader (e.g. | head): nothing more to say
+        _close_stdout()
+        return 1
+    except OSError as exc:  # stdout or stderr unwritable (full disk, closed)
+        _say(f"twolink-pin: error: cannot write the output ({exc.strerror or exc})")
+        return 1
+
+
+def _say(line: str) -> None:
+    try:
+        print(line, file=sys.stderr, flush=True)
+    except OSError:
+        pass
+
+
+def _close_stdout() -> None:
+    import os
+
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except OSError:
+        pass
+
+
+__all__ = ["build_parser", "main"]

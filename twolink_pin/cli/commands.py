@@ -1,0 +1,530 @@
+"""The commands of ``twolink-pin``: each a thin shell over the library.
+
+Every command prints a readable summary, or JSON with ``--json``. The library is imported
+inside each command, so ``--help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from twolink_pin.cli.output import emit, fmt, progress_bar
+from twolink_pin.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from twolink_pin.metrics import Metrics
+    from twolink_pin.model import RobotModel
+    from twolink_pin.simulation import SimulationConfig, SimulationResult
+
+
+def _robot(args: argparse.Namespace) -> RobotModel:
+    from twolink_pin.model import load_robot
+
+    return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
+
+
+def _config(args: argparse.Namespace) -> SimulationConfig:
+    from twolink_pin.simulation import SimulationConfig
+
+    offset = args.q0_offset
+    return SimulationConfig(
+        duration=args.duration,
+        dt=args.dt,
+        method=args.method,
+        q0_offset=None if offset is None else (offset[0] if len(offset) == 1 else tuple(offset)),
+        control_period=args.control_period,
+    )
+
+
+def _smoothing(args: argparse.Namespace) -> float:
+    smoothing = args.friction_smoothing
+    if smoothing is None:
+        smoothing = 1e-3 if args.method == "adaptive" else 0.0
+    return float(smoothing)
+
+
+def _gain_values(texts: list[str]) -> dict[str, Any]:
+    """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}``."""
+    from twolink_pin.cli.parser import finite
+
+    gains: dict[str, Any] = {}
+    for text in texts:
+        name, sep, value = text.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise InvalidParameterError("--gain", text, "NAME=VALUE, e.g. kp=200 or kd=30,40")
+        try:
+            numbers = tuple(finite(x) for x in value.split(","))
+        except argparse.ArgumentTypeError as exc:
+            raise InvalidParameterError(
+                f"--gain {name.strip()}", value, str(exc).removeprefix("expected ")
+            ) from None
+        gains[name.strip()] = numbers[0] if len(numbers) == 1 else numbers
+    return gains
+
+
+def _run_one(args: argparse.Namespace, spec: str, robot: RobotModel) -> SimulationResult:
+    from twolink_pin.scenario import law_class, make_scenario
+    from twolink_pin.simulation import simulate
+    from twolink_pin.trajectory import default_trajectory
+
+    cls = law_class(spec)
+    lam = args.lam
+    if lam is not None and not cls.takes("lam") and getattr(args, "lambda_optional", False):
+        lam = None  # compare/report: λ applies to the laws that have one
+    controller, plant = make_scenario(
+        cls,
+        robot,
+        lam=lam,
+        gains=_gain_values(getattr(args, "gain", []) or []),
+        saturate=args.saturate,
+        friction_smoothing=_smoothing(args),
+    )
+    return simulate(controller, plant, default_trajectory(robot), _config(args))
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    robot = _robot(args)
+    payload: dict[str, Any] = {
+        "robot": robot.name,
+        "urdf": str(robot.urdf_path),
+        "nq": robot.nq,
+        "nv": robot.nv,
+        "gravity": robot.model.gravity.linear.tolist(),
+        "link_lengths": robot.link_lengths.tolist(),
+        "torque_limits": robot.torque_limits.tolist(),
+        "parameter_names": list(robot.parameter_map.names),
+        "p": robot.p.tolist(),
+    }
+    names = robot.parameter_map.names
+    p_text = (
+        ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, robot.p))
+        if len(names) <= 6
+        else f"{len(names)} values"
+    )
+    limits = ", ".join("no limit" if not np.isfinite(x) else f"{x:g}" for x in robot.torque_limits)
+    text = "\n".join(
+        [
+            f"robot      {robot.name}: {robot.model.name} ({robot.urdf_path})",
+            f"joints     nq = {robot.nq}, nv = {robot.nv}; end effector '{robot.ee_frame}'",
+            f"gravity    {fmt(robot.model.gravity.linear, 3)} m/s²",
+            f"links      {fmt(robot.link_lengths, 3)} m",
+            f"limits     ({limits}) N·m",
+            f"payload    {robot.payload:g} kg",
+            f"parameters {p_text}",
+        ]
+    )
+    if args.write_urdf:
+        from twolink_pin.model.payload import write_payload_urdf
+
+        if robot.payload <= 0:
+            raise InvalidParameterError(
+                "--payload", robot.payload, "a mass > 0 kg to write a payload variant"
+            )
+        written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
+        payload["urdf_written"] = str(written)
+        text += f"\nwrote      {written}"
+    emit(args, payload, text)
+    return 0
+
+
+def cmd_robots(args: argparse.Namespace) -> int:
+    from twolink_pin.model import catalog, load_robot
+
+    rows = []
+    for name in catalog.names():
+        robot = load_robot(name)
+        rows.append(
+            {
+                "name": name,
+                "nq": robot.nq,
+                "nv": robot.nv,
+                "gravity": robot.model.gravity.linear.tolist(),
+                "torque_limits": robot.torque_limits.tolist(),
+                "description": robot.profile.description,
+                "source": robot.profile.source,
+            }
+        )
+    lines = []
+    for row in rows:
+        limits = ", ".join("none" if not np.isfinite(x) else f"{x:g}" for x in row["torque_limits"])
+        lines.append(
+            f"{row['name']:16s} nq = {row['nq']}, nv = {row['nv']}, gravity {fmt(row['gravity'], 2)} m/s², "
+            f"effort limits ({limits}) N·m — {row['description']}"
+        )
+    lines.append(
+        "effort limit 'none': the URDF gives none (or 0); no torque check or saturation on that joint"
+    )
+    emit(args, {"robots": rows}, "\n".join(lines))
+    return 0
+
+
+def cmd_controllers(args: argparse.Namespace) -> int:
+    from dataclasses import fields
+
+    from twolink_pin.controllers import available_controllers
+    from twolink_pin.controllers.gains import _spec
+
+    rows = []
+    for name, cls in available_controllers().items():
+        gains = [
+            {
+                "name": f.name,
+                "per": _spec(f).per,
+                "unit": _spec(f).unit,
+                "default": f.default,
+                "doc": _spec(f).doc,
+            }
+            for f in fields(cls.Gains)
+        ]
+        rows.append(
+            {
+                "name": name,
+                "title": cls.title,
+                "class": f"{cls.__module__}:{cls.__qualname__}",
+                "estimates": list(cls.estimates),
+                "gains": gains,
+            }
+        )
+    lines = []
+    for row in rows:
+        gains = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
+        lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {gains}")
+    emit(args, {"controllers": rows}, "\n".join(lines))
+    return 0
+
+
+def cmd_fk(args: argparse.Namespace) -> int:
+    from twolink_pin.kinematics import joint_positions
+
+    robot = _robot(args)
+    q = np.array(args.q, dtype=float)
+    if q.shape != (robot.nq,):
+        raise InvalidParameterError(
+            "Q", args.q, f"{robot.nq} joint angles [rad] for {robot.name} (nq = {robot.nq})"
+        )
+    position = joint_positions(robot, q)[-1]
+    emit(
+        args,
+        {"position": position.tolist(), "xy": position[:2].tolist()},
+        f"end effector at {fmt(position)} m for q = {fmt(q)} rad",
+    )
+    return 0
+
+
+def cmd_ik(args: argparse.Namespace) -> int:
+    from twolink_pin.kinematics import inverse_kinematics
+
+    robot = _robot(args)
+    sols = inverse_kinematics(robot, (args.x, args.y))
+    text = "\n".join(
+        f"{label}: q = {fmt(s)} rad" for label, s in zip(("elbow q2 >= 0", "elbow q2 <= 0"), sols)
+    )
+    emit(args, {"solutions": sols.tolist()}, text)
+    return 0
+
+
+def cmd_trajectory(args: argparse.Namespace) -> int:
+    from twolink_pin.feasibility import check_torques
+    from twolink_pin.trajectory import default_trajectory, default_via_points
+
+    robot = _robot(args)
+    traj = default_trajectory(robot)
+    via = default_via_points(robot)
+    check = check_torques(robot, traj)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.plotting import save_trajectory_figures
+
+        figures = [str(p) for p in save_trajectory_figures(robot, traj, check, Path(args.plot))]
+    payload = {
+        "times": traj.times.tolist(),
+        "via_xy": None if via is None else [list(p) for p in via.xy],
+        "via_q": traj.via_q.tolist(),
+        "coefficients": traj.coefficients.tolist(),
+        "peak_torque": check.peak.tolist(),
+        "peak_time": check.peak_time.tolist(),
+        "torque_limits": check.limits.tolist(),
+        "margin": check.margin.tolist(),
+        "within_limits": check.within_limits,
+        "figures": figures,
+    }
+    lines = ["via points (t [s], q [rad]" + (", end effector (x, y) [m])" if via is not None else ")") + ":"]
+    for k, (t, q) in enumerate(zip(traj.times, traj.via_q)):
+        lines.append(f"  {t:5.2f}  {fmt(q)}" + (f"  {fmt(via.xy[k], 3)}" if via is not None else ""))
+    for j, c in enumerate(traj.coefficients):
+        terms = " ".join(f"{x:+.5g}" for x in c)
+        lines.append(f"q{j + 1}(t) coefficients, ascending powers of t: {terms}")
+    lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
+    lines.append(check.verdict())
+    lines += [f"figure {f}" for f in figures]
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any]:
+    return {
+        "controller": result.controller,
+        "robot": result.robot,
+        "duration": result.duration,
+        "dt": result.dt,
+        "metrics": metrics.as_dict(),
+        "peak_torque": np.abs(result.tau).max(axis=0).tolist(),
+        "peak_command": np.abs(result.tau_command).max(axis=0).tolist(),
+        "torque_limits": result.torque_limits.tolist(),
+        "limit_exceeded": result.limit_exceeded.tolist(),
+        "limit_exceeded_at": result.first_exceeded_at,
+        "parameter_names": list(result.parameter_names),
+        "p_true": None if result.p_true is None else result.p_true.tolist(),
+        "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
+    }
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from twolink_pin.metrics import compute_metrics
+
+    robot = _robot(args)
+    result = _run_one(args, args.controller, robot)
+    metrics = compute_metrics(result)
+    payload = _result_payload(result, metrics)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.plotting import save_simulation_figures
+
+        figures = [str(p) for p in save_simulation_figures(result, Path(args.plot))]
+    if args.save:
+        from twolink_pin.simulation.storage import save_result
+
+        save_result(result, args.save)
+    payload["figures"] = figures
+    lines = [
+        f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
+        f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
+        f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
+        f"  last period max |e| {fmt(metrics.final_period_max_abs_e, 8)} rad",
+    ]
+    for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
+        if over:
+            lines.append(
+                f"  joint {j + 1}: commanded torque exceeded its {result.torque_limits[j]:g} N·m limit "
+                f"(first at t = {at:.3f} s, by up to {result.limit_excess[j]:.3g} N·m"
+                + (
+                    ", clipped by the plant)"
+                    if result.saturate
+                    else "; not saturated: add --saturate to clip)"
+                )
+            )
+    if not np.isfinite(result.torque_limits).any():
+        lines.append("  no effort limits in the model: torques are not checked against limits")
+    if result.p_hat is not None and result.p_true is not None:
+        if len(result.parameter_names) <= 8:
+            lines.append(f"  p_hat(end) {fmt(result.p_hat[-1])}  true {fmt(result.p_true)}")
+        else:
+            err = np.abs(result.p_hat[-1] - result.p_true)
+            lines.append(
+                f"  {len(result.parameter_names)} estimates; max |p_hat − p| at the end {err.max():.4g}"
+            )
+    lines += [f"  figure {f}" for f in figures]
+    if args.save:
+        lines.append(f"  saved {args.save}")
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from twolink_pin.controllers import CONTROLLERS
+    from twolink_pin.files import output_directory
+    from twolink_pin.scenario import law_class
+    from twolink_pin.studies.comparison import run_comparison
+
+    robot = _robot(args)
+    specs = args.controllers or [
+        n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
+    ]
+    names = [law_class(s).name for s in specs]
+    if len(set(names)) != len(names):
+        raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
+    by_name = dict(zip(names, specs))
+    args.lambda_optional = True
+    with output_directory(args.out, ".twolink-pin-compare") as stage:
+        bar = progress_bar(len(names), "run", "compare")
+
+        def on_result(name: str, result: SimulationResult) -> None:
+            if not args.no_plot:
+                from twolink_pin.plotting import save_simulation_figures
+
+                save_simulation_figures(
+                    result, stage / "figures", prefix=name, title=law_class(by_name[name]).title
+                )
+
+        def progress(name: str, result: SimulationResult | None) -> None:
+            if result is not None:
+                bar.update(1)
+            else:
+                bar.set_postfix_str(name)
+
+        try:
+            table = run_comparison(lambda n: _run_one(args, by_name[n], robot), names, progress, on_result)
+        finally:
+            bar.close()
+        files = [Path(args.out) / p.name for p in table.write(stage)]
+    payload = table.as_dict() | {"files": [str(f) for f in files]}
+    emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
+    return 0
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    import signal
+
+    robot = _robot(args)
+    if args.from_file:
+        from twolink_pin.simulation.storage import load_result
+
+        result = load_result(args.from_file)
+        if result.q.shape[1] != robot.nq:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                f"a result for {robot.name} (nq = {robot.nq}); it has {result.q.shape[1]} joints",
+            )
+    elif args.controller is None:
+        raise InvalidParameterError(
+            "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
+        )
+    else:
+        result = _run_one(args, args.controller, robot)
+    from twolink_pin.trajectory import default_via_points
+
+    via = default_via_points(robot)
+    points = None if via is None else np.array(via.xy)
+    if args.html:
+        from twolink_pin.visualization import write_html
+
+        path = write_html(
+            robot, result.t, result.q, result.q_des, path=args.html, via_points=points, loop=args.loop
+        )
+        emit(args, {"html": str(path), "controller": result.controller}, f"animation written to {path}")
+        return 0
+    from twolink_pin.visualization import serve
+
+    def _stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, _stop)  # a service manager's stop shuts down as cleanly as Ctrl-C
+    with serve(
+        robot,
+        result.t,
+        result.q,
+        result.q_des,
+        via_points=points,
+        host=args.host,
+        port=args.port,
+        loop=args.loop,
+        open_browser=not args.no_browser,
+        quiet=True,
+    ) as viewer:
+        emit(
+            args,
+            {"url": viewer.url, "host": viewer.host, "port": viewer.port},
+            f"meshcat viewer at {viewer.url}",
+        )
+        print("press Ctrl-C to stop", file=sys.stderr, flush=True)
+        try:
+            threading.Event().wait()
+        except KeyboardInterrupt:
+            print("stopping the viewer", file=sys.stderr)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from twolink_pin.report import ReportOptions, build_report
+
+    options = ReportOptions(
+        robot=args.robot,
+        payload=args.payload,
+        config=_config(args),
+        lam=args.lam,
+        saturate=args.saturate,
+        friction_smoothing=_smoothing(args),
+        controllers=None if args.controllers is None else tuple(args.controllers),
+        workers=args.workers,
+        animation=not args.no_animation,
+    )
+    command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
+    bar = progress_bar(1, "step", "report")
+
+    def progress(what: str, done: int, total: int) -> None:
+        bar.total = total
+        bar.set_postfix_str(what)
+        bar.update(done - bar.n)
+
+    try:
+        results = build_report(args.out, options, progress=progress, command_line=command)
+    finally:
+        bar.close()
+    index = Path(args.out) / "index.html"
+    emit(
+        args,
+        {"index": str(index), "total_seconds": results["total_seconds"]},
+        f"report written to {index} in {results['total_seconds']:.1f} s",
+    )
+    return 0
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from twolink_pin.studies.sweep import SweepConfig, run_sweep
+    from twolink_pin.trajectory import default_trajectory
+
+    robot = _robot(args)
+    config = SweepConfig(
+        controller=args.controller,
+        samples=args.samples,
+        seed=args.seed,
+        q0_spread=args.q0_spread,
+        param_error=args.param_error,
+        gains=tuple(args.gain),
+        simulation=_config(args),
+        lam=args.lam,
+        saturate=args.saturate,
+        friction_smoothing=_smoothing(args),
+        chunk=args.chunk,
+        threads=args.threads,
+    )
+    bar = progress_bar(config.samples, "run", f"sweep {config.controller}")
+
+    def progress(done: int, total: int) -> None:
+        bar.update(done - bar.n)
+
+    try:
+        output = run_sweep(
+            config,
+            robot,
+            default_trajectory(robot),
+            args.out,
+            progress=progress,
+            keep_trajectories=args.keep_trajectories,
+            plot=not args.no_plot,
+        )
+    finally:
+        bar.close()
+    summary = output.summary
+    if args.json:
+        emit(args, {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}, "")
+        return 0
+    lines = [
+        f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
+        f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
+        f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
+    ]
+    for name, stat in summary["metrics"].items():
+        cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
+        lines.append(f"  {name:28s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
+    lines += [f"  wrote {f}" for f in output.files]
+    emit(args, {}, "\n".join(lines))
+    return 0

@@ -1,0 +1,58 @@
+"""What the CLI prints: text or JSON on stdout, progress on stderr, errors as one line."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+
+def jsonable(obj: Any) -> Any:
+    """``obj`` with numpy values as Python ones and non-finite floats (an absent torque limit
+    is inf) as None, so ``json.dumps(allow_nan=False)`` accepts it."""
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    return obj
+
+
+def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
+    """Print ``payload`` as one JSON line with ``--json``, else ``text``."""
+    if getattr(args, "json", False):
+        sys.stdout.write(json.dumps(jsonable(payload), allow_nan=False) + "\n")
+    else:
+        sys.stdout.write(text + "\n")
+    sys.stdout.flush()
+
+
+def fmt(values: Sequence[float] | np.ndarray, digits: int = 4) -> str:
+    """``(x1, x2, ...)`` with ``digits`` decimals; inf as "none"."""
+    return "(" + ", ".join("none" if not math.isfinite(x) else f"{x:.{digits}f}" for x in values) + ")"
+
+
+def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any:
+    """A tqdm bar on stderr (the one progress display): done, rate and ETA."""
+    from tqdm import tqdm
+
+    return tqdm(
+        total=total,
+        unit=unit,
+        desc=desc,
+        file=sys.stderr,
+        disable=disable,
+        dynamic_ncols=True,
+        mininterval=0.5,
+    )

@@ -1,0 +1,342 @@
+"""The ``twolink-pin`` argument parser: commands, options and the types that check numbers."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import re
+from collections.abc import Callable
+from typing import Any, NoReturn
+
+CONTROLLER_HELP = (
+    "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
+    "or package.module:ClassName"
+)
+ROBOT_HELP = (
+    "robot: a catalog name (twolink-pin robots lists them) or a path to a .urdf file (default twolink)"
+)
+NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+"""A negative number in any float spelling (``-1``, ``-.5``, ``-1e-3``): a value, not an option."""
+MAX_TEXT = 200
+"""Longest option value echoed back in an error message."""
+
+
+class Parser(argparse.ArgumentParser):
+    """An ArgumentParser whose usage errors are one line on stderr and exit 2, and that reads
+    ``-1e-3`` as a number rather than an unknown option."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NUMBER  # argparse's own misses exponents (-1e-3)
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message[: 2 * MAX_TEXT]}\n")
+
+
+def _shown(text: str) -> str:
+    return repr(text if len(text) <= MAX_TEXT else text[:MAX_TEXT] + "…")
+
+
+def finite(text: str) -> float:
+    """A finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {_shown(text)}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {_shown(text)}")
+    return value
+
+
+def bounded(low: float, high: float, *, low_open: bool = False, unit: str = "") -> Callable[[str], float]:
+    """A finite number in ``[low, high]`` (``(low, high]`` with ``low_open``)."""
+
+    def parse(text: str) -> float:
+        value = finite(text)
+        ok = (value > low if low_open else value >= low) and value <= high
+        if not ok:
+            left = "(" if low_open else "["
+            raise argparse.ArgumentTypeError(
+                f"expected a number in {left}{low:g}, {high:g}]{' ' + unit if unit else ''}, got {_shown(text)}"
+            )
+        return value
+
+    return parse
+
+
+def whole(low: int, high: int) -> Callable[[str], int]:
+    """A whole number in ``[low, high]``."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {_shown(text)}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(
+                f"expected a whole number from {low} to {high}, got {_shown(text)}"
+            )
+        return value
+
+    return parse
+
+
+def gain_range(text: str) -> Any:
+    """``NAME=LO:HI`` as a :class:`~twolink_pin.studies.sweep.GainRange`."""
+    from twolink_pin.errors import InvalidParameterError
+    from twolink_pin.studies.sweep import GainRange
+
+    try:
+        return GainRange.parse(text)
+    except InvalidParameterError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def port(text: str) -> int:
+    """A TCP port, 0..65535 (0: any free port)."""
+    return whole(0, 65535)(text)
+
+
+MAX_DURATION = 1e6
+"""Largest simulated time accepted on the command line [s] (the step count is bounded too)."""
+MAX_PAYLOAD = 1e4
+"""Largest payload accepted on the command line [kg]."""
+MAX_OFFSET = 100.0
+"""Largest initial offset accepted on the command line [rad]."""
+MAX_GAIN = 1e12
+"""Largest gain accepted on the command line (any unit)."""
+
+
+def add_robot_options(p: argparse.ArgumentParser, json_flag: bool = True) -> None:
+    p.add_argument("--robot", "--urdf", dest="robot", metavar="NAME|PATH", help=ROBOT_HELP)
+    p.add_argument(
+        "--payload",
+        type=bounded(0.0, MAX_PAYLOAD, unit="kg"),
+        default=0.0,
+        help="point mass at the end effector [kg] (0 to 1e4)",
+    )
+    if json_flag:
+        p.add_argument("--json", action="store_true", help="print JSON instead of text")
+
+
+def add_sim_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--duration",
+        type=bounded(0.0, MAX_DURATION, low_open=True, unit="s"),
+        default=30.0,
+        help="simulated time [s] (default 30)",
+    )
+    p.add_argument(
+        "--dt",
+        type=bounded(0.0, 1.0, low_open=True, unit="s"),
+        default=1e-3,
+        help="RK4 step / output spacing [s] (default 0.001)",
+    )
+    p.add_argument(
+        "--lambda",
+        dest="lam",
+        type=bounded(0.0, MAX_GAIN, low_open=True, unit="1/s"),
+        default=None,
+        help="λ of the laws that have one [1/s] (their default: 5)",
+    )
+    p.add_argument(
+        "--q0-offset",
+        nargs="+",
+        type=bounded(-MAX_OFFSET, MAX_OFFSET, unit="rad"),
+        default=None,
+        metavar="RAD",
+        help="q(0) − q_des(0) [rad]: one value for every joint or one per joint (default: the robot's, twolink 0.1 −0.1)",
+    )
+    p.add_argument("--saturate", action="store_true", help="clip torques at the URDF effort limits")
+    p.add_argument("--method", choices=("rk4", "adaptive"), default="rk4", help="integrator (default rk4)")
+    p.add_argument(
+        "--control-period",
+        type=bounded(0.0, MAX_DURATION, low_open=True, unit="s"),
+        default=None,
+        metavar="T",
+        help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
+    )
+    p.add_argument(
+        "--friction-smoothing",
+        type=bounded(0.0, 1e3, unit="rad/s"),
+        default=None,
+        metavar="EPS",
+        help="ε [rad/s] of tanh(v/ε) for Coulomb friction (default: exact sgn with rk4, 1e-3 with adaptive)",
+    )
+
+
+def add_gain_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--gain",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="set a gain of the law: one value for all joints or comma-separated per joint, e.g. kp=200 or kd=30,40 (repeatable)",
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``twolink-pin`` argument parser."""
+    from twolink_pin.cli import commands as c
+    from twolink_pin.studies.sweep import MAX_CHUNK, MAX_SAMPLES
+
+    parser = Parser(
+        prog="twolink-pin",
+        description="Kinematics, dynamics and tracking control of robot arms on Pinocchio.",
+    )
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
+
+    p = sub.add_parser("info", help="model summary: sizes, link lengths, torque limits, parameters")
+    p.add_argument("--write-urdf", metavar="FILE", help="also write the payload variant as a URDF file")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_info)
+
+    p = sub.add_parser("robots", help="the named robots: nq, nv, gravity, effort limits")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=c.cmd_robots)
+
+    p = sub.add_parser("controllers", help="the registered control laws, their gains and units")
+    p.add_argument("--json", action="store_true", help="print JSON instead of text")
+    p.set_defaults(func=c.cmd_controllers)
+
+    p = sub.add_parser(
+        "fk", help="forward kinematics: end-effector position [m] from q [rad] (one angle per joint)"
+    )
+    p.add_argument("q", nargs="+", type=finite, metavar="Q", help="joint angles [rad], one per joint")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_fk)
+
+    p = sub.add_parser("ik", help="inverse kinematics of a planar 2R arm: both elbow branches for (x, y) [m]")
+    p.add_argument("x", type=finite, help="x [m]")
+    p.add_argument("y", type=finite, help="y [m]")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_ik)
+
+    p = sub.add_parser(
+        "trajectory", help="the robot's reference trajectory, its coefficients and the torque check"
+    )
+    p.add_argument("--plot", metavar="DIR", help="write the trajectory's figures as PNG into DIR")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_trajectory)
+
+    p = sub.add_parser("simulate", help="closed-loop simulation of one control law")
+    p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
+    add_sim_options(p)
+    add_gain_option(p)
+    p.add_argument("--plot", metavar="DIR", help="write the run's figures into DIR")
+    p.add_argument("--save", metavar="FILE.npz", help="save the result (for animate --from)")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_simulate)
+
+    p = sub.add_parser(
+        "compare", help="several laws on one robot: the comparison table (md, csv, json) and figures"
+    )
+    p.add_argument(
+        "controllers",
+        nargs="*",
+        metavar="CONTROLLER",
+        help=f"{CONTROLLER_HELP} (default: every built-in law)",
+    )
+    add_sim_options(p)
+    p.add_argument(
+        "--out", default="out/compare", metavar="DIR", help="output directory (default out/compare)"
+    )
+    p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_compare)
+
+    p = sub.add_parser("animate", help="the tracked motion in meshcat: live in the browser, or one HTML file")
+    p.add_argument("controller", nargs="?", metavar="CONTROLLER", help=CONTROLLER_HELP)
+    add_sim_options(p)
+    add_gain_option(p)
+    p.add_argument(
+        "--from", dest="from_file", metavar="FILE.npz", help="animate a saved result (simulate --save)"
+    )
+    p.add_argument(
+        "--html", metavar="FILE", help="write one self-contained HTML animation instead of serving"
+    )
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)"
+    )
+    p.add_argument("--port", type=port, default=None, help="port of the viewer (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.add_argument("--loop", action="store_true", help="repeat the motion")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_animate)
+
+    p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
+    p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
+    add_sim_options(p)
+    p.add_argument(
+        "--controller",
+        dest="controllers",
+        action="append",
+        default=None,
+        metavar="CONTROLLER",
+        help="a law to run (repeatable; default: the report's five on the twolink, every built-in law elsewhere)",
+    )
+    p.add_argument(
+        "--workers", type=whole(1, 64), default=2, help="processes for the runs (1 to 64, default 2)"
+    )
+    p.add_argument("--no-animation", action="store_true", help="skip the 3-D animation")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_report)
+
+    p = sub.add_parser(
+        "sweep", help="Monte Carlo study of one law on the batch engine: table, summary, histograms"
+    )
+    p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
+    p.add_argument(
+        "--samples",
+        type=whole(1, MAX_SAMPLES),
+        required=True,
+        metavar="N",
+        help=f"number of runs (1 to {MAX_SAMPLES})",
+    )
+    p.add_argument(
+        "--seed",
+        type=whole(0, 2**63 - 1),
+        default=0,
+        help="random seed >= 0 (default 0): same seed, same files",
+    )
+    p.add_argument(
+        "--q0-spread",
+        type=bounded(0.0, MAX_OFFSET, unit="rad"),
+        default=0.0,
+        metavar="RAD",
+        help="initial error q0-offset ± U(RAD) per joint [rad] (default 0)",
+    )
+    p.add_argument(
+        "--param-error",
+        type=bounded(0.0, 0.999999, unit=""),
+        default=0.0,
+        metavar="FRAC",
+        help="the law believes p·(1 + U(±FRAC)) per parameter (0 to <1, default 0)",
+    )
+    p.add_argument(
+        "--gain",
+        type=gain_range,
+        action="append",
+        default=[],
+        metavar="NAME=LO:HI",
+        help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
+    )
+    p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
+    p.add_argument(
+        "--threads", type=whole(1, 256), default=None, help="threads of the batch engine (default all cores)"
+    )
+    p.add_argument(
+        "--chunk",
+        type=whole(1, MAX_CHUNK),
+        default=1000,
+        metavar="N",
+        help=f"runs per batch (1 to {MAX_CHUNK}, default 1000)",
+    )
+    p.add_argument(
+        "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
+    )
+    p.add_argument("--no-plot", action="store_true", help="skip distributions.png")
+    add_sim_options(p)
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_sweep)
+    return parser

@@ -1,0 +1,194 @@
+"""Gains of a control law: a frozen dataclass whose fields declare their shape and unit.
+
+A law's gains class subclasses :class:`Gains` and declares each field with :func:`gain`::
+
+    @dataclass(frozen=True, eq=False)
+    class SlidingModeGains(Gains):
+        k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
+        lam: Any = gain(5.0, unit="1/s", doc="λ in s = ė + λ e")
+
+``per`` says what one value is for: ``"scalar"`` (one number), ``"joint"`` (one per joint,
+or a scalar for all joints) or ``"estimate"`` (one per estimated parameter, or a scalar).
+Validation on construction turns every value into a float or a read-only float array and
+names the field, the value and what was expected on error. Any field may also hold one
+value **per run** — a leading batch axis, shape ``(N, k)`` (``(N,)`` for a scalar field,
+stored as ``(N, 1)``) — so that one law object drives N runs of a batch with N gain sets:
+the law's arithmetic broadcasts, it never sees N.
+
+A per-joint or per-estimate field may default to ``None``: the law then derives the value
+from the robot (its ``scaled_gains``), or the robot's profile supplies one
+(:attr:`twolink_pin.model.RobotModel.gain_presets`, e.g. the course report's gains for
+the twolink).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import MISSING, dataclass, field, fields
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from twolink_pin.errors import InvalidParameterError
+
+SHAPES = ("scalar", "joint", "estimate")
+"""What one value of a gain is for."""
+BOUNDS = ("positive", "nonnegative", "any")
+"""Sign constraints a gain may declare."""
+
+
+class GainSpec(NamedTuple):
+    """What :func:`gain` records in a field's metadata."""
+
+    per: str
+    """One of :data:`SHAPES`."""
+    unit: str
+    """SI unit of the gain (``""`` for a pure number)."""
+    bound: str
+    """One of :data:`BOUNDS`."""
+    doc: str
+    """One-line description."""
+
+
+def gain(default: Any, *, per: str = "scalar", unit: str = "", bound: str = "positive", doc: str = "") -> Any:
+    """A gains field with its default, shape, unit and sign constraint.
+
+    Args:
+        default: The default value (a number, a tuple, or ``None`` for per-joint or
+            per-estimate gains derived from the robot).
+        per: ``"scalar"``, ``"joint"`` or ``"estimate"``.
+        unit: SI unit, e.g. ``"N·m/rad"``.
+        bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0) or ``"any"``.
+        doc: One-line description (shown by the CLI and the report).
+    """
+    if per not in SHAPES:
+        raise ValueError(f"per must be one of {SHAPES}, got {per!r}")
+    if bound not in BOUNDS:
+        raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
+    if default is None and per == "scalar":
+        raise ValueError("a scalar gain needs a default value")
+    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc)})
+
+
+def spec_of(gains_type: type[Gains] | Gains, name: str) -> GainSpec:
+    """The :class:`GainSpec` of field ``name``."""
+    for f in fields(gains_type):
+        if f.name == name:
+            return _spec(f)
+    raise KeyError(name)
+
+
+def _spec(f: Any) -> GainSpec:
+    spec = f.metadata.get("gain")
+    if spec is None:  # a plain dataclass field: a positive scalar without unit
+        return GainSpec("scalar", "", "positive", "")
+    return spec  # type: ignore[no-any-return]
+
+
+def _expected(spec: GainSpec) -> str:
+    sign = {"positive": " > 0", "nonnegative": " >= 0", "any": ""}[spec.bound]
+    unit = f" [{spec.unit}]" if spec.unit else ""
+    return {
+        "scalar": f"a finite number{sign}{unit} (or one per run)",
+        "joint": f"finite numbers{sign}{unit}: one for every joint or one per joint (or a row per run)",
+        "estimate": f"finite numbers{sign}{unit}: one for every estimated parameter or one each (or a row per run)",
+    }[spec.per]
+
+
+def _validate(name: str, value: Any, spec: GainSpec) -> Any:
+    if value is None:
+        if spec.per == "scalar":
+            raise InvalidParameterError(name, value, _expected(spec))
+        return None
+    if isinstance(value, bool):
+        raise InvalidParameterError(name, value, _expected(spec))
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, value, _expected(spec)) from None
+    allowed = (0, 1) if spec.per == "scalar" else (0, 1, 2)
+    if array.ndim not in allowed or array.size == 0:
+        raise InvalidParameterError(name, value, f"{_expected(spec)} (got shape {array.shape})")
+    bad = ~np.isfinite(array)
+    if spec.bound == "positive":
+        bad |= ~(array > 0)
+    elif spec.bound == "nonnegative":
+        bad |= ~(array >= 0)
+    if bad.any():
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        where = f"{name}[{', '.join(map(str, index))}]" if index else name
+        raise InvalidParameterError(where, float(array[index]), _expected(spec))
+    if array.ndim == 0:
+        return float(array)
+    if spec.per == "scalar":  # one value per run: a column, so it broadcasts against (N, k)
+        array = array.reshape(-1, 1)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class Gains:
+    """Base class of every law's gains (see the module docstring)."""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            object.__setattr__(self, f.name, _validate(f.name, getattr(self, f.name), _spec(f)))
+
+    def values(self) -> dict[str, Any]:
+        """Field name → value (float, array or None)."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def describe(self, digits: int = 4) -> str:
+        """``kp = (350, 300) N·m/rad, kd = ...``: every field with its unit."""
+        parts = []
+        for f in fields(self):
+            value, spec = getattr(self, f.name), _spec(f)
+            if value is None:
+                text = "from the robot"
+            elif isinstance(value, float):
+                text = f"{value:.{digits}g}"
+            else:
+                flat = np.asarray(value).ravel()
+                text = (
+                    "("
+                    + ", ".join(f"{x:.{digits}g}" for x in flat[:12])
+                    + (", …)" if flat.size > 12 else ")")
+                )
+            parts.append(f"{f.name} = {text}{' ' + spec.unit if spec.unit else ''}")
+        return ", ".join(parts)
+
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        """The gains' field names, in order."""
+        return tuple(f.name for f in fields(cls))
+
+    @classmethod
+    def defaults(cls) -> dict[str, Any]:
+        """Field name → declared default."""
+        return {f.name: (None if f.default is MISSING else f.default) for f in fields(cls)}
+
+
+def runs_of(value: Any) -> int | None:
+    """The number of runs a validated gain value holds (its leading axis), or None if it
+    is the same for every run."""
+    if isinstance(value, np.ndarray) and value.ndim == 2:
+        return int(value.shape[0])
+    return None
+
+
+def check_width(name: str, value: Any, width: int, what: str) -> None:
+    """Raise unless ``value`` (validated) is a scalar, ``width`` values, or per run one or
+    ``width`` values (shape ``(N, 1)`` or ``(N, width)``)."""
+    if value is None or isinstance(value, float):
+        return
+    ok = value.shape == (width,) if value.ndim == 1 else value.shape[1] in (1, width)
+    if not ok:
+        shown = value.tolist() if value.size <= 24 else f"array of shape {value.shape}"
+        raise InvalidParameterError(
+            name, shown, f"one value or {width} ({what}), or one row of them per run; got shape {value.shape}"
+        )
+
+
+def is_finite_number(x: Any) -> bool:
+    """Whether ``x`` is an int or float (not a bool) and finite."""
+    return isinstance(x, (int, float)) and not isinstance(x, bool) and math.isfinite(x)

@@ -1,0 +1,141 @@
+"""Finding a control law from what a user typed: a name, ``file.py:Class`` or ``module:Class``.
+
+* a registered name (``pd``, ``adaptive``, …, or one a plug-in registered);
+* ``path/to/file.py:ClassName`` — the file is imported as a module of its own (its
+  directory is not put on ``sys.path``) and the class is taken from it;
+* ``package.module:ClassName`` — imported with :func:`importlib.import_module`;
+* installed packages add laws through the entry-point group
+  :data:`ENTRY_POINT_GROUP` (``name = "package.module:ClassName"``), loaded on first use.
+
+Every failure is a :class:`~twolink_pin.errors.ControllerSpecError` naming the reference
+and what is wrong (missing file, no such class, not a controller, the file raised).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import importlib.metadata
+import importlib.util
+import inspect
+import sys
+from pathlib import Path
+
+from twolink_pin.controllers.base import CONTROLLERS, Controller
+from twolink_pin.errors import ControllerSpecError
+
+ENTRY_POINT_GROUP = "twolink_pin.controllers"
+"""Entry-point group through which installed packages add control laws."""
+
+_entry_points_loaded = False
+
+
+def load_entry_points() -> list[str]:
+    """Import every law registered through :data:`ENTRY_POINT_GROUP` (once); returns the
+    problems met, one line each (a broken plug-in must not break the built-in laws)."""
+    global _entry_points_loaded
+    problems: list[str] = []
+    if _entry_points_loaded:
+        return problems
+    _entry_points_loaded = True
+    for entry in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
+        try:
+            cls = entry.load()
+        except Exception as exc:  # a plug-in's own failure: reported, not fatal
+            problems.append(f"entry point {entry.name} = {entry.value}: {type(exc).__name__}: {exc}")
+            continue
+        if not (inspect.isclass(cls) and issubclass(cls, Controller)):
+            problems.append(f"entry point {entry.name} = {entry.value}: not a Controller subclass")
+    return problems
+
+
+def available_controllers() -> dict[str, type[Controller]]:
+    """Every law that can be named: the built-in ones and the installed plug-ins."""
+    import twolink_pin.controllers  # noqa: F401  # the built-in laws register on import
+
+    load_entry_points()
+    return dict(CONTROLLERS)
+
+
+def _from_file(spec: str, file_part: str, class_name: str) -> type:
+    path = Path(file_part).expanduser()
+    if not path.is_file():
+        reason = "no such file" if not path.exists() else "not a regular file"
+        raise ControllerSpecError(spec, f"{reason}: {path}")
+    if path.suffix != ".py":
+        raise ControllerSpecError(spec, f"expected a Python file ending in .py, got {path.name}")
+    resolved = path.resolve()
+    digest = hashlib.sha1(str(resolved).encode()).hexdigest()[:10]
+    module_name = f"twolink_pin_user_{resolved.stem}_{digest}"
+    module = sys.modules.get(module_name)
+    if module is None:
+        loader_spec = importlib.util.spec_from_file_location(module_name, resolved)
+        if loader_spec is None or loader_spec.loader is None:  # pragma: no cover  # .py always has a loader
+            raise ControllerSpecError(spec, f"cannot import {path}")
+        module = importlib.util.module_from_spec(loader_spec)
+        sys.modules[module_name] = module
+        try:
+            loader_spec.loader.exec_module(module)
+        except ControllerSpecError:
+            sys.modules.pop(module_name, None)
+            raise
+        except BaseException as exc:
+            sys.modules.pop(module_name, None)
+            if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+                raise
+            raise ControllerSpecError(spec, f"importing {path} raised {type(exc).__name__}: {exc}") from exc
+    if not hasattr(module, class_name):
+        found = sorted(
+            n
+            for n, v in vars(module).items()
+            if inspect.isclass(v) and issubclass(v, Controller) and not inspect.isabstract(v)
+        )
+        raise ControllerSpecError(
+            spec, f"{path} has no class {class_name!r} (controllers in it: {found or 'none'})"
+        )
+    return getattr(module, class_name)  # type: ignore[no-any-return]
+
+
+def _from_module(spec: str, module_name: str, class_name: str) -> type:
+    try:
+        module = importlib.import_module(module_name)
+    except ImportError as exc:
+        raise ControllerSpecError(spec, f"cannot import module {module_name!r} ({exc})") from exc
+    except Exception as exc:
+        raise ControllerSpecError(
+            spec, f"importing {module_name!r} raised {type(exc).__name__}: {exc}"
+        ) from exc
+    if not hasattr(module, class_name):
+        raise ControllerSpecError(spec, f"module {module_name!r} has no class {class_name!r}")
+    return getattr(module, class_name)  # type: ignore[no-any-return]
+
+
+def load_controller(spec: str) -> type[Controller]:
+    """The control-law class ``spec`` refers to (see the module docstring).
+
+    Raises:
+        ControllerSpecError: no such law, file, module or class, or not a controller.
+    """
+    if not isinstance(spec, str) or not spec.strip():
+        raise ControllerSpecError(str(spec), "expected a law name, path/to/file.py:Class or module:Class")
+    known = available_controllers()
+    if spec in known:
+        return known[spec]
+    location, sep, class_name = spec.rpartition(":")
+    if not sep or not location or not class_name.isidentifier():
+        raise ControllerSpecError(
+            spec,
+            f"no law of that name; registered laws are {', '.join(known)}; or give path/to/file.py:Class "
+            "or package.module:Class",
+        )
+    is_file = location.endswith(".py") or "/" in location or "\\" in location
+    cls = _from_file(spec, location, class_name) if is_file else _from_module(spec, location, class_name)
+    if not (inspect.isclass(cls) and issubclass(cls, Controller)):
+        raise ControllerSpecError(spec, f"{class_name} is not a twolink_pin Controller subclass")
+    if inspect.isabstract(cls):
+        raise ControllerSpecError(
+            spec, f"{class_name} is abstract: it must implement compute(self, x, terms)"
+        )
+    if "name" not in cls.__dict__:
+        raise ControllerSpecError(spec, f"{class_name} must declare its own name = '...'")
+    return cls

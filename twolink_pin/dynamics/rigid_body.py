@@ -1,0 +1,104 @@
+"""Rigid-body dynamics from Pinocchio.
+
+The equation of motion is ``M(q) q̈ + C(q, q̇) q̇ + g(q) + f(q̇) = τ``. Every rigid-body
+term comes from Pinocchio on the loaded model:
+
+=====================  ==========================================
+``mass_matrix``        CRBA (``pin.crba``), symmetric
+``coriolis_matrix``    ``pin.computeCoriolisMatrix`` (Christoffel form: Ṁ − 2C skew)
+``inverse_dynamics``   RNEA (``pin.rnea``)
+``forward_dynamics``   ABA (``pin.aba``, world convention)
+``regressor``          ``pin.computeJointTorqueRegressor``, polarised (below)
+=====================  ==========================================
+
+Friction ``f`` is not in Pinocchio's algorithms: :mod:`twolink_pin.dynamics.friction`.
+All functions take the model and a ``pin.Data`` the caller owns (one per user).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+
+def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """Joint-space inertia ``M(q)`` [kg·m²], shape (nv, nv), symmetric (CRBA)."""
+    M = pin.crba(model, data, q)
+    return np.triu(M) + np.triu(M, 1).T
+
+
+def coriolis_matrix(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Coriolis/centrifugal matrix ``C(q, q̇)`` [kg·m²/s], shape (nv, nv), Christoffel form."""
+    return pin.computeCoriolisMatrix(model, data, q, v).copy()
+
+
+def gravity_torque(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
+    """Gravity torque ``g(q)`` [N·m], shape (nv,) (zero for the horizontal twolink)."""
+    return pin.computeGeneralizedGravity(model, data, q).copy()
+
+
+def inverse_dynamics(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """``τ = M(q) a + C(q, v) v + g(q)`` [N·m] by RNEA."""
+    return pin.rnea(model, data, q, v, a).copy()
+
+
+ABA_CONVENTION = pin.Convention.WORLD
+"""ABA's frame convention everywhere here: same result as LOCAL to rounding, and its Python
+call is ~10 % faster for the twolink (the plant's ABA is the simulator's largest cost)."""
+
+
+def forward_dynamics(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, tau: np.ndarray
+) -> np.ndarray:
+    """``q̈ = M(q)⁻¹ (τ − C(q, v) v − g(q))`` [rad/s²] by ABA."""
+    return pin.aba(model, data, q, v, tau, ABA_CONVENTION).copy()
+
+
+def model_torque(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """``M(q) a + C(q, v) w + g(q)`` [N·m]: RNEA plus the Coriolis matrix times ``w − v``.
+
+    The model term of every law that multiplies ``C(q, q̇)`` by a velocity other than
+    ``q̇`` (feedforward ``C q̇_d``, Slotine–Li ``C q̇_r``).
+    """
+    tau = pin.rnea(model, data, q, v, a).copy()
+    tau += pin.computeCoriolisMatrix(model, data, q, v) @ (w - v)
+    return tau
+
+
+def regressor(
+    model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray
+) -> np.ndarray:
+    """Inertial regressor ``Y_π`` with ``Y_π π = M(q) a + C(q, v) w + g(q)``.
+
+    Pinocchio's ``computeJointTorqueRegressor(q, v, a)`` only gives the case ``w = v``.
+    Slotine–Li control needs ``w = q̇_r ≠ v``. Because ``C`` is the Christoffel matrix,
+    ``C(q, v) w = Γ(v, w)`` is a symmetric bilinear form with ``Γ(x, x) = C(q, x) x``, so
+    by polarisation ``Γ(v, w) = [Γ(v + w, v + w) − Γ(v − w, v − w)] / 4`` and::
+
+        Y_π(q, v, w, a) = Y(q, 0, a) + [Y(q, v + w, 0) − Y(q, v − w, 0)] / 4
+
+    Args:
+        q: Configuration [rad]. v: Velocity in ``C(q, v)`` [rad/s].
+        w: Velocity multiplied by ``C`` [rad/s]. a: Acceleration [rad/s²].
+
+    Returns:
+        ``Y_π``, shape (nv, 10 (njoints − 1)).
+    """
+    zero = np.zeros(model.nv)
+    y = pin.computeJointTorqueRegressor(model, data, q, zero, a).copy()
+    y += 0.25 * pin.computeJointTorqueRegressor(model, data, q, v + w, zero)
+    y -= 0.25 * pin.computeJointTorqueRegressor(model, data, q, v - w, zero)
+    # Gravity is in all three calls; the difference cancels it, so it counts once.
+    return y
+
+
+def joint_inertia(model: pin.Model) -> np.ndarray:
+    """``diag M(q₀)`` [kg·m²] at the neutral configuration ``q₀``, armature included: the
+    inertia each joint moves, the scale that robot-derived default gains use."""
+    data = model.createData()
+    M = pin.crba(model, data, pin.neutral(model))
+    return np.array(np.diag(M), dtype=float)

@@ -1,0 +1,88 @@
+"""Robots by name: where each named robot's URDF is and its profile.
+
+``twolink`` is this package's arm (:mod:`twolink_pin.twolink`); the others come from the
+``example-robot-data`` package, located from its installed files. :func:`resolve` turns
+what a user typed (``--robot NAME|PATH.urdf``) into a URDF path and a profile.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from twolink_pin.errors import InvalidURDFError
+from twolink_pin.model.profile import RobotProfile, generic_profile
+
+
+def example_robot_urdf(relative: str) -> Path:
+    """Path of a URDF shipped by ``example-robot-data``.
+
+    Args:
+        relative: Path below the package's ``robots/`` folder, e.g.
+            ``"double_pendulum_description/urdf/double_pendulum.urdf"``.
+
+    Raises:
+        InvalidURDFError: the distribution is not installed or has no such file.
+    """
+    try:
+        files = importlib.metadata.files("example-robot-data") or []
+    except importlib.metadata.PackageNotFoundError:
+        raise InvalidURDFError(
+            relative, "example-robot-data", "not installed (pip install example-robot-data)"
+        ) from None
+    suffix = "robots/" + relative.lstrip("/")
+    for file in files:
+        if str(file).endswith(suffix):
+            return Path(str(file.locate()))
+    raise InvalidURDFError(
+        relative, "example-robot-data", f"no file ending in {suffix!r} in the installed distribution"
+    )
+
+
+def _twolink() -> tuple[Path, RobotProfile]:
+    from twolink_pin.twolink.profile import TWOLINK, twolink_urdf_path
+
+    return twolink_urdf_path(), TWOLINK
+
+
+CATALOG: dict[str, Callable[[], tuple[Path, RobotProfile]]] = {"twolink": _twolink}
+"""Named robots: name → a function giving its URDF path and profile."""
+
+
+def names() -> tuple[str, ...]:
+    """The catalog's robot names."""
+    return tuple(CATALOG)
+
+
+def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
+    """The URDF path and profile of ``robot``: a catalog name, or a path to a URDF file.
+
+    A path to a catalog robot's own URDF gets that robot's profile; any other file the
+    generic profile (:func:`~twolink_pin.model.profile.generic_profile`).
+
+    Raises:
+        InvalidURDFError: an unknown name (the message lists the valid ones).
+    """
+    if robot is None:
+        return _twolink()
+    text = os.fspath(robot)
+    if text in CATALOG:
+        return CATALOG[text]()
+    path = Path(text)
+    looks_like_path = path.suffix.lower() in (".urdf", ".xml") or os.sep in text or path.exists()
+    if not looks_like_path:
+        raise InvalidURDFError(
+            text,
+            "robot",
+            f"no robot of that name; named robots are {', '.join(CATALOG)}, or give a path to a .urdf file",
+        )
+    for entry in CATALOG.values():
+        own, profile = entry()
+        try:
+            if path.exists() and own.exists() and path.samefile(own):
+                return path, profile
+        except OSError:
+            continue
+    return path, generic_profile(path)

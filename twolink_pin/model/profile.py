@@ -1,0 +1,81 @@
+"""What a named robot brings beyond its URDF: data, no behaviour.
+
+A :class:`RobotProfile` is attached to every :class:`~twolink_pin.model.RobotModel`. For a
+robot of the catalog (:mod:`twolink_pin.model.catalog`) it names the URDF, the parameter
+map, the gains its maintainers recommend per law, the friction of its simulated plant, the
+initial tracking error and the default trajectory; for any other URDF it is
+:func:`generic_profile` (nothing preset: laws derive their gains from the robot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import pinocchio as pin
+
+    from twolink_pin.model.parameters import ParameterMap
+
+
+@dataclass(frozen=True)
+class TrajectorySpec:
+    """A periodic via-point trajectory, as data (built by :mod:`twolink_pin.trajectory`).
+
+    Exactly one of ``joint_points`` and ``cartesian_points`` is given.
+
+    Attributes:
+        times: Via-point times [s], strictly increasing.
+        joint_points: Joint positions [rad] at each time, one tuple of nv values each.
+        cartesian_points: End-effector positions [m] at each time: ``(x, y)`` for a planar
+            2R arm (analytic IK, elbow ``branch``) or ``(x, y, z)`` for any arm.
+        branch: Elbow branch of the planar 2R IK: 0 for ``q2 >= 0``, 1 for ``q2 <= 0``.
+        period: Repetition period [s]; ``None`` means the via-point span.
+    """
+
+    times: tuple[float, ...]
+    joint_points: tuple[tuple[float, ...], ...] | None = None
+    cartesian_points: tuple[tuple[float, ...], ...] | None = None
+    branch: int = 0
+    period: float | None = None
+
+
+@dataclass(frozen=True)
+class RobotProfile:
+    """A robot's name and the defaults the toolkit uses with it.
+
+    Attributes:
+        name: Short name (``twolink``, ``ur5``, or a URDF file's stem).
+        description: One line for listings.
+        parameter_map: Builds the map ``p`` from the Pinocchio model; ``None``: the loader's
+            default (all inertial parameters).
+        gain_presets: Per law name, gains field → value, used when a law is built on this
+            robot without explicit gains (e.g. the course report's gains on the twolink).
+        friction: ``(viscous [N·m·s/rad], coulomb [N·m])`` per joint of the plant that
+            friction-estimating laws run on; ``None``: no friction.
+        q0_offset: Default ``q(0) − q_d(0)`` [rad], one per joint; ``None``: zeros.
+        trajectory: The default reference; ``None``: built from the joint limits.
+        ee_frame: End-effector frame name; ``None``: ``ee_link`` if present, else the last
+            frame on the last joint.
+        package_dirs: Folders in which ``package://`` mesh paths are resolved.
+        source: Where the URDF comes from (shown by ``twolink-pin robots``).
+    """
+
+    name: str
+    description: str = ""
+    parameter_map: Callable[[pin.Model], ParameterMap] | None = None
+    gain_presets: Mapping[str, Mapping[str, Any]] = field(default_factory=lambda: MappingProxyType({}))
+    friction: tuple[tuple[float, ...], tuple[float, ...]] | None = None
+    q0_offset: tuple[float, ...] | None = None
+    trajectory: TrajectorySpec | None = None
+    ee_frame: str | None = None
+    package_dirs: tuple[Path, ...] = ()
+    source: str = ""
+
+
+def generic_profile(path: Path) -> RobotProfile:
+    """The profile of a URDF outside the catalog: named after the file, nothing preset."""
+    return RobotProfile(name=path.stem, description=f"URDF file {path}", source=str(path))

@@ -1,0 +1,31 @@
+"""Figures: the desired trajectory, one run, and distributions over many runs.
+
+The only part of the package that imports matplotlib. It never touches ``pyplot``: every
+figure is a :class:`matplotlib.figure.Figure` drawn by its own
+:class:`~matplotlib.backends.backend_agg.FigureCanvasAgg`, so no GUI backend is selected,
+no global figure registry holds on to anything, and a figure is freed once saved. Every
+file is written atomically (:func:`twolink_pin.files.atomic_write`). Figures know nothing
+of a particular report: a caller that wants "cf. report Fig. N" in the titles passes
+``figure_numbers`` (figure key → number), and the law's long name as ``title``.
+
+===================  =====================================================================
+``_style.py``        sizes, DPI, colours; the Agg figure, atomic saving, titles, limit
+                     lines, annotation placement, the max-|e| envelope
+``trajectory.py``    :func:`save_trajectory_figures`: each joint's desired motion, the arm
+                     and end-effector path (x-y), the desired torque against the limits
+``run.py``           :func:`save_simulation_figures`: one run's states, torques, and the
+                     inertial / friction parameter errors (as the result declares them)
+``distribution.py``  :func:`save_distribution_figure`: histograms of metrics over a sweep
+===================  =====================================================================
+
+Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,
+``_distribution_figure``) returns the :class:`Figure` objects keyed by file suffix, so
+tests can check what is drawn. Units: time [s], angles [rad], rates [rad/s], positions
+[m], torques [N·m].
+"""
+
+from twolink_pin.plotting.distribution import save_distribution_figure
+from twolink_pin.plotting.run import save_simulation_figures
+from twolink_pin.plotting.trajectory import save_trajectory_figures
+
+__all__ = ["save_distribution_figure", "save_simulation_figures", "save_trajectory_figures"]

@@ -1,0 +1,207 @@
+"""What every figure shares: sizes, colours, the non-GUI figure, atomic saving, titles,
+and the helpers that place limit lines, notes and annotations.
+
+Figures are :class:`matplotlib.figure.Figure` objects with their own
+:class:`~matplotlib.backends.backend_agg.FigureCanvasAgg` (never ``pyplot``): no GUI
+backend is selected, no global registry holds a figure, and a figure is freed as soon as
+it is no longer referenced. Sizes [in], resolution [dots per inch], torques [N·m].
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.files import atomic_write
+
+DPI = 110
+"""Resolution of every saved figure [dots per inch]."""
+JOINT_FIGSIZE = (8.0, 8.0)
+"""Size of a trajectory joint figure (four stacked panels) [in]."""
+WORKSPACE_FIGSIZE = (12.0, 5.5)
+"""Size of the workspace figure (full view and zoom on the path) [in]."""
+TORQUE_FIGSIZE = (8.0, 6.0)
+"""Size of the desired-torque figure of a two-joint arm [in]; see :data:`TORQUE_ROW_HEIGHT`."""
+TORQUE_ROW_HEIGHT = 2.7
+"""Height each further (or fewer) joint adds to (takes from) a torque figure [in]."""
+STATE_FIGSIZE = (8.0, 7.5)
+"""Size of a simulation state figure (actual/desired, error, log |error|) [in]."""
+SIM_TORQUE_FIGSIZE = (12.0, 6.5)
+"""Size of a simulation torque figure of a two-joint arm (whole run and last period) [in]."""
+PARAM_FIGSIZE = (8.0, 5.0)
+"""Size of a parameter-error figure with one panel and a legend inside it [in]."""
+PARAM_ROW_HEIGHT = 2.2
+"""Height each further panel adds to a parameter-error figure [in]."""
+
+OFF_SCALE_RATIO = 3.0
+"""A torque limit more than this many times the plotted peak is noted, not drawn in view."""
+ENVELOPE_WINDOWS = 300
+"""Number of windows of the max-|error| envelope drawn on the log-scale panel."""
+LOG_FLOOR = 1e-16
+"""Smallest value shown on a log-scale error panel (exact zeros are drawn there)."""
+
+ACTUAL_COLOR = "tab:blue"
+DESIRED_COLOR = "black"
+ERROR_COLOR = "tab:red"
+LIMIT_COLOR = "tab:red"
+COMMAND_COLOR = "tab:orange"
+REACH_COLOR = "tab:green"
+
+LEGEND_BOX = (0.62, 0.78, 1.0, 1.0)
+"""Region of an "upper right" legend, kept free of annotations [axes fraction]."""
+NOTE_BOX = (0.0, 0.0, 0.75, 0.12)
+"""Region of the off-scale limit note, kept free of annotations [axes fraction]."""
+
+
+# ------------------------------------------------------------------ figures and files
+
+
+def _new_figure(figsize: tuple[float, float]) -> Figure:
+    """A non-GUI figure with its own Agg canvas and constrained layout."""
+    fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tuple[float, float]:
+    """``base`` (the size for two rows) grown or shrunk by ``row_height`` per row [in]."""
+    return (base[0], base[1] + row_height * (rows - 2))
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default)."""
+    fmt = path.suffix[1:].lower() or "png"
+    with atomic_write(path, "wb") as f:
+        fig.savefig(f, format=fmt, dpi=DPI)
+    return path
+
+
+def _save_all(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], prefix: str) -> list[Path]:
+    """Save each figure as ``out_dir/<prefix><key>.png`` in order, then clear them all."""
+    out = Path(out_dir)
+    try:
+        return [_save(fig, out / f"{prefix}{key}.png") for key, fig in figures.items()]
+    finally:
+        for fig in figures.values():
+            fig.clear()
+
+
+# ---------------------------------------------------------------------------- titles
+
+
+def _check_figure_numbers(figure_numbers: Mapping[str, int] | None) -> Mapping[str, int]:
+    """``figure_numbers`` or an empty mapping; each value a positive integer.
+
+    Raises:
+        InvalidParameterError: not a mapping of figure key → positive integer.
+    """
+    if figure_numbers is None:
+        return {}
+    if not isinstance(figure_numbers, Mapping):
+        raise InvalidParameterError(
+            "figure_numbers", figure_numbers, "a mapping figure key → report figure number, or None"
+        )
+    for key, number in figure_numbers.items():
+        if not isinstance(key, str) or isinstance(number, bool) or not isinstance(number, int) or number < 1:
+            raise InvalidParameterError(
+                f"figure_numbers[{key!r}]", number, "a positive integer (the report's figure number)"
+            )
+    return figure_numbers
+
+
+def _title(what: str, key: str, figure_numbers: Mapping[str, int], heading: str | None = None) -> str:
+    """A figure title: ``heading`` on its own line (if any), then ``what``.
+
+    When ``figure_numbers`` has ``key``, "— cf. report Fig. N" ends the first line.
+    """
+    number = figure_numbers.get(key)
+    cite = f" — cf. report Fig. {number}" if number is not None else ""
+    return f"{heading}{cite}\n{what}" if heading else f"{what}{cite}"
+
+
+# ------------------------------------------------------------- helpers on the axes
+
+
+def _envelope(t: np.ndarray, x: np.ndarray, windows: int = ENVELOPE_WINDOWS) -> tuple[np.ndarray, np.ndarray]:
+    """Max ``|x|`` over consecutive windows: (window start times [s], maxima, >= LOG_FLOOR)."""
+    n = len(t)
+    width = max(1, n // windows)
+    starts = np.arange(0, n, width)
+    peaks = np.maximum.reduceat(np.abs(x), starts)
+    return t[starts], np.maximum(peaks, LOG_FLOOR)
+
+
+def _free_spot(
+    ax: Axes,
+    x: np.ndarray,
+    y: np.ndarray,
+    size: tuple[float, float],
+    near: tuple[float, float],
+    avoid: tuple[tuple[float, float, float, float], ...] = (),
+) -> tuple[float, float]:
+    """Centre (axes fraction) of a ``size`` box over as few data points as possible.
+
+    Candidates on a grid; ties go to the one nearest ``near`` (data coordinates). Boxes
+    ``avoid`` (x0, y0, x1, y1 in axes fraction: legend, notes) are never used. Call after
+    the axis limits are final.
+    """
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    step = max(1, len(x) // 4000)
+    fx, fy = (np.asarray(x)[::step] - x0) / (x1 - x0), (np.asarray(y)[::step] - y0) / (y1 - y0)
+    nx, ny = (near[0] - x0) / (x1 - x0), (near[1] - y0) / (y1 - y0)
+    w, h = size
+    best: tuple[int, float, float, float] | None = None
+    for cx in np.linspace(w / 2 + 0.02, 1 - w / 2 - 0.02, 11):
+        for cy in np.linspace(h / 2 + 0.03, 1 - h / 2 - 0.03, 9):
+            bx0, by0, bx1, by1 = cx - w / 2, cy - h / 2, cx + w / 2, cy + h / 2
+            if any(bx0 < a1 and a0 < bx1 and by0 < b1 and b0 < by1 for a0, b0, a1, b1 in avoid):
+                continue
+            inside = int(
+                np.count_nonzero(
+                    (fx > bx0 - 0.02) & (fx < bx1 + 0.02) & (fy > by0 - 0.04) & (fy < by1 + 0.04)
+                )
+            )
+            key = (inside, float(np.hypot(cx - nx, cy - ny)), float(cx), float(cy))
+            if best is None or key < best:
+                best = key
+    return (0.5, 0.5) if best is None else (best[2], best[3])
+
+
+def _limit_lines(ax: Axes, limit: float, peak: float, label: bool = True) -> bool:
+    """Draw ``±limit`` [N·m] dashed; keep them in view unless far beyond ``peak`` [N·m].
+
+    Returns whether the limit is in view. When it is not, the y range stays on the data and
+    a note gives the limit and the peak as a fraction of it. An infinite limit (the URDF
+    gives none) draws nothing and returns False.
+    """
+    top = max(peak, 1e-12)
+    if not math.isfinite(limit):
+        ax.set_ylim(-1.12 * top, 1.4 * top)  # room for the legend above the data
+        return False
+    ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.2, label=f"±limit ({limit:g} N·m)" if label else None)
+    ax.axhline(-limit, color=LIMIT_COLOR, ls="--", lw=1.2)
+    in_view = limit <= OFF_SCALE_RATIO * top
+    if in_view:
+        top = max(limit, top)
+        ax.set_ylim(-1.12 * top, 1.5 * top)  # the legend goes above the +limit line
+    else:
+        ax.set_ylim(-1.4 * top, 1.15 * top)  # room for the note below the data
+        ax.text(
+            0.005,
+            0.03,
+            f"±{limit:g} N·m limit off scale: peak |τ| = {peak:.3g} N·m ({100 * peak / limit:.1f} % of it)",
+            transform=ax.transAxes,
+            fontsize=8.5,
+            color=LIMIT_COLOR,
+            va="bottom",
+            bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85},
+        )
+    return in_view

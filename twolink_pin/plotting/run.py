@@ -1,0 +1,408 @@
+"""Figures of one closed-loop run: each joint's state, the torques, and the parameter
+estimates of laws that estimate parameters.
+
+:func:`save_simulation_figures` writes ``<prefix>_theta1.png``, …, ``<prefix>_theta1dot.png``,
+…, ``<prefix>_torque.png`` and, for runs with estimates, ``<prefix>_param_error.png``
+(``inertial`` parameters) and ``<prefix>_friction_error.png`` (``friction`` ones), as the
+result's ``parameter_kinds`` declare. :func:`_simulation_figures` returns the figures keyed
+by those suffixes (the keys of ``figure_numbers``). Time [s], angles [rad], rates [rad/s],
+torques [N·m]; parameters in the result's ``parameter_units``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.plotting._style import (
+    ACTUAL_COLOR,
+    COMMAND_COLOR,
+    DESIRED_COLOR,
+    ERROR_COLOR,
+    LEGEND_BOX,
+    LIMIT_COLOR,
+    LOG_FLOOR,
+    NOTE_BOX,
+    PARAM_FIGSIZE,
+    PARAM_ROW_HEIGHT,
+    SIM_TORQUE_FIGSIZE,
+    STATE_FIGSIZE,
+    _check_figure_numbers,
+    _envelope,
+    _free_spot,
+    _limit_lines,
+    _new_figure,
+    _rows_figsize,
+    _save_all,
+    _title,
+)
+from twolink_pin.simulation import SimulationResult
+
+SIM_TORQUE_ROW_HEIGHT = 2.75
+"""Height each further (or fewer) joint adds to (takes from) a run's torque figure [in]."""
+PARAMETER_KINDS = ("inertial", "friction")
+"""The kinds of estimated parameters, in figure order."""
+PARAMETER_FIGURES = {"inertial": "param_error", "friction": "friction_error"}
+"""Figure key of each parameter kind."""
+INLINE_LEGEND_ENTRIES = 4
+"""A panel with more lines than this gets its legend outside, on the right."""
+DETAILED_LEGEND_ENTRIES = 12
+"""A panel with more lines than this lists only the names (no true value, no start → end)."""
+LEGEND_ROWS = 12
+"""Most entries per column of an outside legend."""
+
+
+def _heading(result: SimulationResult, title: str | None) -> str:
+    """First title line: the controller's name and, if given, its long title."""
+    return f"controller {result.controller}" + (f" ({title})" if title and title != result.controller else "")
+
+
+def _late_ylim(ax: Axes, y: np.ndarray) -> None:
+    """y range of ``y`` padded by 12 % (symmetric and tiny if ``y`` is all zero)."""
+    lo, hi = float(y.min()), float(y.max())
+    pad = 0.12 * (hi - lo) or 0.12 * max(abs(lo), abs(hi)) or 1e-15
+    ax.set_ylim(lo - pad, hi + pad)
+
+
+# ------------------------------------------------------------------------- state
+
+
+def _state_figure(
+    result: SimulationResult, j: int, derivative: bool, figure_numbers: Mapping[str, int], heading: str
+) -> Figure:
+    """Joint ``j``'s position (or velocity): actual vs desired, error early and late, log |error|."""
+    t = result.t
+    if derivative:
+        actual, desired, error = result.v[:, j], result.v_des[:, j], result.edot[:, j]
+        base, ebase, unit = r"\dot\theta", r"\dot e", "rad/s"
+    else:
+        actual, desired, error = result.q[:, j], result.q_des[:, j], result.e[:, j]
+        base, ebase, unit = r"\theta", "e", "rad"
+    sym, sym_d, esym = f"{base}_{{{j + 1}}}", f"{base}_{{{j + 1},d}}", f"{ebase}_{{{j + 1}}}"
+    duration = float(t[-1] - t[0])
+    split = float(t[0] + min(result.reference_period, duration / 3.0))
+    margin = 0.01 * duration  # keeps what happens at t = 0 off the axis spine
+
+    fig = _new_figure(STATE_FIGSIZE)
+    axd = fig.subplot_mosaic(
+        [["signal", "signal"], ["error", "error-late"], ["error-log", "error-log"]],
+        height_ratios=(1.5, 1.0, 1.0),
+        width_ratios=(1.0, 2.0),
+    )
+    top, early, late, log = axd["signal"], axd["error"], axd["error-late"], axd["error-log"]
+    top.sharex(log)
+    top.tick_params(labelbottom=False)
+
+    top.plot(t, actual, color=ACTUAL_COLOR, lw=2.6, alpha=0.75, label=f"actual ${sym}$")
+    top.plot(t, desired, color=DESIRED_COLOR, lw=1.0, ls="--", label=f"desired ${sym_d}$")
+    top.set_ylabel(f"${sym}$ [{unit}]")
+    top.legend(loc="upper right", fontsize=8, ncols=2, framealpha=0.9)
+    span = float(max(np.ptp(actual), np.ptp(desired)) or 1.0)
+    lo, hi = float(min(actual.min(), desired.min())), float(max(actual.max(), desired.max()))
+    top.set_ylim(lo - 0.08 * span, hi + 0.35 * span)  # head room for the legend
+
+    for ax in (early, late):
+        ax.plot(t, error, color=ERROR_COLOR, lw=1.2, label=f"${esym} = {sym} - {sym_d}$")
+        ax.axhline(0.0, color="0.6", lw=0.7)
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4))
+    early.set_xlim(t[0] - margin / 3.0, split)
+    _late_ylim(early, error[t <= split])
+    early.set_ylabel(f"${esym}$ [{unit}]")
+    early.set_title(f"${esym} = {sym} - {sym_d}$, first {split - t[0]:g} s", fontsize=9)
+    after = t >= split
+    late.set_xlim(split, t[-1])
+    _late_ylim(late, error[after] if after.any() else error)
+    late.set_title(f"${esym}$ for t ≥ {split:g} s (own scale)", fontsize=9)
+
+    te, env = _envelope(t, error)
+    log.semilogy(
+        te, env, color=ERROR_COLOR, lw=1.2, drawstyle="steps-post", label=f"max $|{esym}|$ per window"
+    )
+    log.set_ylim(max(LOG_FLOOR, 0.3 * float(env.min())), 3.0 * float(env.max()))
+    width = float(te[1] - te[0]) if len(te) > 1 else duration
+    log.set_ylabel(f"$|{esym}|$ [{unit}]")
+    log.legend(loc="upper right", fontsize=8, title=f"window {width:.3g} s", title_fontsize=8)
+    log.set_xlabel("t [s]")
+    log.set_xlim(t[0] - margin, t[-1])
+    for ax in (top, early, late, log):
+        ax.grid(True, alpha=0.3)
+    for ax in (early, late):
+        ax.set_xlabel("t [s]", fontsize=9)
+    what = "velocity" if derivative else "position"
+    key = f"theta{j + 1}{'dot' if derivative else ''}"
+    fig.suptitle(
+        _title(f"joint {j + 1} {what}: actual vs desired, error", key, figure_numbers, heading), fontsize=11
+    )
+    return fig
+
+
+# ------------------------------------------------------------------------ torque
+
+
+def _torque_figure(
+    result: SimulationResult, figure_numbers: Mapping[str, int] | None = None, heading: str | None = None
+) -> Figure:
+    """Applied (and commanded, if clipped) torque per joint: whole run and last period."""
+    t = result.t
+    nv = result.tau.shape[1]
+    fig = _new_figure(_rows_figsize(SIM_TORQUE_FIGSIZE, nv, SIM_TORQUE_ROW_HEIGHT))
+    axes = fig.subplots(nv, 2, sharex="col", width_ratios=(1.6, 1.0), squeeze=False)
+    period = result.reference_period
+    last = t >= max(t[0], t[-1] - period)
+    clipped = result.saturate and not np.array_equal(result.tau, result.tau_command)
+    for j in range(nv):
+        limit = float(result.torque_limits[j])
+        for col, mask in ((0, np.ones_like(t, dtype=bool)), (1, last)):
+            ax = axes[j, col]
+            ax.set_label(f"tau{j + 1}" if col == 0 else f"tau{j + 1}-last")
+            tt = t[mask]
+            command = result.tau_command[mask, j]
+            if clipped:
+                ax.plot(tt, command, color=COMMAND_COLOR, lw=1.0, ls="--", label="commanded")
+            ax.plot(tt, result.tau[mask, j], color=ACTUAL_COLOR, lw=1.3, label=rf"applied $\tau_{{{j + 1}}}$")
+            peak_cmd = float(np.abs(command).max())
+            _limit_lines(ax, limit, peak_cmd)
+            ax.axhline(0.0, color="0.8", lw=0.6)
+            ax.grid(True, alpha=0.3)
+            ax.set_xlim(tt[0] - (0.01 * (tt[-1] - tt[0]) if col == 0 else 0.0), tt[-1])
+            over = np.abs(command) > limit
+            if over.any():
+                k = int(np.argmax(np.abs(command)))
+                tk, yk = float(tt[k]), float(command[k])
+                note = "clipped by the plant" if result.saturate else "not saturated in this run"
+                lines = np.linspace(tt[0], tt[-1], 200)
+                spot = _free_spot(
+                    ax,
+                    np.concatenate([tt, lines, lines]),
+                    np.concatenate([result.tau[mask, j], np.full(200, limit), np.full(200, -limit)]),
+                    (0.5, 0.2),
+                    (tk, yk),
+                    (LEGEND_BOX, NOTE_BOX),
+                )
+                ax.annotate(
+                    f"commanded |τ{j + 1}| up to {peak_cmd:.3g} N·m > {limit:g} N·m\n"
+                    f"(first at t = {tt[np.argmax(over)]:.3f} s; {note})",
+                    (tk, yk),
+                    textcoords="axes fraction",
+                    xytext=spot,
+                    ha="center",
+                    va="center",
+                    fontsize=8,
+                    color=LIMIT_COLOR,
+                    arrowprops={"arrowstyle": "->", "color": LIMIT_COLOR},
+                    bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": LIMIT_COLOR},
+                )
+        axes[j, 0].set_ylabel(rf"$\tau_{{{j + 1}}}$ [N·m]")
+        axes[j, 0].legend(loc="upper right", fontsize=8)
+    axes[0, 0].set_title("whole run", fontsize=10)
+    axes[0, 1].set_title(f"last reference period ({period:g} s), own scale", fontsize=10)
+    for ax in axes[-1]:
+        ax.set_xlabel("t [s]")
+    sat = "saturated at the limits" if result.saturate else "no saturation"
+    heading = heading if heading is not None else _heading(result, None)
+    fig.suptitle(_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
+    return fig
+
+
+# -------------------------------------------------------------------- parameters
+
+
+def _is_indexed(name: str) -> bool:
+    """Whether ``name`` is one ASCII letter then digits (``p1``, ``V2``, ``C12``)."""
+    return len(name) >= 2 and name[0].isascii() and name[0].isalpha() and name[1:].isdigit()
+
+
+def _parameter_symbol(name: str) -> str:
+    """``p_1`` in mathtext for ``p1``; any other name as it is."""
+    return rf"${name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
+
+
+def _parameter_label(name: str, true: float, err: np.ndarray, detailed: bool) -> str:
+    """Legend entry of ``p̂ − p``: ``p̂_1 − p_1`` in mathtext (letter+digits) or the name."""
+    sym = rf"$\hat{{{name[0]}}}_{{{name[1:]}}} - {name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
+    return f"{sym} (true {true:.3g}; {err[0]:+.3g} → {err[-1]:+.3g})" if detailed else sym
+
+
+def _line_style(k: int) -> dict[str, str]:
+    """Colour and dash of the ``k``-th line: ten colours, then the next dash."""
+    return {"color": f"C{k % 10}", "ls": ("-", "--", ":", "-.")[(k // 10) % 4]}
+
+
+def _legend(ax: Axes, entries: int) -> float:
+    """A legend inside ``ax`` for a few entries, else outside on the right; its width [in]."""
+    if entries <= INLINE_LEGEND_ENTRIES:
+        ax.legend(loc="best", fontsize=8)
+        return 0.0
+    ncols = math.ceil(entries / LEGEND_ROWS)
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, ncols=ncols, borderaxespad=0.0)
+    return ncols * (2.9 if entries <= DETAILED_LEGEND_ENTRIES else 1.1)
+
+
+def _check_parameters(result: SimulationResult) -> None:
+    """The result declares a name, a unit and a known kind for every estimated parameter.
+
+    Raises:
+        InvalidParameterError: a declaration is missing or a kind is unknown.
+    """
+    assert result.p_hat is not None
+    n_p = result.p_hat.shape[1]
+    for field in ("parameter_names", "parameter_units", "parameter_kinds"):
+        values = getattr(result, field)
+        if len(values) != n_p:
+            raise InvalidParameterError(
+                f"result.{field}", values, f"one entry per estimated parameter ({n_p}) but got {len(values)}"
+            )
+    unknown = sorted(set(result.parameter_kinds) - set(PARAMETER_KINDS))
+    if unknown:
+        raise InvalidParameterError(
+            "result.parameter_kinds", result.parameter_kinds, f"each one of {PARAMETER_KINDS}, not {unknown}"
+        )
+
+
+def _parameter_figure(
+    result: SimulationResult,
+    columns: Sequence[int],
+    kind: str,
+    figure_numbers: Mapping[str, int],
+    heading: str,
+) -> Figure:
+    """``p̂ − p`` of the parameters ``columns`` (one panel per unit), then ``(p̂ − p)/p`` [%]."""
+    assert result.p_error is not None and result.p_true is not None
+    t = result.t
+    p_error, p_true = result.p_error, result.p_true
+    names, units = result.parameter_names, result.parameter_units
+    groups: dict[str, list[int]] = {}
+    for i in columns:
+        groups.setdefault(units[i], []).append(i)
+    scale = float(np.abs(p_true[list(columns)]).max())
+    relative = [i for i in columns if abs(p_true[i]) > max(1e-12, 1e-9 * scale)]
+    # Up to ten parameters: one colour each, the same in every panel. More: each panel
+    # styles its own lines in order, so the lines of a panel stay apart.
+    consistent = len(columns) <= 10
+    style = {i: _line_style(k) for k, i in enumerate(columns)}
+
+    rows = len(groups) + (1 if relative else 0)
+    fig = _new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
+    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
+    legend_width = 0.0
+    for ax, (unit, group) in zip(axes, groups.items()):
+        ax.set_label(f"absolute [{unit}]")
+        detailed = len(group) <= DETAILED_LEGEND_ENTRIES
+        for k, i in enumerate(group):
+            label = _parameter_label(names[i], float(p_true[i]), p_error[:, i], detailed)
+            ax.plot(t, p_error[:, i], lw=1.5, label=label, **(style[i] if consistent else _line_style(k)))
+        ax.set_ylabel(f"estimate − true [{unit}]")
+        legend_width = max(legend_width, _legend(ax, len(group)))
+    if relative:
+        ax = axes[-1]
+        ax.set_label("relative")
+        detailed = len(relative) <= DETAILED_LEGEND_ENTRIES
+        for k, i in enumerate(relative):
+            rel = 100.0 * p_error[:, i] / p_true[i]
+            label = _parameter_symbol(names[i]) + (
+                f": {rel[0]:+.0f} % → {rel[-1]:+.0f} %" if detailed else ""
+            )
+            ax.plot(t, rel, lw=1.3, label=label, **(style[i] if consistent else _line_style(k)))
+        ax.set_ylabel("(estimate − true) / true [%]")
+        legend_width = max(legend_width, _legend(ax, len(relative)))
+    for ax in axes:
+        ax.axhline(0.0, color="0.5", lw=0.8)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("t [s]")
+    axes[-1].set_xlim(t[0], t[-1])
+    fig.set_size_inches(PARAM_FIGSIZE[0] + legend_width, fig.get_size_inches()[1])
+    what = f"{kind} parameter estimation error p̂ − p"
+    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    return fig
+
+
+# ------------------------------------------------------------------------ a run
+
+
+def _simulation_figures(
+    result: SimulationResult, figure_numbers: Mapping[str, int] | None = None, title: str | None = None
+) -> dict[str, Figure]:
+    """Build one run's figures.
+
+    Returns:
+        Suffix → figure: ``theta{i}`` for each joint, then ``theta{i}dot``, ``torque``, and
+        for runs with parameter estimates ``param_error`` (the parameters whose
+        ``parameter_kinds`` entry is ``"inertial"``) and ``friction_error`` (``"friction"``),
+        each only when it has a parameter.
+
+    Raises:
+        InvalidParameterError: ``figure_numbers`` is not a mapping of key → positive
+            integer, ``title`` is not a string, or the result lacks a name, unit or known
+            kind for an estimated parameter.
+    """
+    numbers = _check_figure_numbers(figure_numbers)
+    if title is not None and not isinstance(title, str):
+        raise InvalidParameterError("title", title, "a string (the law's display title) or None")
+    if result.p_error is not None:
+        _check_parameters(result)
+    heading = _heading(result, title)
+    nv = result.nv
+    figures: dict[str, Figure] = {}
+    for j in range(nv):
+        figures[f"theta{j + 1}"] = _state_figure(result, j, False, numbers, heading)
+    for j in range(nv):
+        figures[f"theta{j + 1}dot"] = _state_figure(result, j, True, numbers, heading)
+    figures["torque"] = _torque_figure(result, numbers, heading)
+    if result.p_error is not None:
+        for kind in PARAMETER_KINDS:
+            columns = [i for i, k in enumerate(result.parameter_kinds) if k == kind]
+            if columns:
+                figures[PARAMETER_FIGURES[kind]] = _parameter_figure(result, columns, kind, numbers, heading)
+    return figures
+
+
+def save_simulation_figures(
+    result: SimulationResult,
+    out_dir: str | os.PathLike[str],
+    prefix: str | None = None,
+    figure_numbers: Mapping[str, int] | None = None,
+    title: str | None = None,
+) -> list[Path]:
+    """Write one run's figures as PNG into ``out_dir``.
+
+    * ``<prefix>_theta1.png``, … (position [rad]) and ``<prefix>_theta1dot.png``, …
+      (velocity [rad/s]), one per joint: actual vs desired over the run; the error over the
+      first reference period and, on its own scale, after it; the error's envelope
+      ``max |e|`` per window on a log scale (errors decaying to 1e-10 stay visible);
+    * ``<prefix>_torque.png``: each ``τ_i`` [N·m] with its ``±limit`` lines (applied vs
+      commanded when the plant saturates), for the whole run and the last reference period;
+      a limit far beyond the data is noted instead of squashing the curve, and a commanded
+      torque beyond its limit is annotated;
+    * runs with parameter estimates: ``<prefix>_param_error.png`` (``p̂ − p`` of the
+      ``"inertial"`` parameters, one panel per unit of ``result.parameter_units``, and the
+      relative error [%]) and ``<prefix>_friction_error.png`` (the same for the
+      ``"friction"`` ones, e.g. V [N·m·s/rad] and C [N·m]), as ``result.parameter_kinds``
+      declares.
+
+    Args:
+        result: A simulation result (read only).
+        out_dir: Output directory, created if missing.
+        prefix: File-name prefix; default ``result.controller``; ``""`` for none.
+        figure_numbers: Suffix (``theta1``, ``theta1dot``, ``torque``, ``param_error``,
+            ``friction_error``, …) → the number of the matching figure in a report, cited in
+            the title as "cf. report Fig. N"; keys of no figure are ignored. Default: none.
+        title: The law's display title, shown beside its name in every title
+            (e.g. ``"PD + model feedforward"``). Default: the name only.
+
+    Returns:
+        The paths written, in figure order.
+
+    Raises:
+        InvalidParameterError: see :func:`_simulation_figures`.
+        OutputError: ``out_dir`` cannot be created or written.
+    """
+    figures = _simulation_figures(result, figure_numbers, title)
+    prefix = result.controller if prefix is None else prefix
+    return _save_all(figures, out_dir, f"{prefix}_" if prefix else "")

@@ -1,0 +1,389 @@
+"""``twolink-pin report``: run everything and write the report folder.
+
+Output in ``out_dir``: ``index.html`` (opens from ``file://``, no external request),
+``report.md``, ``comparison.csv``, ``results.json``, ``figures/*.png`` and
+``animation.html``. For the twolink the page follows the course report (Table 1, its
+via points and coefficients, its Table 2 beside ours, the errata); for any other robot it
+shows the same pipeline without the report's sections.
+
+The folder is built in a staging folder and moved into place only when complete
+(:func:`twolink_pin.files.output_directory`), so a failure, Ctrl-C or SIGTERM midway
+leaves the previous report (or nothing) — never a half-written ``index.html`` and no
+worker process behind.
+"""
+
+from __future__ import annotations
+
+import inspect
+import os
+import signal
+import time
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.feasibility import check_torques
+from twolink_pin.files import output_directory
+from twolink_pin.metrics import Metrics, compute_metrics
+from twolink_pin.model import load_robot
+from twolink_pin.report import facts
+from twolink_pin.scenario import law_class, make_scenario
+from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
+from twolink_pin.simulation.config import joint_offsets
+from twolink_pin.studies.comparison import ComparisonTable
+from twolink_pin.trajectory import default_trajectory, default_via_points
+
+MARKER = ".twolink-pin-report"
+"""File that marks a directory as written by this command (safe to replace)."""
+MAX_WORKERS = 64
+"""Largest number of worker processes (more than the runs is never used)."""
+ANIMATED = "adaptive"
+"""The law whose run the report animates (the first law if it is not run)."""
+
+Progress = Callable[[str, int, int], None]
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """What the report runs.
+
+    Attributes:
+        robot: A catalog name or a URDF path; None for the twolink.
+        payload: End-effector payload [kg].
+        config: Simulation settings of every run.
+        lam: λ [1/s] of the laws that have one (None: their default).
+        saturate: Clip torques at the URDF limits in every plant.
+        friction_smoothing: ε [rad/s] of the friction sign (0: exact sgn).
+        controllers: The laws to run (names, ``file.py:Class``, ``module:Class``); None for
+            the course report's five on the twolink, every built-in law elsewhere.
+        workers: Processes for the runs and figures (1: in this process), 1 to 64.
+        animation: Whether to write the self-contained animation.
+    """
+
+    robot: str | None = None
+    payload: float = 0.0
+    config: SimulationConfig = field(default_factory=SimulationConfig)
+    lam: float | None = None
+    saturate: bool = False
+    friction_smoothing: float = 0.0
+    controllers: tuple[str, ...] | None = None
+    workers: int = 2
+    animation: bool = True
+
+    def __post_init__(self) -> None:
+        if not (
+            isinstance(self.workers, int)
+            and not isinstance(self.workers, bool)
+            and 1 <= self.workers <= MAX_WORKERS
+        ):
+            raise InvalidParameterError("workers", self.workers, f"a whole number from 1 to {MAX_WORKERS}")
+
+
+def _run(
+    spec: str,
+    options: ReportOptions,
+    fig_dir: str,
+    figure_numbers: dict[str, int] | None,
+) -> tuple[SimulationResult, Metrics, list[str], float]:
+    """Worker: one law's run, metrics and figures (picklable arguments only)."""
+    from twolink_pin.plotting import save_simulation_figures
+
+    start = time.perf_counter()
+    robot = load_robot(options.robot, payload=options.payload)
+    cls = law_class(spec)
+    controller, plant = make_scenario(
+        cls,
+        robot,
+        lam=options.lam if cls.takes("lam") else None,
+        saturate=options.saturate,
+        friction_smoothing=options.friction_smoothing,
+    )
+    result = simulate(controller, plant, default_trajectory(robot), options.config)
+    metrics = compute_metrics(result)
+    paths = save_simulation_figures(
+        result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title
+    )
+    return result, metrics, [Path(p).name for p in paths], time.perf_counter() - start
+
+
+def _trajectory_figures(
+    options: ReportOptions, fig_dir: str, figure_numbers: dict[str, int] | None
+) -> list[str]:
+    """Worker: the desired trajectory's figures (picklable arguments only)."""
+    from twolink_pin.plotting import save_trajectory_figures
+
+    robot = load_robot(options.robot, payload=options.payload)
+    trajectory = default_trajectory(robot)
+    check = check_torques(robot, trajectory)
+    paths = save_trajectory_figures(robot, trajectory, check, Path(fig_dir), figure_numbers=figure_numbers)
+    return [p.name for p in paths]
+
+
+class _InProcess:
+    """A stand-in for ProcessPoolExecutor that runs each task at submit (workers = 1)."""
+
+    def __enter__(self) -> _InProcess:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
+        future: Future[Any] = Future()
+        try:
+            future.set_result(fn(*args))
+        except Exception as exc:
+            future.set_exception(exc)
+        return future
+
+    def shutdown(self, wait: bool = True, cancel_futures: bool = False) -> None:
+        return None
+
+
+@contextmanager
+def _pool(workers: int) -> Iterator[Any]:
+    """Worker processes that never outlive the report: on an error, Ctrl-C or SIGTERM the
+    pending runs are cancelled and the workers killed before the exception goes on."""
+    if workers <= 1:
+        with _InProcess() as pool:
+            yield pool
+        return
+    pool = ProcessPoolExecutor(max_workers=workers)
+    previous = signal.getsignal(signal.SIGTERM)
+
+    def _terminate(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    in_main = _is_main_thread()
+    if in_main:
+        signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield pool
+    except BaseException:
+        processes = list(getattr(pool, "_processes", {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            if process.is_alive():
+                process.kill()
+        for process in processes:
+            process.join(timeout=5)
+        raise
+    else:
+        pool.shutdown(wait=True)
+    finally:
+        if in_main:
+            signal.signal(signal.SIGTERM, previous)
+
+
+def _is_main_thread() -> bool:
+    import threading
+
+    return threading.current_thread() is threading.main_thread()
+
+
+def laws_to_run(options: ReportOptions, is_twolink: bool) -> tuple[str, ...]:
+    """The laws the report runs (see :class:`ReportOptions`)."""
+    if options.controllers is not None:
+        names = tuple(law_class(spec).name for spec in options.controllers)
+        if len(set(names)) != len(names):
+            raise InvalidParameterError("controllers", list(options.controllers), "each law at most once")
+        return tuple(options.controllers)
+    if is_twolink:
+        from twolink_pin.twolink.reference import REPORT_CONTROLLERS
+
+        return REPORT_CONTROLLERS
+    from twolink_pin.controllers import CONTROLLERS
+
+    return tuple(
+        name for name, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
+    )
+
+
+def build_report(
+    out_dir: str | os.PathLike[str],
+    options: ReportOptions | None = None,
+    progress: Progress | None = None,
+    command_line: str = "",
+) -> dict[str, Any]:
+    """Write the report into ``out_dir``; returns the ``results.json`` content.
+
+    Raises:
+        OutputError: ``out_dir`` is a file or a non-empty directory that holds no report,
+            or it cannot be written.
+        SimulationDivergedError, ControllerError: a run failed (the message names the law
+            and the time); nothing is written.
+    """
+    options = options if options is not None else ReportOptions()
+    started = time.perf_counter()
+    robot = load_robot(options.robot, payload=options.payload)
+    is_twolink = robot.name == "twolink"
+    specs = laws_to_run(options, is_twolink)
+    steps = 4 + len(specs) + (1 if options.animation else 0)
+    done = 0
+
+    def tick(what: str) -> None:
+        nonlocal done
+        done += 1
+        if progress:
+            progress(what, done, steps)
+
+    with output_directory(out_dir, MARKER, "written by twolink-pin report\n") as stage:
+        results = _build(stage, robot, is_twolink, specs, options, tick)
+        results["total_seconds"] = time.perf_counter() - started
+        results["command_line"] = command_line
+        from twolink_pin.report.pages import write_pages
+
+        write_pages(stage, results)
+        tick("done")
+    return results
+
+
+def _build(
+    stage: Path,
+    robot: Any,
+    is_twolink: bool,
+    specs: Sequence[str],
+    options: ReportOptions,
+    tick: Callable[[str], None],
+) -> dict[str, Any]:
+    fig_dir = stage / "figures"
+    fig_dir.mkdir()
+    trajectory = default_trajectory(robot)
+    via = default_via_points(robot)
+    check = check_torques(robot, trajectory)
+    numbers: dict[str, dict[str, int]] = {}
+    if is_twolink:
+        from twolink_pin.twolink.reference import REPORT_FIGURES
+
+        numbers = REPORT_FIGURES
+    names = [law_class(spec).name for spec in specs]
+    animated = ANIMATED if ANIMATED in names else names[0]
+    order = [animated, *(n for n in names if n != animated)]
+    by_name = dict(zip(names, specs))
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
+    animation = None
+    workers = min(options.workers, len(order) + 1)
+    with _pool(workers) as pool:
+        futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
+        traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
+        model = facts.model_facts(robot)
+        twolink: dict[str, Any] | None = None
+        if is_twolink:
+            twolink = {"closed_form_check": facts.twolink_closed_form_check(robot)}
+            if via is not None:
+                twolink["table1"] = facts.table1(robot, via)
+        tick("model and trajectory")
+        for name in order:
+            runs[name] = futures[name].result()
+            tick(f"controller {name}")
+            if name == animated and options.animation:
+                from twolink_pin.visualization import write_html
+
+                res = runs[name][0]
+                points = None if via is None else np.array(via.xy)
+                write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points)
+                animation = "animation.html"
+                tick("animation")
+        traj_figs = traj_future.result()
+        tick("trajectory figures")
+    runs = {n: runs[n] for n in names}  # the order asked for
+    table = ComparisonTable(
+        {n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()}, options.config.duration
+    )
+    cfg = options.config
+    q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
+    controllers = {}
+    lams: dict[str, float] = {}
+    for name, (result, metrics, figures, seconds) in runs.items():
+        cls = law_class(by_name[name])
+        controller = make_scenario(cls, robot, lam=options.lam if cls.takes("lam") else None).controller
+        if cls.takes("lam"):
+            lams[name] = float(np.max(controller.gains.lam))
+        controllers[name] = {
+            "title": cls.title,
+            "law": inspect.getdoc(cls) or "",
+            "gains": controller.gains.describe(),
+            "metrics": metrics.as_dict(),
+            "figures": figures,
+            "seconds": seconds,
+            "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
+            "p_true": None if result.p_true is None else result.p_true.tolist(),
+            "parameter_names": list(result.parameter_names),
+            "limit_exceeded": result.limit_exceeded.tolist(),
+            "limit_exceeded_at": result.first_exceeded_at,
+        }
+    errata: list[dict[str, Any]] = []
+    if is_twolink:
+        lam = next(iter(lams.values()), 5.0)
+        errata = _twolink_errata(robot, trajectory, runs, by_name, options, q0_offset, lam)
+    tick("errata")
+    out: dict[str, Any] = {
+        "robot": model,
+        "twolink": twolink,
+        "trajectory": {
+            "times": trajectory.times.tolist(),
+            "via_q": trajectory.via_q.tolist(),
+            "via_xy": None if via is None else [list(p) for p in via.xy],
+            "period_s": trajectory.period,
+            "coefficients": trajectory.coefficients.tolist(),
+            "figures": traj_figs,
+        },
+        "torque_check": facts.torque_facts(check),
+        "simulation": asdict(cfg)
+        | {
+            "q0_offset": q0_offset.tolist(),
+            "lambda": lams,
+            "saturate": options.saturate,
+            "friction_smoothing": options.friction_smoothing,
+        },
+        "controllers": controllers,
+        "comparison": table.as_dict(),
+        "comparison_markdown": table.markdown(),
+        "comparison_csv": table.csv(),
+        "animation": animation,
+        "animated": animated,
+        "errata": errata,
+        "versions": facts.versions(),
+    }
+    if is_twolink:
+        from twolink_pin.twolink.reference import (
+            REPORT_COEFFICIENTS,
+            REPORT_P,
+            REPORT_TABLE2,
+            REPORT_TABLE2_COLUMNS,
+        )
+
+        assert twolink is not None
+        twolink["report_p"] = REPORT_P
+        twolink["report_coefficients"] = [list(c) for c in REPORT_COEFFICIENTS]
+        twolink["report_table2"] = {n: list(v) for n, v in REPORT_TABLE2.items()}
+        twolink["report_table2_columns"] = list(REPORT_TABLE2_COLUMNS)
+    return out
+
+
+def _twolink_errata(
+    robot: Any,
+    trajectory: Any,
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
+    by_name: dict[str, str],
+    options: ReportOptions,
+    q0_offset: np.ndarray,
+    lam: float,
+) -> list[dict[str, Any]]:
+    from twolink_pin.twolink import errata
+
+    items = [errata.third_via_point(robot), errata.printed_coefficients(trajectory), errata.y3_sign(robot)]
+    items.append(errata.unstated_settings(lam, tuple(q0_offset.tolist())))
+    if "robust" in runs:
+        items.append(errata.robust_naming(runs["robust"][0]))
+    if "adaptive" in runs:
+        cls = law_class(by_name["adaptive"])
+        controller = make_scenario(cls, robot, lam=options.lam).controller
+        items.append(errata.parameter_convergence(runs["adaptive"][0], controller, trajectory))  # type: ignore[arg-type]
+    return [e._asdict() for e in items]

@@ -1,0 +1,98 @@
+"""A law and the plant it drives: :func:`make_scenario`.
+
+The plant is the robot itself, with the friction of its profile when the law estimates
+friction (the twolink: the report's V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m), as in
+the report's experiments; the law believes that same friction (its estimates start from
+``friction_initial_estimate`` × it). Nothing here knows a law by name: what a law
+estimates and which gains it has, its class declares.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Mapping
+from typing import Any, NamedTuple
+
+from twolink_pin.controllers import Controller, load_controller
+from twolink_pin.dynamics import Friction
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.model import RobotModel
+from twolink_pin.plant import Plant
+
+
+class Scenario(NamedTuple):
+    """A controller and the plant it drives."""
+
+    controller: Controller
+    """The control law."""
+    plant: Plant
+    """The simulated arm."""
+
+
+def law_class(law: str | type[Controller]) -> type[Controller]:
+    """A law class from a class, a registered name, ``file.py:Class`` or ``module:Class``."""
+    if isinstance(law, type) and issubclass(law, Controller):
+        return law
+    if isinstance(law, str):
+        return load_controller(law)
+    raise InvalidParameterError(
+        "controller", law, "a Controller subclass or a name / file.py:Class / module:Class"
+    )
+
+
+def make_scenario(
+    law: str | type[Controller],
+    robot: RobotModel,
+    *,
+    lam: float | None = None,
+    gains: Mapping[str, Any] | None = None,
+    saturate: bool = False,
+    friction_smoothing: float = 0.0,
+    friction: Friction | None = None,
+    model_parameters: Any = None,
+) -> Scenario:
+    """The law on ``robot`` with its default gains (the robot's presets), and its plant.
+
+    Args:
+        law: The law (class, registered name, ``file.py:Class`` or ``module:Class``).
+        robot: The arm (plant and law model).
+        lam: ``λ`` [1/s] for a law whose gains have ``lam``; refused for one without.
+        gains: Other gains by field name (one value, one per joint, ...), over the defaults.
+        saturate: Clip torques at the URDF limits in the plant.
+        friction_smoothing: ε [rad/s] of ``tanh(q̇/ε)`` for Coulomb friction (0: exact sgn).
+        friction: The plant's friction; default the profile's for a friction-estimating
+            law, else none.
+        model_parameters: The parameters the law's model believes (see
+            :class:`~twolink_pin.controllers.Controller`); one row per run for a batch.
+
+    Raises:
+        InvalidParameterError: ``lam`` or a gain the law does not have.
+        ControllerSpecError: no such law.
+    """
+    cls = law_class(law)
+    changes: dict[str, Any] = dict(gains or {})
+    if lam is not None:
+        if not cls.takes("lam"):
+            raise InvalidParameterError(
+                "lambda",
+                lam,
+                f"a law with a λ gain; '{cls.name}' has none (its gains: {', '.join(cls.Gains.field_names())})",
+            )
+        changes["lam"] = lam
+    unknown = [k for k in changes if k not in cls.Gains.field_names()]
+    if unknown:
+        raise InvalidParameterError(
+            "gain", unknown[0], f"one of the gains of '{cls.name}': {', '.join(cls.Gains.field_names())}"
+        )
+    presets = {k: v for k, v in robot.gain_presets.get(cls.name, {}).items() if k in cls.Gains.field_names()}
+    gains_obj = cls.Gains(**{**presets, **changes})
+    if friction is None and "friction" in cls.estimates and robot.profile.friction is not None:
+        viscous, coulomb = robot.profile.friction
+        friction = Friction(viscous, coulomb, smoothing=friction_smoothing)
+    elif friction is not None and friction_smoothing and not friction.smoothing:
+        friction = dataclasses.replace(friction, smoothing=friction_smoothing)
+    kwargs: dict[str, Any] = {}
+    if "friction" in cls.estimates:
+        kwargs["friction"] = friction
+    controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
+    return Scenario(controller, Plant(robot, friction=friction, saturate=saturate))

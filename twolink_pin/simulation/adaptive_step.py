@@ -1,0 +1,102 @@
+"""The adaptive-step method for one run: scipy's ``solve_ivp`` (DOP853) on the same law.
+
+The right-hand side evaluates the law (through the same :class:`~twolink_pin.controllers.Terms`
+as the fixed-step engine, with N = 1) and the plant's ABA; output on the fixed grid
+``t_k = k dt``. Coulomb friction must use a smooth sign (``Friction.smoothing > 0``): an
+exact ``sgn`` makes the step size collapse when a joint sticks. A collapsing step is
+bounded (:data:`~twolink_pin.simulation.config.MAX_EVALUATIONS_PER_STEP` evaluations per
+output interval) and reported as a divergence, never a hang.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from twolink_pin.controllers import Controller, LawInput
+from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.plant import Plant
+from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
+from twolink_pin.simulation.engine import Samples, _validate
+from twolink_pin.simulation.forward import SingleRunDynamics
+from twolink_pin.simulation.terms import SingleRunTerms
+from twolink_pin.trajectory import JointTrajectory
+
+
+def integrate_adaptive(
+    controller: Controller,
+    plant: Plant,
+    trajectory: JointTrajectory,
+    config: SimulationConfig,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    z0: np.ndarray,
+) -> Samples:
+    """One run by DOP853 with error control; every output sample (shapes as the engine's, N = 1).
+
+    Raises:
+        SimulationDivergedError: the state left the bounds, or the step size collapsed.
+        ControllerError: the law raised or returned the wrong shape.
+    """
+    nv, nz = q0.shape[1], z0.shape[1]
+    n = config.steps
+    dt = config.duration / n
+    t = np.arange(n + 1) * dt
+    name = controller.name
+    terms = SingleRunTerms(controller)
+    accel = SingleRunDynamics(plant)
+    budget = MAX_EVALUATIONS_PER_STEP * n + 10_000
+    calls = 0
+
+    def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        ref = trajectory.sample(time)
+        try:
+            out = controller.compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
+        except TwolinkPinError as exc:
+            raise ControllerError(name, time, str(exc)) from exc
+        except Exception as exc:
+            raise ControllerError(name, time, f"{type(exc).__name__}: {exc}") from exc
+        if calls <= 1:
+            _validate(controller, out, 1, nv, nz, time)
+        return out.tau, (out.dz if nz else np.zeros((1, 0)))
+
+    def rhs(time: float, x: np.ndarray) -> np.ndarray:
+        nonlocal calls
+        calls += 1
+        if calls > budget:  # a collapsing step size: stiff or diverging, never a hang
+            raise SimulationDivergedError(
+                name,
+                time,
+                f"the adaptive step collapsed ({budget} evaluations); the problem is too stiff for DOP853",
+            )
+        if not np.all(np.abs(x) < DIVERGENCE_LIMIT):
+            raise SimulationDivergedError(
+                name,
+                time,
+                "non-finite state" if not np.all(np.isfinite(x)) else f"|state| > {DIVERGENCE_LIMIT:g}",
+            )
+        q, v, z = x[None, :nv], x[None, nv : 2 * nv], x[None, 2 * nv :]
+        tau, dz = law(time, q, v, z)
+        if not np.all(np.isfinite(tau)):
+            raise ControllerError(
+                name, time, f"the controller returned a non-finite torque τ = {tau[0].tolist()}"
+            )
+        return np.concatenate([v[0], accel(q, v, tau)[0], dz[0]])
+
+    with np.errstate(all="ignore"):
+        sol = solve_ivp(
+            rhs,
+            (t[0], t[-1]),
+            np.concatenate([q0[0], v0[0], z0[0]]),
+            method="DOP853",
+            t_eval=t,
+            rtol=config.rtol,
+            atol=config.atol,
+        )
+    if sol.status != 0:
+        raise SimulationDivergedError(name, float(sol.t[-1]) if sol.t.size else 0.0, sol.message)
+    x = sol.y.T
+    q, v, z = x[:, None, :nv], x[:, None, nv : 2 * nv], x[:, None, 2 * nv :]
+    ref = trajectory.sample(t)
+    tau = np.array([law(float(t[k]), q[k], v[k], z[k])[0] for k in range(len(t))])
+    return Samples(0, t, q, v, z, tau, ref.q[:, None, :], ref.v[:, None, :], ref.a[:, None, :])

@@ -1,0 +1,69 @@
+"""The plant's accelerations for N runs: ``pin.aba`` for one, ``abaInParallel`` for many."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.dynamics import ABA_CONVENTION
+from twolink_pin.plant import Plant
+from twolink_pin.simulation.terms import check_parallel, threads_for
+
+
+class SingleRunDynamics:
+    """``q̈`` [rad/s²] of one run, shape (1, nv), from ``(1, nv)`` state and torque."""
+
+    def __init__(self, plant: Plant) -> None:
+        self._plant = plant
+        self._model = plant.model
+        self._data = plant.model.createData()
+        self._nv = plant.model.nv
+        friction = plant.friction
+        self._friction = (
+            None if friction is None else (np.array(friction.viscous), np.array(friction.coulomb))
+        )
+        self._exact_sign = friction is None or friction.smoothing == 0
+        self._saturate = plant.saturate
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        # plant.motor_torque, spelled out: this runs four times per step.
+        u = self._plant.applied_torque(tau) if self._saturate else tau
+        if self._friction is not None:
+            viscous, coulomb = self._friction
+            sign = np.sign(v) if self._exact_sign else self._plant.friction.torque(v) - viscous * v  # type: ignore[union-attr]
+            u = u - (viscous * v + coulomb * sign) if self._exact_sign else u - (viscous * v + sign)
+        return pin.aba(self._model, self._data, q[0], v[0], u[0], ABA_CONVENTION)[None]
+
+
+class BatchDynamics:
+    """``q̈`` [rad/s²] of N runs, shape (N, nv), one ``abaInParallel`` call."""
+
+    def __init__(self, plant: Plant, runs: int, threads: int | None) -> None:
+        check_parallel()
+        self._plant = plant
+        self._threads = threads_for(runs, threads)
+        self._pool = pin.ModelPool(plant.model, self._threads)
+        # RK4 keeps the four stages' accelerations alive at once: four output buffers in turn.
+        self._outs = [np.empty((runs, plant.model.nv)) for _ in range(4)]
+        self._next = 0
+        self._plain = plant.friction is None and not plant.saturate
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """The result is valid until the fourth call after this one."""
+        u = tau if self._plain else self._plant.motor_torque(v, tau)
+        out = self._outs[self._next]
+        self._next = (self._next + 1) % 4
+        pin.abaInParallel(
+            self._threads,
+            self._pool,
+            np.ascontiguousarray(q).T,
+            np.ascontiguousarray(v).T,
+            np.ascontiguousarray(u).T,
+            out.T,
+        )
+        return out
+
+
+def dynamics_for(plant: Plant, runs: int, threads: int | None = None) -> SingleRunDynamics | BatchDynamics:
+    """The plant's acceleration function for ``runs`` runs advanced together."""
+    return SingleRunDynamics(plant) if runs == 1 else BatchDynamics(plant, runs, threads)

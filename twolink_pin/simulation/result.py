@@ -1,0 +1,96 @@
+"""One closed-loop run, recorded: :class:`SimulationResult` (read-only arrays with units)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """One closed-loop run. Arrays are read-only; K = number of output samples."""
+
+    controller: str
+    """Controller's registry name."""
+    method: str
+    """Integrator: ``"rk4"`` or ``"adaptive"``."""
+    dt: float
+    """Output grid spacing (and RK4 step) [s]."""
+    t: np.ndarray = field(repr=False)
+    """Time [s], shape (K,)."""
+    q: np.ndarray = field(repr=False)
+    """Joint positions [rad], shape (K, nv)."""
+    v: np.ndarray = field(repr=False)
+    """Joint velocities [rad/s], shape (K, nv)."""
+    tau_command: np.ndarray = field(repr=False)
+    """Torque the controller asked for [N·m], shape (K, nv)."""
+    tau: np.ndarray = field(repr=False)
+    """Torque applied to the arm (saturated if ``saturate``) [N·m], shape (K, nv)."""
+    q_des: np.ndarray = field(repr=False)
+    """Reference positions [rad], shape (K, nv)."""
+    v_des: np.ndarray = field(repr=False)
+    """Reference velocities [rad/s], shape (K, nv)."""
+    a_des: np.ndarray = field(repr=False)
+    """Reference accelerations [rad/s²], shape (K, nv)."""
+    torque_limits: np.ndarray = field(repr=False)
+    """Motor limits [N·m], shape (nv,); inf where the model has none."""
+    saturate: bool
+    """Whether the plant clipped torques to the limits."""
+    reference_period: float
+    """Period of the reference trajectory [s]."""
+    p_hat: np.ndarray | None = field(repr=False, default=None)
+    """Parameter estimates, shape (K, n_p), for laws that estimate parameters; else None."""
+    p_true: np.ndarray | None = field(repr=False, default=None)
+    """The plant's values of the estimated parameters, shape (n_p,), or None."""
+    parameter_names: tuple[str, ...] = ()
+    """Names of the estimated parameters."""
+    control_period: float | None = None
+    """Sampling period of the held law [s], or None if the law ran at every RK4 stage."""
+    parameter_units: tuple[str, ...] = ()
+    """SI unit of each estimated parameter."""
+    parameter_kinds: tuple[str, ...] = ()
+    """``"inertial"`` or ``"friction"`` for each estimated parameter."""
+    robot: str = ""
+    """Name of the robot simulated."""
+
+    @property
+    def duration(self) -> float:
+        """Simulated time [s]."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def nv(self) -> int:
+        """Number of joints."""
+        return int(self.q.shape[1])
+
+    @property
+    def e(self) -> np.ndarray:
+        """Position error ``q − q_d`` [rad], shape (K, nv)."""
+        return self.q - self.q_des
+
+    @property
+    def edot(self) -> np.ndarray:
+        """Velocity error ``q̇ − q̇_d`` [rad/s], shape (K, nv)."""
+        return self.v - self.v_des
+
+    @property
+    def p_error(self) -> np.ndarray | None:
+        """``p̂ − p`` over time, shape (K, n_p), or None."""
+        return None if self.p_hat is None or self.p_true is None else self.p_hat - self.p_true
+
+    @property
+    def limit_excess(self) -> np.ndarray:
+        """Largest ``|τ_command| − limit`` per joint [N·m], 0 where never exceeded."""
+        return np.maximum(np.abs(self.tau_command) - self.torque_limits, 0.0).max(axis=0)
+
+    @property
+    def limit_exceeded(self) -> np.ndarray:
+        """Whether the commanded torque ever exceeded each joint's limit, shape (nv,)."""
+        return self.limit_excess > 0
+
+    @property
+    def first_exceeded_at(self) -> list[float | None]:
+        """First time [s] each joint's commanded torque exceeded its limit, or None."""
+        over = np.abs(self.tau_command) > self.torque_limits
+        return [float(self.t[np.argmax(col)]) if col.any() else None for col in over.T]

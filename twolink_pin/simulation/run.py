@@ -1,0 +1,131 @@
+"""``simulate``: one closed-loop run, recorded — N = 1 of the engine."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from twolink_pin.arrays import readonly, readonly_or_none
+from twolink_pin.controllers import Controller
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.plant import Plant
+from twolink_pin.simulation.adaptive_step import integrate_adaptive
+from twolink_pin.simulation.config import SimulationConfig, joint_offsets
+from twolink_pin.simulation.engine import integrate
+from twolink_pin.simulation.result import SimulationResult
+from twolink_pin.trajectory import JointTrajectory
+
+
+def check_setup(controller: Controller, plant: Plant, trajectory: JointTrajectory) -> None:
+    """Raise unless the law, the plant and the reference are for the same number of joints."""
+    nv = plant.robot.nv
+    if not isinstance(controller, Controller):
+        raise InvalidParameterError("controller", type(controller).__name__, "a twolink_pin Controller")
+    if controller.robot.nv != nv:
+        raise InvalidParameterError(
+            "controller",
+            f"{controller.name} for nv = {controller.robot.nv}",
+            f"a law built for the plant's nv = {nv}",
+        )
+    if trajectory.nv != nv:
+        raise InvalidParameterError(
+            "trajectory", f"{trajectory.nv} joints", f"a trajectory for the plant's {nv} joints"
+        )
+
+
+def initial_state(
+    plant: Plant, trajectory: JointTrajectory, config: SimulationConfig
+) -> tuple[np.ndarray, np.ndarray]:
+    """``q(0) = q_d(0) + q0_offset`` and ``q̇(0) = q̇_d(0) + v0_offset``, shape (nv,) each."""
+    nv = plant.robot.nv
+    ref0 = trajectory.sample(0.0)
+    q0 = ref0.q + joint_offsets("q0_offset", config.q0_offset, plant.robot.profile.q0_offset, nv)
+    v0 = ref0.v + joint_offsets("v0_offset", config.v0_offset, None, nv)
+    return q0, v0
+
+
+def estimated_truth(controller: Controller, plant: Plant) -> np.ndarray | None:
+    """The plant's actual values of what ``controller`` estimates (None if nothing):
+    its map's parameters of the plant's model, then the plant's friction (zeros without)."""
+    parts = []
+    for kind in controller.estimates:
+        if kind == "inertial":
+            parts.append(np.asarray(controller.robot.parameter_map.values(plant.model), dtype=float))
+        else:
+            friction = plant.friction
+            parts.append(np.zeros(2 * plant.robot.nv) if friction is None else friction.parameters)
+    return np.concatenate(parts) if parts else None
+
+
+def simulate(
+    controller: Controller,
+    plant: Plant,
+    trajectory: JointTrajectory,
+    config: SimulationConfig | None = None,
+) -> SimulationResult:
+    """Run ``controller`` on ``plant`` tracking ``trajectory``, every sample recorded.
+
+    Raises:
+        InvalidParameterError: the law, plant and trajectory disagree on nv, offsets of the
+            wrong length, per-run gains (use :func:`twolink_pin.simulate_batch`), or exact-sign
+            friction with the adaptive method.
+        SimulationDivergedError: the state became non-finite or absurd (the time is given).
+        ControllerError: the law raised, or returned the wrong shape or a non-finite torque.
+    """
+    config = config if config is not None else SimulationConfig()
+    check_setup(controller, plant, trajectory)
+    runs = controller.runs
+    if runs not in (None, 1):
+        raise InvalidParameterError(
+            "controller", f"per-run gains for {runs} runs", "one value set (simulate_batch runs N)"
+        )
+    q0, v0 = initial_state(plant, trajectory, config)
+    z0 = np.atleast_2d(np.asarray(controller.initial_state(), dtype=float)).reshape(1, -1)
+    if config.method == "rk4":
+        samples = integrate(
+            controller,
+            plant,
+            trajectory,
+            config,
+            q0[None],
+            v0[None],
+            z0,
+            record=True,
+            stop_on_divergence=True,
+        ).record
+        assert samples is not None
+    else:
+        friction = plant.friction
+        if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
+            raise InvalidParameterError(
+                "friction.smoothing", 0.0, "> 0 rad/s with the adaptive-step method (exact sgn stalls it)"
+            )
+        samples = integrate_adaptive(controller, plant, trajectory, config, q0[None], v0[None], z0)
+    tau_command = samples.tau_command[:, 0, :]
+    z = samples.z[:, 0, :]
+    estimates = controller.state_size > 0 and controller.estimates
+    true = estimated_truth(controller, plant)
+    return SimulationResult(
+        controller=controller.name,
+        method=config.method,
+        dt=config.duration / config.steps,
+        t=readonly(samples.t),
+        q=readonly(samples.q[:, 0, :]),
+        v=readonly(samples.v[:, 0, :]),
+        tau_command=readonly(tau_command),
+        tau=readonly(plant.applied_torque(tau_command)),
+        q_des=readonly(samples.q_des[:, 0, :]),
+        v_des=readonly(samples.v_des[:, 0, :]),
+        a_des=readonly(samples.a_des[:, 0, :]),
+        torque_limits=readonly(plant.limits),
+        saturate=plant.saturate,
+        reference_period=trajectory.period,
+        p_hat=readonly(z) if estimates else None,
+        p_true=readonly_or_none(true) if estimates else None,
+        parameter_names=controller.parameter_names if estimates else (),
+        control_period=None
+        if config.hold_steps is None
+        else config.hold_steps * config.duration / config.steps,
+        parameter_units=controller.parameter_units if estimates else (),
+        parameter_kinds=controller.parameter_kinds if estimates else (),
+        robot=plant.robot.name,
+    )

@@ -1,0 +1,343 @@
+"""The Pinocchio terms a law asks for (:class:`~twolink_pin.controllers.Terms`), for N runs.
+
+:func:`terms_for` builds what the engine passes to ``Controller.compute``:
+
+* **one run** (:class:`SingleRunTerms`): the model term ``M̂ a + Ĉ(q, v) w + ĝ`` by one
+  ``pin.rnea`` on the :func:`~twolink_pin.dynamics.polarisation_pair` of the law's model,
+  the regressor by one ``pin.computeJointTorqueRegressor`` on the same pair (the
+  difference of its diagonal blocks, times the parameter map);
+* **N runs** (:class:`BatchTerms`): ``pin.rneaInParallel`` over a ``pin.ModelPool``. The
+  model term of a law whose runs share one model is one call on that model's pair. The
+  regressor is built column by column from RNEA, which is linear in the inertial
+  parameters π: on models that differ from a base ``π₀`` by the map's column ``P_j``,
+  ``Y_j = τ(π₀ + P_j) − τ(π₀)``, all columns in one call on a
+  :func:`~twolink_pin.dynamics.polarisation_forest`. Columns that are a constant matrix
+  times ``a`` (no q, velocity or gravity dependence: e.g. the twolink's p1 and p2) are
+  detected numerically once and evaluated as that matrix, with no RNEA. When the law's
+  runs believe different parameters, its model term is ``Y p`` per run.
+
+Every run's numbers are computed by the same code whatever N and whichever runs share its
+batch (element-wise numpy, one Pinocchio evaluation per column), so a batch equals N
+single runs to rounding and a run's result does not depend on how a sweep is chunked.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.dynamics import friction_regressor, polarisation_forest, polarisation_pair
+from twolink_pin.errors import InvalidParameterError, TwolinkPinError
+from twolink_pin.model.parameters import (
+    N_BODY_PARAMETERS,
+    ParameterMap,
+    inertial_parameters,
+    model_with_parameters,
+    with_inertial_parameters,
+)
+
+if TYPE_CHECKING:
+    from twolink_pin.controllers import Controller
+
+MIN_RUNS_PER_THREAD = 256
+"""Fewer runs than this per thread and a batch uses fewer threads: a parallel region on a
+handful of columns costs more in synchronisation than it saves."""
+
+
+class BatchUnavailableError(TwolinkPinError):
+    """Pinocchio lacks the parallel algorithms the batch engine needs.
+
+    Attributes:
+        missing: Names of the missing ``pinocchio`` attributes.
+    """
+
+    _fields = ("missing",)
+
+    def __init__(self, missing: Sequence[str]) -> None:
+        self.missing = tuple(missing)
+        super().__init__(
+            f"pinocchio {pin.__version__} has no {', '.join(self.missing)}: it was built without its "
+            "parallel module (OpenMP). Install a build that has it (pip install 'pin>=3' or conda-forge "
+            "pinocchio), or run the cases one by one with twolink_pin.simulate"
+        )
+
+
+def check_parallel() -> None:
+    """Raise :class:`BatchUnavailableError` unless Pinocchio has its parallel algorithms."""
+    missing = [name for name in ("ModelPool", "abaInParallel", "rneaInParallel") if not hasattr(pin, name)]
+    if missing:
+        raise BatchUnavailableError(missing)
+
+
+def default_threads() -> int:
+    """Cores available to this process (the default thread count)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def threads_for(runs: int, threads: int | None) -> int:
+    """Threads a batch of ``runs`` uses: at most one per :data:`MIN_RUNS_PER_THREAD` runs."""
+    requested = default_threads() if threads is None else threads
+    if not (isinstance(requested, int) and not isinstance(requested, bool) and requested >= 1):
+        raise InvalidParameterError("threads", threads, "a whole number >= 1")
+    return max(1, min(requested, runs // MIN_RUNS_PER_THREAD))
+
+
+# -- one run ---------------------------------------------------------------------------------
+
+
+class _PairInputs:
+    """The pair's RNEA inputs ``Q = (q, q)``, ``V = ((v+w)/2, (v−w)/2)``, ``A = (a, 0)``.
+
+    Built in one product ``[q v w a] T`` with a constant 0/±1/±½ matrix ``T``: two numpy
+    calls instead of five (each entry is one input, or a half-sum that FMA or not rounds
+    exactly like ``(v ± w)/2``).
+    """
+
+    def __init__(self, nv: int) -> None:
+        self.nv = nv
+        eye = np.eye(nv)
+        T = np.zeros((4 * nv, 6 * nv))
+        T[0:nv, 0:nv] = T[0:nv, nv : 2 * nv] = eye  # q -> both copies
+        T[nv : 2 * nv, 2 * nv : 3 * nv] = T[nv : 2 * nv, 3 * nv : 4 * nv] = 0.5 * eye  # v/2 -> both
+        T[2 * nv : 3 * nv, 2 * nv : 3 * nv] = 0.5 * eye  # +w/2 -> copy A
+        T[2 * nv : 3 * nv, 3 * nv : 4 * nv] = -0.5 * eye  # −w/2 -> copy B
+        T[3 * nv :, 4 * nv : 5 * nv] = eye  # a -> copy A; copy B's acceleration stays 0
+        self._T = T
+
+    def fill(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, ...]:
+        """``(Q, V, A)``, each of shape (2 nv,)."""
+        nv = self.nv
+        b = (np.concatenate(np.broadcast_arrays(q, v, w, a), axis=1) @ self._T)[0]
+        return b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :]
+
+
+class SingleRunTerms:
+    """:class:`~twolink_pin.controllers.Terms` for one run (arrays of shape (1, nv))."""
+
+    def __init__(self, controller: Controller) -> None:
+        robot = controller.robot
+        model = robot.model
+        p = controller.model_parameters
+        if p is not None:
+            model = model_with_parameters(model, robot.parameter_map, np.asarray(p).reshape(-1))
+        self._pair = polarisation_pair(model)
+        self._data = self._pair.createData()
+        self._nv = robot.nv
+        self._inputs = _PairInputs(robot.nv)
+        self._n_pi = N_BODY_PARAMETERS * (model.njoints - 1)
+        self._P = np.ascontiguousarray(robot.parameter_map.matrix)
+
+    def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        nv = self._nv
+        tau = pin.rnea(self._pair, self._data, *self._inputs.fill(q, v, w, a))
+        return tau[None, :nv] - tau[None, nv:]
+
+    def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        nv, n_pi = self._nv, self._n_pi
+        R = pin.computeJointTorqueRegressor(self._pair, self._data, *self._inputs.fill(q, v, w, a))
+        return ((R[:nv, :n_pi] - R[nv:, n_pi:]) @ self._P)[None]
+
+    def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
+        return friction_regressor(np.reshape(v, (1, self._nv)), smoothing)
+
+
+# -- N runs ----------------------------------------------------------------------------------
+
+
+class _PolarisedTerms:
+    """``M_i(q) a + C_i(q, v) w + g_i(q)`` [N·m] of several models over the batch, in one call.
+
+    One ``rneaInParallel`` on the :func:`~twolink_pin.dynamics.polarisation_forest` of the
+    models (same kinematics): the two terms of the polarisation identity of every model in
+    one parallel region.
+    """
+
+    def __init__(self, models: Sequence[pin.Model], threads: int, n: int) -> None:
+        forest = polarisation_forest(models)
+        self.pool = pin.ModelPool(forest, threads)
+        self.threads = threads
+        self.k, self.nv = len(models), models[0].nv
+        size = 2 * self.k * self.nv
+        self.q, self.v, self.a = np.empty((n, size)), np.empty((n, size)), np.zeros((n, size))
+        self.out = np.empty((n, size))
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
+        n, k, nv = self.q.shape[0], self.k, self.nv
+        self.q.reshape(n, 2 * k, nv)[:] = q[:, None, :]
+        velocities = self.v.reshape(n, k, 2, nv)
+        velocities[:, :, 0, :] = (0.5 * (v + w))[:, None, :]
+        velocities[:, :, 1, :] = (0.5 * (v - w))[:, None, :]
+        self.a.reshape(n, k, 2, nv)[:, :, 0, :] = np.broadcast_to(a, (n, nv))[
+            :, None, :
+        ]  # copies B keep a = 0
+        pin.rneaInParallel(self.threads, self.pool, self.q.T, self.v.T, self.a.T, self.out.T)
+        out = self.out.reshape(n, k, 2, nv)
+        return [out[:, i, 0, :] - out[:, i, 1, :] for i in range(k)]
+
+
+class _Regressor:
+    """``Y_p(q, v, w, a)`` with ``Y_p p = M a + C(q, v) w + g`` over the batch: a list of
+    n_p arrays of shape (N, nv), one per column of the parameter map.
+
+    π₀ is ``model``'s parameters with any zero mass set to 1 kg, so that every column model
+    ``π₀ + P_j`` has a finite inertia. Constant columns (``Y_j = C_j a``, checked at
+    random states) are evaluated as ``a C_jᵀ``. When the map describes π₀'s dynamics
+    completely, ``τ(π₀) = Y p₀`` gives the base term from the column models themselves
+    (no base model); otherwise the base model is computed too.
+    """
+
+    def __init__(self, model: pin.Model, parameter_map: ParameterMap, threads: int, n: int) -> None:
+        pi0 = inertial_parameters(model)
+        masses = pi0[::N_BODY_PARAMETERS]
+        masses[masses <= 0] = 1.0
+        pi0[::N_BODY_PARAMETERS] = masses
+        base = with_inertial_parameters(model, pi0)
+        P = parameter_map.matrix
+        size = P.shape[1]
+        self.size = size
+        columns = [with_inertial_parameters(model, pi0 + P[:, j]) for j in range(size)]
+        probe = _Probe(model.nv)
+        direct = probe.evaluate([base, *columns])
+        y = [column - direct[0] for column in direct[1:]]
+        self.constant: dict[int, np.ndarray] = {}
+        for j in range(size):
+            C = probe.constant_matrix(y[j])
+            if C is not None:
+                self.constant[j] = np.ascontiguousarray(C.T)
+        self.varying = [j for j in range(size) if j not in self.constant]
+        p0 = parameter_map.values(base)
+        weights = p0[self.varying]
+        denominator = 1.0 + float(np.sum(weights))
+        self.base_weights: np.ndarray | None = None
+        if self.varying and abs(denominator) > 1e-6:
+            # τ(π₀) (1 + Σ_{j varying} p0_j) = Σ_{j constant} p0_j Y_j + Σ_{j varying} p0_j T_j
+            predicted = sum((p0[j] * y[j] for j in self.constant), np.zeros_like(direct[0]))
+            predicted = predicted + sum(p0[j] * direct[1 + j] for j in self.varying)
+            if _close(predicted / denominator, direct[0]):
+                self.base_weights = p0 / denominator
+        models = [columns[j] for j in self.varying]
+        if self.base_weights is None and self.varying:
+            models = [base, *models]
+        self.terms = _PolarisedTerms(models, threads, n) if models else None
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
+        out: list[np.ndarray | None] = [None] * self.size
+        a_full = np.broadcast_to(a, q.shape)
+        for j, Ct in self.constant.items():
+            out[j] = a_full @ Ct
+        if self.terms is not None:
+            terms = self.terms(q, v, w, a)
+            if self.base_weights is None:
+                base, varying = terms[0], terms[1:]
+            else:
+                varying = terms
+                weights = self.base_weights
+                base = None
+                for j in self.constant:
+                    base = out[j] * weights[j] if base is None else base + out[j] * weights[j]
+                for j, term in zip(self.varying, varying, strict=True):
+                    base = term * weights[j] if base is None else base + term * weights[j]
+            for j, term in zip(self.varying, varying, strict=True):
+                out[j] = term - base
+        return out  # type: ignore[return-value]
+
+
+class _Probe:
+    """Random states and the model terms of several models there (to analyse columns)."""
+
+    def __init__(self, nv: int, count: int = 8) -> None:
+        rng = np.random.default_rng(0)
+        self.q, self.v, self.w, self.a = (rng.uniform(-2.0, 2.0, (count, nv)) for _ in range(4))
+        self.nv, self.count = nv, count
+
+    def evaluate(self, models: Sequence[pin.Model]) -> list[np.ndarray]:
+        terms = _PolarisedTerms(models, 1, self.count)
+        return [t.copy() for t in terms(self.q, self.v, self.w, self.a)]
+
+    def constant_matrix(self, y: np.ndarray) -> np.ndarray | None:
+        """``C`` if ``y = a Cᵀ`` at every probe state (to 1e-10 relative), else None."""
+        C, *_ = np.linalg.lstsq(self.a, y, rcond=None)
+        return C.T if _close(self.a @ C, y) else None
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    scale = max(1.0, float(np.abs(b).max()), float(np.abs(a).max()))
+    return bool(np.abs(a - b).max() <= 1e-10 * scale)
+
+
+class BatchTerms:
+    """:class:`~twolink_pin.controllers.Terms` for N runs advanced together."""
+
+    def __init__(self, controller: Controller, runs: int, threads: int) -> None:
+        check_parallel()
+        robot = controller.robot
+        self._nv = robot.nv
+        self._runs = runs
+        self._threads = threads
+        self._model = robot.model
+        self._map = robot.parameter_map
+        self._regressor: _Regressor | None = None
+        p = controller.model_parameters
+        self._p_rows: np.ndarray | None = None
+        self._shared: _PolarisedTerms | None = None
+        if p is not None and p.ndim == 2 and p.shape[0] > 1:
+            if p.shape[0] != runs:
+                raise InvalidParameterError(
+                    "model_parameters", f"shape {p.shape}", f"one row per run ({runs}) or one row for all"
+                )
+            self._p_rows = np.ascontiguousarray(p)
+        else:
+            model = robot.model if p is None else model_with_parameters(robot.model, self._map, p.reshape(-1))
+            self._shared = _PolarisedTerms([model], threads, runs)
+
+    def _columns(self) -> _Regressor:
+        if self._regressor is None:
+            self._regressor = _Regressor(self._model, self._map, self._threads, self._runs)
+        return self._regressor
+
+    def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        if self._shared is not None:
+            return self._shared(q, v, w, a)[0]
+        assert self._p_rows is not None
+        columns = self._columns()(q, v, w, a)
+        p = self._p_rows
+        tau = columns[0] * p[:, 0:1]
+        for j in range(1, len(columns)):
+            tau = tau + columns[j] * p[:, j : j + 1]
+        return tau
+
+    def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        return np.stack(self._columns()(q, v, w, a), axis=2)
+
+    def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
+        return friction_regressor(np.broadcast_to(v, (self._runs, self._nv)), smoothing)
+
+
+def terms_for(
+    controller: Controller, runs: int = 1, threads: int | None = None
+) -> SingleRunTerms | BatchTerms:
+    """The terms the engine passes to ``controller.compute`` for ``runs`` runs.
+
+    Args:
+        controller: The law (its robot and, if any, its ``model_parameters``).
+        runs: N, the number of runs evaluated together.
+        threads: Threads for Pinocchio's parallel algorithms (N > 1); default all cores,
+            at most one per :data:`MIN_RUNS_PER_THREAD` runs.
+    """
+    if not (isinstance(runs, int) and runs >= 1):
+        raise InvalidParameterError("runs", runs, "a whole number >= 1")
+    p = controller.model_parameters
+    if runs == 1:
+        if p is not None and p.ndim == 2 and p.shape[0] != 1:
+            raise InvalidParameterError("model_parameters", f"shape {p.shape}", "one row for a single run")
+        return SingleRunTerms(controller)
+    return BatchTerms(controller, runs, threads_for(runs, threads))

@@ -1,0 +1,221 @@
+"""N runs of one law advanced together, with each run's metrics streamed: :func:`simulate_batch`.
+
+The runs share the plant and the reference; they differ in their initial state and in
+whatever the law object holds per run — gains of shape ``(N, k)``, believed parameters
+``model_parameters`` of shape ``(N, n_p)`` (see :mod:`twolink_pin.controllers.gains`).
+Every run is what :func:`~twolink_pin.simulate` computes for its row (to rounding;
+tested), except that a diverging run is parked and flagged instead of raising. Memory is
+O(N) unless ``record=True``: the engine hands each block of samples to
+:class:`~twolink_pin.metrics.RunningMetrics`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.arrays import readonly, readonly_or_none
+from twolink_pin.controllers import Controller
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.metrics import BatchMetrics, RunningMetrics
+from twolink_pin.plant import Plant
+from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
+from twolink_pin.simulation.run import check_setup, initial_state
+from twolink_pin.simulation.terms import check_parallel, threads_for
+from twolink_pin.trajectory import JointTrajectory
+
+
+@dataclass(frozen=True)
+class BatchResult:
+    """N runs of one law. Arrays are read-only; K = number of output samples."""
+
+    controller: str
+    """Controller's registry name."""
+    dt: float
+    """Output grid spacing (and RK4 step) [s]."""
+    t: np.ndarray = field(repr=False)
+    """Time [s], shape (K,)."""
+    q0_offset: np.ndarray = field(repr=False)
+    """``q(0) − q_d(0)`` of each run [rad], shape (N, nv)."""
+    v0_offset: np.ndarray = field(repr=False)
+    """``q̇(0) − q̇_d(0)`` of each run [rad/s], shape (N, nv)."""
+    metrics: BatchMetrics = field(repr=False)
+    """Each run's metrics (NaN rows for diverged runs)."""
+    diverged_at: np.ndarray = field(repr=False)
+    """Time [s] at which each run diverged (as :func:`~twolink_pin.simulate` would report
+    it); NaN for runs that did not, shape (N,)."""
+    divergence: tuple[str | None, ...]
+    """What was detected for each diverged run (None for the others)."""
+    torque_limits: np.ndarray = field(repr=False)
+    """Motor limits [N·m], shape (nv,)."""
+    saturate: bool
+    """Whether the plant clipped torques to the limits."""
+    threads: int
+    """Threads given to Pinocchio's parallel algorithms."""
+    control_period: float | None = None
+    """Sampling period of the held law [s], or None (law at every RK4 stage)."""
+    p_hat_final: np.ndarray | None = field(repr=False, default=None)
+    """Parameter estimates at the end, shape (N, n_p) (NaN if diverged); None if the law
+    estimates nothing."""
+    p_true: np.ndarray | None = field(repr=False, default=None)
+    """The plant's values of the estimated parameters, shape (n_p,), or None."""
+    parameter_names: tuple[str, ...] = ()
+    """Names of the estimated parameters."""
+    parameter_units: tuple[str, ...] = ()
+    """Their SI units."""
+    q: np.ndarray | None = field(repr=False, default=None)
+    """Joint positions [rad], shape (N, K, nv), only with ``record=True``."""
+    v: np.ndarray | None = field(repr=False, default=None)
+    """Joint velocities [rad/s], shape (N, K, nv), only with ``record=True``."""
+    tau_command: np.ndarray | None = field(repr=False, default=None)
+    """Commanded torque [N·m], shape (N, K, nv), only with ``record=True``."""
+    p_hat: np.ndarray | None = field(repr=False, default=None)
+    """Parameter estimates, shape (N, K, n_p), only with ``record=True``."""
+
+    @property
+    def n_runs(self) -> int:
+        """Number of runs N."""
+        return int(self.diverged_at.shape[0])
+
+    @property
+    def diverged(self) -> np.ndarray:
+        """Whether each run diverged, shape (N,)."""
+        return ~np.isnan(self.diverged_at)
+
+    @property
+    def limit_exceeded(self) -> np.ndarray:
+        """Whether each run's command ever exceeded each joint's limit, shape (N, nv)."""
+        return ~np.isnan(self.metrics.first_exceeded_at)
+
+
+def _per_run(name: str, value: Any, runs: int, nv: int) -> np.ndarray | None:
+    if value is None:
+        return None
+    array = np.array(value, dtype=float)
+    if array.shape != (runs, nv):
+        raise InvalidParameterError(name, f"shape {array.shape}", f"shape ({runs}, {nv}): one row per run")
+    bad = np.argwhere(~np.isfinite(array))
+    if len(bad):
+        i, j = (int(x) for x in bad[0])
+        raise InvalidParameterError(f"{name}[{i}, {j}]", float(array[i, j]), "finite offsets [rad or rad/s]")
+    return array
+
+
+def batch_size(controller: Controller, *arrays: Any, runs: int | None = None) -> int:
+    """N from ``runs``, the per-run arrays (leading axis) and the law's per-run values, all
+    of which must agree."""
+    counts: dict[str, int] = {}
+    if runs is not None:
+        if not (isinstance(runs, int) and not isinstance(runs, bool) and runs >= 1):
+            raise InvalidParameterError("runs", runs, "a whole number >= 1")
+        counts["runs"] = runs
+    for i, array in enumerate(arrays):
+        if array is not None:
+            counts[f"offsets[{i}]"] = int(np.shape(array)[0]) if np.ndim(array) else 1
+    law_runs = controller.runs
+    if law_runs is not None:
+        counts["the controller's per-run gains"] = law_runs
+    sizes = set(counts.values())
+    if len(sizes) > 1:
+        raise InvalidParameterError("runs", counts, "one number of runs N for every per-run input")
+    return sizes.pop() if sizes else 1
+
+
+def simulate_batch(
+    controller: Controller,
+    plant: Plant,
+    trajectory: JointTrajectory,
+    config: SimulationConfig | None = None,
+    *,
+    runs: int | None = None,
+    q0_offsets: np.ndarray | Sequence[Sequence[float]] | None = None,
+    v0_offsets: np.ndarray | Sequence[Sequence[float]] | None = None,
+    threads: int | None = None,
+    record: bool = False,
+    progress: Callable[[int, int], None] | None = None,
+) -> BatchResult:
+    """Run N copies of ``controller`` on ``plant`` along ``trajectory``, all together.
+
+    Args:
+        controller: One law object; gains or ``model_parameters`` with a leading run axis
+            give each run its own (N inferred from them).
+        plant: The arm all runs drive (friction and saturation shared).
+        trajectory: The reference.
+        config: Duration, step, ``control_period``; ``method`` must be ``"rk4"``. Its
+            ``q0_offset`` / ``v0_offset`` are the defaults for every run.
+        runs: N, when nothing else says it.
+        q0_offsets: ``q(0) − q_d(0)`` per run [rad], shape (N, nv).
+        v0_offsets: ``q̇(0) − q̇_d(0)`` per run [rad/s], shape (N, nv).
+        threads: Threads for Pinocchio's parallel algorithms; default all cores, at most
+            one per 256 runs.
+        record: Keep every run's trajectory (memory N × K × nv × 8 bytes per signal).
+        progress: Called as ``progress(steps_done, steps_total)`` after each block.
+
+    Raises:
+        InvalidParameterError: inconsistent N, bad offsets, ``method != "rk4"``.
+        BatchUnavailableError: this Pinocchio has no parallel algorithms.
+    """
+    check_parallel()
+    config = config if config is not None else SimulationConfig()
+    if config.method != "rk4":
+        raise InvalidParameterError("method", config.method, "'rk4' (the batch engine is fixed-step)")
+    check_setup(controller, plant, trajectory)
+    nv = plant.robot.nv
+    n = batch_size(controller, q0_offsets, v0_offsets, runs=runs)
+    q0_nominal, v0_nominal = initial_state(plant, trajectory, config)
+    ref0 = trajectory.sample(0.0)
+    q0_off = _per_run("q0_offsets", q0_offsets, n, nv)
+    v0_off = _per_run("v0_offsets", v0_offsets, n, nv)
+    q0_off = np.tile(q0_nominal - ref0.q, (n, 1)) if q0_off is None else q0_off
+    v0_off = np.tile(v0_nominal - ref0.v, (n, 1)) if v0_off is None else v0_off
+    z0 = np.asarray(controller.initial_state(), dtype=float)
+    z0 = np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
+    used = threads_for(n, threads) if n > 1 else 1
+    steps = config.steps
+    dt = config.duration / steps
+    observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
+    run = integrate(
+        controller,
+        plant,
+        trajectory,
+        config,
+        ref0.q + q0_off,
+        ref0.v + v0_off,
+        z0,
+        record=record,
+        observer=observer,
+        threads=used,
+        progress=progress,
+    )
+    dead = ~np.isnan(run.diverged_at)
+    estimates = controller.state_size > 0 and bool(controller.estimates)
+    p_hat_final = None
+    if estimates:
+        p_hat_final = run.z_final.copy()
+        p_hat_final[dead] = np.nan
+    rec = run.record
+    return BatchResult(
+        controller=controller.name,
+        dt=dt,
+        t=readonly(run.t),
+        q0_offset=readonly(q0_off),
+        v0_offset=readonly(v0_off),
+        metrics=observer.result(dead),
+        diverged_at=readonly(run.diverged_at),
+        divergence=run.detail,
+        torque_limits=readonly(plant.limits),
+        saturate=plant.saturate,
+        threads=used,
+        control_period=None if config.hold_steps is None else config.hold_steps * dt,
+        p_hat_final=readonly_or_none(p_hat_final),
+        p_true=readonly_or_none(estimated_truth(controller, plant)) if estimates else None,
+        parameter_names=controller.parameter_names if estimates else (),
+        parameter_units=controller.parameter_units if estimates else (),
+        q=readonly(rec.q.transpose(1, 0, 2)) if rec is not None else None,
+        v=readonly(rec.v.transpose(1, 0, 2)) if rec is not None else None,
+        tau_command=readonly(rec.tau_command.transpose(1, 0, 2)) if rec is not None else None,
+        p_hat=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and estimates else None,
+    )

@@ -1,0 +1,145 @@
+"""Several laws side by side on one robot: the metrics table (our Table 2).
+
+:func:`run_comparison` runs each law through a caller-supplied runner (so the simulation
+settings stay the caller's), computes its metrics and, optionally, writes its figures;
+:class:`ComparisonTable` renders the table with one column per joint of the robot, as
+Markdown, CSV and JSON. The course report's own Table 2 is the twolink's business
+(:mod:`twolink_pin.twolink.reference`); the report shows it beside ours.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from twolink_pin.files import atomic_write, write_json
+from twolink_pin.metrics import Metrics, compute_metrics
+from twolink_pin.simulation import SimulationResult
+
+SIGNALS = (("e", "e", "rad"), ("edot", "ė", "rad/s"), ("tau", "τ", "N·m"))
+"""(field, symbol, unit) of each signal of the table."""
+NORMS = {"rms": ("RMS = sqrt((1/T)∫x² dt)", ""), "l2": ("L2 = sqrt(∫x² dt)", "·√s"), "max": ("max |x|", "")}
+"""Title and unit suffix of each norm."""
+
+
+def columns(nv: int) -> list[str]:
+    """Column names of a row: ``e1..e_nv, edot1.., tau1..``."""
+    return [f"{name}{j + 1}" for name, _, _ in SIGNALS for j in range(nv)]
+
+
+def headers(nv: int, kind: str) -> list[str]:
+    """Column headers with units for norm ``kind``: ``e1 [rad]``, ..."""
+    suffix = NORMS[kind][1]
+    return [f"{symbol}{j + 1} [{unit}{suffix}]" for _, symbol, unit in SIGNALS for j in range(nv)]
+
+
+def row(metrics: Metrics, kind: str) -> list[float]:
+    """One norm of every signal and joint, in :func:`columns` order."""
+    norms = getattr(metrics, kind)
+    return [float(x) for name, _, _ in SIGNALS for x in getattr(norms, name)]
+
+
+@dataclass(frozen=True)
+class ComparisonTable:
+    """Metrics of every law run, in the order run."""
+
+    metrics: dict[str, Metrics]
+    """Metrics by law name."""
+    seconds: dict[str, float]
+    """Wall-clock time of each run [s]."""
+    duration: float
+    """Simulated time of each run [s]."""
+
+    @property
+    def nv(self) -> int:
+        """Joints of the robot."""
+        first = next(iter(self.metrics.values()))
+        return int(first.rms.e.shape[0])
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        return {
+            "controllers": {name: m.as_dict() for name, m in self.metrics.items()},
+            "columns": columns(self.nv),
+            "duration_s": self.duration,
+            "seconds": self.seconds,
+        }
+
+    def csv(self) -> str:
+        """One row per (law, norm), then the last-period max |e| row per law."""
+        buffer = io.StringIO()
+        writer = csv.writer(buffer, lineterminator="\n")
+        cols = columns(self.nv)
+        writer.writerow(["controller", "norm", *cols])
+        for name, m in self.metrics.items():
+            for kind in NORMS:
+                writer.writerow([name, kind, *(f"{x:.6g}" for x in row(m, kind))])
+            e_last = [f"{x:.6g}" for x in m.final_period_max_abs_e]
+            writer.writerow([name, "last_period_max_abs_e", *e_last, *([""] * (len(cols) - len(e_last)))])
+        return buffer.getvalue()
+
+    def markdown(self) -> str:
+        """Our three norms and the last-period error as Markdown tables."""
+        out = []
+        for kind, (title, _) in NORMS.items():
+            out.append(f"### {title} over {self.duration:g} s\n")
+            heads = headers(self.nv, kind)
+            out.append("| controller | " + " | ".join(heads) + " |")
+            out.append("|---|" + "---:|" * len(heads))
+            for name, m in self.metrics.items():
+                out.append(f"| {name} | " + " | ".join(f"{x:.4g}" for x in row(m, kind)) + " |")
+            out.append("")
+        out.append("### max |e| over the last reference period [rad]\n")
+        out.append("| controller | " + " | ".join(f"e{j + 1}" for j in range(self.nv)) + " |")
+        out.append("|---|" + "---:|" * self.nv)
+        for name, m in self.metrics.items():
+            out.append(f"| {name} | " + " | ".join(f"{x:.3g}" for x in m.final_period_max_abs_e) + " |")
+        return "\n".join(out) + "\n"
+
+    def write(self, out_dir: Path) -> list[Path]:
+        """``comparison.md``, ``comparison.csv``, ``comparison.json`` into ``out_dir``."""
+        paths = [out_dir / "comparison.md", out_dir / "comparison.csv"]
+        with atomic_write(paths[0]) as f:
+            f.write(self.markdown())
+        with atomic_write(paths[1]) as f:
+            f.write(self.csv())
+        paths.append(write_json(out_dir / "comparison.json", self.as_dict()))
+        return paths
+
+
+def run_comparison(
+    runner: Callable[[str], SimulationResult],
+    names: Sequence[str],
+    progress: Callable[[str, SimulationResult | None], None] | None = None,
+    on_result: Callable[[str, SimulationResult], None] | None = None,
+) -> ComparisonTable:
+    """Run every law in ``names`` with ``runner`` and tabulate their metrics.
+
+    Args:
+        runner: Runs one law by name and returns its result.
+        names: The laws, in table order.
+        progress: Called as ``progress(name, None)`` before and ``progress(name, result)``
+            after each run.
+        on_result: Called with each result (e.g. to write its figures).
+    """
+    metrics: dict[str, Metrics] = {}
+    seconds: dict[str, float] = {}
+    duration = 0.0
+    for name in names:
+        if progress:
+            progress(name, None)
+        start = time.perf_counter()
+        result = runner(name)
+        metrics[name] = compute_metrics(result)
+        duration = result.duration
+        if on_result is not None:
+            on_result(name, result)
+        seconds[name] = time.perf_counter() - start
+        if progress:
+            progress(name, result)
+    return ComparisonTable(metrics, seconds, duration)

@@ -1,0 +1,32 @@
+"""The twolink's entry in the robot catalog: its URDF, the lumped map, the report's defaults."""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+from types import MappingProxyType
+
+from twolink_pin.model.profile import RobotProfile, TrajectorySpec
+from twolink_pin.twolink import reference
+from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
+
+
+def twolink_urdf_path() -> Path:
+    """Path of the shipped ``twolink.urdf`` (works from a checkout and an installed wheel)."""
+    return Path(str(resources.files("twolink_pin.robots").joinpath("twolink.urdf")))
+
+
+TWOLINK = RobotProfile(
+    name="twolink",
+    description="the course report's 2-link planar arm (horizontal, p = (3.4, 0.4, 0.3) kg·m²)",
+    parameter_map=TwoLinkLumpedMap,
+    gain_presets=MappingProxyType({k: MappingProxyType(v) for k, v in reference.REPORT_GAINS.items()}),
+    friction=reference.REPORT_FRICTION,
+    q0_offset=reference.Q0_OFFSET,
+    trajectory=TrajectorySpec(
+        times=reference.REPORT_TIMES, cartesian_points=reference.REPORT_VIA_XY, branch=0
+    ),
+    ee_frame="ee_link",
+    source="robots/twolink.urdf (this package)",
+)
+"""The twolink's profile: the report's gains, friction, initial offset and via points."""

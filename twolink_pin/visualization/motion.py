@@ -1,0 +1,134 @@
+"""The motion to show: the caller's arrays checked, then resampled to animation frames.
+
+:func:`_prepare` is the one entry point; every check names the offending entry and the
+valid range (:class:`~twolink_pin.errors.InvalidParameterError`). Times [s], joint
+angles [rad], positions [m].
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.model import RobotModel
+
+
+@dataclass(frozen=True)
+class _Motion:
+    """A validated motion, resampled to the animation's frames."""
+
+    frames: np.ndarray
+    """Frame numbers, shape (F,): frame ``k`` is shown at ``k / fps`` s of animation time."""
+    fps: float
+    """Frames per second of motion time [1/s]."""
+    q: np.ndarray
+    """Joint angles at the frames [rad], shape (F, nq)."""
+    q_des: np.ndarray | None
+    """Desired joint angles at the frames [rad], shape (F, nq), or ``None``."""
+    via_points: np.ndarray | None
+    """End-effector via points [m], shape (M, 3) (z = 0 when given as (x, y)), or ``None``."""
+
+
+def _finite_array(name: str, value: npt.ArrayLike, unit: str) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InvalidParameterError(name, value, f"an array of numbers {unit}") from exc
+    bad = np.argwhere(~np.isfinite(array))
+    if len(bad):
+        index = tuple(int(i) for i in bad[0])
+        label = f"{name}[{', '.join(map(str, index))}]" if index else name
+        raise InvalidParameterError(label, float(array[index]), f"finite values {unit}")
+    return array
+
+
+def _check_times(t: npt.ArrayLike) -> np.ndarray:
+    t_arr = _finite_array("t", t, "[s]")
+    if t_arr.ndim != 1 or len(t_arr) < 2:
+        raise InvalidParameterError("t.shape", t_arr.shape, "(N,) with N >= 2 sample times [s]")
+    steps = np.diff(t_arr)
+    if np.any(steps <= 0):
+        i = int(np.argmax(steps <= 0)) + 1
+        raise InvalidParameterError(
+            f"t[{i}]",
+            float(t_arr[i]),
+            f"a time > t[{i - 1}] = {t_arr[i - 1]:g} s (strictly increasing times)",
+        )
+    return t_arr
+
+
+def _check_q(name: str, q: npt.ArrayLike, n: int, nq: int) -> np.ndarray:
+    q_arr = _finite_array(name, q, "[rad]")
+    if q_arr.shape != (n, nq):
+        raise InvalidParameterError(f"{name}.shape", q_arr.shape, f"({n}, {nq}) = (len(t), robot.nq)")
+    return q_arr
+
+
+def _check_fps(fps: float) -> float:
+    if not (isinstance(fps, (int, float)) and not isinstance(fps, bool) and math.isfinite(fps) and fps > 0):
+        raise InvalidParameterError("fps", fps, "a finite frame rate > 0 [1/s]")
+    return float(fps)
+
+
+def _check_via(via_points: npt.ArrayLike | None) -> np.ndarray | None:
+    """Via points as (M, 3) [m]: two columns are ``(x, y)`` with z = 0."""
+    if via_points is None:
+        return None
+    points = _finite_array("via_points", via_points, "[m]")
+    if points.ndim != 2 or points.shape[1] not in (2, 3) or len(points) == 0:
+        raise InvalidParameterError(
+            "via_points.shape", points.shape, "(M, 2) or (M, 3) with M >= 1: end-effector positions [m]"
+        )
+    if points.shape[1] == 2:
+        points = np.column_stack([points, np.zeros(len(points))])
+    return points
+
+
+def _frame_numbers(t: np.ndarray, fps: float) -> np.ndarray:
+    """Frames ``0, 1, 2, …`` every ``1/fps`` s from ``t[0]``, plus a last one at ``t[-1]``."""
+    span = float(t[-1] - t[0]) * fps
+    whole = math.floor(span + 1e-9)
+    frames = np.arange(whole + 1, dtype=float)
+    if span - whole > 1e-6:
+        frames = np.append(frames, span)
+    return frames
+
+
+def _resample(t: np.ndarray, q: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """Linear interpolation of every column of ``q`` (shape (N, nq)) at ``times``."""
+    return np.column_stack([np.interp(times, t, q[:, j]) for j in range(q.shape[1])])
+
+
+def _prepare(
+    robot: RobotModel,
+    t: npt.ArrayLike,
+    q: npt.ArrayLike,
+    q_des: npt.ArrayLike | None,
+    via_points: npt.ArrayLike | None,
+    fps: float,
+) -> _Motion:
+    """Check the caller's arrays against ``robot`` and resample them at ``fps`` [1/s].
+
+    Raises:
+        InvalidParameterError: a shape mismatch, a non-finite value, times not strictly
+            increasing, ``fps <= 0`` or via points not (M, 2) / (M, 3).
+    """
+    t_arr = _check_times(t)
+    q_arr = _check_q("q", q, len(t_arr), robot.nq)
+    q_des_arr = None if q_des is None else _check_q("q_des", q_des, len(t_arr), robot.nq)
+    fps = _check_fps(fps)
+    via = _check_via(via_points)
+    frames = _frame_numbers(t_arr, fps)
+    times = t_arr[0] + frames / fps
+    times[-1] = min(times[-1], t_arr[-1])  # rounding
+    return _Motion(
+        frames=frames,
+        fps=fps,
+        q=_resample(t_arr, q_arr, times),
+        q_des=None if q_des_arr is None else _resample(t_arr, q_des_arr, times),
+        via_points=via,
+    )
