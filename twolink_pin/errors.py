@@ -20,7 +20,7 @@ class TwolinkPinError(Exception):
 
     _fields: tuple[str, ...] = ()
 
-    def __reduce__(self) -> tuple[Any, ...]:
+    def __reduce__(self) -> str | tuple[Any, ...]:
         if not self._fields:
             return super().__reduce__()
         return (type(self), tuple(getattr(self, name) for name in self._fields))

@@ -171,9 +171,9 @@ def cmd_controllers(args: argparse.Namespace) -> int:
     from twolink_pin.controllers import available_controllers
     from twolink_pin.controllers.gains import _spec
 
-    rows = []
+    rows: list[dict[str, Any]] = []
     for name, cls in available_controllers().items():
-        gains = [
+        gains: list[dict[str, Any]] = [
             {
                 "name": f.name,
                 "per": _spec(f).per,
@@ -194,8 +194,8 @@ def cmd_controllers(args: argparse.Namespace) -> int:
         )
     lines = []
     for row in rows:
-        gains = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
-        lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {gains}")
+        listed = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
+        lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {listed}")
     emit(args, {"controllers": rows}, "\n".join(lines))
     return 0
 

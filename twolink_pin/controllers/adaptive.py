@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -11,6 +11,7 @@ from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, SLIDING_RATE
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.dynamics import Friction, joint_inertia, regressor, smooth_sign
+from twolink_pin.model import RobotModel
 
 ADAPTATION_RATE = 1.0
 """α [1/s] of the robot-derived default adaptation gains (see :meth:`Adaptive.scaled_gains`)."""
@@ -34,7 +35,7 @@ class AdaptiveGains(Gains):
     initial_estimate: Any = gain(0.5, bound="nonnegative", doc="p̂(0) = initial_estimate × p")
 
 
-class Adaptive(Controller):
+class Adaptive(Controller[AdaptiveGains]):
     r"""Slotine–Li adaptive control (report "Adaptive Controller")::
 
         τ = Y(q, q̇, q̇_r, q̈_r) p̂ − K s,      dp̂/dt = −Γ Yᵀ s,   Γ = diag(1/γ_i)
@@ -51,12 +52,12 @@ class Adaptive(Controller):
     name = "adaptive"
     title = "Slotine–Li adaptive, p̂(0) = 0.5 p"
     Gains = AdaptiveGains
-    estimates = ("inertial",)
+    estimates: ClassVar[tuple[str, ...]] = ("inertial",)
 
     def __init__(
         self,
-        robot: Any,
-        gains: Gains | None = None,
+        robot: RobotModel,
+        gains: AdaptiveGains | None = None,
         *,
         model_parameters: np.ndarray | None = None,
         friction: Friction | None = None,
@@ -82,7 +83,7 @@ class Adaptive(Controller):
                 parts.append(g.initial_estimate * self.believed_parameters())
             else:
                 values = np.zeros(2 * self.robot.nv) if self.friction is None else self.friction.parameters
-                parts.append(g.friction_initial_estimate * values)
+                parts.append(getattr(g, "friction_initial_estimate", 1.0) * values)
         if all(np.ndim(p) == 1 for p in parts):
             return np.concatenate(parts)
         rows = max(np.atleast_2d(p).shape[0] for p in parts)

@@ -5,13 +5,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from twolink_pin.controllers.adaptive import Adaptive
-from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA
-from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.adaptive import Adaptive, AdaptiveGains
+from twolink_pin.controllers.gains import gain
 
 
 @dataclass(frozen=True, eq=False)
-class AdaptiveFrictionGains(Gains):
+class AdaptiveFrictionGains(AdaptiveGains):
     """Gains of :class:`AdaptiveFriction` (report: K = diag(90, 90),
     γ = (0.5, 0.15, 0.6, 1.7, 1.4, 2.5, 2.5) for p1, p2, p3, V1, V2, C1, C2).
 
@@ -25,10 +24,6 @@ class AdaptiveFrictionGains(Gains):
             the law believes (the report says only "close to their real values": 0.9).
     """
 
-    k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
-    gamma: Any = gain(None, per="estimate", doc="γ_i, adaptation gain Γ = diag(1/γ_i)")
-    lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
-    initial_estimate: Any = gain(0.5, bound="nonnegative", doc="p̂(0) = initial_estimate × p")
     friction_initial_estimate: Any = gain(0.9, bound="nonnegative", doc="f̂(0) = this × the believed friction")
 
 

@@ -28,11 +28,12 @@ from __future__ import annotations
 
 import abc
 import dataclasses
-from typing import Any, ClassVar, NamedTuple, Protocol
+from typing import Any, ClassVar, Generic, NamedTuple, Protocol, TypeVar
 
 import numpy as np
 
-from twolink_pin.controllers.gains import Gains, _spec, check_width, runs_of
+from twolink_pin.controllers.gains import Gains as GainsBase
+from twolink_pin.controllers.gains import _spec, check_width, runs_of
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -94,12 +95,15 @@ class Terms(Protocol):
         ...
 
 
-CONTROLLERS: dict[str, type[Controller]] = {}
+G = TypeVar("G", bound=GainsBase)
+"""The gains class of a law (``Controller[PDGains]``); a user's law may leave it out."""
+
+CONTROLLERS: dict[str, type[Controller[Any]]] = {}
 """Every registered law by name: the built-in ones, then those defined later (a user's
 file, a package's entry point ``twolink_pin.controllers``), in definition order."""
 
 
-def _register(cls: type[Controller]) -> None:
+def _register(cls: type[Controller[Any]]) -> None:
     name = cls.__dict__["name"]
     if not isinstance(name, str) or not name or name.strip() != name or " " in name:
         raise ControllerSpecError(
@@ -109,7 +113,9 @@ def _register(cls: type[Controller]) -> None:
         if not hasattr(cls, attr):
             raise ControllerSpecError(name, f"{cls.__qualname__} must declare {attr!r}")
     if not (
-        isinstance(cls.Gains, type) and issubclass(cls.Gains, Gains) and dataclasses.is_dataclass(cls.Gains)
+        isinstance(cls.Gains, type)
+        and issubclass(cls.Gains, GainsBase)
+        and dataclasses.is_dataclass(cls.Gains)
     ):
         raise ControllerSpecError(name, f"{cls.__qualname__}.Gains must be a dataclass subclassing Gains")
     unknown = [e for e in cls.estimates if e not in ESTIMATES]
@@ -129,7 +135,7 @@ def _register(cls: type[Controller]) -> None:
     CONTROLLERS[name] = cls
 
 
-class Controller(abc.ABC):
+class Controller(abc.ABC, Generic[G]):
     """Base class of every control law (see the module docstring for the contract).
 
     Args:
@@ -146,8 +152,8 @@ class Controller(abc.ABC):
     """Registry name, e.g. ``"pd"``."""
     title: ClassVar[str]
     """Display title, e.g. ``"PD + model feedforward"``."""
-    Gains: ClassVar[type[Gains]]
-    """The law's gains class."""
+    Gains: ClassVar[type[Any]]
+    """The law's gains class (a :class:`~twolink_pin.controllers.gains.Gains` dataclass)."""
     estimates: ClassVar[tuple[str, ...]] = ()
     """Parameters held in ``z``: a subsequence of :data:`ESTIMATES`."""
 
@@ -161,7 +167,7 @@ class Controller(abc.ABC):
     def __init__(
         self,
         robot: RobotModel,
-        gains: Gains | None = None,
+        gains: G | None = None,
         *,
         model_parameters: np.ndarray | None = None,
     ) -> None:
@@ -179,7 +185,8 @@ class Controller(abc.ABC):
             raise InvalidParameterError(
                 "gains", type(gains).__name__, f"an instance of {self.Gains.__name__}"
             )
-        self.gains = self._resolve(gains)
+        self.gains: G = self._resolve(gains)
+        """The law's gains, validated: floats or read-only arrays (per joint, per run)."""
         self.model_parameters = self._check_parameters(model_parameters)
 
     # -- declarations derived from the class and the robot -----------------------------
@@ -272,7 +279,7 @@ class Controller(abc.ABC):
 
     # -- internals ----------------------------------------------------------------------
 
-    def _resolve(self, gains: Gains) -> Gains:
+    def _resolve(self, gains: G) -> G:
         missing = [name for name, value in gains.values().items() if value is None]
         if missing:
             derived = self.scaled_gains()

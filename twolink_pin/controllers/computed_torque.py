@@ -29,7 +29,7 @@ class SlotineLiGains(Gains):
     lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
 
 
-class ComputedTorque(Controller):
+class ComputedTorque(Controller[SlotineLiGains]):
     r"""Slotine–Li control with the exact model (report "Modified Computed Torque")::
 
         τ = M(q) q̈_r + C(q, q̇) q̇_r + g(q) − K s,

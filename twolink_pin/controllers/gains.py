@@ -82,7 +82,7 @@ def _spec(f: Any) -> GainSpec:
     spec = f.metadata.get("gain")
     if spec is None:  # a plain dataclass field: a positive scalar without unit
         return GainSpec("scalar", "", "positive", "")
-    return spec  # type: ignore[no-any-return]
+    return spec
 
 
 def _expected(spec: GainSpec) -> str:

@@ -93,7 +93,7 @@ def _from_file(spec: str, file_part: str, class_name: str) -> type:
         raise ControllerSpecError(
             spec, f"{path} has no class {class_name!r} (controllers in it: {found or 'none'})"
         )
-    return getattr(module, class_name)  # type: ignore[no-any-return]
+    return getattr(module, class_name)
 
 
 def _from_module(spec: str, module_name: str, class_name: str) -> type:
@@ -107,7 +107,7 @@ def _from_module(spec: str, module_name: str, class_name: str) -> type:
         ) from exc
     if not hasattr(module, class_name):
         raise ControllerSpecError(spec, f"module {module_name!r} has no class {class_name!r}")
-    return getattr(module, class_name)  # type: ignore[no-any-return]
+    return getattr(module, class_name)
 
 
 def load_controller(spec: str) -> type[Controller]:

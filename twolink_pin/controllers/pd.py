@@ -27,7 +27,7 @@ class PDGains(Gains):
     kd: Any = gain(None, per="joint", unit="N·m·s/rad", doc="velocity gain Kd")
 
 
-class PDFeedforward(Controller):
+class PDFeedforward(Controller[PDGains]):
     r"""PD with feedforward of the desired motion (report eq. 8)::
 
         τ = M(q) q̈_d + C(q, q̇) q̇_d + g(q) − Kp e − Kd ė

@@ -26,7 +26,7 @@ class WrongModelGains(Gains):
     model_scale: Any = gain(0.5, bound="nonnegative", doc="β: M̂ = β M, Ĉ = β C, ĝ = β g")
 
 
-class WrongModel(Controller):
+class WrongModel(Controller[WrongModelGains]):
     r"""Slotine–Li control on a scaled model ``M̂ = β M``, ``Ĉ = β C``, ``ĝ = β g``::
 
         τ = β [M(q) q̈_r + C(q, q̇) q̇_r + g(q)] − K s      (report: β = 0.5)

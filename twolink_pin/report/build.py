@@ -151,8 +151,8 @@ def _pool(workers: int) -> Iterator[Any]:
     """Worker processes that never outlive the report: on an error, Ctrl-C or SIGTERM the
     pending runs are cancelled and the workers killed before the exception goes on."""
     if workers <= 1:
-        with _InProcess() as pool:
-            yield pool
+        with _InProcess() as serial:
+            yield serial
         return
     pool = ProcessPoolExecutor(max_workers=workers)
     previous = signal.getsignal(signal.SIGTERM)

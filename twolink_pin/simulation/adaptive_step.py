@@ -58,7 +58,7 @@ def integrate_adaptive(
             raise ControllerError(name, time, f"{type(exc).__name__}: {exc}") from exc
         if calls <= 1:
             _validate(controller, out, 1, nv, nz, time)
-        return out.tau, (out.dz if nz else np.zeros((1, 0)))
+        return out.tau, (out.dz if out.dz is not None else np.zeros((1, 0)))
 
     def rhs(time: float, x: np.ndarray) -> np.ndarray:
         nonlocal calls

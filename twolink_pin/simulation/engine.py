@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import NamedTuple, Protocol
+from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
@@ -168,7 +168,12 @@ def integrate(
     # LawInput(...) through tuple.__new__: the NamedTuple's own __new__ is a Python function
     # that costs twice as much, four times a step.
     new = tuple.__new__
-    tau1 = dz1 = None
+    # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
+    tau1: Any = None
+    dz1: Any = None
+    dz2: Any
+    dz3: Any
+    dz4: Any
     first = True
     now = 0.0  # time of the law evaluation under way (for error messages)
     with np.errstate(all="ignore"):  # a diverging run overflows before its block is checked

@@ -29,6 +29,7 @@ world origin, which is then ``c``. Read positions in our frame from three.js wit
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 import os
@@ -279,14 +280,16 @@ def _drawables(robot: RobotModel, geom: pin.GeometryModel) -> list[_Drawable | N
                 out.append(None)
                 continue
             corners = _box_corners(vertices.min(axis=0).astype(float), vertices.max(axis=0).astype(float))
-            out.append(_Drawable(lambda v=vertices, f=faces: mg.TriangularMeshGeometry(v, f), False, corners))
+            out.append(
+                _Drawable(functools.partial(mg.TriangularMeshGeometry, vertices, faces), False, corners)
+            )
             continue
         if primitives.loadPrimitive(obj) is None:  # warns, as Pinocchio does
             out.append(None)
             continue
         shape.computeLocalAABB()
         corners = _box_corners(np.array(shape.aabb_local.min_), np.array(shape.aabb_local.max_))
-        out.append(_Drawable(lambda o=obj: primitives.loadPrimitive(o), True, corners))
+        out.append(_Drawable(functools.partial(primitives.loadPrimitive, obj), True, corners))
     return out
 
 
