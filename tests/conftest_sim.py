@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.controllers import Adaptive, Controller, Gains, LawInput, LawOutput, Terms, gain
+from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import mass_matrix
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
 from twolink_pin.scenario import make_scenario
@@ -103,5 +104,5 @@ def adaptive_lyapunov(result: SimulationResult, controller: Adaptive) -> np.ndar
         [0.5 * s[k] @ mass_matrix(ROBOT.model, data, result.q[k]) @ s[k] for k in range(len(s))]
     )
     p_tilde = result.p_hat - result.p_true
-    gamma = np.broadcast_to(controller.gains.gamma, (p_tilde.shape[1],))
+    gamma = one_row(controller.gains.gamma, p_tilde.shape[1])
     return kinetic + 0.5 * np.einsum("ij,j,ij->i", p_tilde, gamma, p_tilde)

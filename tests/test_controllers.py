@@ -37,6 +37,7 @@ from twolink_pin.controllers import (
     WrongModelGains,
     gain,
 )
+from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import Friction, joint_inertia
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.scenario import make_scenario
@@ -220,7 +221,7 @@ def test_laws_with_gravity_equal_their_closed_form_on_the_double_pendulum(name: 
             expected = model - g.k * s
             if name == "sliding-mode":
                 expected = expected - g.ks * np.clip(s / g.phi, -1.0, 1.0)
-        np.testing.assert_allclose(tau, expected, rtol=1e-10, atol=1e-9)
+        np.testing.assert_allclose(tau, np.ravel(expected), rtol=1e-10, atol=1e-9)
 
 
 def test_model_parameters_change_what_the_model_term_believes() -> None:
@@ -260,16 +261,16 @@ def test_the_twolink_gets_the_reports_gains_and_other_robots_derived_ones() -> N
     """The twolink profile presets the report's gains; the double pendulum gets Kp = ω² I, Kd = 2ω I
     (ω = 10 rad/s, I = diag M(q₀)) and K = 10 I."""
     pd = PDFeedforward(ROBOT)
-    np.testing.assert_array_equal(pd.gains.kp, [350.0, 300.0])
-    np.testing.assert_array_equal(pd.gains.kd, [40.0, 50.0])
+    np.testing.assert_array_equal(pd.gains.kp, [[350.0, 300.0]])  # one row: the same for every run
+    np.testing.assert_array_equal(pd.gains.kd, [[40.0, 50.0]])
     robot = pendulum()
     inertia = joint_inertia(robot.model)
-    np.testing.assert_allclose(PDFeedforward(robot).gains.kp, 100.0 * inertia, rtol=1e-12)
-    np.testing.assert_allclose(PDFeedforward(robot).gains.kd, 20.0 * inertia, rtol=1e-12)
-    np.testing.assert_allclose(ComputedTorque(robot).gains.k, 10.0 * inertia, rtol=1e-12)
+    np.testing.assert_allclose(PDFeedforward(robot).gains.kp, [100.0 * inertia], rtol=1e-12)
+    np.testing.assert_allclose(PDFeedforward(robot).gains.kd, [20.0 * inertia], rtol=1e-12)
+    np.testing.assert_allclose(ComputedTorque(robot).gains.k, [10.0 * inertia], rtol=1e-12)
     adaptive = Adaptive(robot)
     assert np.all(np.isfinite(adaptive.gains.gamma)) and np.all(np.asarray(adaptive.gains.gamma) > 0)
-    assert np.asarray(adaptive.gains.gamma).shape == (adaptive.state_size,)
+    assert np.asarray(adaptive.gains.gamma).shape == (1, adaptive.state_size)
 
 
 def test_initial_estimates_are_the_reports() -> None:
@@ -454,7 +455,7 @@ def test_adaptive_lyapunov_derivative_is_minus_s_k_s(lyapunov_run: tuple[Any, An
     """
     controller, result, V = lyapunov_run
     s = slotine_li_s(result, float(controller.gains.lam))
-    power = np.einsum("ij,j,ij->i", s, np.asarray(controller.gains.k), s)
+    power = np.einsum("ij,j,ij->i", s, one_row(controller.gains.k, 2), s)
     dV = (V[2:] - V[:-2]) / (2 * result.dt)
     after = result.t[1:-1] >= 0.1
     scale = power[1:-1][after].max()

@@ -48,6 +48,6 @@ class ComputedTorque(Controller[SlotineLiGains]):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         g = self.gains
-        e, edot = x.q - x.q_des, x.v - x.v_des
-        tau = terms.model(x.q, x.v, x.v_des - g.lam * e, x.a_des - g.lam * edot)
-        return LawOutput(tau - g.k * (edot + g.lam * e))
+        lam_e, edot = g.lam * (x.q - x.q_des), x.v - x.v_des
+        tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - g.lam * edot)
+        return LawOutput(tau - g.k * (edot + lam_e))

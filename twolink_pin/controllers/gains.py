@@ -10,10 +10,12 @@ A law's gains class subclasses :class:`Gains` and declares each field with :func
 ``per`` says what one value is for: ``"scalar"`` (one number), ``"joint"`` (one per joint,
 or a scalar for all joints) or ``"estimate"`` (one per estimated parameter, or a scalar).
 Validation on construction turns every value into a float or a read-only float array and
-names the field, the value and what was expected on error. Any field may also hold one
-value **per run** — a leading batch axis, shape ``(N, k)`` (``(N,)`` for a scalar field,
-stored as ``(N, 1)``) — so that one law object drives N runs of a batch with N gain sets:
-the law's arithmetic broadcasts, it never sees N.
+names the field, the value and what was expected on error: a per-joint or per-estimate
+sequence is stored as one row ``(1, k)`` — the same 2-D layout as the laws' ``(N, nv)``
+arrays, which keeps numpy on its fast path for N = 1. Any field may also hold one value
+**per run** — a leading batch axis, shape ``(N, k)`` (``(N,)`` for a scalar field, stored
+as ``(N, 1)``) — so that one law object drives N runs of a batch with N gain sets: the
+law's arithmetic broadcasts, it never sees N.
 
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
 from the robot (its ``scaled_gains``), or the robot's profile supplies one
@@ -122,6 +124,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
         return float(array)
     if spec.per == "scalar":  # one value per run: a column, so it broadcasts against (N, k)
         array = array.reshape(-1, 1)
+    elif array.ndim == 1:  # one row for every run: (1, k), like the laws' (N, nv) arrays
+        array = array.reshape(1, -1)
     array.setflags(write=False)
     return array
 
@@ -171,9 +175,17 @@ class Gains:
 def runs_of(value: Any) -> int | None:
     """The number of runs a validated gain value holds (its leading axis), or None if it
     is the same for every run."""
-    if isinstance(value, np.ndarray) and value.ndim == 2:
+    if isinstance(value, np.ndarray) and value.ndim == 2 and value.shape[0] > 1:
         return int(value.shape[0])
     return None
+
+
+def one_row(value: Any, width: int) -> np.ndarray:
+    """A single-run gain (a number or a ``(1, k)`` row) as ``width`` values, shape (width,)."""
+    array = np.asarray(value, dtype=float)
+    if array.ndim == 2 and array.shape[0] != 1:
+        raise InvalidParameterError("gain", f"shape {array.shape}", "one value set (not one row per run)")
+    return np.broadcast_to(array.reshape(-1), (width,)).copy()
 
 
 def check_width(name: str, value: Any, width: int, what: str) -> None:
@@ -181,9 +193,9 @@ def check_width(name: str, value: Any, width: int, what: str) -> None:
     ``width`` values (shape ``(N, 1)`` or ``(N, width)``)."""
     if value is None or isinstance(value, float):
         return
-    ok = value.shape == (width,) if value.ndim == 1 else value.shape[1] in (1, width)
-    if not ok:
-        shown = value.tolist() if value.size <= 24 else f"array of shape {value.shape}"
+    if value.shape[1] not in (1, width):
+        rows = value.tolist()
+        shown = (rows[0] if len(rows) == 1 else rows) if value.size <= 24 else f"array of shape {value.shape}"
         raise InvalidParameterError(
             name, shown, f"one value or {width} ({what}), or one row of them per run; got shape {value.shape}"
         )

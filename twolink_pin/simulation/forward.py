@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.dynamics import ABA_CONVENTION
+from twolink_pin.dynamics import ABA_CONVENTION, smooth_sign
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.terms import check_parallel, threads_for
 
@@ -19,19 +19,19 @@ class SingleRunDynamics:
         self._data = plant.model.createData()
         self._nv = plant.model.nv
         friction = plant.friction
+        # (1, nv) rows: numpy's fast path against the (1, nv) state
         self._friction = (
-            None if friction is None else (np.array(friction.viscous), np.array(friction.coulomb))
+            None if friction is None else (np.array([friction.viscous]), np.array([friction.coulomb]))
         )
-        self._exact_sign = friction is None or friction.smoothing == 0
+        self._smoothing = 0.0 if friction is None else friction.smoothing
         self._saturate = plant.saturate
 
     def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        # plant.motor_torque, spelled out: this runs four times per step.
+        # plant.motor_torque, spelled out with the rows above: this runs four times per step.
         u = self._plant.applied_torque(tau) if self._saturate else tau
         if self._friction is not None:
             viscous, coulomb = self._friction
-            sign = np.sign(v) if self._exact_sign else self._plant.friction.torque(v) - viscous * v  # type: ignore[union-attr]
-            u = u - (viscous * v + coulomb * sign) if self._exact_sign else u - (viscous * v + sign)
+            u = u - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
         return pin.aba(self._model, self._data, q[0], v[0], u[0], ABA_CONVENTION)[None]
 
 

@@ -114,7 +114,11 @@ class _PairInputs:
     def fill(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, ...]:
         """``(Q, V, A)``, each of shape (2 nv,)."""
         nv = self.nv
-        b = (np.concatenate(np.broadcast_arrays(q, v, w, a), axis=1) @ self._T)[0]
+        try:
+            x = np.concatenate((q, v, w, a), axis=1)
+        except (ValueError, np.exceptions.AxisError):  # a (nv,) argument: bring it to (1, nv)
+            x = np.concatenate([np.reshape(y, (1, nv)) for y in (q, v, w, a)], axis=1)
+        b = (x @ self._T)[0]
         return b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :]
 
 

@@ -12,6 +12,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from twolink_pin.controllers import Adaptive
+from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.kinematics import inverse_kinematics
@@ -151,10 +152,8 @@ def parameter_convergence(
     n_p = robot.parameter_map.size
     P = robot.parameter_map.matrix
     data = robot.create_data()
-    k = np.broadcast_to(np.asarray(controller.gains.k, dtype=float), (robot.nv,))
-    rate = (
-        1.0 / np.broadcast_to(np.asarray(controller.gains.gamma, dtype=float), (controller.state_size,))[:n_p]
-    )
+    k = one_row(controller.gains.k, robot.nv)
+    rate = 1.0 / one_row(controller.gains.gamma, controller.state_size)[:n_p]
     t = trajectory.t0 + np.linspace(0.0, trajectory.period, 2001)
     ref = trajectory.sample(t)
     gram = np.zeros((n_p, n_p))
