@@ -64,6 +64,7 @@ from twolink_pin.trajectory import (
     build_trajectory,
     default_trajectory,
 )
+from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
 
 __version__ = "0.2.0"
 

@@ -1,7 +1,8 @@
 """``twolink-pin``: the command-line shell over the library.
 
 ==============  ===================================================================
-``parser.py``   commands, options, and the argument types that check numbers
+``parser.py``   commands and options
+``arguments.py`` the argument types that check numbers against their bounds
 ``commands.py`` one function per command, each a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr
 ==============  ===================================================================

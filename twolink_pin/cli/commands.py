@@ -52,7 +52,7 @@ def _smoothing(args: argparse.Namespace) -> float:
 
 def _gain_values(texts: list[str]) -> dict[str, Any]:
     """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}``."""
-    from twolink_pin.cli.parser import finite
+    from twolink_pin.cli.arguments import finite
 
     gains: dict[str, Any] = {}
     for text in texts:

@@ -3,10 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import math
-import re
-from collections.abc import Callable
 from typing import Any, NoReturn
+
+from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -15,10 +14,6 @@ CONTROLLER_HELP = (
 ROBOT_HELP = (
     "robot: a catalog name (twolink-pin robots lists them) or a path to a .urdf file (default twolink)"
 )
-NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
-"""A negative number in any float spelling (``-1``, ``-.5``, ``-1e-3``): a value, not an option."""
-MAX_TEXT = 200
-"""Longest option value echoed back in an error message."""
 
 
 class Parser(argparse.ArgumentParser):
@@ -31,70 +26,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message[: 2 * MAX_TEXT]}\n")
-
-
-def _shown(text: str) -> str:
-    return repr(text if len(text) <= MAX_TEXT else text[:MAX_TEXT] + "…")
-
-
-def finite(text: str) -> float:
-    """A finite number."""
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {_shown(text)}") from None
-    if not math.isfinite(value):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {_shown(text)}")
-    return value
-
-
-def bounded(low: float, high: float, *, low_open: bool = False, unit: str = "") -> Callable[[str], float]:
-    """A finite number in ``[low, high]`` (``(low, high]`` with ``low_open``)."""
-
-    def parse(text: str) -> float:
-        value = finite(text)
-        ok = (value > low if low_open else value >= low) and value <= high
-        if not ok:
-            left = "(" if low_open else "["
-            raise argparse.ArgumentTypeError(
-                f"expected a number in {left}{low:g}, {high:g}]{' ' + unit if unit else ''}, got {_shown(text)}"
-            )
-        return value
-
-    return parse
-
-
-def whole(low: int, high: int) -> Callable[[str], int]:
-    """A whole number in ``[low, high]``."""
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a whole number, got {_shown(text)}") from None
-        if not low <= value <= high:
-            raise argparse.ArgumentTypeError(
-                f"expected a whole number from {low} to {high}, got {_shown(text)}"
-            )
-        return value
-
-    return parse
-
-
-def gain_range(text: str) -> Any:
-    """``NAME=LO:HI`` as a :class:`~twolink_pin.studies.sweep.GainRange`."""
-    from twolink_pin.errors import InvalidParameterError
-    from twolink_pin.studies.sweep import GainRange
-
-    try:
-        return GainRange.parse(text)
-    except InvalidParameterError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def port(text: str) -> int:
-    """A TCP port, 0..65535 (0: any free port)."""
-    return whole(0, 65535)(text)
 
 
 MAX_DURATION = 1e6

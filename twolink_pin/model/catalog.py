@@ -1,8 +1,9 @@
 """Robots by name: where each named robot's URDF is and its profile.
 
-``twolink`` is this package's arm (:mod:`twolink_pin.twolink`); the others come from the
-``example-robot-data`` package, located from its installed files. :func:`resolve` turns
-what a user typed (``--robot NAME|PATH.urdf``) into a URDF path and a profile.
+The catalog is a registry: a robot's own package adds its entry with :func:`register`
+(the twolink's, :mod:`twolink_pin.twolink.profile`, when the package is imported), so this
+module names no robot's code. :func:`resolve` turns what a user typed
+(``--robot NAME|PATH.urdf``) into a URDF path and a profile.
 """
 
 from __future__ import annotations
@@ -41,14 +42,15 @@ def example_robot_urdf(relative: str) -> Path:
     )
 
 
-def _twolink() -> tuple[Path, RobotProfile]:
-    from twolink_pin.twolink.profile import TWOLINK, twolink_urdf_path
+CATALOG: dict[str, Callable[[], tuple[Path, RobotProfile]]] = {}
+"""Named robots: name → a function giving its URDF path and profile (located on use)."""
+DEFAULT_ROBOT = "twolink"
+"""The robot a command or :func:`~twolink_pin.model.load_robot` uses when none is named."""
 
-    return twolink_urdf_path(), TWOLINK
 
-
-CATALOG: dict[str, Callable[[], tuple[Path, RobotProfile]]] = {"twolink": _twolink}
-"""Named robots: name → a function giving its URDF path and profile."""
+def register(name: str, entry: Callable[[], tuple[Path, RobotProfile]]) -> None:
+    """Add a named robot: ``entry()`` gives its URDF path and profile."""
+    CATALOG[name] = entry
 
 
 def names() -> tuple[str, ...]:
@@ -65,9 +67,7 @@ def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
     Raises:
         InvalidURDFError: an unknown name (the message lists the valid ones).
     """
-    if robot is None:
-        return _twolink()
-    text = os.fspath(robot)
+    text = DEFAULT_ROBOT if robot is None else os.fspath(robot)
     if text in CATALOG:
         return CATALOG[text]()
     path = Path(text)

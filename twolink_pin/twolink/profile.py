@@ -1,4 +1,8 @@
-"""The twolink's entry in the robot catalog: its URDF, the lumped map, the report's defaults."""
+"""The twolink's entry in the robot catalog: its URDF, the lumped map, the report's defaults.
+
+Importing this module registers the twolink in :mod:`twolink_pin.model.catalog` (the
+package's ``__init__`` does).
+"""
 
 from __future__ import annotations
 
@@ -6,6 +10,7 @@ from importlib import resources
 from pathlib import Path
 from types import MappingProxyType
 
+from twolink_pin.model import catalog
 from twolink_pin.model.profile import RobotProfile, TrajectorySpec
 from twolink_pin.twolink import reference
 from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
@@ -30,3 +35,5 @@ TWOLINK = RobotProfile(
     source="robots/twolink.urdf (this package)",
 )
 """The twolink's profile: the report's gains, friction, initial offset and via points."""
+
+catalog.register("twolink", lambda: (twolink_urdf_path(), TWOLINK))
