@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from twolink_pin.errors import OutputError
+from twolink_pin.errors import InputFileError, OutputError
 from twolink_pin.files import atomic_write, check_input_file, output_directory, write_json
 
 
@@ -48,7 +48,7 @@ def test_a_fifo_is_refused_as_output_and_as_input(tmp_path: Path) -> None:
     os.mkfifo(fifo)
     with pytest.raises(OutputError, match="not a regular file"), atomic_write(fifo) as f:
         f.write("x")
-    with pytest.raises(OutputError, match="not a regular file"):
+    with pytest.raises(InputFileError, match="not a regular file"):
         check_input_file(fifo, 100, "a URDF file")
     assert stat.S_ISFIFO(fifo.stat().st_mode)
 
@@ -103,9 +103,11 @@ def test_an_interrupted_folder_leaves_the_previous_one(tmp_path: Path) -> None:
 def test_an_input_file_must_be_regular_and_bounded(tmp_path: Path) -> None:
     big = tmp_path / "big.urdf"
     big.write_bytes(b"x" * 101)
-    with pytest.raises(OutputError, match="is 101 bytes, more than the 100 bytes accepted for a URDF file"):
+    with pytest.raises(
+        InputFileError, match="is 101 bytes, more than the 100 bytes accepted for a URDF file"
+    ):
         check_input_file(big, 100, "a URDF file")
-    with pytest.raises(OutputError, match="no such file"):
+    with pytest.raises(InputFileError, match="file not found"):
         check_input_file(tmp_path / "absent", 100, "a URDF file")
-    with pytest.raises(OutputError, match="is not a regular file"):
+    with pytest.raises(InputFileError, match="is not a regular file"):
         check_input_file("/dev/zero", 100, "a URDF file")

@@ -134,7 +134,7 @@ def test_unreadable_file_is_reported_not_raised_as_oserror(tmp_path: Path) -> No
     with pytest.raises(InvalidURDFError) as info:
         validate_urdf_file(tmp_path)  # a directory
     assert info.value.element == "file"
-    assert "cannot read the file" in info.value.reason
+    assert "is a directory" in info.value.reason
 
 
 def test_truncated_file_reports_parser_message_with_line_and_column(tmp_path: Path) -> None:
@@ -600,3 +600,60 @@ def test_pinocchio_hides_reason_for_truncated_file(tmp_path: Path, capfd: pytest
     with pytest.raises(InvalidURDFError) as ours:
         validate_urdf_file(path)
     assert "line" in ours.value.reason and "column" in ours.value.reason
+
+
+# -- the validator and Pinocchio read the same document -----------------------------------------
+
+_ENTITY_MASS = """<?xml version="1.0"?>
+<!DOCTYPE robot [<!ENTITY m "2.0">]>
+<robot name="r"><link name="base"/>
+<joint name="j" type="revolute"><parent link="base"/><child link="l"/><axis xyz="0 0 1"/>
+<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+<link name="l"><inertial><mass value="&m;"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+</robot>
+"""
+
+
+def test_an_entity_defined_mass_is_refused_because_pinocchio_would_drop_it(tmp_path: Path) -> None:
+    """Python's parser expands ``&m;`` to 2.0; Pinocchio's does not and silently gives the link no
+    inertia (shown below). A DTD or entity declaration is refused, naming the line."""
+    path = tmp_path / "entity.urdf"
+    path.write_text(_ENTITY_MASS)
+    model = pin.buildModelFromUrdf(str(path))
+    assert model.inertias[1].mass == 0.0  # the silent loss the refusal prevents
+    with pytest.raises(
+        InvalidURDFError, match=r"declares a <!DOCTYPE> \(line 2\); expected a URDF without DTD or entities"
+    ):
+        validate_urdf_file(path)
+
+
+def test_an_external_entity_is_refused_before_it_is_read(tmp_path: Path) -> None:
+    secret = tmp_path / "secret.txt"
+    secret.write_text("1.0")
+    doc = _ENTITY_MASS.replace('<!ENTITY m "2.0">', f'<!ENTITY m SYSTEM "file://{secret}">')
+    with pytest.raises(InvalidURDFError, match="DOCTYPE"):
+        validate_urdf_string(doc)
+
+
+def test_a_utf16_file_is_refused_naming_the_encoding(tmp_path: Path) -> None:
+    path = tmp_path / "u16.urdf"
+    path.write_bytes(
+        _ENTITY_MASS.replace('<!DOCTYPE robot [<!ENTITY m "2.0">]>\n', "")
+        .replace("&m;", "2")
+        .encode("utf-16")
+    )
+    with pytest.raises(InvalidURDFError, match="is UTF-16 encoded; expected UTF-8"):
+        validate_urdf_file(path)
+
+
+def test_a_fifo_and_a_device_are_refused_without_reading(tmp_path: Path) -> None:
+    """Reading a FIFO blocks and /dev/zero never ends: both are refused before any read."""
+    import os
+
+    fifo = tmp_path / "robot.urdf"
+    os.mkfifo(fifo)
+    start = time.perf_counter()
+    for path in (fifo, Path("/dev/zero")):
+        with pytest.raises(InvalidURDFError, match="is not a regular file"):
+            validate_urdf_file(path)
+    assert time.perf_counter() - start < 5

@@ -137,6 +137,22 @@ class ControllerSpecError(TwolinkPinError):
         super().__init__(f"controller {spec!r}: {reason}")
 
 
+class InputFileError(TwolinkPinError):
+    """An input file that cannot be read safely (missing, not a regular file, too large).
+
+    Attributes:
+        path: The offending path.
+        reason: What is wrong and what was expected.
+    """
+
+    _fields = ("path", "reason")
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"{path}: {reason}")
+
+
 class OutputError(TwolinkPinError):
     """An output location that cannot be written safely.
 

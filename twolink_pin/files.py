@@ -27,7 +27,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from twolink_pin.errors import OutputError
+from twolink_pin.errors import InputFileError, OutputError
 
 
 def _reason(exc: OSError) -> str:
@@ -188,24 +188,40 @@ def check_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) ->
     obscurely: they are refused before any read.
 
     Raises:
-        OutputError: missing, not a regular file, unreadable, or larger than ``max_bytes``
+        InputFileError: missing, not a regular file, unreadable, or larger than ``max_bytes``
             (the message names the bound).
     """
     file = Path(path)
     try:
         info = os.stat(file)
     except FileNotFoundError:
-        raise OutputError(str(file), f"no such file (expected {what})") from None
+        raise InputFileError(str(file), f"file not found (expected {what})") from None
     except OSError as exc:
-        raise OutputError(str(file), f"cannot be examined ({_reason(exc)})") from exc
+        raise InputFileError(str(file), f"cannot be examined ({_reason(exc)})") from exc
     if stat.S_ISDIR(info.st_mode):
-        raise OutputError(str(file), f"is a directory (expected {what})")
+        raise InputFileError(str(file), f"is a directory (expected {what})")
     if not stat.S_ISREG(info.st_mode):
-        raise OutputError(str(file), f"is not a regular file (a device, pipe or socket; expected {what})")
+        raise InputFileError(str(file), f"is not a regular file (a device, pipe or socket; expected {what})")
     if info.st_size > max_bytes:
-        raise OutputError(
+        raise InputFileError(
             str(file), f"is {info.st_size} bytes, more than the {max_bytes} bytes accepted for {what}"
         )
     if not os.access(file, os.R_OK):
-        raise OutputError(str(file), "cannot be read (permission denied)")
+        raise InputFileError(str(file), "cannot be read (permission denied)")
     return file
+
+
+def read_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> bytes:
+    """The bytes of ``path`` after :func:`check_input_file`, read without following a swap to
+    a device between the check and the read (the size is checked again on the open file)."""
+    file = check_input_file(path, max_bytes, what)
+    try:
+        with open(file, "rb") as f:
+            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                raise InputFileError(str(file), f"is not a regular file (expected {what})")
+            data = f.read(max_bytes + 1)
+    except OSError as exc:
+        raise InputFileError(str(file), f"cannot be read ({_reason(exc)})") from exc
+    if len(data) > max_bytes:
+        raise InputFileError(str(file), f"is more than the {max_bytes} bytes accepted for {what}")
+    return data

@@ -90,9 +90,36 @@ def workspace(robot: RobotModel) -> Workspace:
     return Workspace(abs(l1 - l2), l1 + l2)
 
 
+PLANAR_2R_TOLERANCE = 1e-9
+"""How closely [m] an arm's forward kinematics must follow the planar 2R formula for the
+analytic inverse kinematics to apply."""
+
+
 def _require_2r(robot: RobotModel) -> None:
-    if robot.nv != 2:
-        raise InvalidParameterError("robot", robot.model.name, "a planar 2R arm (nv = 2) for analytic IK")
+    """Raise unless ``robot`` is a planar 2R arm in the sense of the analytic IK: its end
+    effector at ``(L1 cos q1 + L2 cos(q1 + q2), L1 sin q1 + L2 sin(q1 + q2))`` in the base's
+    x-y plane (checked numerically at eight seeded configurations, to 1e-9 m)."""
+    if robot.nv != 2 or robot.nq != 2:
+        raise InvalidParameterError(
+            "robot", robot.name, f"a planar 2R arm (nv = 2) for the analytic IK; it has nv = {robot.nv}"
+        )
+    l1, l2 = (float(x) for x in robot.link_lengths)
+    rng = np.random.default_rng(0)
+    q = rng.uniform(-np.pi, np.pi, (8, 2))
+    points = joint_positions(robot, q)[:, -1, :]
+    expected = np.column_stack(
+        [l1 * np.cos(q[:, 0]) + l2 * np.cos(q.sum(axis=1)), l1 * np.sin(q[:, 0]) + l2 * np.sin(q.sum(axis=1))]
+    )
+    miss = float(np.abs(points[:, :2] - expected).max())
+    height = float(np.ptp(points[:, 2]))
+    if miss > PLANAR_2R_TOLERANCE or height > PLANAR_2R_TOLERANCE:
+        raise InvalidParameterError(
+            "robot",
+            robot.name,
+            "a planar 2R arm for the analytic IK (two revolute joints about z, the end effector at "
+            f"L1 = {l1:.4g} m and L2 = {l2:.4g} m along the links' x axes); its forward kinematics misses "
+            f"that formula by {max(miss, height):.3g} m",
+        )
 
 
 def inverse_kinematics(

@@ -13,11 +13,22 @@ simulation, a law that raised) exit status 1; Ctrl-C exit status 130.
 
 from __future__ import annotations
 
+import signal
 import sys
+import threading
 from collections.abc import Sequence
 
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised where the program is so that every ``with`` block cleans up (staging
+    folders removed, worker processes stopped) as for Ctrl-C."""
+
+
+def _terminate(signum: int, frame: object) -> None:
+    raise Terminated
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -25,6 +36,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.argv = list(sys.argv[1:] if argv is None else argv)
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         return int(args.func(args))
     except (SimulationDivergedError, ControllerError) as exc:
@@ -33,15 +47,22 @@ def main(argv: Sequence[str] | None = None) -> int:
     except TwolinkPinError as exc:
         _say(f"twolink-pin: error: {exc}")
         return 2
+    except Terminated:
+        _say("twolink-pin: terminated")
+        return 143
     except KeyboardInterrupt:
         _say("twolink-pin: interrupted")
         return 130
     except BrokenPipeError:  # stdout closed by the reader (e.g. | head): nothing more to say
         _close_stdout()
         return 1
-    except OSError as exc:  # stdout or stderr unwritable (full disk, closed)
+    except OSError as exc:  # stdout unwritable (a full disk or device): say so once, then be quiet
+        _close_stdout()
         _say(f"twolink-pin: error: cannot write the output ({exc.strerror or exc})")
         return 1
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 def _say(line: str) -> None:
@@ -52,12 +73,15 @@ def _say(line: str) -> None:
 
 
 def _close_stdout() -> None:
+    """Point stdout at /dev/null, so that the interpreter's final flush cannot fail again."""
     import os
 
     try:
         devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-    except OSError:
+        if sys.stdout is not None:
+            os.dup2(devnull, sys.stdout.fileno())
+            sys.stdout = open(devnull, "w", closefd=False)  # lives until exit
+    except (OSError, ValueError):
         pass
 
 

@@ -30,7 +30,17 @@ def jsonable(obj: Any) -> Any:
 
 
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
-    """Print ``payload`` as one JSON line with ``--json``, else ``text``."""
+    """Print ``payload`` as one JSON line with ``--json``, else ``text``.
+
+    Raises:
+        OutputError: stdout is closed (nothing can be printed).
+    """
+    if sys.stdout is None:
+        from twolink_pin.errors import OutputError
+
+        raise OutputError(
+            "<stdout>", "is closed; nothing can be printed (reopen it or redirect it to a file)"
+        )
     if getattr(args, "json", False):
         sys.stdout.write(json.dumps(jsonable(payload), allow_nan=False) + "\n")
     else:

@@ -12,36 +12,69 @@ term comes from Pinocchio on the loaded model:
 =====================  ==========================================
 
 Friction ``f`` is not in Pinocchio's algorithms: :mod:`twolink_pin.dynamics.friction`.
-All functions take the model and a ``pin.Data`` the caller owns (one per user).
+All functions take the model and a ``pin.Data`` the caller owns (one per user), and check
+their vectors first: one value per joint, finite (an :class:`InvalidParameterError` naming
+the argument, never NaN results or a C++ signature dump).
 """
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pinocchio as pin
+
+from twolink_pin.errors import InvalidParameterError
+
+
+def _model(model: Any, data: Any) -> None:
+    if not isinstance(model, pin.Model):
+        raise InvalidParameterError("model", type(model).__name__, "a pinocchio.Model (robot.model)")
+    if not isinstance(data, pin.Data):
+        raise InvalidParameterError("data", type(data).__name__, "a pinocchio.Data (model.createData())")
+
+
+def _vector(name: str, value: Any, n: int, unit: str) -> np.ndarray:
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, value, f"{n} finite numbers [{unit}]") from None
+    if array.shape != (n,):
+        raise InvalidParameterError(
+            name, f"shape {array.shape}", f"shape ({n},): one value per joint [{unit}]"
+        )
+    if not np.all(np.isfinite(array)):
+        raise InvalidParameterError(name, array.tolist(), f"{n} finite numbers [{unit}]")
+    return array
 
 
 def mass_matrix(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
     """Joint-space inertia ``M(q)`` [kg·m²], shape (nv, nv), symmetric (CRBA)."""
-    M = pin.crba(model, data, q)
+    _model(model, data)
+    M = pin.crba(model, data, _vector("q", q, model.nq, "rad"))
     return np.triu(M) + np.triu(M, 1).T
 
 
 def coriolis_matrix(model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Coriolis/centrifugal matrix ``C(q, q̇)`` [kg·m²/s], shape (nv, nv), Christoffel form."""
+    _model(model, data)
+    q, v = _vector("q", q, model.nq, "rad"), _vector("v", v, model.nv, "rad/s")
     return pin.computeCoriolisMatrix(model, data, q, v).copy()
 
 
 def gravity_torque(model: pin.Model, data: pin.Data, q: np.ndarray) -> np.ndarray:
     """Gravity torque ``g(q)`` [N·m], shape (nv,) (zero for the horizontal twolink)."""
-    return pin.computeGeneralizedGravity(model, data, q).copy()
+    _model(model, data)
+    return pin.computeGeneralizedGravity(model, data, _vector("q", q, model.nq, "rad")).copy()
 
 
 def inverse_dynamics(
     model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, a: np.ndarray
 ) -> np.ndarray:
     """``τ = M(q) a + C(q, v) v + g(q)`` [N·m] by RNEA."""
-    return pin.rnea(model, data, q, v, a).copy()
+    _model(model, data)
+    q, v = _vector("q", q, model.nq, "rad"), _vector("v", v, model.nv, "rad/s")
+    return pin.rnea(model, data, q, v, _vector("a", a, model.nv, "rad/s²")).copy()
 
 
 ABA_CONVENTION = pin.Convention.WORLD
@@ -53,7 +86,9 @@ def forward_dynamics(
     model: pin.Model, data: pin.Data, q: np.ndarray, v: np.ndarray, tau: np.ndarray
 ) -> np.ndarray:
     """``q̈ = M(q)⁻¹ (τ − C(q, v) v − g(q))`` [rad/s²] by ABA."""
-    return pin.aba(model, data, q, v, tau, ABA_CONVENTION).copy()
+    _model(model, data)
+    q, v = _vector("q", q, model.nq, "rad"), _vector("v", v, model.nv, "rad/s")
+    return pin.aba(model, data, q, v, _vector("tau", tau, model.nv, "N·m"), ABA_CONVENTION).copy()
 
 
 def model_torque(
@@ -64,6 +99,9 @@ def model_torque(
     The model term of every law that multiplies ``C(q, q̇)`` by a velocity other than
     ``q̇`` (feedforward ``C q̇_d``, Slotine–Li ``C q̇_r``).
     """
+    _model(model, data)
+    q, v = _vector("q", q, model.nq, "rad"), _vector("v", v, model.nv, "rad/s")
+    w, a = _vector("w", w, model.nv, "rad/s"), _vector("a", a, model.nv, "rad/s²")
     tau = pin.rnea(model, data, q, v, a).copy()
     tau += pin.computeCoriolisMatrix(model, data, q, v) @ (w - v)
     return tau
@@ -88,6 +126,9 @@ def regressor(
     Returns:
         ``Y_π``, shape (nv, 10 (njoints − 1)).
     """
+    _model(model, data)
+    q, v = _vector("q", q, model.nq, "rad"), _vector("v", v, model.nv, "rad/s")
+    w, a = _vector("w", w, model.nv, "rad/s"), _vector("a", a, model.nv, "rad/s²")
     zero = np.zeros(model.nv)
     y = pin.computeJointTorqueRegressor(model, data, q, zero, a).copy()
     y += 0.25 * pin.computeJointTorqueRegressor(model, data, q, v + w, zero)

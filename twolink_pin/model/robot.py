@@ -114,6 +114,71 @@ def _link_lengths(model: pin.Model, ee_frame_id: int) -> np.ndarray:
     return np.array(lengths)
 
 
+SINGULAR_INERTIA = 1e-12
+"""A joint whose ``M_jj`` is below this [kg·m²] moves no inertia: ``M(q)`` is singular."""
+
+
+def _child_link(model: pin.Model, joint: int) -> str:
+    for frame in model.frames:
+        if frame.parentJoint == joint and frame.type == pin.FrameType.BODY:
+            return str(frame.name)
+    return str(model.names[joint])
+
+
+def _check_inertias(model: pin.Model, path: Path, payload: float) -> None:
+    """Every body's inertial parameters finite (a huge payload can overflow them)."""
+    for j in range(1, model.njoints):
+        if not np.all(np.isfinite(model.inertias[j].toDynamicParameters())):
+            if payload > 0:
+                raise InvalidParameterError(
+                    "payload",
+                    payload,
+                    f"a mass [kg] that keeps the inertia of link '{_child_link(model, j)}' finite",
+                )
+            raise InvalidURDFError(
+                str(path), f"link '{_child_link(model, j)}'", "non-finite inertial parameters"
+            )
+
+
+def _check_moves_inertia(model: pin.Model, path: Path) -> None:
+    """``M(q)`` positive definite at the neutral and three seeded configurations: a joint that
+    moves no mass (its link and every link after it massless) would make every run diverge at
+    its first step with nothing to say why."""
+    data = model.createData()
+    lower = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
+    upper = np.where(np.isfinite(model.upperPositionLimit), model.upperPositionLimit, np.pi)
+    rng = np.random.default_rng(0)
+    configurations = [pin.neutral(model)] + [
+        rng.uniform(np.maximum(lower, -np.pi), np.minimum(upper, np.pi)) for _ in range(3)
+    ]
+    for q in configurations:
+        M = pin.crba(model, data, q)
+        M = np.triu(M) + np.triu(M, 1).T
+        diagonal = np.diag(M)
+        idle = [int(i) for i in np.flatnonzero(diagonal < SINGULAR_INERTIA)]
+        if idle:
+            joint = next(
+                j
+                for j in range(1, model.njoints)
+                if model.idx_vs[j] <= idle[0] < model.idx_vs[j] + model.nvs[j]
+            )
+            raise InvalidURDFError(
+                str(path),
+                f"joint '{model.names[joint]}'",
+                f"moves no mass or inertia (M = {diagonal[idle[0]]:.3g} kg·m²: its link "
+                f"'{_child_link(model, joint)}' and every link after it are massless); expected an <inertial> "
+                "with a mass > 0 on a link it moves",
+            )
+        try:
+            np.linalg.cholesky(M)
+        except np.linalg.LinAlgError:
+            raise InvalidURDFError(
+                str(path),
+                "<robot>",
+                f"the joint-space inertia M(q) is singular at q = {np.round(q, 4).tolist()} rad",
+            ) from None
+
+
 def load_robot(
     robot: str | os.PathLike[str] | None = None,
     payload: float = 0.0,
@@ -160,6 +225,8 @@ def load_robot(
         frame = model.frames[ee_id]
         point = pin.Inertia(float(payload), np.zeros(3), np.zeros((3, 3)))
         model.inertias[frame.parentJoint] = model.inertias[frame.parentJoint] + frame.placement.act(point)
+    _check_inertias(model, path, payload)
+    _check_moves_inertia(model, path)
     factory = parameter_map if parameter_map is not None else profile.parameter_map
     pmap: ParameterMap = factory(model) if factory is not None else InertialParameterMap(model)
     return RobotModel(

@@ -13,7 +13,13 @@ Why this module exists: Pinocchio 4.1's URDF parser (``pin.buildModelFromUrdf`` 
 * it silently **drops a link's whole inertia** (mass and inertia become 0) when the mass
   value is not a number, e.g. ``"abc"`` or ``"nan"``, with only a line on stderr;
 * it reports a truncated or malformed XML file only as a bare ``ValueError`` ("does not
-  contain a valid URDF model"), the actual reason and line going to stderr.
+  contain a valid URDF model"), the actual reason and line going to stderr;
+* it does **not expand XML entities** (``<!ENTITY m "2.0">`` … ``value="&m;"``), while
+  Python's XML parser does: a mass given through an entity would pass a validator that
+  expands it and then be silently dropped by Pinocchio. A DTD or an entity is therefore
+  refused, so that the validator and Pinocchio read the same document (this also refuses
+  external entities and entity-expansion bombs before anything is expanded);
+* it reads **UTF-8 only**: a UTF-16 file is "not a valid URDF model" with no reason.
 
 :func:`validate_urdf_file` and :func:`validate_urdf_string` check a description with
 the standard library's XML parser and numpy, and raise
@@ -25,7 +31,9 @@ sound Pinocchio model: no crash, no silent nonsense.
 
 Checks, in order:
 
-1. the file exists and is readable, and is well-formed XML whose root is ``<robot>``;
+1. the file is a regular, readable file of at most :data:`MAX_URDF_BYTES` (a FIFO or a
+   device such as ``/dev/zero`` is refused before any read), UTF-8 encoded, without a DTD
+   or entity declarations, and well-formed XML whose root is ``<robot>``;
 2. at least one ``<link>``, at most :data:`MAX_LINKS` links and joints (counted before
    any other work, so a huge file is rejected quickly);
 3. every link and joint has a unique, non-empty ``name``;
@@ -57,21 +65,25 @@ import re
 import xml.etree.ElementTree as ET
 from collections import Counter
 from collections.abc import Iterable, Sequence
-from pathlib import Path
 from typing import Final
 
 import numpy as np
 
-from twolink_pin.errors import InvalidURDFError
+from twolink_pin.errors import InputFileError, InvalidURDFError
+from twolink_pin.files import read_input_file
 
 __all__ = [
     "AXIS_JOINT_TYPES",
     "JOINT_TYPES",
     "MAX_LINKS",
+    "MAX_URDF_BYTES",
     "TRIANGLE_RTOL",
     "validate_urdf_file",
     "validate_urdf_string",
 ]
+
+MAX_URDF_BYTES: Final[int] = 32 * 2**20
+"""Largest URDF file read (32 MiB; example-robot-data's arms are under 100 kB)."""
 
 MAX_LINKS: Final[int] = 1000
 """Most links (and joints) a description may have.
@@ -117,14 +129,9 @@ def validate_urdf_file(path: str | os.PathLike[str]) -> None:
     """
     name = os.fsdecode(path)
     try:
-        data = Path(name).read_bytes()
-    except FileNotFoundError:
-        raise InvalidURDFError(name, "file", "file not found; expected an existing URDF file") from None
-    except OSError as err:
-        detail = err.strerror or type(err).__name__
-        raise InvalidURDFError(
-            name, "file", f"cannot read the file ({detail}); expected a readable URDF file"
-        ) from None
+        data = read_input_file(name, MAX_URDF_BYTES, "a URDF file")
+    except InputFileError as err:
+        raise InvalidURDFError(name, "file", err.reason) from None
     _validate_robot(_parse(data, name), name)
 
 
@@ -146,9 +153,43 @@ def validate_urdf_string(xml: str, path: str = "<string>") -> None:
 # --- document level -------------------------------------------------------------------------
 
 
+_BOMS: Final[tuple[tuple[bytes, str], ...]] = (
+    (b"\x00\x00\xfe\xff", "UTF-32"),
+    (b"\xff\xfe\x00\x00", "UTF-32"),
+    (b"\xfe\xff", "UTF-16"),
+    (b"\xff\xfe", "UTF-16"),
+)
+_DECLARATION = re.compile(rb"<!(DOCTYPE|ENTITY)", re.IGNORECASE)
+
+
 def _parse(text: str | bytes, path: str) -> ET.Element:
+    data = text.encode("utf-8") if isinstance(text, str) else text
+    for bom, encoding in _BOMS:
+        if data.startswith(bom):
+            raise InvalidURDFError(
+                path,
+                "XML document",
+                f"is {encoding} encoded; expected UTF-8 (Pinocchio's URDF parser reads UTF-8 only)",
+            )
     try:
-        return ET.fromstring(text)
+        data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = data[: err.start].count(b"\n") + 1
+        raise InvalidURDFError(
+            path, "XML document", f"is not valid UTF-8 (byte {err.start}, line {line}); expected a UTF-8 file"
+        ) from None
+    found = _DECLARATION.search(data)
+    if found:
+        line = data[: found.start()].count(b"\n") + 1
+        raise InvalidURDFError(
+            path,
+            "XML document",
+            f"declares a <!{found.group(1).decode().upper()}> (line {line}); expected a URDF without DTD or "
+            "entities (Pinocchio's parser does not expand them, so a value given through an entity would be "
+            "dropped)",
+        )
+    try:
+        return ET.fromstring(data)
     except ET.ParseError as err:
         # str(err) is e.g. "no element found: line 12, column 4".
         raise InvalidURDFError(

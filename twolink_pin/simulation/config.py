@@ -17,6 +17,10 @@ MAX_EVALUATIONS_PER_STEP = 200
 run is declared diverged (DOP853 needs about 12 per accepted step)."""
 MAX_STEPS = 10_000_000
 """Cap on the number of fixed steps (duration / dt) of one run."""
+MAX_RECORDED_VALUES = 50_000_000
+"""Cap on the floats a recorded run holds, ``(steps + 1) × (6 nv + nz)`` per run (400 MB):
+a longer run is refused before anything is allocated (a batch without recording is not
+bounded by it: its memory is O(N))."""
 
 METHODS = ("rk4", "adaptive")
 """Integrators: fixed-step RK4, or scipy's DOP853 with error control (single runs)."""
@@ -114,6 +118,18 @@ class SimulationConfig:
     def steps(self) -> int:
         """Number of steps ``round(duration / dt)``."""
         return max(1, round(self.duration / self.dt))
+
+
+def check_recorded_size(steps: int, nv: int, nz: int, runs: int = 1) -> None:
+    """Raise unless a recorded run of ``steps`` steps fits :data:`MAX_RECORDED_VALUES`."""
+    values = runs * (steps + 1) * (6 * nv + nz)
+    if values > MAX_RECORDED_VALUES:
+        raise InvalidParameterError(
+            "steps",
+            steps,
+            f"at most {MAX_RECORDED_VALUES:.3g} recorded values (runs × (steps + 1) × (6 nv + nz)); this run needs "
+            f"{values:.3g}: use a larger dt, a shorter duration, or simulate_batch without recording",
+        )
 
 
 def joint_offsets(name: str, value: float | tuple[float, ...] | None, default: Any, nv: int) -> np.ndarray:

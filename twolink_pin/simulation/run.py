@@ -9,7 +9,7 @@ from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.adaptive_step import integrate_adaptive
-from twolink_pin.simulation.config import SimulationConfig, joint_offsets
+from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, joint_offsets
 from twolink_pin.simulation.engine import integrate
 from twolink_pin.simulation.result import SimulationResult
 from twolink_pin.trajectory import JointTrajectory
@@ -80,6 +80,7 @@ def simulate(
         )
     q0, v0 = initial_state(plant, trajectory, config)
     z0 = np.atleast_2d(np.asarray(controller.initial_state(), dtype=float)).reshape(1, -1)
+    check_recorded_size(config.steps, plant.robot.nv, z0.shape[1])
     if config.method == "rk4":
         samples = integrate(
             controller,

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import OutputError
+from twolink_pin.errors import InputFileError, OutputError
 from twolink_pin.files import atomic_write, check_input_file
 from twolink_pin.simulation.result import SimulationResult
 
@@ -40,7 +40,10 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
     Raises:
         OutputError: the file is missing or is not a saved simulation result.
     """
-    check_input_file(path, MAX_RESULT_BYTES, "a saved simulation result (.npz)")
+    try:
+        check_input_file(path, MAX_RESULT_BYTES, "a saved simulation result (.npz)")
+    except InputFileError as exc:
+        raise OutputError(exc.path, exc.reason) from None
     try:
         with np.load(path, allow_pickle=False) as data:
             raw = {k: data[k] for k in data.files}

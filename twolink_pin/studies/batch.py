@@ -23,6 +23,7 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.metrics import BatchMetrics, RunningMetrics
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
+from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state
 from twolink_pin.simulation.terms import check_parallel, threads_for
 from twolink_pin.trajectory import JointTrajectory
@@ -173,6 +174,8 @@ def simulate_batch(
     v0_off = np.tile(v0_nominal - ref0.v, (n, 1)) if v0_off is None else v0_off
     z0 = np.asarray(controller.initial_state(), dtype=float)
     z0 = np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
+    if record:
+        check_recorded_size(config.steps, nv, controller.state_size, n)
     used = threads_for(n, threads) if n > 1 else 1
     steps = config.steps
     dt = config.duration / steps
