@@ -259,15 +259,15 @@ def test_what_each_law_declares() -> None:
 
 def test_the_twolink_gets_the_reports_gains_and_other_robots_derived_ones() -> None:
     """The twolink profile presets the report's gains; the double pendulum gets Kp = ω² I, Kd = 2ω I
-    (ω = 10 rad/s, I = diag M(q₀)) and K = 10 I."""
+    (ω = 10 rad/s, I = diag M at the robot's home) and K = κ I (κ = 50 1/s)."""
     pd = PDFeedforward(ROBOT)
     np.testing.assert_array_equal(pd.gains.kp, [[350.0, 300.0]])  # one row: the same for every run
     np.testing.assert_array_equal(pd.gains.kd, [[40.0, 50.0]])
     robot = pendulum()
-    inertia = joint_inertia(robot.model)
+    inertia = joint_inertia(robot.model, robot.home)
     np.testing.assert_allclose(PDFeedforward(robot).gains.kp, [100.0 * inertia], rtol=1e-12)
     np.testing.assert_allclose(PDFeedforward(robot).gains.kd, [20.0 * inertia], rtol=1e-12)
-    np.testing.assert_allclose(ComputedTorque(robot).gains.k, [10.0 * inertia], rtol=1e-12)
+    np.testing.assert_allclose(ComputedTorque(robot).gains.k, [50.0 * inertia], rtol=1e-12)
     adaptive = Adaptive(robot)
     assert np.all(np.isfinite(adaptive.gains.gamma)) and np.all(np.asarray(adaptive.gains.gamma) > 0)
     assert np.asarray(adaptive.gains.gamma).shape == (1, adaptive.state_size)

@@ -4,6 +4,8 @@ controllers track joint-space trajectories on them."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pinocchio as pin
 import pytest
@@ -22,6 +24,7 @@ from twolink_pin import (
 )
 from twolink_pin.dynamics import regressor
 from twolink_pin.model import example_robot_urdf
+from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.parameters import InertialParameterMap, inertial_parameters
 
 ROBOTS = ["double_pendulum_description/urdf/double_pendulum.urdf", "asr_twodof_description/urdf/TwoDofs.urdf"]
@@ -37,11 +40,26 @@ def test_unknown_example_robot_is_named() -> None:
         example_robot_urdf("no_such_robot.urdf")
 
 
-def test_a_generic_urdf_gets_the_generic_profile_and_all_inertial_parameters(robot) -> None:
-    """A URDF outside the catalog: named after its file, no presets, the map p = π."""
-    assert robot.name == robot.urdf_path.stem and robot.gain_presets == {}
-    assert isinstance(robot.parameter_map, InertialParameterMap)
-    assert robot.parameter_map.size == 10 * robot.nv
+def test_a_catalog_urdf_by_path_gets_its_profile_and_the_base_parameters(robot) -> None:
+    """example-robot-data's file by path is the catalog's robot: its name, no gain presets, and
+    p = β, the identifiable base parameters (4 for the horizontal arm, 6 under gravity)."""
+    assert robot.name in ("double_pendulum", "asr_twodof") and robot.gain_presets == {}
+    assert isinstance(robot.parameter_map, BaseParameterMap)
+    assert robot.parameter_map.size == {"double_pendulum": 6, "asr_twodof": 4}[robot.name]
+
+
+def test_a_urdf_outside_the_catalog_gets_the_generic_profile(tmp_path: Path) -> None:
+    """A copy of the double pendulum's URDF elsewhere: named after its file, no presets, no
+    home (the middle of its unlimited joints: 0), its base parameters; p = π on request."""
+    path = tmp_path / "my_pendulum.urdf"
+    path.write_bytes(example_robot_urdf(ROBOTS[0]).read_bytes())
+    robot = load_robot(path)
+    assert robot.name == "my_pendulum" and robot.gain_presets == {} and robot.profile.home is None
+    np.testing.assert_array_equal(robot.home, [0.0, 0.0])
+    assert isinstance(robot.parameter_map, BaseParameterMap) and robot.parameter_map.size == 6
+    full = load_robot(path, parameter_map=InertialParameterMap)
+    assert full.parameter_map.size == 20
+    np.testing.assert_array_equal(full.p, inertial_parameters(full.model))
 
 
 def test_the_double_pendulum_feels_gravity_and_the_planar_arm_does_not() -> None:

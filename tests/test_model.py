@@ -171,11 +171,11 @@ def _double_pendulum_urdf() -> Path | None:
 
 def test_example_robot_data_double_pendulum_loads_with_inertial_map() -> None:
     """example-robot-data's double pendulum (joints about x, not a planar-z 2R arm) loads
-    with InertialParameterMap, and its p is Pinocchio's stacked inertial parameters π."""
+    with InertialParameterMap when asked, and its p is Pinocchio's stacked inertial parameters π."""
     path = _double_pendulum_urdf()
     if path is None or not path.is_file():
         pytest.skip("example-robot-data's double_pendulum.urdf not found (pip install example-robot-data)")
-    pendulum = load_robot(path)
+    pendulum = load_robot(path, parameter_map=InertialParameterMap)
     assert pendulum.nv == 2
     assert not TwoLinkLumpedMap.applies_to(pendulum.model)
     assert isinstance(pendulum.parameter_map, InertialParameterMap)

@@ -49,7 +49,7 @@ _RUNS: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
 @functools.cache
 def ur5() -> RobotModel:
     """example-robot-data's UR5: six revolute joints, a Collada mesh per link."""
-    return load_robot(str(example_robot_urdf(UR5_URDF)))
+    return load_robot("ur5")
 
 
 def sample_run(robot: RobotModel = ROBOT) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

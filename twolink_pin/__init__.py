@@ -46,6 +46,7 @@ from twolink_pin.errors import (
     ControllerSpecError,
     InvalidParameterError,
     InvalidURDFError,
+    InverseKinematicsError,
     OutputError,
     SimulationDivergedError,
     TwolinkPinError,
@@ -59,10 +60,13 @@ from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate,
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (
     JointTrajectory,
+    Trajectory,
     TrajectorySample,
     ViaPoints,
     build_trajectory,
+    cartesian_trajectory,
     default_trajectory,
+    read_trajectory_file,
 )
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
 
@@ -84,6 +88,7 @@ __all__ = [
     "Gains",
     "InvalidParameterError",
     "InvalidURDFError",
+    "InverseKinematicsError",
     "JointTrajectory",
     "LawInput",
     "LawOutput",
@@ -100,6 +105,7 @@ __all__ = [
     "SimulationResult",
     "SlotineLiGains",
     "Terms",
+    "Trajectory",
     "TrajectorySample",
     "TwolinkPinError",
     "UnreachableTargetError",
@@ -107,6 +113,7 @@ __all__ = [
     "WrongModel",
     "WrongModelGains",
     "build_trajectory",
+    "cartesian_trajectory",
     "compute_metrics",
     "coriolis_matrix",
     "default_trajectory",
@@ -119,6 +126,7 @@ __all__ = [
     "make_scenario",
     "mass_matrix",
     "model_torque",
+    "read_trajectory_file",
     "regressor",
     "simulate",
     "simulate_batch",

@@ -84,6 +84,26 @@ class UnreachableTargetError(TwolinkPinError, ValueError):
         )
 
 
+class InverseKinematicsError(TwolinkPinError, ValueError):
+    """A Cartesian target the numerical inverse kinematics did not reach, or reached only
+    at a singular configuration.
+
+    Attributes:
+        target: The target position [m] (2 or 3 coordinates).
+        reason: What went wrong (closest distance reached, or the singular value).
+        q: The configuration the solver stopped at [rad].
+    """
+
+    _fields = ("target", "reason", "q")
+
+    def __init__(self, target: tuple[float, ...], reason: str, q: tuple[float, ...]) -> None:
+        self.target = target
+        self.reason = reason
+        self.q = q
+        point = ", ".join(f"{c:.4g}" for c in target)
+        super().__init__(f"end-effector target ({point}) m: {reason}")
+
+
 class SimulationDivergedError(TwolinkPinError):
     """A closed-loop run whose state became non-finite or absurd.
 

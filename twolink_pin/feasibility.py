@@ -14,7 +14,7 @@ import pinocchio as pin
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import Trajectory
 
 
 class TorqueCheck(NamedTuple):
@@ -54,7 +54,7 @@ class TorqueCheck(NamedTuple):
         )
 
 
-def check_torques(robot: RobotModel, trajectory: JointTrajectory, samples: int = 4001) -> TorqueCheck:
+def check_torques(robot: RobotModel, trajectory: Trajectory, samples: int = 4001) -> TorqueCheck:
     """Inverse dynamics (RNEA) along one period of ``trajectory`` at ``samples`` instants."""
     if not (isinstance(samples, int) and samples >= 2):
         raise InvalidParameterError("samples", samples, "an integer >= 2")

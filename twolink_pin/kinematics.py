@@ -4,7 +4,9 @@
   and ``∂(x, y)/∂q`` (the base frame's x-y plane);
 * :func:`joint_positions`: every joint origin and the end effector in 3-D, for many
   configurations (what figures and the 3-D view draw);
-* :func:`inverse_kinematics` / :func:`workspace`: both elbow branches of a planar 2R arm.
+* :func:`inverse_kinematics` / :func:`workspace`: both elbow branches of a planar 2R arm;
+* :func:`end_effector_position` / :func:`position_jacobian` / :func:`solve_position`: the
+  end effector in 3-D and a damped least-squares inverse kinematics for any arm.
 
 Angles [rad], positions [m].
 """
@@ -17,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.errors import InvalidParameterError, UnreachableTargetError
+from twolink_pin.errors import InvalidParameterError, InverseKinematicsError, UnreachableTargetError
 from twolink_pin.model import RobotModel
 
 
@@ -95,6 +97,16 @@ PLANAR_2R_TOLERANCE = 1e-9
 analytic inverse kinematics to apply."""
 
 
+def is_planar_2r(robot: RobotModel) -> bool:
+    """Whether the analytic planar 2R inverse kinematics applies to ``robot`` (see
+    :func:`inverse_kinematics`)."""
+    try:
+        _require_2r(robot)
+    except InvalidParameterError:
+        return False
+    return True
+
+
 def _require_2r(robot: RobotModel) -> None:
     """Raise unless ``robot`` is a planar 2R arm in the sense of the analytic IK: its end
     effector at ``(L1 cos q1 + L2 cos(q1 + q2), L1 sin q1 + L2 sin(q1 + q2))`` in the base's
@@ -161,3 +173,127 @@ def inverse_kinematics(
         k1, k2 = l1 + l2 * math.cos(elbow), l2 * math.sin(elbow)
         solutions.append((math.atan2(y, x) - math.atan2(k2, k1), elbow))
     return np.array(solutions)
+
+
+# ----------------------------------------------------------------------- any arm, numerically
+
+
+def end_effector_position(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    """End-effector position ``(x, y, z)`` [m] in the base frame at ``q`` [rad]."""
+    q = _check_q(robot, q)
+    data = data if data is not None else robot.create_data()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return data.oMf[robot.ee_frame_id].translation.copy()
+
+
+def position_jacobian(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
+    """``∂(x, y, z)/∂q`` of the end effector [m/rad], shape (3, nv), base-frame axes."""
+    q = _check_q(robot, q)
+    data = data if data is not None else robot.create_data()
+    J = pin.computeFrameJacobian(robot.model, data, q, robot.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+    return J[:3, :].copy()
+
+
+IK_TOLERANCE = 1e-10
+"""Distance [m] at which :func:`solve_position` has reached its target."""
+IK_MAX_ITERATIONS = 500
+"""Iterations :func:`solve_position` takes at most."""
+IK_RESTARTS = 4
+"""Perturbed seeds (±0.2 rad, seeded) :func:`solve_position` tries when the seed does not reach."""
+IK_MIN_SINGULAR_VALUE = 1e-3
+"""Smallest singular value [m/rad] of the position Jacobian accepted at a solution: below
+it the arm is (nearly) singular there, and a trajectory through the point would need
+joint speeds out of proportion with the end effector's."""
+
+
+def solve_position(
+    robot: RobotModel,
+    target: tuple[float, ...] | np.ndarray,
+    q_seed: np.ndarray,
+    *,
+    tol: float = IK_TOLERANCE,
+    max_iterations: int = IK_MAX_ITERATIONS,
+    min_singular_value: float = IK_MIN_SINGULAR_VALUE,
+) -> np.ndarray:
+    """A configuration [rad] that puts the end effector at ``target`` [m], from ``q_seed``.
+
+    Damped least squares on Pinocchio's frame Jacobian (Levenberg–Marquardt with the
+    damping ``λ² = ½ |e|² + 1e-9 m²`` of Sugihara, 2011, which converges quadratically and
+    stays bounded near singularities)::
+
+        Δq = Jᵀ (J Jᵀ + λ² I)⁻¹ e,      q ← clip(q + α Δq, joint limits)
+
+    with ``α`` halved until ``|e|`` decreases; if that stalls short of the target (a seed
+    at a singularity), up to :data:`IK_RESTARTS` perturbed seeds are tried. ``target`` has three coordinates, or two
+    (``x, y``: only the base's x-y plane is constrained, for a planar arm). A redundant
+    arm moves as little as the damping allows from ``q_seed`` (seed each via point with
+    the previous one for a smooth path).
+
+    Raises:
+        InverseKinematicsError: the target is not reached to ``tol`` (the message gives the
+            closest distance reached: out of reach or beyond the joint limits), or is reached
+            only at a configuration whose Jacobian has a singular value below
+            ``min_singular_value`` [m/rad].
+        InvalidParameterError: ``target`` is not 2 or 3 finite numbers, or ``q_seed`` not nq.
+    """
+    goal = np.asarray(target, dtype=float)
+    if goal.shape not in ((2,), (3,)) or not np.all(np.isfinite(goal)):
+        raise InvalidParameterError(
+            "target", np.asarray(target).tolist(), "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
+        )
+    rows = goal.size
+    q = _check_q(robot, q_seed)
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    q = np.clip(q, lower, upper)
+    data = robot.create_data()
+
+    def residual(qk: np.ndarray) -> np.ndarray:
+        return goal - end_effector_position(robot, qk, data)[:rows]
+
+    def descend(qk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        e = residual(qk)
+        for _ in range(max_iterations):
+            if float(np.linalg.norm(e)) <= tol:
+                break
+            J = position_jacobian(robot, qk, data)[:rows]
+            damping = 0.5 * float(e @ e) + 1e-9
+            step = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(rows), e)
+            for _ in range(30):
+                trial = np.clip(qk + step, lower, upper)
+                e_trial = residual(trial)
+                if float(e_trial @ e_trial) < float(e @ e):
+                    qk, e = trial, e_trial
+                    break
+                step = 0.5 * step
+            else:
+                break  # no descent: a local minimum of the distance (out of reach, a limit, a singular seed)
+        return qk, e
+
+    # A seed exactly at a singularity (a straight arm) has no descent direction towards some
+    # targets: up to IK_RESTARTS seeded perturbations of the seed are tried, then it gives up.
+    rng = np.random.default_rng(0)
+    q, e = descend(q)
+    for _ in range(IK_RESTARTS):
+        if float(np.linalg.norm(e)) <= tol:
+            break
+        q_try, e_try = descend(np.clip(q_seed + rng.uniform(-0.2, 0.2, robot.nq), lower, upper))
+        if float(e_try @ e_try) < float(e @ e):
+            q, e = q_try, e_try
+    distance = float(np.linalg.norm(e))
+    point = tuple(float(c) for c in goal)
+    if distance > tol:
+        raise InverseKinematicsError(
+            point,
+            f"not reached: the closest the end effector came is {distance:.3g} m away (outside the arm's "
+            "reach, or beyond its joint limits from this seed)",
+            tuple(float(x) for x in q),
+        )
+    sigma = float(np.linalg.svd(position_jacobian(robot, q, data)[:rows], compute_uv=False)[-1])
+    if sigma < min_singular_value:
+        raise InverseKinematicsError(
+            point,
+            f"reached only at a singular configuration (smallest singular value of the position Jacobian "
+            f"{sigma:.3g} m/rad < {min_singular_value:g})",
+            tuple(float(x) for x in q),
+        )
+    return q

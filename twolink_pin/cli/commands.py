@@ -22,12 +22,21 @@ if TYPE_CHECKING:
     from twolink_pin.metrics import Metrics
     from twolink_pin.model import RobotModel
     from twolink_pin.simulation import SimulationConfig, SimulationResult
+    from twolink_pin.trajectory import JointTrajectory
 
 
 def _robot(args: argparse.Namespace) -> RobotModel:
     from twolink_pin.model import load_robot
 
     return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
+
+
+def _trajectory(args: argparse.Namespace, robot: RobotModel) -> JointTrajectory:
+    """The reference of ``--trajectory FILE``, else the robot's default."""
+    from twolink_pin.trajectory import default_trajectory, read_trajectory_file
+
+    path = getattr(args, "trajectory", None)
+    return read_trajectory_file(path, robot) if path else default_trajectory(robot)
 
 
 def _config(args: argparse.Namespace) -> SimulationConfig:
@@ -69,10 +78,11 @@ def _gain_values(texts: list[str]) -> dict[str, Any]:
     return gains
 
 
-def _run_one(args: argparse.Namespace, spec: str, robot: RobotModel) -> SimulationResult:
+def _run_one(
+    args: argparse.Namespace, spec: str, robot: RobotModel, trajectory: JointTrajectory | None = None
+) -> SimulationResult:
     from twolink_pin.scenario import law_class, make_scenario
     from twolink_pin.simulation import simulate
-    from twolink_pin.trajectory import default_trajectory
 
     cls = law_class(spec)
     lam = args.lam
@@ -86,11 +96,19 @@ def _run_one(args: argparse.Namespace, spec: str, robot: RobotModel) -> Simulati
         saturate=args.saturate,
         friction_smoothing=_smoothing(args),
     )
-    return simulate(controller, plant, default_trajectory(robot), _config(args))
+    reference = trajectory if trajectory is not None else _trajectory(args, robot)
+    return simulate(controller, plant, reference, _config(args))
 
 
 def cmd_info(args: argparse.Namespace) -> int:
+    from twolink_pin.model.base_parameters import BaseParameterMap
+
     robot = _robot(args)
+    base = (
+        robot.parameter_map
+        if isinstance(robot.parameter_map, BaseParameterMap)
+        else BaseParameterMap(robot.model)
+    )
     payload: dict[str, Any] = {
         "robot": robot.name,
         "urdf": str(robot.urdf_path),
@@ -101,7 +119,18 @@ def cmd_info(args: argparse.Namespace) -> int:
         "torque_limits": robot.torque_limits.tolist(),
         "parameter_names": list(robot.parameter_map.names),
         "p": robot.p.tolist(),
+        "base_parameters": {
+            "count": base.size,
+            "names": list(base.names),
+            "units": list(base.units),
+            "values": base.values(robot.model).tolist(),
+        },
     }
+    if args.friction:
+        payload["friction_parameters"] = {
+            "names": [f"V{j + 1}" for j in range(robot.nv)] + [f"C{j + 1}" for j in range(robot.nv)],
+            "units": ["N·m·s/rad"] * robot.nv + ["N·m"] * robot.nv,
+        }
     names = robot.parameter_map.names
     p_text = (
         ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, robot.p))
@@ -118,6 +147,8 @@ def cmd_info(args: argparse.Namespace) -> int:
             f"limits     ({limits}) N·m",
             f"payload    {robot.payload:g} kg",
             f"parameters {p_text}",
+            f"base       {base.size} identifiable base parameters (twolink-pin info --json lists them)"
+            + (f", plus {2 * robot.nv} friction (viscous V, Coulomb C per joint)" if args.friction else ""),
         ]
     )
     if args.write_urdf:
@@ -219,24 +250,37 @@ def cmd_fk(args: argparse.Namespace) -> int:
 
 
 def cmd_ik(args: argparse.Namespace) -> int:
-    from twolink_pin.kinematics import inverse_kinematics
+    from twolink_pin.kinematics import inverse_kinematics, is_planar_2r, solve_position
+    from twolink_pin.trajectory import home_configuration
 
     robot = _robot(args)
-    sols = inverse_kinematics(robot, (args.x, args.y))
-    text = "\n".join(
-        f"{label}: q = {fmt(s)} rad" for label, s in zip(("elbow q2 >= 0", "elbow q2 <= 0"), sols)
+    if args.z is None and args.seed is None and is_planar_2r(robot):
+        sols = inverse_kinematics(robot, (args.x, args.y))
+        text = "\n".join(
+            f"{label}: q = {fmt(s)} rad" for label, s in zip(("elbow q2 >= 0", "elbow q2 <= 0"), sols)
+        )
+        emit(args, {"solutions": sols.tolist()}, text)
+        return 0
+    target = (args.x, args.y) if args.z is None else (args.x, args.y, args.z)
+    seed = home_configuration(robot) if args.seed is None else np.array(args.seed, dtype=float)
+    if seed.shape != (robot.nv,):
+        raise InvalidParameterError("--seed", args.seed, f"{robot.nv} joint angles [rad] for {robot.name}")
+    q = solve_position(robot, target, seed)
+    emit(
+        args,
+        {"solutions": [q.tolist()], "seed": seed.tolist()},
+        f"q = {fmt(q)} rad (damped least squares from {'home' if args.seed is None else 'the seed'})",
     )
-    emit(args, {"solutions": sols.tolist()}, text)
     return 0
 
 
 def cmd_trajectory(args: argparse.Namespace) -> int:
     from twolink_pin.feasibility import check_torques
-    from twolink_pin.trajectory import default_trajectory, default_via_points
+    from twolink_pin.trajectory import default_via_points
 
     robot = _robot(args)
-    traj = default_trajectory(robot)
-    via = default_via_points(robot)
+    traj = _trajectory(args, robot)
+    via = default_via_points(robot) if not args.trajectory else None
     check = check_torques(robot, traj)
     figures: list[str] = []
     if args.plot:
@@ -352,6 +396,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
         raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
     by_name = dict(zip(names, specs))
     args.lambda_optional = True
+    reference = _trajectory(args, robot)
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(names), "run", "compare")
 
@@ -370,7 +415,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
                 bar.set_postfix_str(name)
 
         try:
-            table = run_comparison(lambda n: _run_one(args, by_name[n], robot), names, progress, on_result)
+            table = run_comparison(
+                lambda n: _run_one(args, by_name[n], robot, reference), names, progress, on_result
+            )
         finally:
             bar.close()
         files = [Path(args.out) / p.name for p in table.write(stage)]
@@ -383,6 +430,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
     import signal
 
     robot = _robot(args)
+    reference = _trajectory(args, robot)
     if args.from_file:
         from twolink_pin.simulation.storage import load_result
 
@@ -398,11 +446,10 @@ def cmd_animate(args: argparse.Namespace) -> int:
             "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
         )
     else:
-        result = _run_one(args, args.controller, robot)
-    from twolink_pin.trajectory import default_via_points
+        result = _run_one(args, args.controller, robot, reference)
+    from twolink_pin.kinematics import joint_positions
 
-    via = default_via_points(robot)
-    points = None if via is None else np.array(via.xy)
+    points = joint_positions(robot, reference.via_q)[:, -1, :]  # the end effector's via points
     if args.html:
         from twolink_pin.visualization import write_html
 

@@ -50,7 +50,18 @@ def add_robot_options(p: argparse.ArgumentParser, json_flag: bool = True) -> Non
         p.add_argument("--json", action="store_true", help="print JSON instead of text")
 
 
+TRAJECTORY_HELP = (
+    "the reference: a TOML or JSON file of via points, joint (times, joints [rad]) or end-effector "
+    "(times, positions [m]); default: the robot's own"
+)
+
+
+def add_trajectory_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--trajectory", "--via", dest="trajectory", metavar="FILE", help=TRAJECTORY_HELP)
+
+
 def add_sim_options(p: argparse.ArgumentParser) -> None:
+    add_trajectory_option(p)
     p.add_argument(
         "--duration",
         type=bounded(0.0, MAX_DURATION, low_open=True, unit="s"),
@@ -119,6 +130,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("info", help="model summary: sizes, link lengths, torque limits, parameters")
     p.add_argument("--write-urdf", metavar="FILE", help="also write the payload variant as a URDF file")
+    p.add_argument(
+        "--friction",
+        action="store_true",
+        help="append viscous and Coulomb friction per joint to the base parameters",
+    )
     add_robot_options(p)
     p.set_defaults(func=c.cmd_info)
 
@@ -137,9 +153,22 @@ def build_parser() -> argparse.ArgumentParser:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_fk)
 
-    p = sub.add_parser("ik", help="inverse kinematics of a planar 2R arm: both elbow branches for (x, y) [m]")
+    p = sub.add_parser(
+        "ik",
+        help="inverse kinematics: both elbow branches of a planar 2R arm for (x, y), or a damped "
+        "least-squares solution from the robot's home for (x, y[, z]) [m]",
+    )
     p.add_argument("x", type=finite, help="x [m]")
     p.add_argument("y", type=finite, help="y [m]")
+    p.add_argument("z", type=finite, nargs="?", default=None, help="z [m] (arms that are not planar 2R)")
+    p.add_argument(
+        "--seed",
+        nargs="+",
+        type=finite,
+        default=None,
+        metavar="RAD",
+        help="IK seed, nv angles [rad] (default: home)",
+    )
     add_robot_options(p)
     p.set_defaults(func=c.cmd_ik)
 
@@ -147,6 +176,7 @@ def build_parser() -> argparse.ArgumentParser:
         "trajectory", help="the robot's reference trajectory, its coefficients and the torque check"
     )
     p.add_argument("--plot", metavar="DIR", help="write the trajectory's figures as PNG into DIR")
+    add_trajectory_option(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_trajectory)
 

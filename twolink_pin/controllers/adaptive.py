@@ -13,7 +13,7 @@ from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.dynamics import Friction, joint_inertia, regressor, smooth_sign
 from twolink_pin.model import RobotModel
 
-ADAPTATION_RATE = 1.0
+ADAPTATION_RATE = 5.0
 """α [1/s] of the robot-derived default adaptation gains (see :meth:`Adaptive.scaled_gains`)."""
 
 
@@ -95,7 +95,7 @@ class Adaptive(Controller[AdaptiveGains]):
         """``K = κ diag M(q₀)`` and ``γ_i = G_ii / α``: ``G = Σ Yᵀ K⁻¹ Y`` over unit joint
         accelerations and gravity at 8 seeded configurations within the joint limits, so
         that each parameter alone adapts at about α = 1 1/s under unit excitation."""
-        k = SLIDING_RATE * joint_inertia(self.robot.model)
+        k = SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)
         return {"k": k, "gamma": _gram_diagonal(self, k) / ADAPTATION_RATE}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:

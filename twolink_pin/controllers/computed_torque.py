@@ -11,7 +11,7 @@ from twolink_pin.dynamics import joint_inertia
 
 DEFAULT_LAMBDA = 5.0
 """λ [1/s]. The report never states its λ; 5 s⁻¹ is our documented default."""
-SLIDING_RATE = 10.0
+SLIDING_RATE = 50.0
 """κ [1/s] of the robot-derived default ``K = κ diag M(q₀)``: each joint's ``s`` decays at
 about κ on its own inertia."""
 
@@ -44,7 +44,7 @@ class ComputedTorque(Controller[SlotineLiGains]):
     Gains = SlotineLiGains
 
     def scaled_gains(self) -> dict[str, Any]:
-        return {"k": SLIDING_RATE * joint_inertia(self.robot.model)}
+        return {"k": SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         g = self.gains

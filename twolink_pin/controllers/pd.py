@@ -41,7 +41,7 @@ class PDFeedforward(Controller[PDGains]):
     Gains = PDGains
 
     def scaled_gains(self) -> dict[str, Any]:
-        inertia = joint_inertia(self.robot.model)
+        inertia = joint_inertia(self.robot.model, self.robot.home)
         return {"kp": NATURAL_FREQUENCY**2 * inertia, "kd": 2.0 * NATURAL_FREQUENCY * inertia}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:

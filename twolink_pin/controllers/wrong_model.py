@@ -42,7 +42,7 @@ class WrongModel(Controller[WrongModelGains]):
     Gains = WrongModelGains
 
     def scaled_gains(self) -> dict[str, Any]:
-        return {"k": SLIDING_RATE * joint_inertia(self.robot.model)}
+        return {"k": SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         g = self.gains

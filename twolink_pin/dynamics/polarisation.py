@@ -70,12 +70,17 @@ def polarisation_forest(models: Sequence[pin.Model]) -> pin.Model:
 
 
 def _renamed(model: pin.Model, prefix: str) -> pin.Model:
-    """A copy of ``model`` with ``prefix`` on every joint and frame name but the universe's."""
+    """A copy of ``model`` with ``prefix`` on every joint and frame name but the universe's
+    (a frame whose name another frame has already, as a link and the fixed joint before it
+    may, also gets ``#index``: ``appendModel`` looks frames up by name)."""
     copy = pin.Model(model)
     for j in range(1, copy.njoints):
         copy.names[j] = prefix + copy.names[j]
+    seen: set[str] = set()
     for i in range(1, len(copy.frames)):
         frame = copy.frames[i]
-        frame.name = prefix + frame.name
+        name = prefix + frame.name
+        frame.name = name if name not in seen else f"{name}#{i}"
+        seen.add(frame.name)
         copy.frames[i] = frame
     return copy

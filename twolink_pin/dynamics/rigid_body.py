@@ -137,9 +137,10 @@ def regressor(
     return y
 
 
-def joint_inertia(model: pin.Model) -> np.ndarray:
-    """``diag M(q₀)`` [kg·m²] at the neutral configuration ``q₀``, armature included: the
-    inertia each joint moves, the scale that robot-derived default gains use."""
+def joint_inertia(model: pin.Model, q: np.ndarray | None = None) -> np.ndarray:
+    """``diag M(q)`` [kg·m²] at ``q`` [rad] (default Pinocchio's neutral configuration),
+    armature included: the inertia each joint moves, the scale robot-derived default gains
+    use (at the robot's home, :attr:`~twolink_pin.model.RobotModel.home`)."""
     data = model.createData()
-    M = pin.crba(model, data, pin.neutral(model))
+    M = pin.crba(model, data, pin.neutral(model) if q is None else np.asarray(q, dtype=float))
     return np.array(np.diag(M), dtype=float)

@@ -54,8 +54,8 @@ def register(name: str, entry: Callable[[], tuple[Path, RobotProfile]]) -> None:
 
 
 def names() -> tuple[str, ...]:
-    """The catalog's robot names."""
-    return tuple(CATALOG)
+    """The catalog's robot names, the default robot first."""
+    return tuple(sorted(CATALOG, key=lambda name: name != DEFAULT_ROBOT))
 
 
 def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
@@ -76,7 +76,7 @@ def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
         raise InvalidURDFError(
             text,
             "robot",
-            f"no robot of that name; named robots are {', '.join(CATALOG)}, or give a path to a .urdf file",
+            f"no robot of that name; named robots are {', '.join(names())}, or give a path to a .urdf file",
         )
     for entry in CATALOG.values():
         own, profile = entry()

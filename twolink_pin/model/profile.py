@@ -62,6 +62,12 @@ class RobotProfile:
             frame on the last joint.
         package_dirs: Folders in which ``package://`` mesh paths are resolved.
         source: Where the URDF comes from (shown by ``twolink-pin robots``).
+        locked_joints: Joints held fixed at their ``locked_positions`` (a gripper's
+            fingers): the model is Pinocchio's reduced model, their links' masses carried by
+            the link they hang from.
+        locked_positions: Position of each locked joint [rad or m]; ``None``: 0 clipped to its limits.
+        home: A configuration the default trajectory and the viewer start from [rad], one
+            per joint of the (reduced) model; ``None``: the middle of each joint's range.
     """
 
     name: str
@@ -74,6 +80,9 @@ class RobotProfile:
     ee_frame: str | None = None
     package_dirs: tuple[Path, ...] = ()
     source: str = ""
+    locked_joints: tuple[str, ...] = ()
+    locked_positions: tuple[float, ...] | None = None
+    home: tuple[float, ...] | None = None
 
 
 def generic_profile(path: Path) -> RobotProfile:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 import os
+import xml.etree.ElementTree as ET
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -22,8 +23,9 @@ import pinocchio as pin
 
 from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
+from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.catalog import example_robot_urdf, resolve
-from twolink_pin.model.parameters import InertialParameterMap, ParameterMap
+from twolink_pin.model.parameters import ParameterMap
 from twolink_pin.model.profile import RobotProfile
 from twolink_pin.model.urdf_validation import validate_urdf_file
 
@@ -75,6 +77,17 @@ class RobotModel:
         return self.profile.gain_presets
 
     @property
+    def home(self) -> np.ndarray:
+        """A configuration [rad] inside the joint limits that default trajectories swing about
+        and robot-derived gains are scaled at: the profile's ``home``, else the middle of each
+        joint's range (0 rad for a joint without limits)."""
+        if self.profile.home is not None:
+            return np.array(self.profile.home, dtype=float)
+        lower, upper = np.array(self.model.lowerPositionLimit), np.array(self.model.upperPositionLimit)
+        finite = np.isfinite(lower) & np.isfinite(upper)
+        return np.where(finite, 0.5 * (np.where(finite, lower, 0.0) + np.where(finite, upper, 0.0)), 0.0)
+
+    @property
     def nq(self) -> int:
         """Size of the configuration vector."""
         return int(self.model.nq)
@@ -99,7 +112,9 @@ def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path) -> i
         if not model.existFrame(ee_frame):
             names = [f.name for f in model.frames]
             raise InvalidURDFError(str(path), f"frame '{ee_frame}'", f"no such frame; frames are {names}")
-        return int(model.getFrameId(ee_frame))
+        matches = [i for i, f in enumerate(model.frames) if f.name == ee_frame]
+        bodies = [i for i in matches if model.frames[i].type == pin.FrameType.BODY]
+        return (bodies or matches)[0]  # a link's frame before a fixed joint of the same name
     if model.existFrame(DEFAULT_EE_FRAME):
         return int(model.getFrameId(DEFAULT_EE_FRAME))
     # Otherwise: the last frame attached to the last joint.
@@ -179,6 +194,101 @@ def _check_moves_inertia(model: pin.Model, path: Path) -> None:
             ) from None
 
 
+CONTINUOUS = "continuous"
+
+
+def _revolute_continuous(text: str) -> tuple[str, tuple[str, ...]]:
+    """``text`` with every continuous joint made revolute (one angle, unbounded: see
+    :func:`_build_model`), and the names of those joints."""
+    root = ET.fromstring(text)
+    names = []
+    for joint in root.iter("joint"):
+        if joint.get("type") == CONTINUOUS:
+            joint.set("type", "revolute")
+            limit = joint.find("limit")
+            if limit is None:
+                limit = ET.SubElement(joint, "limit", {"effort": "0", "velocity": "0"})
+            limit.set("lower", "-1")
+            limit.set("upper", "1")
+            names.append(str(joint.get("name")))
+    if not names:
+        return text, ()
+    return ET.tostring(root, encoding="unicode"), tuple(names)
+
+
+def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
+    """The Pinocchio model of the checked URDF at ``path``, for tracking control:
+
+    * a continuous joint becomes a revolute joint without position limits: one angle
+      [rad] in ℝ instead of Pinocchio's (cos, sin) pair, so that ``nq == nv`` and a
+      joint error is ``q − q_d`` (the dynamics are the same; the angle is not wrapped);
+    * a joint whose lower and upper limits are equal (URDF's default 0 and 0 when the
+      ``<limit>`` gives none, as in the double pendulum) has no position limit;
+    * the profile's ``locked_joints`` are fixed at ``locked_positions``
+      (``pin.buildReducedModel``: their links ride on the link before them).
+    """
+    text = validate_urdf_file(path)
+    text, continuous = _revolute_continuous(text)
+    try:
+        model = pin.buildModelFromXML(text)
+    except (ValueError, RuntimeError) as exc:  # validated already; keep any surprise readable
+        raise InvalidURDFError(str(path), "<robot>", f"Pinocchio could not build a model: {exc}") from exc
+    lower, upper = model.lowerPositionLimit.copy(), model.upperPositionLimit.copy()
+    for j in range(1, model.njoints):
+        i, n = model.idx_qs[j], model.nqs[j]
+        if model.names[j] in continuous or (n == 1 and lower[i] == upper[i]):
+            lower[i : i + n], upper[i : i + n] = -np.inf, np.inf
+    model.lowerPositionLimit, model.upperPositionLimit = lower, upper
+    if profile.locked_joints:
+        model = _lock(model, profile, path)
+    if model.nv == 0:
+        raise InvalidURDFError(str(path), "<robot>", "expected at least one moving joint, found none")
+    if model.nq != model.nv:
+        kinds = sorted({model.joints[j].shortname() for j in range(1, model.njoints) if model.nqs[j] != 1})
+        raise InvalidURDFError(
+            str(path),
+            "<robot>",
+            f"expected joints of one coordinate each (revolute, continuous, prismatic), got nq = {model.nq}, "
+            f"nv = {model.nv} ({', '.join(kinds)})",
+        )
+    return model
+
+
+def _lock(model: pin.Model, profile: RobotProfile, path: Path) -> pin.Model:
+    ids = []
+    for name in profile.locked_joints:
+        if not model.existJointName(name):
+            raise InvalidURDFError(
+                str(path), f"joint '{name}'", f"no such joint to lock; joints are {list(model.names)[1:]}"
+            )
+        ids.append(int(model.getJointId(name)))
+    q = np.zeros(model.nq)
+    positions = profile.locked_positions or (0.0,) * len(ids)
+    for j, value in zip(ids, positions):
+        i = model.idx_qs[j]
+        q[i] = np.clip(value, model.lowerPositionLimit[i], model.upperPositionLimit[i])
+    return pin.buildReducedModel(model, ids, q)
+
+
+def _check_home(model: pin.Model, profile: RobotProfile, path: Path) -> None:
+    if profile.home is None:
+        return
+    home = np.array(profile.home, dtype=float)
+    if home.shape != (model.nq,) or not np.all(np.isfinite(home)):
+        raise InvalidURDFError(
+            str(path), "home", f"{profile.home} must be {model.nq} finite joint positions [rad]"
+        )
+    outside = np.flatnonzero((home < model.lowerPositionLimit) | (home > model.upperPositionLimit))
+    if outside.size:
+        j = int(outside[0])
+        raise InvalidURDFError(
+            str(path),
+            "home",
+            f"joint {j + 1} at {home[j]:g} rad is outside its limits "
+            f"[{model.lowerPositionLimit[j]:g}, {model.upperPositionLimit[j]:g}] rad",
+        )
+
+
 def load_robot(
     robot: str | os.PathLike[str] | None = None,
     payload: float = 0.0,
@@ -193,7 +303,8 @@ def load_robot(
         ee_frame: Name of the end-effector frame; default the profile's, else ``ee_link``
             if present, else the last frame on the last joint.
         parameter_map: Parameter-map class (called with the model); default the profile's
-            (the twolink's lumped p1..p3), else :class:`InertialParameterMap` (all π).
+            (the twolink's lumped p1..p3), else the model's identifiable base parameters
+            (:class:`~twolink_pin.model.base_parameters.BaseParameterMap`).
 
     Raises:
         InvalidURDFError: unknown name, missing file, or a file that gives no sound model.
@@ -207,19 +318,8 @@ def load_robot(
     ):
         raise InvalidParameterError("payload", payload, "a finite mass >= 0 kg")
     path, profile = resolve(robot)
-    validate_urdf_file(path)
-    try:
-        model = pin.buildModelFromUrdf(str(path))
-    except (ValueError, RuntimeError) as exc:  # validated already; keep any surprise readable
-        raise InvalidURDFError(str(path), "<robot>", f"Pinocchio could not build a model: {exc}") from exc
-    if model.nv == 0:
-        raise InvalidURDFError(str(path), "<robot>", "expected at least one moving joint, found none")
-    if model.nq != model.nv:
-        raise InvalidURDFError(
-            str(path),
-            "<robot>",
-            f"expected only 1-DoF joints (nq == nv), got nq = {model.nq}, nv = {model.nv}",
-        )
+    model = _build_model(path, profile)
+    _check_home(model, profile, path)
     ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
     if payload > 0:
         frame = model.frames[ee_id]
@@ -228,7 +328,7 @@ def load_robot(
     _check_inertias(model, path, payload)
     _check_moves_inertia(model, path)
     factory = parameter_map if parameter_map is not None else profile.parameter_map
-    pmap: ParameterMap = factory(model) if factory is not None else InertialParameterMap(model)
+    pmap: ParameterMap = factory(model) if factory is not None else BaseParameterMap(model)
     return RobotModel(
         model=model,
         urdf_path=path,

@@ -116,11 +116,15 @@ _DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 _ROBOT = "<robot>"
 
 
-def validate_urdf_file(path: str | os.PathLike[str]) -> None:
+def validate_urdf_file(path: str | os.PathLike[str]) -> str:
     """Check that a URDF file can safely be given to Pinocchio.
 
     Args:
         path: The URDF file.
+
+    Returns:
+        The document checked (UTF-8 text): give this to Pinocchio (``buildModelFromXML``),
+        not the file again, so that what is built is what was checked.
 
     Raises:
         InvalidURDFError: If the file is missing or unreadable (element ``file``), is not
@@ -133,6 +137,7 @@ def validate_urdf_file(path: str | os.PathLike[str]) -> None:
     except InputFileError as err:
         raise InvalidURDFError(name, "file", err.reason) from None
     _validate_robot(_parse(data, name), name)
+    return data.decode("utf-8")
 
 
 def validate_urdf_string(xml: str, path: str = "<string>") -> None:

@@ -22,7 +22,7 @@ from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_
 from twolink_pin.simulation.engine import Samples, _validate
 from twolink_pin.simulation.forward import SingleRunDynamics
 from twolink_pin.simulation.terms import SingleRunTerms
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import Trajectory
 
 PROGRESS_WINDOW = 20_000
 """Evaluations between two checks that the adaptive step still makes progress."""
@@ -34,7 +34,7 @@ MIN_PROGRESS = 1e-3
 def integrate_adaptive(
     controller: Controller,
     plant: Plant,
-    trajectory: JointTrajectory,
+    trajectory: Trajectory,
     config: SimulationConfig,
     q0: np.ndarray,
     v0: np.ndarray,

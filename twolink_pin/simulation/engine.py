@@ -39,7 +39,7 @@ from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.terms import terms_for
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import Trajectory
 
 BLOCK = 128
 """Steps per block: how often states are checked and unrecorded samples handed on."""
@@ -114,7 +114,7 @@ def _bad_rows(x: np.ndarray) -> np.ndarray:
 def integrate(
     controller: Controller,
     plant: Plant,
-    trajectory: JointTrajectory,
+    trajectory: Trajectory,
     config: SimulationConfig,
     q0: np.ndarray,
     v0: np.ndarray,

@@ -12,10 +12,10 @@ from twolink_pin.simulation.adaptive_step import integrate_adaptive
 from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, joint_offsets
 from twolink_pin.simulation.engine import integrate
 from twolink_pin.simulation.result import SimulationResult
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import Trajectory
 
 
-def check_setup(controller: Controller, plant: Plant, trajectory: JointTrajectory) -> None:
+def check_setup(controller: Controller, plant: Plant, trajectory: Trajectory) -> None:
     """Raise unless the law, the plant and the reference are for the same number of joints."""
     nv = plant.robot.nv
     if not isinstance(controller, Controller):
@@ -33,7 +33,7 @@ def check_setup(controller: Controller, plant: Plant, trajectory: JointTrajector
 
 
 def initial_state(
-    plant: Plant, trajectory: JointTrajectory, config: SimulationConfig
+    plant: Plant, trajectory: Trajectory, config: SimulationConfig
 ) -> tuple[np.ndarray, np.ndarray]:
     """``q(0) = q_d(0) + q0_offset`` and ``q̇(0) = q̇_d(0) + v0_offset``, shape (nv,) each."""
     nv = plant.robot.nv
@@ -59,7 +59,7 @@ def estimated_truth(controller: Controller, plant: Plant) -> np.ndarray | None:
 def simulate(
     controller: Controller,
     plant: Plant,
-    trajectory: JointTrajectory,
+    trajectory: Trajectory,
     config: SimulationConfig | None = None,
 ) -> SimulationResult:
     """Run ``controller`` on ``plant`` tracking ``trajectory``, every sample recorded.

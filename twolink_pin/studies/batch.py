@@ -26,7 +26,7 @@ from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state
 from twolink_pin.simulation.terms import check_parallel, threads_for
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import Trajectory
 
 
 @dataclass(frozen=True)
@@ -128,7 +128,7 @@ def batch_size(controller: Controller, *arrays: Any, runs: int | None = None) ->
 def simulate_batch(
     controller: Controller,
     plant: Plant,
-    trajectory: JointTrajectory,
+    trajectory: Trajectory,
     config: SimulationConfig | None = None,
     *,
     runs: int | None = None,

@@ -1,0 +1,51 @@
+"""What the engine asks of a reference: desired q, q̇, q̈ (and jerk) at any time, periodic."""
+
+from __future__ import annotations
+
+import abc
+from typing import NamedTuple
+
+import numpy as np
+
+
+class TrajectorySample(NamedTuple):
+    """Desired motion at one or more times; each array has shape (nv,) or (N, nv)."""
+
+    q: np.ndarray
+    """Position [rad]."""
+    v: np.ndarray
+    """Velocity [rad/s]."""
+    a: np.ndarray
+    """Acceleration [rad/s²]."""
+    jerk: np.ndarray
+    """Jerk [rad/s³]."""
+
+
+class Trajectory(abc.ABC):
+    """A periodic joint reference.
+
+    Attributes:
+        t0: Start of the first period [s].
+        period: Repetition period [s].
+    """
+
+    t0: float
+    period: float
+
+    @property
+    @abc.abstractmethod
+    def nv(self) -> int:
+        """Number of joints."""
+
+    @abc.abstractmethod
+    def sample(self, t: float | np.ndarray) -> TrajectorySample:
+        """Desired q, q̇, q̈ and jerk at time(s) ``t`` [s]: shape (nv,) for a scalar ``t``,
+        (N, nv) for N times."""
+
+    @property
+    def via_times(self) -> np.ndarray:
+        """Times [s] of the via points figures mark (none unless the reference has some)."""
+        return np.zeros(0)
+
+    def __call__(self, t: float | np.ndarray) -> TrajectorySample:
+        return self.sample(t)

@@ -1,0 +1,228 @@
+"""Trajectory files: a reference as a small TOML or JSON file (``--trajectory FILE``).
+
+Via points in joint space::
+
+    times = [0.0, 1.0, 2.0, 3.0, 4.0]           # s, strictly increasing
+    joints = [[0.0, -1.57, 1.57, -1.57, -1.57, 0.0], ...]   # rad, nv values per row
+    period = 4.0                                # s, optional (default: the span)
+
+or through end-effector positions of the robot's end-effector frame (solved by
+:func:`~twolink_pin.trajectory.cartesian_via_q`, each point seeded by the one before)::
+
+    times = [0.0, 1.0, 2.0, 3.0, 4.0]
+    positions = [[0.45, 0.10, 0.40], ...]       # m: (x, y, z), or (x, y) for a planar arm
+    seed = [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]   # rad, optional IK seed (default: home)
+
+A JSON file has the same keys. The file is read as a bounded regular file; every value is
+checked against the robot: the number of joints, finite and strictly increasing times,
+joint values within the joint limits (the message names the value and the limit), the
+last via point equal to the first (the reference repeats every period), and the sampled
+trajectory within the limits between via points too.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.errors import InputFileError, InvalidParameterError
+from twolink_pin.files import read_input_file
+from twolink_pin.model import RobotModel
+from twolink_pin.trajectory.base import Trajectory
+from twolink_pin.trajectory.cartesian import cartesian_via_q
+from twolink_pin.trajectory.polynomial import JointTrajectory
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+MAX_TRAJECTORY_BYTES = 1 << 20
+"""Largest trajectory file read (1 MiB)."""
+MAX_VIA_POINTS = 24
+"""Most via points of one file: the polynomial through n points has degree n + 5, and
+beyond about two dozen points its normal equations lose the digits the fit needs."""
+LIMIT_SAMPLES = 2001
+"""Samples over one period at which the trajectory is checked against the joint limits."""
+
+CLOSURE_TOLERANCE = 1e-6
+"""How far [rad] the last via point may be from the first (in joint space)."""
+
+KEYS = frozenset({"times", "joints", "positions", "period", "seed"})
+
+
+def _load(path: Path) -> dict[str, Any]:
+    data = read_input_file(path, MAX_TRAJECTORY_BYTES, "a trajectory file (.toml or .json)")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise InputFileError(
+            str(path), f"is not UTF-8 (byte {err.start}); expected a UTF-8 text file"
+        ) from None
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".json":
+            document = json.loads(text)
+        elif suffix == ".toml":
+            document = tomllib.loads(text)
+        else:
+            raise InputFileError(str(path), f"has the suffix {suffix!r}; expected .toml or .json")
+    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as err:
+        raise InputFileError(str(path), f"is not valid {suffix[1:].upper()}: {err}") from None
+    if not isinstance(document, dict):
+        raise InputFileError(str(path), "expected a table (TOML) or an object (JSON) at the top level")
+    return document
+
+
+def _numbers(path: Path, key: str, value: Any, shape: str) -> np.ndarray:
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{path}: {key}", value, shape) from None
+    if not np.all(np.isfinite(array)):
+        raise InvalidParameterError(f"{path}: {key}", value, f"finite numbers: {shape}")
+    return array
+
+
+def check_within_limits(robot: RobotModel, values: np.ndarray, what: str) -> None:
+    """Raise unless every row of ``values`` [rad] (shape (n, nv)) is within the joint limits."""
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    for k, row in enumerate(values):
+        for j, x in enumerate(row):
+            if not lower[j] <= x <= upper[j]:
+                raise InvalidParameterError(
+                    f"{what}[{k}][{j}]",
+                    float(x),
+                    f"a position of joint {j + 1} ({robot.model.names[j + 1]}) within its limits "
+                    f"[{lower[j]:g}, {upper[j]:g}] rad",
+                )
+
+
+def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str = "trajectory") -> None:
+    """Raise unless the trajectory stays within the joint limits over a period (sampled)."""
+    t = trajectory.t0 + np.linspace(0.0, trajectory.period, LIMIT_SAMPLES)
+    q = trajectory.sample(t).q
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    over = (q < lower) | (q > upper)
+    if over.any():
+        k, j = (int(i) for i in np.argwhere(over)[0])
+        raise InvalidParameterError(
+            what,
+            f"q{j + 1}({t[k]:.4g} s) = {q[k, j]:.6g} rad",
+            f"a motion within joint {j + 1}'s limits [{lower[j]:g}, {upper[j]:g}] rad between the via points "
+            "too (move the via points inwards, or space them further apart)",
+        )
+
+
+def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> JointTrajectory:
+    """The trajectory a TOML or JSON file describes for ``robot`` (see the module docstring).
+
+    Raises:
+        InputFileError: the file cannot be read or parsed.
+        InvalidParameterError: a key or value is wrong (the message names it and says what
+            was expected).
+        InverseKinematicsError: an end-effector point is out of reach or singular.
+    """
+    file = Path(os.fspath(path))
+    document = _load(file)
+    unknown = sorted(set(document) - KEYS)
+    if unknown:
+        raise InvalidParameterError(
+            f"{file}: {unknown[0]}", document[unknown[0]], f"only the keys {sorted(KEYS)}"
+        )
+    if "times" not in document:
+        raise InvalidParameterError(f"{file}: times", None, "a list of via-point times [s]")
+    times = _numbers(file, "times", document["times"], "a list of times [s]")
+    if times.ndim != 1 or not 2 <= times.size <= MAX_VIA_POINTS:
+        raise InvalidParameterError(
+            f"{file}: times", document["times"], f"a list of 2 to {MAX_VIA_POINTS} times [s]"
+        )
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        k = int(np.flatnonzero(steps <= 0)[0])
+        raise InvalidParameterError(
+            f"{file}: times[{k + 1}]",
+            float(times[k + 1]),
+            f"strictly increasing times: > times[{k}] = {times[k]:g} s",
+        )
+    period = document.get("period")
+    if period is not None and not (isinstance(period, (int, float)) and math.isfinite(period)):
+        raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
+    given = [key for key in ("joints", "positions") if key in document]
+    if len(given) != 1:
+        raise InvalidParameterError(
+            f"{file}", given or None, "exactly one of 'joints' (rad) and 'positions' (m)"
+        )
+    key = given[0]
+    rows: Sequence[Any] = document[key]
+    if not isinstance(rows, list) or len(rows) != times.size:
+        raise InvalidParameterError(
+            f"{file}: {key}",
+            f"{len(rows) if isinstance(rows, list) else type(rows).__name__} rows",
+            f"one row per time ({times.size})",
+        )
+    if key == "joints":
+        for k, row in enumerate(rows):
+            if not isinstance(row, list) or len(row) != robot.nv:
+                raise InvalidParameterError(
+                    f"{file}: joints[{k}]",
+                    row,
+                    f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
+                )
+        via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
+        check_within_limits(robot, via_q, f"{file}: joints")
+    else:
+        width = {len(row) if isinstance(row, list) else -1 for row in rows}
+        if len(width) != 1 or width.pop() not in (2, 3):
+            raise InvalidParameterError(
+                f"{file}: positions",
+                rows,
+                "rows of 3 coordinates (x, y, z) [m], or 2 (x, y) for a planar arm, all alike",
+            )
+        points = _numbers(file, "positions", rows, "end-effector positions [m]")
+        seed = None
+        if "seed" in document:
+            seed = _numbers(file, "seed", document["seed"], f"{robot.nv} joint positions [rad]")
+            if seed.shape != (robot.nv,):
+                raise InvalidParameterError(
+                    f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
+                )
+            check_within_limits(robot, seed[None, :], f"{file}: seed")
+        via_q = cartesian_via_q(robot, points, seed)
+    closing = float(np.abs(via_q[-1] - via_q[0]).max())
+    if closing > CLOSURE_TOLERANCE:
+        raise InvalidParameterError(
+            f"{file}: {key}[{len(rows) - 1}]",
+            rows[-1],
+            f"the first via point {rows[0]} again (to {CLOSURE_TOLERANCE:g} rad in joint space): the reference "
+            "repeats every period, so it must end where it starts",
+        )
+    try:
+        trajectory = JointTrajectory.from_via_q(
+            tuple(times), via_q, None if period is None else float(period)
+        )
+    except InvalidParameterError as err:
+        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    check_trajectory_limits(robot, trajectory, f"{file}")
+    return trajectory
+
+
+def write_trajectory_file(path: str | os.PathLike[str], trajectory: JointTrajectory) -> Path:
+    """Write ``trajectory``'s joint via points as a JSON trajectory file (atomically)."""
+    from twolink_pin.files import write_json
+
+    return write_json(
+        path,
+        {
+            "times": trajectory.times.tolist(),
+            "joints": trajectory.via_q.tolist(),
+            "period": trajectory.period,
+        },
+    )
