@@ -335,3 +335,27 @@ def test_simulate_adaptive_on_the_ur5_tracks_within_its_limits(capsys: pytest.Ca
     assert max(out["metrics"]["final_period_max_abs_e"]) < 0.02  # rad
     assert not any(out["limit_exceeded"])
     assert len(out["p_hat_final"]) == 36
+
+
+def test_the_end_effector_figure_draws_the_distance_pinocchio_gives(tmp_path: Path) -> None:
+    """The right panel's curve is |x − x_d| [mm] from Pinocchio's frame placements at every
+    sample; the left panel draws the plane the desired path spans most (y-z for the square)."""
+    from twolink_pin.plotting.cartesian import _end_effector_figure, save_end_effector_figure
+
+    robot = _robots["ur5"]
+    trajectory = read_trajectory_file(Path(__file__).parents[1] / "examples" / "ur5_square.toml", robot)
+    controller, plant = make_scenario("adaptive", robot)
+    result = simulate(controller, plant, trajectory, SimulationConfig(duration=0.5))
+    data = robot.create_data()
+    expected = []
+    for q, qd in zip(result.q, result.q_des):
+        pin.framesForwardKinematics(robot.model, data, qd)
+        x_d = data.oMf[robot.ee_frame_id].translation.copy()
+        pin.framesForwardKinematics(robot.model, data, q)
+        expected.append(np.linalg.norm(data.oMf[robot.ee_frame_id].translation - x_d) * 1e3)
+    fig = _end_effector_figure(robot, result)
+    path_ax, error_ax = fig.axes
+    np.testing.assert_allclose(error_ax.get_lines()[0].get_ydata(), expected, rtol=1e-12)
+    assert path_ax.get_xlabel() == "y [m]" and path_ax.get_ylabel() == "z [m]"
+    written = save_end_effector_figure(robot, result, tmp_path / "ee.png")
+    assert written.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

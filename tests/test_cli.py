@@ -177,3 +177,23 @@ def test_animate_live_serves_on_loopback_and_stops_cleanly_on_ctrl_c(tmp_path) -
         if proc.poll() is None:
             proc.kill()
             proc.wait()
+
+
+def test_a_bug_is_one_line_and_exit_1_or_its_traceback_on_request(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """An exception the library does not expect (here a RuntimeError in a command) is one line on
+    stderr that says it is ours, exit status 1; TWOLINK_PIN_DEBUG=1 re-raises it."""
+    from twolink_pin.cli import commands
+
+    def broken(args: object) -> int:
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(commands, "cmd_robots", broken)
+    monkeypatch.delenv("TWOLINK_PIN_DEBUG", raising=False)
+    assert main(["robots"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "internal error: RuntimeError: boom" in err
+    monkeypatch.setenv("TWOLINK_PIN_DEBUG", "1")
+    with pytest.raises(RuntimeError, match="boom"):
+        main(["robots"])

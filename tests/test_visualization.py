@@ -347,6 +347,24 @@ def test_camera_looks_down_on_planar_motion_and_obliquely_on_3d_motion() -> None
     np.testing.assert_allclose([np.array(c["matrix"][12:15]) for c in vias], via, rtol=0, atol=1e-6)
 
 
+def test_camera_faces_a_vertical_end_effector_path_from_the_far_side_of_the_base() -> None:
+    """The UR5 drawing a square in the plane x = 0.45 m (in front of its base): the camera sits
+    on the +x side, 35° to the side of the plane's normal and 25° above the horizontal, so the
+    square is seen face-on rather than edge-on."""
+    from twolink_pin.trajectory import read_trajectory_file
+
+    robot = ur5()
+    trajectory = read_trajectory_file(Path(__file__).parents[1] / "examples" / "ur5_square.toml", robot)
+    t = np.linspace(0.0, 8.0, 201)
+    q_des = trajectory.sample(t).q
+    commands = scene_commands(robot, _prepare(robot, t, q_des, q_des, None, FPS)).commands
+    _, offset = _camera(commands)
+    direction = offset / np.linalg.norm(offset)
+    assert np.degrees(np.arcsin(direction[2])) == pytest.approx(25.0, abs=1e-6)
+    horizontal = direction[:2] / np.linalg.norm(direction[:2])
+    assert np.degrees(np.arccos(horizontal[0])) == pytest.approx(35.0, abs=1.0)  # from +x, the normal
+
+
 # ----------------------------------------------------------------------------- live server: binding
 
 

@@ -8,7 +8,9 @@
 ==============  ===================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
-simulation, a law that raised) exit status 1; Ctrl-C exit status 130.
+simulation, a law that raised) exit status 1; Ctrl-C exit status 130, SIGTERM 143. An
+unexpected exception (a bug) is one line with exit status 1, or its traceback with
+``TWOLINK_PIN_DEBUG=1``.
 """
 
 from __future__ import annotations
@@ -59,6 +61,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except OSError as exc:  # stdout unwritable (a full disk or device): say so once, then be quiet
         _close_stdout()
         _say(f"twolink-pin: error: cannot write the output ({exc.strerror or exc})")
+        return 1
+    except Exception as exc:  # a bug of ours: one line that says so (TWOLINK_PIN_DEBUG=1 for the traceback)
+        import os
+
+        if os.environ.get("TWOLINK_PIN_DEBUG"):
+            raise
+        _say(
+            f"twolink-pin: internal error: {type(exc).__name__}: {str(exc)[:500]} — please report it with the "
+            "command line (TWOLINK_PIN_DEBUG=1 shows the traceback)"
+        )
         return 1
     finally:
         if previous is not None:

@@ -171,13 +171,21 @@ def cmd_robots(args: argparse.Namespace) -> int:
     rows = []
     for name in catalog.names():
         robot = load_robot(name)
+        model = robot.model
         rows.append(
             {
                 "name": name,
                 "nq": robot.nq,
                 "nv": robot.nv,
-                "gravity": robot.model.gravity.linear.tolist(),
+                "gravity": model.gravity.linear.tolist(),
                 "torque_limits": robot.torque_limits.tolist(),
+                "end_effector": robot.ee_frame,
+                "unlimited_joints": [
+                    str(model.names[int(j) + 1]) for j in np.flatnonzero(np.isinf(model.lowerPositionLimit))
+                ],
+                "locked_joints": list(robot.profile.locked_joints),
+                "home": robot.home.tolist(),
+                "base_parameters": robot.parameter_map.size if name != "twolink" else 4,
                 "description": robot.profile.description,
                 "source": robot.profile.source,
             }
@@ -185,9 +193,15 @@ def cmd_robots(args: argparse.Namespace) -> int:
     lines = []
     for row in rows:
         limits = ", ".join("none" if not np.isfinite(x) else f"{x:g}" for x in row["torque_limits"])
+        notes = []
+        if row["unlimited_joints"]:
+            notes.append(f"no position limit on {', '.join(row['unlimited_joints'])}")
+        if row["locked_joints"]:
+            notes.append(f"locked {', '.join(row['locked_joints'])}")
         lines.append(
             f"{row['name']:16s} nq = {row['nq']}, nv = {row['nv']}, gravity {fmt(row['gravity'], 2)} m/s², "
             f"effort limits ({limits}) N·m — {row['description']}"
+            + (f"\n{'':16s} {'; '.join(notes)}" if notes else "")
         )
     lines.append(
         "effort limit 'none': the URDF gives none (or 0); no torque check or saturation on that joint"
@@ -502,6 +516,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         controllers=None if args.controllers is None else tuple(args.controllers),
         workers=args.workers,
         animation=not args.no_animation,
+        trajectory=args.trajectory,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
     bar = progress_bar(1, "step", "report")

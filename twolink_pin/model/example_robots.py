@@ -59,7 +59,7 @@ _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
     "kinova": (
         "kinova_description/robots/kinova.urdf",
         {
-            "description": "Kinova Jaco j2s6s200, 6 revolute joints (4 continuous)",
+            "description": "Kinova Jaco j2s6s200, 6 revolute joints (3 of them continuous)",
             "ee_frame": "j2s6s200_end_effector",
             "home": (1.5707, 2.618, 4.7124, 3.1415, 2.618, 0.0),
         },

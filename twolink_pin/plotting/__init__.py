@@ -16,6 +16,8 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ``run.py``           :func:`save_simulation_figures`: one run's states, torques, and the
                      inertial / friction parameter errors (as the result declares them)
 ``distribution.py``  :func:`save_distribution_figure`: histograms of metrics over a sweep
+``cartesian.py``     :func:`save_end_effector_figure`: the end-effector path and its distance
+                     to the desired one
 ===================  =====================================================================
 
 Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,
@@ -24,8 +26,14 @@ tests can check what is drawn. Units: time [s], angles [rad], rates [rad/s], pos
 [m], torques [N·m].
 """
 
+from twolink_pin.plotting.cartesian import save_end_effector_figure
 from twolink_pin.plotting.distribution import save_distribution_figure
 from twolink_pin.plotting.run import save_simulation_figures
 from twolink_pin.plotting.trajectory import save_trajectory_figures
 
-__all__ = ["save_distribution_figure", "save_simulation_figures", "save_trajectory_figures"]
+__all__ = [
+    "save_distribution_figure",
+    "save_end_effector_figure",
+    "save_simulation_figures",
+    "save_trajectory_figures",
+]

@@ -64,6 +64,10 @@ class ReportOptions:
             the course report's five on the twolink, every built-in law elsewhere.
         workers: Processes for the runs and figures (1: in this process), 1 to 64.
         animation: Whether to write the self-contained animation.
+        trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
+            to track instead of the robot's default; the twolink's sections about the
+            report's own trajectory (Table 1, the printed coefficients) then still describe
+            the report's.
     """
 
     robot: str | None = None
@@ -75,6 +79,7 @@ class ReportOptions:
     controllers: tuple[str, ...] | None = None
     workers: int = 2
     animation: bool = True
+    trajectory: str | None = None
 
     def __post_init__(self) -> None:
         if not (
@@ -83,6 +88,15 @@ class ReportOptions:
             and 1 <= self.workers <= MAX_WORKERS
         ):
             raise InvalidParameterError("workers", self.workers, f"a whole number from 1 to {MAX_WORKERS}")
+
+
+def _reference(robot: Any, options: ReportOptions) -> Any:
+    """The trajectory the runs track: the options' file, else the robot's default."""
+    from twolink_pin.trajectory import read_trajectory_file
+
+    return (
+        read_trajectory_file(options.trajectory, robot) if options.trajectory else default_trajectory(robot)
+    )
 
 
 def _run(
@@ -104,7 +118,7 @@ def _run(
         saturate=options.saturate,
         friction_smoothing=options.friction_smoothing,
     )
-    result = simulate(controller, plant, default_trajectory(robot), options.config)
+    result = simulate(controller, plant, _reference(robot, options), options.config)
     metrics = compute_metrics(result)
     paths = save_simulation_figures(
         result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title
@@ -119,7 +133,7 @@ def _trajectory_figures(
     from twolink_pin.plotting import save_trajectory_figures
 
     robot = load_robot(options.robot, payload=options.payload)
-    trajectory = default_trajectory(robot)
+    trajectory = _reference(robot, options)
     check = check_torques(robot, trajectory)
     paths = save_trajectory_figures(robot, trajectory, check, Path(fig_dir), figure_numbers=figure_numbers)
     return [p.name for p in paths]
@@ -254,8 +268,8 @@ def _build(
 ) -> dict[str, Any]:
     fig_dir = stage / "figures"
     fig_dir.mkdir()
-    trajectory = default_trajectory(robot)
-    via = default_via_points(robot)
+    trajectory = _reference(robot, options)
+    via = default_via_points(robot) if not options.trajectory else None
     check = check_torques(robot, trajectory)
     numbers: dict[str, dict[str, int]] = {}
     if is_twolink:
@@ -286,7 +300,9 @@ def _build(
                 from twolink_pin.visualization import write_html
 
                 res = runs[name][0]
-                points = None if via is None else np.array(via.xy)
+                from twolink_pin.kinematics import joint_positions
+
+                points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
                 write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points)
                 animation = "animation.html"
                 tick("animation")
@@ -378,7 +394,12 @@ def _twolink_errata(
 ) -> list[dict[str, Any]]:
     from twolink_pin.twolink import errata
 
-    items = [errata.third_via_point(robot), errata.printed_coefficients(trajectory), errata.y3_sign(robot)]
+    report_trajectory = default_trajectory(robot)  # the errata are about the report's own trajectory
+    items = [
+        errata.third_via_point(robot),
+        errata.printed_coefficients(report_trajectory),
+        errata.y3_sign(robot),
+    ]
     items.append(errata.unstated_settings(lam, tuple(q0_offset.tolist())))
     if "robust" in runs:
         items.append(errata.robust_naming(runs["robust"][0]))

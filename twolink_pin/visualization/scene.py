@@ -389,18 +389,48 @@ def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.linalg.norm(v)
 
 
-def _view_direction(joints: np.ndarray) -> np.ndarray:
+def _path_normal(path: np.ndarray | None) -> np.ndarray | None:
+    """The horizontal normal of a (nearly) planar, (nearly) vertical end-effector path,
+    pointing from the base (the origin) towards the path; None for any other path."""
+    if path is None or len(path) < 3:
+        return None
+    centred = path - path.mean(axis=0)
+    values, vectors = np.linalg.eigh(centred.T @ centred)
+    if values[2] <= 1e-12 or values[0] > (PLANAR_RATIO**2) * values[1]:
+        return None  # a line, a point, or not planar
+    normal = vectors[:, 0]
+    if abs(normal[2]) > 0.5:
+        return None  # a horizontal plane: the oblique view sees it well
+    normal = _unit(np.array([normal[0], normal[1], 0.0]))
+    return normal if normal @ path.mean(axis=0) >= 0 else -normal
+
+
+def _view_direction(joints: np.ndarray, path: np.ndarray | None = None) -> np.ndarray:
     """Unit vector from the view centre towards the camera (our axes).
 
     Planar motion (the joints' z extent at most :data:`PLANAR_RATIO` of their x-y extent):
     from above, tilted slightly towards −y, so x points right and y up on the screen.
-    Otherwise obliquely, :data:`OBLIQUE_ELEVATION` above the horizontal and
-    :data:`OBLIQUE_AZIMUTH` away from the horizontal direction in which the joints move
-    least (the normal of a vertical plane of motion: never edge-on), on the −y side.
+    A desired end-effector ``path`` in a vertical plane (a square drawn in front of the
+    robot): facing that plane from the side away from the base, :data:`OBLIQUE_AZIMUTH`
+    to the side and :data:`OBLIQUE_ELEVATION` above the horizontal. Otherwise obliquely,
+    :data:`OBLIQUE_ELEVATION` above the horizontal and :data:`OBLIQUE_AZIMUTH` away from
+    the horizontal direction in which the joints move least (the normal of a vertical plane
+    of motion: never edge-on), on the −y side.
     """
     span = np.ptp(joints, axis=0)
     if span[2] <= PLANAR_RATIO * max(span[0], span[1]):
         return _unit(np.array([0.0, -CAMERA_TILT, 1.0]))
+    normal = _path_normal(path)
+    if normal is not None:
+        azimuth = math.atan2(normal[1], normal[0]) - math.radians(OBLIQUE_AZIMUTH)
+        elevation = math.radians(OBLIQUE_ELEVATION)
+        return np.array(
+            [
+                math.cos(elevation) * math.cos(azimuth),
+                math.cos(elevation) * math.sin(azimuth),
+                math.sin(elevation),
+            ]
+        )
     xy = joints[:, :2] - joints[:, :2].mean(axis=0)
     values, vectors = np.linalg.eigh(xy.T @ xy)
     flat = vectors[:, 0] if values[1] > 1e-9 else np.array([0.0, 1.0])
@@ -417,12 +447,15 @@ def _view_direction(joints: np.ndarray) -> np.ndarray:
     )
 
 
-def _camera(joints: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _camera(
+    joints: np.ndarray, points: np.ndarray, path: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """View centre and camera position (both in our axes [m]) framing ``points``.
 
     Args:
         joints: Joint and end-effector positions over the motion [m], shape (P, 3): they
-            decide the view direction (:func:`_view_direction`).
+            decide the view direction (:func:`_view_direction`), with ``path`` (the desired
+            end-effector path, shape (F, 3), if any).
         points: Everything to keep in view [m], shape (Q, 3): joints, the geometry's
             bounding-box corners over the motion, via points.
 
@@ -433,7 +466,7 @@ def _camera(joints: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndar
         within the field of view (vertical :data:`CAMERA_FOV`, aspect
         :data:`CAMERA_ASPECT`, :data:`CAMERA_MARGIN`).
     """
-    d = _view_direction(joints)
+    d = _view_direction(joints, path)
     right = _unit(np.cross(-d, [0.0, 0.0, 1.0]))
     up = np.cross(right, -d)
     axes = np.array([right, up, d])  # rows: screen right, screen up, towards the camera
@@ -571,6 +604,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
         arms.append((GHOST_NODE, ghost_visual_model(geom, GHOST_ALPHA, GHOST_RGB), motion.q_des, True))
     framing: list[np.ndarray] = []
     joints: list[np.ndarray] = []
+    desired_path: np.ndarray | None = None
     for root, model_geom, q_frames, ghost in arms:
         placements = _placements(robot.model, model_geom, drawables, q_frames)
         _add_arm(vis, animation, model_geom, drawables, placements, root, motion, ghost)
@@ -586,6 +620,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
                     )
                 )
         if ghost:
+            desired_path = positions[:, -1]
             vis[DESIRED_PATH_NODE].set_object(_line(positions[:, -1], DESIRED_PATH_COLOR, PATH_LIFT))
         else:
             _add_trail(vis, animation, motion, positions[:, -1])
@@ -598,7 +633,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
         framing.append(motion.via_points)
     joint_points = np.vstack(joints)
     in_view = np.vstack([joint_points, *framing])
-    centre, camera = _camera(joint_points, in_view)
+    centre, camera = _camera(joint_points, in_view, desired_path)
     spacing, (minor, major) = _grid(in_view, centre, camera)
     for name, segments, color in (("minor", minor, GRID_COLORS[0]), ("major", major, GRID_COLORS[1])):
         if len(segments):
