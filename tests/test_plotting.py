@@ -13,9 +13,11 @@ from __future__ import annotations
 
 import dataclasses
 import gc
+import math
 import subprocess
 import sys
 import types
+import warnings
 import weakref
 from pathlib import Path
 
@@ -32,8 +34,14 @@ from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
 from twolink_pin.plotting import _style
 from twolink_pin.plotting.distribution import _distribution_figure
+from twolink_pin.plotting.parameters import (
+    MANY_PARAMETERS,
+    RELATIVE_FLOOR,
+    _parameter_figures,
+    _relative_columns,
+)
 from twolink_pin.plotting.run import _simulation_figures, _torque_figure
-from twolink_pin.plotting.trajectory import _trajectory_figures
+from twolink_pin.plotting.trajectory import _motion_plane, _trajectory_figures
 from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.trajectory import JointTrajectory, default_trajectory
@@ -126,6 +134,92 @@ def _assert_png(path: Path, figsize: tuple[float, float]) -> None:
     gray = image[..., :3].mean(axis=2)
     assert gray.std() > 0.05, f"{path.name} looks blank (std {gray.std():.4f})"
     assert (gray < 0.5).mean() > 0.005, f"{path.name} has almost no dark pixels (no text or lines)"
+
+
+def _final_bars(ax) -> list:  # type: ignore[no-untyped-def]  # matplotlib Axes → Rectangle patches
+    """The bars of the final error p̂(T) − p of a bar panel (its second bar container)."""
+    assert len(ax.containers) == 2, [c.get_label() for c in ax.containers]
+    return list(ax.containers[1])
+
+
+def _assert_inside_figure(fig: Figure) -> None:
+    """After a draw, every legend, drawn tick label, axis label and title lies within the
+    figure (1 px of rounding allowed)."""
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    box = fig.bbox
+    for ax in fig.axes:
+        (x0, x1), (y0, y1) = sorted(ax.get_xlim()), sorted(ax.get_ylim())
+        artists = [ax.get_legend(), ax.title, ax.xaxis.label, ax.yaxis.label]
+        artists += [t for t in ax.get_xticklabels() if x0 <= t.get_position()[0] <= x1]  # drawn ones
+        artists += [t for t in ax.get_yticklabels() if y0 <= t.get_position()[1] <= y1]
+        for artist in artists:
+            if artist is None or not artist.get_visible() or getattr(artist, "get_text", lambda: "x")() == "":
+                continue
+            extent = artist.get_window_extent(renderer)
+            inside = box.x0 - 1 <= extent.x0 and extent.x1 <= box.x1 + 1
+            inside = inside and box.y0 - 1 <= extent.y0 and extent.y1 <= box.y1 + 1
+            assert inside, (ax.get_label(), type(artist).__name__, getattr(artist, "get_text", str)(), extent)
+
+
+def _synthetic_result(
+    names: tuple[str, ...],
+    units: tuple[str, ...],
+    kinds: tuple[str, ...],
+    p_true: np.ndarray,
+    nv: int = 6,
+    samples: int = 201,
+    tau: np.ndarray | None = None,
+) -> SimulationResult:
+    """A 1 s "run" of an nv-joint arm whose estimates start at half the true values (at
+    0.1 where the true value is 0) and wander; τ [N·m] sinusoidal unless given."""
+    t = np.linspace(0.0, 1.0, samples)
+    rng = np.random.default_rng(3)
+    start = np.where(p_true != 0, 0.5 * p_true, 0.1)
+    drift = rng.normal(scale=0.3, size=len(p_true)) * (np.abs(p_true) + 0.05)
+    p_hat = start + np.outer(np.sin(2.0 * t), drift)
+    q = 0.1 * np.sin(np.outer(t, np.arange(1, nv + 1)))
+    torque = 5.0 * np.cos(np.outer(t, np.arange(1, nv + 1))) if tau is None else tau
+    return SimulationResult(
+        controller="adaptive",
+        method="rk4",
+        dt=float(t[1] - t[0]),
+        t=t,
+        q=q,
+        v=np.gradient(q, t, axis=0),
+        tau_command=torque,
+        tau=torque,
+        q_des=0.9 * q,
+        v_des=0.9 * np.gradient(q, t, axis=0),
+        a_des=np.zeros_like(q),
+        torque_limits=np.full(nv, 100.0),
+        saturate=False,
+        reference_period=0.5,
+        p_hat=p_hat,
+        p_true=p_true,
+        parameter_names=names,
+        parameter_units=units,
+        parameter_kinds=kinds,
+        robot="synthetic",
+    )
+
+
+def _base_parameters(n: int = 36) -> tuple[tuple[str, ...], tuple[str, ...], np.ndarray]:
+    """``n`` base-parameter-like names (long combinations and single terms), units (kg·m²,
+    and kg·m for every third), and true values with exact zeros and one negligible value."""
+    units = tuple("kg·m" if k % 3 == 1 else "kg·m²" for k in range(n))
+    names = tuple(
+        f"link{k // 6 + 1}.{'mcx' if units[k] == 'kg·m' else 'Ixx'}"
+        + (
+            f" - 1 link{k // 6 + 1}.Izz + 0.1806 link{k // 6 + 2}.m + 0.1806 link{k // 6 + 3}.m"
+            if k % 2 == 0
+            else ""
+        )
+        for k in range(n)
+    )
+    p_true = np.array([0.0 if k % 5 == 3 else (-1.0) ** k * (0.2 + 0.1 * k) for k in range(n)])
+    p_true[7] = 1e-6  # a kg·m² value far below 1 % of the largest one
+    return names, units, p_true
 
 
 def _chain_urdf(path: Path, n: int, effort: float = 200.0) -> Path:
@@ -497,8 +591,11 @@ def test_undeclared_parameters_are_refused(adaptive: SimulationResult, change: d
 def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, nv: int) -> None:
     """An nv-joint arm gets one trajectory figure and two state figures per joint, a torque
     panel pair per joint at least 1.5 in tall (the figure grows with nv), the workspace
-    without an annulus (no closed form for nv != 2), and its base parameters in one panel
-    per unit (kg·m² only for the single yaw joint; kg·m and kg·m² otherwise); every file is written."""
+    without an annulus (no closed form for nv != 2; a 3-D view for the chains that leave
+    every plane), and its base parameters: the single yaw joint's one inertia as a curve
+    (kg·m²), the 15 and 36 of the longer chains as norms and one bar pair each, a bar
+    panel per unit (kg·m² and kg·m); every file is written, and matplotlib warns of
+    nothing (no collapsed constrained layout)."""
     robot = load_robot(_chain_urdf(tmp_path / f"chain{nv}.urdf", nv))
     assert robot.nv == nv
     trajectory = default_trajectory(robot)
@@ -507,6 +604,7 @@ def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, n
     assert list(figures) == [*(f"theta{j + 1}" for j in range(nv)), "workspace", "desired_torque"]
     full = _axes(figures["workspace"], "workspace")
     assert [ln for ln in full.get_lines() if ln.get_color() == _style.REACH_COLOR] == []
+    assert full.name == ("rectilinear" if nv == 1 else "3d")
     assert len([ax for ax in figures["desired_torque"].axes if ax.get_label().startswith("tau")]) == nv
 
     result = _run("adaptive", duration=0.2, robot=robot)
@@ -525,22 +623,216 @@ def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, n
             _line(_axes(torque, f"tau{j + 1}"), "applied").get_ydata(), result.tau[:, j]
         )
     param = run["param_error"]
-    units = ["kg·m²"] if nv == 1 else ["kg·m", "kg·m²"]
     labels = [ax.get_label() for ax in param.axes]
-    assert sorted(labels[:-1]) == [f"absolute [{u}]" for u in units] and labels[-1] == "relative"
-    assert sum(len(_data_lines(ax)) for ax in param.axes[: len(units)]) == len(result.parameter_names)
+    n_p = len(result.parameter_names)
+    if nv == 1:
+        assert n_p <= MANY_PARAMETERS
+        assert labels == ["absolute [kg·m²]", "relative"]
+        assert len(_data_lines(param.axes[0])) == n_p
+    else:
+        assert n_p == {3: 15, 6: 36}[nv] > MANY_PARAMETERS
+        units = ["kg·m²", "kg·m"]  # in order of first use
+        assert labels == ["normalised", *(f"final [{u}]" for u in units), *(f"relative [{u}]" for u in units)]
+        assert sum(len(_final_bars(param.axes[1 + k])) for k in range(len(units))) == n_p
 
     real_save = _style._save
     rendered = ("trajectory_workspace.png", "adaptive_torque.png", "adaptive_param_error.png")
     monkeypatch.setattr(  # render the three largest figures, only name the others (speed)
         _style, "_save", lambda fig, path: real_save(fig, path) if path.name in rendered else path
     )
-    paths = plotting.save_trajectory_figures(robot, trajectory, check, tmp_path)
-    paths += plotting.save_simulation_figures(result, tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)
+        paths = plotting.save_trajectory_figures(robot, trajectory, check, tmp_path)
+        paths += plotting.save_simulation_figures(result, tmp_path)
     expected = [f"trajectory_{k}.png" for k in figures] + [f"adaptive_{k}.png" for k in run]
     assert [p.name for p in paths] == expected
     for name in rendered:
         _assert_png(tmp_path / name, tuple((figures | run)[name.split("_", 1)[1][:-4]].get_size_inches()))
+
+
+# ---------------------------------------------------- many joints, many parameters
+
+
+@pytest.fixture(scope="module")
+def many() -> SimulationResult:
+    """A 6-joint run estimating 36 base-parameter-like inertial parameters."""
+    names, units, p_true = _base_parameters()
+    return _synthetic_result(names, units, ("inertial",) * 36, p_true)
+
+
+def _unit_columns(result: SimulationResult, unit: str) -> list[int]:
+    return [i for i, u in enumerate(result.parameter_units) if u == unit]
+
+
+def test_many_parameters_show_norms_and_one_bar_pair_each(many: SimulationResult) -> None:
+    """36 parameters (more than MANY_PARAMETERS): one panel of ‖p̂ − p‖ / ‖p‖ per unit over
+    time, equal to the norms computed here (from p̂(0) at t = 0), and one bar panel per unit
+    with an initial and a final bar per parameter (36 final bars in all), their widths
+    p̂(0) − p and p̂(T) − p, labelled β<k> with the first term of the k-th name."""
+    fig = _parameter_figures(many, {}, "controller adaptive")["param_error"]
+    units = ("kg·m²", "kg·m")
+    assert [ax.get_label() for ax in fig.axes] == [
+        "normalised",
+        *(f"final [{u}]" for u in units),
+        *(f"relative [{u}]" for u in units),
+    ]
+    assert many.p_hat is not None and many.p_true is not None
+    err = many.p_hat - many.p_true
+    for unit in units:
+        group = _unit_columns(many, unit)
+        line = _line(_axes(fig, "normalised"), f"[{unit}]")
+        first = math.sqrt(sum((many.p_hat[0, i] - many.p_true[i]) ** 2 for i in group))
+        first /= math.sqrt(sum(many.p_true[i] ** 2 for i in group))
+        np.testing.assert_allclose(np.asarray(line.get_ydata())[0], first, rtol=1e-12)
+        expected = np.sqrt((err[:, group] ** 2).sum(axis=1) / (many.p_true[group] ** 2).sum())
+        np.testing.assert_allclose(line.get_ydata(), expected, rtol=1e-12)
+        bars = _axes(fig, f"final [{unit}]")
+        initial, final = list(bars.containers[0]), _final_bars(bars)
+        assert len(initial) == len(final) == len(group)
+        np.testing.assert_allclose([b.get_width() for b in initial], err[0, group], rtol=0, atol=0)
+        np.testing.assert_allclose([b.get_width() for b in final], err[-1, group], rtol=0, atol=0)
+        expected_labels = []
+        for i in group:
+            head, *rest = many.parameter_names[i].split(" - ", 1)
+            expected_labels.append(f"β{i + 1}: {head}" + (" + …" if rest else ""))
+        assert [text.get_text() for text in bars.get_yticklabels()] == expected_labels
+    assert sum(len(_final_bars(_axes(fig, f"final [{u}]"))) for u in units) == len(many.parameter_names) == 36
+
+
+def test_relative_errors_only_where_the_true_value_is_not_negligible(many: SimulationResult) -> None:
+    """Beside each bar: the final 100 (p̂ − p)/p [%] where |p| >= RELATIVE_FLOOR (1 %) of the
+    largest |p| of its unit, "p = 0" for a true zero and "|p| ≈ 0" for the 1e-6 kg·m² value
+    (no division by a value near 0). The few-parameter figure applies the same floor: the
+    double pendulum's 5.8e-7 kg·m and 6.4e-11 kg·m get no relative curve, the twolink's
+    p1, p2, p3 all do."""
+    assert RELATIVE_FLOOR == 0.01
+    fig = _parameter_figures(many, {}, "controller adaptive")["param_error"]
+    assert many.p_hat is not None and many.p_true is not None
+    err = many.p_hat - many.p_true
+    seen = set()
+    for unit in ("kg·m²", "kg·m"):
+        group = _unit_columns(many, unit)
+        scale = max(abs(many.p_true[i]) for i in group)
+        texts = [text.get_text() for text in _axes(fig, f"relative [{unit}]").get_yticklabels()]
+        assert len(texts) == len(group)
+        for i, text in zip(group, texts):
+            p = float(many.p_true[i])
+            if p == 0:
+                assert text == "p = 0", (i, text)
+            elif abs(p) < 0.01 * scale:
+                assert text == "|p| ≈ 0", (i, text)
+            else:
+                assert text == f"{100 * err[-1, i] / p:+.1f} %", (i, text)
+            seen.add(text if not text.endswith("%") else "%")
+    assert seen == {"p = 0", "|p| ≈ 0", "%"}
+    assert _relative_columns(many.p_true, many.parameter_units, range(36)).count(7) == 0
+
+    pendulum = np.array([5.8018e-07, 4.2854e-02, 4.0784e-03, 6.4385e-11, 3.3530e-02, 4.5579e-03])
+    units = ("kg·m", "kg·m", "kg·m²", "kg·m", "kg·m", "kg·m²")
+    result = _synthetic_result(tuple(f"p{k}" for k in range(1, 7)), units, ("inertial",) * 6, pendulum, nv=2)
+    relative = _axes(_parameter_figures(result, {}, "controller adaptive")["param_error"], "relative")
+    assert [str(ln.get_label()).split(":")[0] for ln in _data_lines(relative)] == [
+        rf"$p_{{{k}}}$" for k in (2, 3, 5, 6)
+    ]
+
+
+def test_friction_the_plant_lacks_gets_error_norms() -> None:
+    """14 friction parameters whose true values are all 0 (a plant without friction): no
+    normalised panel (‖p‖ = 0) but ‖p̂ − p‖ per unit [N·m·s/rad], [N·m], bars labelled
+    V₁…C₇ in mathtext, "p = 0" beside every bar, and everything inside the figure."""
+    names = tuple(f"V{j}" for j in range(1, 8)) + tuple(f"C{j}" for j in range(1, 8))
+    units = ("N·m·s/rad",) * 7 + ("N·m",) * 7
+    result = _synthetic_result(names, units, ("friction",) * 14, np.zeros(14), nv=7)
+    fig = _parameter_figures(result, {}, "controller adaptive")["friction_error"]
+    assert [ax.get_label() for ax in fig.axes] == [
+        "norm [N·m·s/rad]",
+        "norm [N·m]",
+        "final [N·m·s/rad]",
+        "final [N·m]",
+        "relative [N·m·s/rad]",
+        "relative [N·m]",
+    ]
+    assert result.p_hat is not None
+    (line,) = _data_lines(_axes(fig, "norm [N·m]"))
+    np.testing.assert_allclose(line.get_ydata(), np.sqrt((result.p_hat[:, 7:] ** 2).sum(axis=1)), rtol=1e-12)
+    ticks = [text.get_text() for text in _axes(fig, "final [N·m·s/rad]").get_yticklabels()]
+    assert ticks == [rf"$V_{{{j}}}$" for j in range(1, 8)]
+    assert {text.get_text() for text in _axes(fig, "relative [N·m]").get_yticklabels()} == {"p = 0"}
+    _assert_inside_figure(fig)
+
+
+def test_six_joints_and_36_parameters_fit_in_their_figures(many: SimulationResult) -> None:
+    """With nv = 6 and 36 parameters, building and drawing the run's figures raises no
+    matplotlib UserWarning (constrained layout is applied, no axes collapse), and no legend,
+    tick label, axis label or title extends beyond the figure."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", UserWarning)
+        figures = _simulation_figures(many)
+        assert list(figures)[-2:] == ["torque", "param_error"]
+        for key in ("theta6", "theta6dot", "torque", "param_error"):
+            _assert_inside_figure(figures[key])
+    assert figures["param_error"].get_size_inches()[1] >= 36 * _style.BAR_HEIGHT
+
+
+def test_a_torque_legend_moves_off_a_curve_near_the_top(pd_figures: dict[str, Figure]) -> None:
+    """A torque that stays near its peak (like the Panda's τ4, 20–24 N·m) would run under
+    the "upper right" legend: the legend goes where it covers no point of the curve. The
+    twolink's legends stay in the upper right corner and cover no point either."""
+    t = np.linspace(0.0, 1.0, 201)
+    tau = np.column_stack([5.0 * np.cos(3.0 * t), 22.0 + 2.0 * np.sin(10.0 * t)])
+    result = _synthetic_result(
+        ("p1", "p2", "p3"), ("kg·m²",) * 3, ("inertial",) * 3, np.ones(3), nv=2, tau=tau
+    )
+    for fig, run in ((_torque_figure(result), result), (pd_figures["torque"], None)):
+        fig.canvas.draw()
+        for j in range(2):
+            ax = _axes(fig, f"tau{j + 1}")
+            legend = ax.get_legend()
+            assert legend is not None
+            box = legend.get_window_extent()
+            line = _line(ax, "applied")
+            points = ax.transData.transform(np.column_stack([line.get_xdata(), line.get_ydata()]))
+            covered = (points[:, 0] >= box.x0) & (points[:, 0] <= box.x1)
+            covered &= (points[:, 1] >= box.y0) & (points[:, 1] <= box.y1)
+            assert not covered.any(), (j, int(covered.sum()))
+            corner = ax.get_window_extent()
+            at_corner = corner.x1 - box.x1 < 15 and corner.y1 - box.y1 < 15
+            assert at_corner == (run is None or j == 0), (j, box, corner)
+
+
+def test_workspace_of_an_arm_moving_in_3d(tmp_path: Path) -> None:
+    """A chain that leaves every plane gets a 3-D view (its blue arms are joint_positions at
+    the via points, in 3-D), the end-effector path seen from above (x-y) and from the side
+    (z), and via labels with their three coordinates; the twolink moves in x-y and the
+    double pendulum in y-z (their figures stay 2-D)."""
+    robot = load_robot(_chain_urdf(tmp_path / "chain3.urdf", 3))
+    trajectory = default_trajectory(robot)
+    t = trajectory.t0 + np.linspace(0.0, trajectory.span, 201)
+    points = joint_positions(robot, trajectory.sample(t).q)
+    assert _motion_plane(points) is None
+    assert _motion_plane(joint_positions(ROBOT, TRAJ.sample(t).q)) == [0, 1]
+    pendulum = load_robot(str(example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf")))
+    assert _motion_plane(joint_positions(pendulum, default_trajectory(pendulum).sample(t).q)) == [1, 2]
+
+    check = check_torques(robot, trajectory, samples=101)
+    fig = _trajectory_figures(robot, trajectory, check, samples=201)["workspace"]
+    view, top, side = _axes(fig, "workspace"), _axes(fig, "path"), _axes(fig, "path-side")
+    assert view.name == "3d" and "3-D" in fig.get_suptitle()
+    arms = [ln for ln in view.get_lines() if ln.get_color() == "tab:blue"]
+    via = joint_positions(robot, trajectory.via_q)
+    assert len(arms) == len(via)
+    for line, arm in zip(arms, via):
+        np.testing.assert_allclose(np.column_stack(line.get_data_3d()), arm, rtol=0, atol=0)
+    ee = points[:, -1]
+    path = _line(top, "end-effector path")
+    np.testing.assert_allclose(np.column_stack([path.get_xdata(), path.get_ydata()]), ee[:, :2], atol=0)
+    assert (top.get_xlabel(), top.get_ylabel()) == ("x [m]", "y [m]")
+    assert side.get_xlabel() in ("x [m]", "y [m]") and side.get_ylabel() == "z [m]"
+    np.testing.assert_allclose(_line(side, "end-effector path").get_ydata(), ee[:, 2], atol=0)
+    labels = [text.get_text() for text in top.texts]
+    for x, y, z in via[:, -1]:
+        assert any(f"({x:.2f}, {y:.2f}, {z:.2f}) m" in s for s in labels), labels
+    assert fig.get_size_inches().tolist() == list(_style.WORKSPACE_3D_FIGSIZE)
 
 
 # ---------------------------------------------------------------------- saving
@@ -660,7 +952,7 @@ def test_figures_are_freed_after_saving(
 
 def test_no_pyplot_and_only_the_public_names() -> None:
     """Building and saving figures never imports pyplot (checked in a fresh interpreter),
-    and the package exports exactly its three save functions (no report tables)."""
+    and the package exports exactly its four save functions (no report tables)."""
     code = (
         "import sys, tempfile, numpy as np\n"
         "import twolink_pin.plotting as p\n"
@@ -671,6 +963,7 @@ def test_no_pyplot_and_only_the_public_names() -> None:
     assert done.returncode == 0, done.stderr
     assert sorted(plotting.__all__) == [
         "save_distribution_figure",
+        "save_end_effector_figure",
         "save_simulation_figures",
         "save_trajectory_figures",
     ]

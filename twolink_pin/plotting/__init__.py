@@ -12,9 +12,13 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ``_style.py``        sizes, DPI, colours; the Agg figure, atomic saving, titles, limit
                      lines, annotation placement, the max-|e| envelope
 ``trajectory.py``    :func:`save_trajectory_figures`: each joint's desired motion, the arm
-                     and end-effector path (x-y), the desired torque against the limits
+                     and end-effector path (in its plane, or a 3-D view and two projections),
+                     the desired torque against the limits
 ``run.py``           :func:`save_simulation_figures`: one run's states, torques, and the
                      inertial / friction parameter errors (as the result declares them)
+``parameters.py``    the parameter-error figures: a curve per parameter for a few (the
+                     twolink), norms over time and a bar pair per parameter for many (the
+                     base parameters of a 6- or 7-joint arm)
 ``distribution.py``  :func:`save_distribution_figure`: histograms of metrics over a sweep
 ``cartesian.py``     :func:`save_end_effector_figure`: the end-effector path and its distance
                      to the desired one

@@ -1,5 +1,5 @@
 """What every figure shares: sizes, colours, the non-GUI figure, atomic saving, titles,
-and the helpers that place limit lines, notes and annotations.
+and the helpers that place limit lines, notes, annotations and legends.
 
 Figures are :class:`matplotlib.figure.Figure` objects with their own
 :class:`~matplotlib.backends.backend_agg.FigureCanvasAgg` (never ``pyplot``): no GUI
@@ -11,13 +11,17 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+import re
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.transforms import Bbox
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.files import atomic_write
@@ -40,6 +44,18 @@ PARAM_FIGSIZE = (8.0, 5.0)
 """Size of a parameter-error figure with one panel and a legend inside it [in]."""
 PARAM_ROW_HEIGHT = 2.2
 """Height each further panel adds to a parameter-error figure [in]."""
+SUMMARY_WIDTH = 10.0
+"""Width of a parameter-error figure of many parameters (norms over time, bars) [in]."""
+NORM_PANEL_HEIGHT = 2.2
+"""Height of a panel of error norms over time in a many-parameter figure [in]."""
+BAR_HEIGHT = 0.2
+"""Height each parameter's bar pair takes in a many-parameter figure [in]."""
+PANEL_DECORATION_HEIGHT = 0.85
+"""Height of a panel's title, tick labels and x label, beside its drawing area [in]."""
+SUPTITLE_HEIGHT = 0.75
+"""Height of a figure's (two- or three-line) title [in]."""
+WORKSPACE_3D_FIGSIZE = (16.0, 5.8)
+"""Size of the workspace figure of an arm moving in 3-D (a 3-D view, two projections) [in]."""
 
 OFF_SCALE_RATIO = 3.0
 """A torque limit more than this many times the plotted peak is noted, not drawn in view."""
@@ -59,6 +75,19 @@ LEGEND_BOX = (0.62, 0.78, 1.0, 1.0)
 """Region of an "upper right" legend, kept free of annotations [axes fraction]."""
 NOTE_BOX = (0.0, 0.0, 0.75, 0.12)
 """Region of the off-scale limit note, kept free of annotations [axes fraction]."""
+LegendPlace = Literal[
+    "upper right", "center right", "upper left", "center left", "lower right", "upper center"
+]
+LEGEND_PLACES: tuple[LegendPlace, ...] = (
+    "upper right",
+    "center right",
+    "upper left",
+    "center left",
+    "lower right",
+    "upper center",
+)
+"""Where a torque panel's legend may go, in order of preference; the first is where it is
+made (see :func:`_unblock_legends`)."""
 
 
 # ------------------------------------------------------------------ figures and files
@@ -173,6 +202,70 @@ def _free_spot(
             if best is None or key < best:
                 best = key
     return (0.5, 0.5) if best is None else (best[2], best[3])
+
+
+def _legend_size(legend: Legend, dpi: float) -> tuple[float, float]:
+    """An upper estimate of a one-column legend's width and height [px] from its labels'
+    lengths and its spacings (in font sizes), without laying out its text (measuring a
+    mathtext label from inside a figure builder keeps the figure alive for a second
+    garbage-collection pass)."""
+    em = legend.prop.get_size_in_points() * dpi / 72.0
+    # A mathtext command (\tau) counts as one character; $ { } _ ^ as none.
+    labels = [re.sub(r"[${}_^]", "", re.sub(r"\\[A-Za-z]+", "x", text.get_text())) for text in legend.texts]
+    chars = max((len(label) for label in labels), default=0)
+    width = legend.handlelength + legend.handletextpad + 2.0 * legend.borderpad + 0.6 * chars
+    height = 1.25 * len(labels) + legend.labelspacing * max(len(labels) - 1, 0) + 2.0 * legend.borderpad
+    return width * em, height * em
+
+
+def _legend_box(ax: Axes, loc: LegendPlace, size: tuple[float, float], pad: float) -> Bbox:
+    """Where a legend of ``size`` [px] at ``loc``, ``pad`` [px] from the axes edges, lies [px]."""
+    box = ax.get_window_extent()
+    w, h = size
+    x0 = {"left": box.x0 + pad, "right": box.x1 - pad - w, "center": 0.5 * (box.x0 + box.x1 - w)}
+    y0 = {"upper": box.y1 - pad - h, "center": 0.5 * (box.y0 + box.y1 - h), "lower": box.y0 + pad}
+    vertical, horizontal = loc.split()
+    return Bbox.from_bounds(x0[horizontal], y0[vertical], w, h)
+
+
+def _unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.ndarray]]) -> None:
+    """Move each "upper right" legend that covers a point of its axes' curves to a free place.
+
+    ``curves`` gives, per axes whose legend was made at ``loc="upper right"``, the points
+    of its curves (x, y in data coordinates). A legend covering none of the points stays
+    where it is (the twolink's legends do not move); else it goes to the first of
+    :data:`LEGEND_PLACES` that covers no point and no text (annotation, note), else to the
+    one covering fewest points, then fewest texts. Call once the figure is complete.
+
+    The test is conservative: it runs before the layout, on axes of the plain subplot grid
+    (smaller than constrained layout makes them), with an upper estimate of the legend's
+    size (:func:`_legend_size`), so a legend is judged larger than it will be drawn, and
+    no layout pass is needed. Matplotlib's ``loc="best"`` does a similar search at each
+    draw, but also avoids the ±limit lines the legend is meant to sit above, and it warns
+    on long runs.
+    """
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]  # the Agg canvas has one
+    for ax, x, y in curves:
+        legend = ax.get_legend()
+        if legend is None:
+            continue
+        points = ax.transData.transform(np.column_stack([np.ravel(x), np.ravel(y)]))
+        texts = [text.get_window_extent(renderer) for text in ax.texts]
+        size = _legend_size(legend, fig.dpi)
+        pad = legend.borderaxespad * legend.prop.get_size_in_points() * fig.dpi / 72.0
+        scores: list[tuple[int, int]] = []
+        for loc in LEGEND_PLACES:
+            box = _legend_box(ax, loc, size, pad)
+            (x0, y0), (x1, y1) = box.get_points()
+            inside = (points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)
+            scores.append((int(np.count_nonzero(inside)), sum(1 for text in texts if box.overlaps(text))))
+            if loc == LEGEND_PLACES[0] and scores[0][0] == 0:
+                break  # where it was made, over no point: it stays
+            if scores[-1] == (0, 0):
+                break
+        best = LEGEND_PLACES[min(range(len(scores)), key=lambda k: scores[k])]
+        if best != LEGEND_PLACES[0]:
+            legend.set_loc(best)
 
 
 def _limit_lines(ax: Axes, limit: float, peak: float, label: bool = True) -> bool:

@@ -4,16 +4,16 @@ estimates of laws that estimate parameters.
 :func:`save_simulation_figures` writes ``<prefix>_theta1.png``, …, ``<prefix>_theta1dot.png``,
 …, ``<prefix>_torque.png`` and, for runs with estimates, ``<prefix>_param_error.png``
 (``inertial`` parameters) and ``<prefix>_friction_error.png`` (``friction`` ones), as the
-result's ``parameter_kinds`` declare. :func:`_simulation_figures` returns the figures keyed
-by those suffixes (the keys of ``figure_numbers``). Time [s], angles [rad], rates [rad/s],
-torques [N·m]; parameters in the result's ``parameter_units``.
+result's ``parameter_kinds`` declare (drawn by :mod:`twolink_pin.plotting.parameters`).
+:func:`_simulation_figures` returns the figures keyed by those suffixes (the keys of
+``figure_numbers``). Time [s], angles [rad], rates [rad/s], torques [N·m]; parameters in
+the result's ``parameter_units``.
 """
 
 from __future__ import annotations
 
-import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -30,8 +30,6 @@ from twolink_pin.plotting._style import (
     LIMIT_COLOR,
     LOG_FLOOR,
     NOTE_BOX,
-    PARAM_FIGSIZE,
-    PARAM_ROW_HEIGHT,
     SIM_TORQUE_FIGSIZE,
     STATE_FIGSIZE,
     _check_figure_numbers,
@@ -42,21 +40,13 @@ from twolink_pin.plotting._style import (
     _rows_figsize,
     _save_all,
     _title,
+    _unblock_legends,
 )
+from twolink_pin.plotting.parameters import _check_parameters, _parameter_figures
 from twolink_pin.simulation import SimulationResult
 
 SIM_TORQUE_ROW_HEIGHT = 2.75
 """Height each further (or fewer) joint adds to (takes from) a run's torque figure [in]."""
-PARAMETER_KINDS = ("inertial", "friction")
-"""The kinds of estimated parameters, in figure order."""
-PARAMETER_FIGURES = {"inertial": "param_error", "friction": "friction_error"}
-"""Figure key of each parameter kind."""
-INLINE_LEGEND_ENTRIES = 4
-"""A panel with more lines than this gets its legend outside, on the right."""
-DETAILED_LEGEND_ENTRIES = 12
-"""A panel with more lines than this lists only the names (no true value, no start → end)."""
-LEGEND_ROWS = 12
-"""Most entries per column of an outside legend."""
 
 
 def _heading(result: SimulationResult, title: str | None) -> str:
@@ -208,118 +198,9 @@ def _torque_figure(
     sat = "saturated at the limits" if result.saturate else "no saturation"
     heading = heading if heading is not None else _heading(result, None)
     fig.suptitle(_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
-    return fig
-
-
-# -------------------------------------------------------------------- parameters
-
-
-def _is_indexed(name: str) -> bool:
-    """Whether ``name`` is one ASCII letter then digits (``p1``, ``V2``, ``C12``)."""
-    return len(name) >= 2 and name[0].isascii() and name[0].isalpha() and name[1:].isdigit()
-
-
-def _parameter_symbol(name: str) -> str:
-    """``p_1`` in mathtext for ``p1``; any other name as it is."""
-    return rf"${name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
-
-
-def _parameter_label(name: str, true: float, err: np.ndarray, detailed: bool) -> str:
-    """Legend entry of ``p̂ − p``: ``p̂_1 − p_1`` in mathtext (letter+digits) or the name."""
-    sym = rf"$\hat{{{name[0]}}}_{{{name[1:]}}} - {name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
-    return f"{sym} (true {true:.3g}; {err[0]:+.3g} → {err[-1]:+.3g})" if detailed else sym
-
-
-def _line_style(k: int) -> dict[str, str]:
-    """Colour and dash of the ``k``-th line: ten colours, then the next dash."""
-    return {"color": f"C{k % 10}", "ls": ("-", "--", ":", "-.")[(k // 10) % 4]}
-
-
-def _legend(ax: Axes, entries: int) -> float:
-    """A legend inside ``ax`` for a few entries, else outside on the right; its width [in]."""
-    if entries <= INLINE_LEGEND_ENTRIES:
-        ax.legend(loc="best", fontsize=8)
-        return 0.0
-    ncols = math.ceil(entries / LEGEND_ROWS)
-    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=7, ncols=ncols, borderaxespad=0.0)
-    return ncols * (2.9 if entries <= DETAILED_LEGEND_ENTRIES else 1.1)
-
-
-def _check_parameters(result: SimulationResult) -> None:
-    """The result declares a name, a unit and a known kind for every estimated parameter.
-
-    Raises:
-        InvalidParameterError: a declaration is missing or a kind is unknown.
-    """
-    assert result.p_hat is not None
-    n_p = result.p_hat.shape[1]
-    for field in ("parameter_names", "parameter_units", "parameter_kinds"):
-        values = getattr(result, field)
-        if len(values) != n_p:
-            raise InvalidParameterError(
-                f"result.{field}", values, f"one entry per estimated parameter ({n_p}) but got {len(values)}"
-            )
-    unknown = sorted(set(result.parameter_kinds) - set(PARAMETER_KINDS))
-    if unknown:
-        raise InvalidParameterError(
-            "result.parameter_kinds", result.parameter_kinds, f"each one of {PARAMETER_KINDS}, not {unknown}"
-        )
-
-
-def _parameter_figure(
-    result: SimulationResult,
-    columns: Sequence[int],
-    kind: str,
-    figure_numbers: Mapping[str, int],
-    heading: str,
-) -> Figure:
-    """``p̂ − p`` of the parameters ``columns`` (one panel per unit), then ``(p̂ − p)/p`` [%]."""
-    assert result.p_error is not None and result.p_true is not None
-    t = result.t
-    p_error, p_true = result.p_error, result.p_true
-    names, units = result.parameter_names, result.parameter_units
-    groups: dict[str, list[int]] = {}
-    for i in columns:
-        groups.setdefault(units[i], []).append(i)
-    scale = float(np.abs(p_true[list(columns)]).max())
-    relative = [i for i in columns if abs(p_true[i]) > max(1e-12, 1e-9 * scale)]
-    # Up to ten parameters: one colour each, the same in every panel. More: each panel
-    # styles its own lines in order, so the lines of a panel stay apart.
-    consistent = len(columns) <= 10
-    style = {i: _line_style(k) for k, i in enumerate(columns)}
-
-    rows = len(groups) + (1 if relative else 0)
-    fig = _new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
-    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
-    legend_width = 0.0
-    for ax, (unit, group) in zip(axes, groups.items()):
-        ax.set_label(f"absolute [{unit}]")
-        detailed = len(group) <= DETAILED_LEGEND_ENTRIES
-        for k, i in enumerate(group):
-            label = _parameter_label(names[i], float(p_true[i]), p_error[:, i], detailed)
-            ax.plot(t, p_error[:, i], lw=1.5, label=label, **(style[i] if consistent else _line_style(k)))
-        ax.set_ylabel(f"estimate − true [{unit}]")
-        legend_width = max(legend_width, _legend(ax, len(group)))
-    if relative:
-        ax = axes[-1]
-        ax.set_label("relative")
-        detailed = len(relative) <= DETAILED_LEGEND_ENTRIES
-        for k, i in enumerate(relative):
-            rel = 100.0 * p_error[:, i] / p_true[i]
-            label = _parameter_symbol(names[i]) + (
-                f": {rel[0]:+.0f} % → {rel[-1]:+.0f} %" if detailed else ""
-            )
-            ax.plot(t, rel, lw=1.3, label=label, **(style[i] if consistent else _line_style(k)))
-        ax.set_ylabel("(estimate − true) / true [%]")
-        legend_width = max(legend_width, _legend(ax, len(relative)))
-    for ax in axes:
-        ax.axhline(0.0, color="0.5", lw=0.8)
-        ax.grid(True, alpha=0.3)
-    axes[-1].set_xlabel("t [s]")
-    axes[-1].set_xlim(t[0], t[-1])
-    fig.set_size_inches(PARAM_FIGSIZE[0] + legend_width, fig.get_size_inches()[1])
-    what = f"{kind} parameter estimation error p̂ − p"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    shown = np.concatenate([result.tau, result.tau_command]) if clipped else result.tau
+    times = np.concatenate([t, t]) if clipped else t
+    _unblock_legends(fig, [(axes[j, 0], times, shown[:, j]) for j in range(nv)])
     return fig
 
 
@@ -346,7 +227,7 @@ def _simulation_figures(
     if title is not None and not isinstance(title, str):
         raise InvalidParameterError("title", title, "a string (the law's display title) or None")
     if result.p_error is not None:
-        _check_parameters(result)
+        _check_parameters(result)  # before drawing anything
     heading = _heading(result, title)
     nv = result.nv
     figures: dict[str, Figure] = {}
@@ -356,10 +237,7 @@ def _simulation_figures(
         figures[f"theta{j + 1}dot"] = _state_figure(result, j, True, numbers, heading)
     figures["torque"] = _torque_figure(result, numbers, heading)
     if result.p_error is not None:
-        for kind in PARAMETER_KINDS:
-            columns = [i for i, k in enumerate(result.parameter_kinds) if k == kind]
-            if columns:
-                figures[PARAMETER_FIGURES[kind]] = _parameter_figure(result, columns, kind, numbers, heading)
+        figures |= _parameter_figures(result, numbers, heading)
     return figures
 
 
@@ -378,13 +256,18 @@ def save_simulation_figures(
       ``max |e|`` per window on a log scale (errors decaying to 1e-10 stay visible);
     * ``<prefix>_torque.png``: each ``τ_i`` [N·m] with its ``±limit`` lines (applied vs
       commanded when the plant saturates), for the whole run and the last reference period;
-      a limit far beyond the data is noted instead of squashing the curve, and a commanded
-      torque beyond its limit is annotated;
+      a limit far beyond the data is noted instead of squashing the curve, a commanded
+      torque beyond its limit is annotated, and a legend that would cover the curve moves
+      to a free corner or side; the figure grows by 2.75 in per joint;
     * runs with parameter estimates: ``<prefix>_param_error.png`` (``p̂ − p`` of the
       ``"inertial"`` parameters, one panel per unit of ``result.parameter_units``, and the
       relative error [%]) and ``<prefix>_friction_error.png`` (the same for the
       ``"friction"`` ones, e.g. V [N·m·s/rad] and C [N·m]), as ``result.parameter_kinds``
-      declares.
+      declares. A figure of more than 8 parameters (the base parameters of a 6- or 7-joint
+      arm) shows instead the normalised error ``‖p̂ − p‖ / ‖p‖`` of each unit over time and
+      the error of each parameter at the start and the end as bars, labelled ``β<k>``
+      (:func:`twolink_pin.plotting.parameters._parameter_summary_figure`). Relative errors
+      only where ``|p_i|`` is at least 1 % of the largest ``|p_j|`` of its unit.
 
     Args:
         result: A simulation result (read only).

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +32,7 @@ from twolink_pin.plotting._style import (
     REACH_COLOR,
     TORQUE_FIGSIZE,
     TORQUE_ROW_HEIGHT,
+    WORKSPACE_3D_FIGSIZE,
     WORKSPACE_FIGSIZE,
     _check_figure_numbers,
     _free_spot,
@@ -40,11 +41,19 @@ from twolink_pin.plotting._style import (
     _rows_figsize,
     _save_all,
     _title,
+    _unblock_legends,
 )
 from twolink_pin.trajectory import JointTrajectory
 
 PLANAR_TOLERANCE = 1e-9
 """Largest spread of the arm's z [m] for which it counts as moving in the x-y plane."""
+VIEW_ELEVATION = 25.0
+"""Elevation of the 3-D view of an arm moving in 3-D [deg]."""
+VIEW_TURN = 35.0
+"""How far the 3-D view turns from looking straight at the end-effector path [deg]."""
+MOTION_PLANE_TOLERANCE = 1e-6
+"""Largest motion [m] of any point of the arm along an axis for which the arm counts as moving
+in the plane of the other two (drawn in 2-D there); beyond it on every axis, it moves in 3-D."""
 
 
 def _joint_trajectory_figure(
@@ -108,22 +117,175 @@ def _draw_annulus(ax: Axes, robot: RobotModel, centre: np.ndarray) -> None:
         )
 
 
-def _projection(points: np.ndarray) -> list[int]:
-    """The coordinate plane to draw ``points`` (…, 3) [m] in, as two axis indices: drop the
-    axis along which they spread least, z on a tie (an arm moving in x-y is drawn in x-y)."""
-    spread = np.ptp(points.reshape(-1, 3), axis=0)
-    dropped = 2 if spread[2] <= spread[:2].min() else int(np.argmin(spread[:2]))
+def _motion_plane(points: np.ndarray) -> list[int] | None:
+    """The coordinate plane an arm moves in, as two axis indices, or None if it moves in 3-D.
+
+    ``points`` (samples, njoints, 3) [m] are the arm's joint origins and end effector over
+    the motion. The arm moves in a coordinate plane when along one axis no point moves by
+    more than :data:`MOTION_PLANE_TOLERANCE` (z for the twolink, x for the double pendulum
+    swinging in y-z); that axis is dropped, z on a tie (an arm moving in x-y is drawn in x-y).
+    """
+    excursion = np.ptp(points, axis=0).max(axis=0)  # largest motion of any point along x, y, z
+    if float(excursion.min()) > MOTION_PLANE_TOLERANCE:
+        return None
+    dropped = 2 if excursion[2] <= excursion[:2].min() else int(np.argmin(excursion[:2]))
     return [k for k in range(3) if k != dropped]
+
+
+def _via_groups(ee: np.ndarray, times: np.ndarray) -> dict[tuple[float, ...], list[float]]:
+    """The via points' end-effector positions ``ee`` (n_via, d) [m] rounded to 1 µm → the
+    times [s] at which the path passes there (coinciding points share one entry)."""
+    groups: dict[tuple[float, ...], list[float]] = {}
+    for xyz, tv in zip(ee, times):
+        # "+ 0.0" turns a rounded -0.0 into 0.0 for the label.
+        groups.setdefault(tuple(round(float(c), 6) + 0.0 for c in xyz), []).append(float(tv))
+    return groups
+
+
+def _path_view(
+    ax: Axes,
+    t: np.ndarray,
+    path: np.ndarray,
+    mid_t: np.ndarray,
+    labels: Sequence[tuple[tuple[float, float], str]],
+    centre: np.ndarray,
+    names: tuple[str, str],
+) -> None:
+    """The end-effector ``path`` (samples, 2) [m] in a plane whose axes are ``names``:
+    arrows of the motion at ``mid_t`` [s], a square view on the path, and each via point of
+    ``labels`` ((h, v) [m], text) marked and labelled, the label pushed away from ``centre``."""
+    ax.plot(path[:, 0], path[:, 1], color=ERROR_COLOR, lw=1.8, label="end-effector path", zorder=4)
+    ax.plot(0.0, 0.0, "ks", ms=7, zorder=5)  # the world origin
+    ax.set_aspect("equal")
+    ax.set_xlabel(f"{names[0]} [m]")
+    ax.set_ylabel(f"{names[1]} [m]")
+    ax.grid(True, alpha=0.3)
+    # Direction of motion: arrows at the middle of each segment.
+    for tm in mid_t:
+        k = int(np.argmin(np.abs(t - tm)))
+        ax.annotate(
+            "",
+            xy=path[min(k + 3, len(path) - 1)],
+            xytext=path[k],
+            arrowprops={"arrowstyle": "-|>", "color": ERROR_COLOR, "lw": 1.5},
+            zorder=6,
+        )
+    # A square view on the path (equal aspect fills the panel), padded for the labels.
+    span = float(np.ptp(path, axis=0).max()) or 0.05 * (float(np.abs(path).max()) or 1.0)
+    middle = 0.5 * (path.min(axis=0) + path.max(axis=0))
+    ax.set_xlim(middle[0] - 0.85 * span, middle[0] + 0.85 * span)
+    ax.set_ylim(middle[1] - 0.85 * span, middle[1] + 0.85 * span)
+    for (x, y), text in labels:
+        ax.plot(x, y, "o", color="black", mfc="yellow", ms=8, zorder=7)
+        direction = np.array([x, y]) - centre
+        norm = float(np.linalg.norm(direction))
+        direction = direction / norm if norm > 1e-3 * span else np.array([0.0, 1.0])
+        ax.annotate(
+            text,
+            (x, y),
+            textcoords="offset points",
+            xytext=tuple(46 * direction),
+            ha="center",
+            va="center",
+            fontsize=9,
+            bbox={"boxstyle": "round,pad=0.25", "fc": "lightyellow", "ec": "0.5"},
+            zorder=8,
+        )
+
+
+def _times(times: Sequence[float]) -> str:
+    """``t = 0, 2, 4 s``."""
+    return f"t = {', '.join(f'{tv:g}' for tv in times)} s"
+
+
+def _view_azimuth(path: np.ndarray) -> float:
+    """Azimuth [deg] of a 3-D view from in front of the arm: from the horizontal direction
+    of the end-effector ``path``'s centre (samples, 3) [m] seen from the base, turned by
+    :data:`VIEW_TURN` so that the arm's depth shows (matplotlib's −60° if the path is
+    centred above the base)."""
+    cx, cy = (float(c) for c in path[:, :2].mean(axis=0))
+    if math.hypot(cx, cy) < 1e-3:
+        return -60.0
+    return math.degrees(math.atan2(cy, cx)) - VIEW_TURN
+
+
+def _workspace_figure_3d(
+    robot: RobotModel, trajectory: JointTrajectory, samples: int, figure_numbers: Mapping[str, int]
+) -> Figure:
+    """An arm moving in 3-D: a 3-D view of the arm at the via points and between them with
+    the end-effector path, then the path seen from above (x-y) and from the side (z against
+    the horizontal axis along which the path spreads most) [m]."""
+    t = trajectory.t0 + np.linspace(0.0, trajectory.span, samples)
+    points = joint_positions(robot, trajectory.sample(t).q)  # (samples, njoints, 3)
+    path = points[:, -1]
+    via_arms = joint_positions(robot, trajectory.via_q)
+    mid_t = 0.5 * (trajectory.times[:-1] + trajectory.times[1:])
+    quarter_t = np.concatenate([trajectory.times[:-1] + 0.25 * np.diff(trajectory.times), mid_t])
+    mid_arms = joint_positions(robot, trajectory.sample(np.sort(quarter_t)).q)
+    groups = _via_groups(via_arms[:, -1], trajectory.times)
+    across = 0 if np.ptp(path[:, 0]) >= np.ptp(path[:, 1]) else 1
+    side_plane = [across, 2]
+
+    fig = _new_figure(WORKSPACE_3D_FIGSIZE)
+    grid = fig.add_gridspec(1, 3, width_ratios=(1.3, 1.0, 1.0))
+    view = fig.add_subplot(grid[0], projection="3d")
+    top, side = fig.add_subplot(grid[1]), fig.add_subplot(grid[2])
+    view.set_label("workspace")
+    top.set_label("path")
+    side.set_label("path-side")
+    base = np.vstack([np.zeros(3), via_arms[0, 0]])
+    view.plot(*base.T, color="black", lw=3.0, alpha=0.6, label="base: origin → joint 1")
+    for k, arm in enumerate(mid_arms):
+        label = "intermediate poses" if k == 0 else None
+        view.plot(*arm.T, "-o", color="0.7", lw=1.5, ms=3, label=label)
+    for k, arm in enumerate(via_arms):
+        label = "arm at via points" if k == 0 else None
+        view.plot(*arm.T, "-o", color="tab:blue", lw=2.2, ms=4, label=label)
+    view.plot(*path.T, color=ERROR_COLOR, lw=1.8, label="end-effector path")
+    ends = np.array(list(groups))
+    view.plot(*ends.T, "o", color="black", mfc="yellow", ms=7, ls="none")
+    view.plot(0.0, 0.0, 0.0, "ks", ms=6)
+    view.set_xlabel("x [m]")
+    view.set_ylabel("y [m]")
+    view.set_zlabel("z [m]")
+    view.set_aspect("equal")
+    view.view_init(elev=VIEW_ELEVATION, azim=_view_azimuth(path))
+    view.set_box_aspect(None, zoom=0.85)  # room for the z label
+    view.locator_params(nbins=5)
+    view.tick_params(labelsize=8)
+    view.legend(loc="upper left", fontsize=8)
+    view.set_title("arm poses in 3-D (joint origins, end effector)", fontsize=10)
+
+    for ax, plane in ((top, [0, 1]), (side, side_plane)):
+        for arm in via_arms[:, :, plane]:
+            ax.plot(arm[:, 0], arm[:, 1], "-o", color="tab:blue", lw=1.5, ms=3, alpha=0.35)
+        if ax is top:  # the label says where the via point is in 3-D
+            labels = [
+                ((x, y), f"{_times(times)}\n({x:.2f}, {y:.2f}, {z:.2f}) m")
+                for (x, y, z), times in groups.items()
+            ]
+        else:
+            labels = [((xyz[plane[0]], xyz[plane[1]]), _times(times)) for xyz, times in groups.items()]
+        centre = via_arms[:, -1, plane].mean(axis=0)
+        _path_view(ax, t, path[:, plane], mid_t, labels, centre, ("xyz"[plane[0]], "xyz"[plane[1]]))
+    top.set_title("end-effector path from above (x-y), arrows: direction of motion", fontsize=10)
+    side.set_title(f"from the side ({'xy'[across]}-z)", fontsize=10)
+    what = f"arm and end-effector path in 3-D over one period (T = {trajectory.period:g} s)"
+    fig.suptitle(_title(what, "workspace", figure_numbers))
+    return fig
 
 
 def _workspace_figure(
     robot: RobotModel, trajectory: JointTrajectory, samples: int, figure_numbers: Mapping[str, int]
 ) -> Figure:
-    """The arm at the via points and between them, and the end-effector path [m], projected
-    on the coordinate plane the arm moves in most (x-y for an arm moving in that plane)."""
+    """The arm at the via points and between them, and the end-effector path [m], drawn
+    in the coordinate plane the arm moves in (x-y for the twolink); an arm moving in 3-D gets
+    :func:`_workspace_figure_3d`."""
     t = trajectory.t0 + np.linspace(0.0, trajectory.span, samples)
     points = joint_positions(robot, trajectory.sample(t).q)  # (samples, njoints, 3)
-    plane = _projection(points)
+    plane = _motion_plane(points)
+    if plane is None:
+        return _workspace_figure_3d(robot, trajectory, samples, figure_numbers)
     h_name, v_name = ("xyz"[k] for k in plane)
     path = points[:, -1][:, plane]
     via_arms = joint_positions(robot, trajectory.via_q)[:, :, plane]
@@ -150,52 +312,19 @@ def _workspace_figure(
         for k, arm in enumerate(via_arms):
             label = "arm at via points" if k == 0 else None
             ax.plot(arm[:, 0], arm[:, 1], "-o", color="tab:blue", lw=2.2, ms=4, alpha=alpha, label=label)
-        ax.plot(path[:, 0], path[:, 1], color=ERROR_COLOR, lw=1.8, label="end-effector path", zorder=4)
-        ax.plot(0.0, 0.0, "ks", ms=7, zorder=5)  # the world origin
-        ax.set_aspect("equal")
-        ax.set_xlabel(f"{h_name} [m]")
-        ax.set_ylabel(f"{v_name} [m]")
-        ax.grid(True, alpha=0.3)
-    # Direction of motion: arrows at the middle of each segment.
-    for tm in mid_t:
-        k = int(np.argmin(np.abs(t - tm)))
-        zoom.annotate(
-            "",
-            xy=path[min(k + 3, len(path) - 1)],
-            xytext=path[k],
-            arrowprops={"arrowstyle": "-|>", "color": ERROR_COLOR, "lw": 1.5},
-            zorder=6,
-        )
-    # A square view on the path (equal aspect fills the panel), padded for the labels.
-    span = float(np.ptp(path, axis=0).max()) or 0.05 * (float(np.abs(path).max()) or 1.0)
-    middle = 0.5 * (path.min(axis=0) + path.max(axis=0))
-    zoom.set_xlim(middle[0] - 0.85 * span, middle[0] + 0.85 * span)
-    zoom.set_ylim(middle[1] - 0.85 * span, middle[1] + 0.85 * span)
-    # Via points, labelled with their times (coinciding points share one label), pushed
-    # away from the via points' centre.
+    full.plot(path[:, 0], path[:, 1], color=ERROR_COLOR, lw=1.8, label="end-effector path", zorder=4)
+    full.plot(0.0, 0.0, "ks", ms=7, zorder=5)  # the world origin
+    full.set_aspect("equal")
+    full.set_xlabel(f"{h_name} [m]")
+    full.set_ylabel(f"{v_name} [m]")
+    full.grid(True, alpha=0.3)
+    # Via points, labelled with their times and positions (coinciding points share one label).
     ee = via_arms[:, -1]
-    groups: dict[tuple[float, float], list[float]] = {}
-    for xy, tv in zip(ee, trajectory.times):
-        # "+ 0.0" turns a rounded -0.0 into 0.0 for the label.
-        groups.setdefault((round(float(xy[0]), 6) + 0.0, round(float(xy[1]), 6) + 0.0), []).append(float(tv))
-    centre = ee.mean(axis=0)
-    for (x, y), times in groups.items():
-        for ax in (full, zoom):
-            ax.plot(x, y, "o", color="black", mfc="yellow", ms=8, zorder=7)
-        direction = np.array([x, y]) - centre
-        norm = float(np.linalg.norm(direction))
-        direction = direction / norm if norm > 1e-3 * span else np.array([0.0, 1.0])
-        zoom.annotate(
-            f"t = {', '.join(f'{tv:g}' for tv in times)} s\n({x:.2f}, {y:.2f}) m",
-            (x, y),
-            textcoords="offset points",
-            xytext=tuple(46 * direction),
-            ha="center",
-            va="center",
-            fontsize=9,
-            bbox={"boxstyle": "round,pad=0.25", "fc": "lightyellow", "ec": "0.5"},
-            zorder=8,
-        )
+    groups = _via_groups(ee, trajectory.times)
+    labels = [((x, y), f"{_times(times)}\n({x:.2f}, {y:.2f}) m") for (x, y), times in groups.items()]
+    _path_view(zoom, t, path, mid_t, labels, ee.mean(axis=0), (h_name, v_name))
+    for (x, y), _ in labels:
+        full.plot(x, y, "o", color="black", mfc="yellow", ms=8, zorder=7)
     zoom.set_title("zoom on the end-effector path (arrows: direction of motion)", fontsize=10)
     where = "in the reachable workspace" if annulus else f"projected on the {h_name}-{v_name} plane"
     full.set_title(f"arm poses {where}", fontsize=10)
@@ -247,6 +376,7 @@ def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]
         verdict = ("within" if check.within_limits else "EXCEEDS") + " the motor limits"
     what = f"desired torques M q̈ + C q̇ + g along one period: {verdict}"
     fig.suptitle(_title(what, "desired_torque", figure_numbers))
+    _unblock_legends(fig, [(ax, check.t, check.tau[:, j]) for j, ax in enumerate(axes)])
     return fig
 
 
@@ -300,11 +430,16 @@ def save_trajectory_figures(
     * ``trajectory_workspace.png``: the arm (joint origins and end effector,
       :func:`twolink_pin.kinematics.joint_positions`) at the via points and at
       intermediate poses, and the end-effector path with the via points labelled by time
-      [s], projected on the coordinate plane the arm moves in most (x-y [m] unless it
-      spreads least along x or y, e.g. a pendulum swinging in y-z); for a planar 2R arm
-      moving in x-y, its reachable annulus too;
+      [s]. An arm moving in a coordinate plane (every point keeps its coordinate along one
+      axis: the twolink in x-y, a pendulum swinging in y-z) is drawn in that plane [m],
+      beside a zoom on the path; a planar 2R arm moving in x-y gets its reachable annulus
+      too. An arm moving in 3-D (the UR5, the Panda) gets a 3-D view of its poses and the
+      path, seen from in front of the arm, then the path from above (x-y) and from the
+      side (z against x or y, whichever the path spans more), the via points labelled
+      with their times and (x, y, z);
     * ``trajectory_desired_torque.png``: each ``τ_i`` [N·m] of ``check`` with the
-      ``±limit`` lines and the peaks annotated.
+      ``±limit`` lines and the peaks annotated; a legend that would cover the curve moves
+      to a free corner or side.
 
     Args:
         robot: The arm (forward kinematics for the workspace figure).
