@@ -1,12 +1,25 @@
 """Regenerate the images the README and docs/ show, from the current code.
 
-    .venv/bin/python scripts/docs_images.py [NAME ...]     # default: all of them
+    .venv/bin/python scripts/docs_images.py [NAME ...] [--out DIR]   # default: all, into docs/images
 
-Each image is made by running the toolkit (a report, a simulation, an exported animation)
-and, for pages, photographing them in headless Chromium (Debian's ``chromium`` and
-``chromium-driver``, as the browser tests use: ``scripts/install_browser.sh``). Images land
-in ``docs/images/``; ``tests/test_docs_images.py`` checks that every image a page links
-decodes and is not blank. Numbers the docs quote beside the images are printed.
+Each image is made by running the toolkit (a report, a simulation, an exported or live
+animation, the package's figures) and, for pages, photographing them in headless Chromium
+(Debian's ``chromium`` and ``chromium-driver``, as the browser tests use:
+``scripts/install_browser.sh``). Images land in ``docs/images/``;
+``tests/test_docs_images.py`` checks that every image a page links exists, decodes, has a
+sensible size and is not blank, and that every image here is linked. Numbers the docs
+quote beside the images are printed. The tutorial's figures are not made here: the site
+shows the ones the executed notebook draws (``docs/hooks/tutorial_page.py``).
+
+=============  ==============================================================  =========
+name           image(s)                                                         about
+=============  ==============================================================  =========
+report         report.png: the HTML report (``make demo``), top of the page     20 s
+animation      animation.png: the exported meshcat animation (adaptive, 8 s)    5 s
+live           live.png: the same run served live (``twolink-pin animate``)     10 s
+figures        trajectory_workspace.png, adaptive_theta1.png                    10 s
+ur5_square     ur5_square_end_effector.png, ur5_square_meshcat.png              40 s
+=============  ==============================================================  =========
 """
 
 from __future__ import annotations
@@ -17,11 +30,13 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 IMAGES = ROOT / "docs" / "images"
+"""Where the images go (``--out`` changes it)."""
 sys.path.insert(0, str(ROOT / "tests"))  # the one Chromium starter, shared with the browser tests
 
 from browser import start_chromium  # noqa: E402
@@ -50,6 +65,22 @@ def _photograph(url: str, out: Path, width: int, height: int, ready: str | None 
 
 
 SCENE_READY = "return window.sceneLoaded === true;"
+LIVE_READY = (  # the live server sends the scene tree in its own order: wait for the last pieces
+    "var n = viewer.scene_tree, path = ['meshcat', 'via', '4', '<object>'];"
+    "for (var i = 0; i < path.length && n; i++) { n = n.children[path[i]]; }"
+    "return !!(n && n.object && n.object.type === 'Mesh' && viewer.animator.actions.length > 0);"
+)
+SEEK = "viewer.animator.play(); viewer.animator.pause(); viewer.animator.seek({t}); viewer.set_dirty(); return true;"
+
+
+def _adaptive_run(duration: float = 8.0) -> tuple[Any, Any, Any]:
+    """The twolink, its reference and an adaptive-law run of ``duration`` [s]."""
+    from twolink_pin.trajectory import default_trajectory
+
+    robot = load_robot("twolink")
+    controller, plant = make_scenario("adaptive", robot)
+    trajectory = default_trajectory(robot)
+    return robot, trajectory, simulate(controller, plant, trajectory, SimulationConfig(duration=duration))
 
 
 def report() -> list[Path]:
@@ -63,16 +94,57 @@ def report() -> list[Path]:
 
 def animation() -> list[Path]:
     """The twolink's exported meshcat animation (adaptive law), mid-run."""
-    from twolink_pin.trajectory import default_trajectory
     from twolink_pin.visualization import write_html
 
-    robot = load_robot("twolink")
-    controller, plant = make_scenario("adaptive", robot)
-    trajectory = default_trajectory(robot)
-    result = simulate(controller, plant, trajectory, SimulationConfig(duration=8.0))
+    robot, _, result = _adaptive_run()
     with tempfile.TemporaryDirectory() as tmp:
         path = write_html(robot, result.t, result.q, result.q_des, path=Path(tmp) / "a.html")
         return [_photograph(path.as_uri(), IMAGES / "animation.png", 800, 500, SCENE_READY)]
+
+
+def live() -> list[Path]:
+    """The same run served live by meshcat on 127.0.0.1 (``twolink-pin animate adaptive``),
+    with the report's via points, paused at 1.5 s."""
+    from twolink_pin.twolink.reference import REPORT_VIA_XY
+    from twolink_pin.visualization import serve
+
+    robot, _, result = _adaptive_run()
+    with serve(robot, result.t, result.q, result.q_des, via_points=REPORT_VIA_XY, quiet=True) as viewer:
+        ready = f"if (!(function () {{ {LIVE_READY} }})()) return false; {SEEK.format(t=1.5)}"
+        return [_photograph(viewer.url, IMAGES / "live.png", 800, 500, ready)]
+
+
+def figures() -> list[Path]:
+    """The package's own figures: the reference's workspace view (docs/trajectory.md) and
+    joint 1 of a 30-s adaptive run (docs/controllers.md)."""
+    import shutil
+
+    from twolink_pin.feasibility import check_torques
+    from twolink_pin.plotting import save_simulation_figures, save_trajectory_figures
+
+    robot, trajectory, result = _adaptive_run(30.0)
+    with tempfile.TemporaryDirectory() as tmp:
+        made = save_trajectory_figures(robot, trajectory, check_torques(robot, trajectory), tmp)
+        made += save_simulation_figures(
+            result, tmp, prefix="adaptive", title="Slotine–Li adaptive, p̂(0) = 0.5 p"
+        )
+        wanted = {
+            "trajectory_workspace.png": "trajectory_workspace.png",
+            "adaptive_theta1.png": "adaptive_theta1.png",
+        }
+        out = []
+        for path in made:
+            if path.name in wanted:
+                target = IMAGES / wanted[path.name]
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(path, target)
+                out.append(target)
+        missing = set(wanted) - {p.name for p in made}
+        if missing:
+            raise RuntimeError(
+                f"the plotting module no longer writes {sorted(missing)}: update scripts/docs_images.py"
+            )
+    return out
 
 
 def ur5_square() -> list[Path]:
@@ -121,17 +193,25 @@ def ur5_square() -> list[Path]:
 MAKERS: dict[str, Callable[[], list[Path]]] = {
     "report": report,
     "animation": animation,
+    "live": live,
+    "figures": figures,
     "ur5_square": ur5_square,
 }
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    global IMAGES
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("names", nargs="*", choices=[*MAKERS, []], help="images to make (default: all)")
-    names = parser.parse_args().names or list(MAKERS)
-    for name in names:
+    parser.add_argument(
+        "--out", type=Path, default=IMAGES, help="folder to write into (default: docs/images)"
+    )
+    args = parser.parse_args(argv)
+    IMAGES = args.out.resolve()
+    for name in args.names or list(MAKERS):
         for path in MAKERS[name]():
-            print(f"wrote {path.relative_to(ROOT)}")
+            shown = path.relative_to(ROOT) if path.is_relative_to(ROOT) else path
+            print(f"wrote {shown}")
 
 
 if __name__ == "__main__":

@@ -49,6 +49,22 @@ def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:
     assert not re.findall(r"\d\.\d{9,}", body)
 
 
+def test_laws_read_as_on_the_site_math_as_mathml(report_dir: Path) -> None:
+    """Each law's docstring is rendered (Markdown, its formulas as MathML), not shown as source:
+    no ``$$``, no double backticks, no Sphinx role; the adaptive law's update law is a <math>
+    whose TeX annotation holds Γ Yᵀ s. The errata's evidence has no numpy array print-out."""
+    text = (report_dir / "index.html").read_text()
+    laws = re.findall(r'<div class="law">(.*?)</div>', text, re.DOTALL)
+    assert len(laws) == len(REPORT_CONTROLLERS)
+    for law in laws:
+        assert "<math" in law and "$$" not in law and "``" not in law and ":class:" not in law
+    adaptive = next(law for law in laws if "Slotine" in law and "Gamma" in law)
+    assert re.search(r'<annotation encoding="application/x-tex">[^<]*\\Gamma\\, Y\^\\top s', adaptive)
+    evidence = "".join(re.findall(r"<pre>(.*?)</pre>", text, re.DOTALL))
+    assert "[[" not in evidence
+    assert not re.search(r"\[\s*-?\d+\.\d+\s+-?\d", evidence)  # no "[0.1  0.2" numpy rows
+
+
 @pytest.mark.browser
 def test_index_html_images_tables_and_animation_in_chromium(report_dir: Path) -> None:
     """Every image decodes, the tables have their rows, the animation link opens a scene."""

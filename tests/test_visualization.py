@@ -25,6 +25,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 from browser import network_requests, require_chromium, screenshot, start_chromium
+from browser import scene_js as js  # the scene helpers (node, seek, link2End, …) shared with test_tutorial
 
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError, OutputError
 from twolink_pin.kinematics import joint_positions
@@ -425,56 +426,6 @@ def test_bad_port_is_rejected_before_anything_listens() -> None:
 
 
 # ----------------------------------------------------------------------------- in the browser
-
-HELPERS = """
-function node(path) {
-  var n = viewer.scene_tree;
-  for (var i = 0; i < path.length; i++) { n = n.children[path[i]]; if (n === undefined) return null; }
-  return n;
-}
-function visual(root, name) { return node(['meshcat', root, 'visuals', name, '<object>']).object; }
-function ours(object, local) {  // a point of object's frame, in our (x, y, z) [m]
-  viewer.scene.updateMatrixWorld(true);
-  var v = object.localToWorld(object.position.clone().set(local[0], local[1], local[2]));
-  return viewer.scene.worldToLocal(v).toArray();
-}
-function pose(object) {  // object's 4x4 transform in our frame, column-major
-  viewer.scene.updateMatrixWorld(true);
-  return object.matrixWorld.clone().premultiply(viewer.scene.matrixWorld.clone().invert()).elements;
-}
-function bounds(object) {  // bounding box of the drawn vertices in our frame: [min, max] [m]
-  var m = object.matrixWorld.clone().premultiply(viewer.scene.matrixWorld.clone().invert());
-  var p = object.geometry.attributes.position, v = object.position.clone(), lo = [1e9, 1e9, 1e9], hi = [-1e9, -1e9, -1e9];
-  for (var i = 0; i < p.count; i++) {
-    v.set(p.getX(i), p.getY(i), p.getZ(i)).applyMatrix4(m);
-    var a = v.toArray();
-    for (var k = 0; k < 3; k++) { lo[k] = Math.min(lo[k], a[k]); hi[k] = Math.max(hi[k], a[k]); }
-  }
-  return [lo, hi];
-}
-function onScreen(points) {  // our points [m] -> normalised device coordinates of the camera
-  viewer.scene.updateMatrixWorld(true); viewer.camera.updateMatrixWorld(true);
-  return points.map(function (p) {
-    var v = viewer.camera.position.clone().set(p[0], p[1], p[2]);
-    return viewer.scene.localToWorld(v).project(viewer.camera).toArray();
-  });
-}
-function link2End(root) {
-  var mesh = visual(root, 'link2_0');
-  return ours(mesh, [mesh.geometry.parameters.width / 2, 0, 0]);
-}
-function visibleTrail() {
-  var pieces = node(['meshcat', 'trail']).children, shown = 0, total = 0;
-  for (var k in pieces) { total += 1; if (pieces[k].object.visible) shown += 1; }
-  return [shown, total];
-}
-function seek(t) { viewer.animator.pause(); viewer.animator.seek(t); }
-"""
-
-
-def js(driver: Any, body: str, *args: Any) -> Any:
-    """Run ``body`` in the page with the helper functions above defined."""
-    return driver.execute_script(HELPERS + body, *args)
 
 
 @dataclass

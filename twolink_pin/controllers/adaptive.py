@@ -19,14 +19,14 @@ ADAPTATION_RATE = 5.0
 
 @dataclass(frozen=True, eq=False)
 class AdaptiveGains(Gains):
-    """Gains of :class:`Adaptive` (report: K = diag(120, 120), γ = (0.5, 0.15, 0.6)).
+    r"""Gains of :class:`Adaptive` (report: $K = \operatorname{diag}(120, 120)$, $\gamma = (0.5, 0.15, 0.6)$).
 
     Attributes:
-        k: Sliding gain ``K`` [N·m·s/rad], diagonal; default ``κ diag M(q₀)``.
-        gamma: The report's ``γ_i``, one per estimated parameter; the adaptation gain is
-            ``Γ = diag(1/γ_i)``. Default: see :meth:`Adaptive.scaled_gains`.
-        lam: ``λ`` [1/s] (not in the report; our default 5).
-        initial_estimate: ``p̂(0) = initial_estimate × p`` (report: 50 % underestimated).
+        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        gamma: The report's $\gamma_i$, one per estimated parameter; the adaptation gain is
+            $\Gamma = \operatorname{diag}(1/\gamma_i)$. Default: see :meth:`Adaptive.scaled_gains`.
+        lam: $\lambda$ [1/s] (not in the report; our default 5).
+        initial_estimate: $\hat p(0)$ = ``initial_estimate`` × $p$ (report: 50 % underestimated).
     """
 
     k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
@@ -36,17 +36,24 @@ class AdaptiveGains(Gains):
 
 
 class Adaptive(Controller[AdaptiveGains]):
-    r"""Slotine–Li adaptive control (report "Adaptive Controller")::
+    r"""Slotine–Li adaptive control (report "Adaptive Controller"):
 
-        τ = Y(q, q̇, q̇_r, q̈_r) p̂ − K s,      dp̂/dt = −Γ Yᵀ s,   Γ = diag(1/γ_i)
+    $$\tau = Y(q, \dot q, \dot q_r, \ddot q_r)\,\hat p - K s, \qquad
+    \dot{\hat p} = -\Gamma\, Y^\top s, \qquad \Gamma = \operatorname{diag}(1/\gamma_i)$$
 
-    ``Y p = M(q) q̈_r + C(q, q̇) q̇_r + g(q)``: Pinocchio's joint-torque regressor, polarised
-    to ``w = q̇_r ≠ q̇``, times the robot's parameter map. With
-    ``V = ½ sᵀ M s + ½ p̃ᵀ Γ⁻¹ p̃``, ``V̇ = −sᵀ K s <= 0``: ``s → 0`` (Barbalat), while
-    ``p̃`` converges only if the motion is persistently exciting. The state ``z`` is ``p̂``.
-    A subclass that also estimates friction (``estimates`` with ``"friction"``) appends
-    ``Y_f = [diag(q̇), diag(sgn q̇)]`` to ``Y``: the law is the same (written with ``Y_f``'s
-    diagonal structure: ``Y_f f̂ = V̂ ⊙ q̇ + Ĉ ⊙ sgn q̇``, ``Y_fᵀ s = (q̇ ⊙ s, sgn q̇ ⊙ s)``).
+    with $s$, $\dot q_r$ and $\ddot q_r$ as in :class:`ComputedTorque`, and
+    $Y p = M(q)\,\ddot q_r + C(q, \dot q)\,\dot q_r + g(q)$: Pinocchio's joint-torque
+    regressor, polarised to $w = \dot q_r \ne \dot q$, times the robot's parameter map.
+    With $V = \tfrac12 s^\top M s + \tfrac12 \tilde p^\top \Gamma^{-1} \tilde p$ and
+    $\tilde p = \hat p - p$, $\dot V = -s^\top K s \le 0$: $s \to 0$ (Barbalat), while
+    $\tilde p$ converges only if the motion is persistently exciting. The state $z$ is
+    $\hat p$. A subclass that also estimates friction (``estimates`` with ``"friction"``)
+    appends $Y_f = [\operatorname{diag}(\dot q), \operatorname{diag}(\operatorname{sgn} \dot q)]$
+    to $Y$: the law is the same (written with $Y_f$'s diagonal structure:
+    $Y_f \hat f = \hat V \odot \dot q + \hat C \odot \operatorname{sgn} \dot q$ and
+    $Y_f^\top s = (\dot q \odot s, \operatorname{sgn} \dot q \odot s)$). Slotine and Li,
+    "On the adaptive control of robot manipulators", *Int. J. Robotics Research* 6(3),
+    1987; *Applied Nonlinear Control*, chapter 9.
     """
 
     name = "adaptive"

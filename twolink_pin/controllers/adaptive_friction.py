@@ -11,15 +11,15 @@ from twolink_pin.controllers.gains import gain
 
 @dataclass(frozen=True, eq=False)
 class AdaptiveFrictionGains(AdaptiveGains):
-    """Gains of :class:`AdaptiveFriction` (report: K = diag(90, 90),
-    γ = (0.5, 0.15, 0.6, 1.7, 1.4, 2.5, 2.5) for p1, p2, p3, V1, V2, C1, C2).
+    r"""Gains of :class:`AdaptiveFriction` (report: $K = \operatorname{diag}(90, 90)$,
+    $\gamma = (0.5, 0.15, 0.6, 1.7, 1.4, 2.5, 2.5)$ for $p_1, p_2, p_3, V_1, V_2, C_1, C_2$).
 
     Attributes:
-        k: Sliding gain ``K`` [N·m·s/rad], diagonal.
-        gamma: ``γ`` per estimated parameter (inertial, then V and C per joint);
-            ``Γ = diag(1/γ_i)``.
-        lam: ``λ`` [1/s].
-        initial_estimate: ``p̂(0) = initial_estimate × p``.
+        k: Sliding gain $K$ [N·m·s/rad], diagonal.
+        gamma: $\gamma_i$ per estimated parameter (inertial, then $V$ and $C$ per joint);
+            $\Gamma = \operatorname{diag}(1/\gamma_i)$.
+        lam: $\lambda$ [1/s].
+        initial_estimate: $\hat p(0)$ = ``initial_estimate`` × $p$.
         friction_initial_estimate: Friction estimates start at this factor × the values
             the law believes (the report says only "close to their real values": 0.9).
     """
@@ -28,14 +28,19 @@ class AdaptiveFrictionGains(AdaptiveGains):
 
 
 class AdaptiveFriction(Adaptive):
-    r"""Adaptive control with viscous and Coulomb friction in the regressor::
+    r"""Adaptive control with viscous and Coulomb friction in the regressor:
 
-        τ = [Y  Y_f] (p̂, f̂) − K s,    d(p̂, f̂)/dt = −Γ [Y  Y_f]ᵀ s,
-        Y_f(q̇) = [diag(q̇), diag(sgn q̇)],  f̂ = (V̂_1..V̂_n, Ĉ_1..Ĉ_n)
+    $$\tau = \begin{bmatrix} Y & Y_f \end{bmatrix} \begin{bmatrix} \hat p \\ \hat f \end{bmatrix} - K s,
+    \qquad \frac{d}{dt} \begin{bmatrix} \hat p \\ \hat f \end{bmatrix}
+    = -\Gamma \begin{bmatrix} Y^\top \\ Y_f^\top \end{bmatrix} s$$
 
-    for the plant ``M q̈ + C q̇ + g + V q̇ + C_c sgn(q̇) = τ`` (the law of :class:`Adaptive`
-    with friction among its estimates). Its ``friction`` argument is the friction model it
-    believes: the sign smoothing and the values ``f̂(0)`` is scaled from.
+    $$Y_f(\dot q) = \begin{bmatrix} \operatorname{diag}(\dot q) & \operatorname{diag}(\operatorname{sgn} \dot q) \end{bmatrix},
+    \qquad \hat f = (\hat V_1, \dots, \hat V_n, \hat C_1, \dots, \hat C_n)$$
+
+    for the plant $M \ddot q + C \dot q + g + V \dot q + C_c \operatorname{sgn}(\dot q) = \tau$
+    (the law of :class:`Adaptive` with friction among its estimates). Its ``friction``
+    argument is the friction model it believes: the sign smoothing and the values
+    $\hat f(0)$ is scaled from.
     """
 
     name = "adaptive-friction"

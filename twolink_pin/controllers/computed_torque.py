@@ -18,11 +18,11 @@ about κ on its own inertia."""
 
 @dataclass(frozen=True, eq=False)
 class SlotineLiGains(Gains):
-    """Gains of :class:`ComputedTorque` (report: K = diag(40, 50), equal to PD's Kd).
+    r"""Gains of :class:`ComputedTorque` (report: $K = \operatorname{diag}(40, 50)$, equal to PD's $K_d$).
 
     Attributes:
-        k: Sliding gain ``K`` [N·m·s/rad], diagonal; default ``κ diag M(q₀)``.
-        lam: ``λ`` [1/s] in ``s = ė + λ e`` (not in the report; our default 5).
+        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        lam: $\lambda$ [1/s] in $s = \dot e + \lambda e$ (not in the report; our default 5).
     """
 
     k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
@@ -30,13 +30,16 @@ class SlotineLiGains(Gains):
 
 
 class ComputedTorque(Controller[SlotineLiGains]):
-    r"""Slotine–Li control with the exact model (report "Modified Computed Torque")::
+    r"""Slotine–Li control with the exact model (report "Modified Computed Torque"):
 
-        τ = M(q) q̈_r + C(q, q̇) q̇_r + g(q) − K s,
-        s = ė + λ e,  q̇_r = q̇_d − λ e,  q̈_r = q̈_d − λ ė
+    $$\tau = M(q)\,\ddot q_r + C(q, \dot q)\,\dot q_r + g(q) - K s$$
 
-    ``V = ½ sᵀ M s`` gives ``V̇ = −sᵀ K s`` (using Ṁ − 2C skew-symmetric), so ``s → 0``
-    and ``e → 0`` exponentially with rate λ once on the surface.
+    with $e = q - q_d$, the sliding variable $s = \dot e + \lambda e$ and the reference
+    $\dot q_r = \dot q_d - \lambda e$, $\ddot q_r = \ddot q_d - \lambda \dot e$.
+    $V = \tfrac12 s^\top M s$ gives $\dot V = -s^\top K s$ (using that $\dot M - 2C$ is
+    skew-symmetric), so $s \to 0$, and $e \to 0$ exponentially with rate $\lambda$ once on
+    the surface $s = 0$. Slotine and Li, *Applied Nonlinear Control* (Prentice Hall,
+    1991), chapter 9.
     """
 
     name = "computed-torque"

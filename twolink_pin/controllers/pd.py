@@ -16,11 +16,12 @@ damping of each joint's inertia ``I = diag M(q₀)`` alone)."""
 
 @dataclass(frozen=True, eq=False)
 class PDGains(Gains):
-    """Gains of :class:`PDFeedforward` (report: Kp = diag(350, 300), Kd = diag(40, 50)).
+    r"""Gains of :class:`PDFeedforward` (report: $K_p = \operatorname{diag}(350, 300)$,
+    $K_d = \operatorname{diag}(40, 50)$).
 
     Attributes:
-        kp: Position gains ``Kp`` [N·m/rad], diagonal; default ``ω² diag M(q₀)``.
-        kd: Velocity gains ``Kd`` [N·m·s/rad], diagonal; default ``2 ω diag M(q₀)``.
+        kp: Position gains $K_p$ [N·m/rad], diagonal; default $\omega^2 \operatorname{diag} M(q_0)$.
+        kd: Velocity gains $K_d$ [N·m·s/rad], diagonal; default $2 \omega \operatorname{diag} M(q_0)$.
     """
 
     kp: Any = gain(None, per="joint", unit="N·m/rad", doc="position gain Kp")
@@ -28,12 +29,15 @@ class PDGains(Gains):
 
 
 class PDFeedforward(Controller[PDGains]):
-    r"""PD with feedforward of the desired motion (report eq. 8)::
+    r"""PD with feedforward of the desired motion (report eq. 8):
 
-        τ = M(q) q̈_d + C(q, q̇) q̇_d + g(q) − Kp e − Kd ė
+    $$\tau = M(q)\,\ddot q_d + C(q, \dot q)\,\dot q_d + g(q) - K_p e - K_d \dot e$$
 
-    (``g = 0`` for the horizontal twolink.) With ``V = ½ ėᵀ M ė + ½ eᵀ Kp e`` the report
-    shows ``V̇ = −ėᵀ Kd ė`` (eqs. 9–10).
+    with the tracking error $e = q - q_d$ ($g = 0$ for the horizontal twolink). With
+    $V = \tfrac12 \dot e^\top M \dot e + \tfrac12 e^\top K_p e$ the report shows
+    $\dot V = -\dot e^\top K_d \dot e$ (eqs. 9–10). The law is the "PD plus feedforward"
+    of Spong, Hutchinson and Vidyasagar, *Robot Modeling and Control* (Wiley), chapter on
+    multivariable control.
     """
 
     name = "pd"

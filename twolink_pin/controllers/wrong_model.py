@@ -13,12 +13,12 @@ from twolink_pin.dynamics import joint_inertia
 
 @dataclass(frozen=True, eq=False)
 class WrongModelGains(Gains):
-    """Gains of :class:`WrongModel` (report: K = diag(40, 50), β = 0.5).
+    r"""Gains of :class:`WrongModel` (report: $K = \operatorname{diag}(40, 50)$, $\beta = 0.5$).
 
     Attributes:
-        k: Sliding gain ``K`` [N·m·s/rad], diagonal; default ``κ diag M(q₀)``.
-        lam: ``λ`` [1/s] in ``s = ė + λ e``.
-        model_scale: ``β``, the factor on the model terms (report: 0.5), >= 0.
+        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        lam: $\lambda$ [1/s] in $s = \dot e + \lambda e$.
+        model_scale: $\beta$, the factor on the model terms (report: 0.5), >= 0.
     """
 
     k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
@@ -27,14 +27,16 @@ class WrongModelGains(Gains):
 
 
 class WrongModel(Controller[WrongModelGains]):
-    r"""Slotine–Li control on a scaled model ``M̂ = β M``, ``Ĉ = β C``, ``ĝ = β g``::
+    r"""Slotine–Li control on a scaled model $\hat M = \beta M$, $\hat C = \beta C$, $\hat g = \beta g$:
 
-        τ = β [M(q) q̈_r + C(q, q̇) q̇_r + g(q)] − K s      (report: β = 0.5)
+    $$\tau = \beta \left[ M(q)\,\ddot q_r + C(q, \dot q)\,\dot q_r + g(q) \right] - K s$$
 
+    (report: $\beta = 0.5$), with $s$, $\dot q_r$ and $\ddot q_r$ as in :class:`ComputedTorque`.
     Despite the report's name "Robust Controller" there is no robustifying term (no
-    switching or saturated ``−k sgn(s)`` term sized on the model error bound): it is law 2
-    with every inertial parameter scaled by β, which shows what model error alone does.
-    The tracking error stays bounded and periodic but does not vanish.
+    switching or saturated $-k \operatorname{sgn}(s)$ term sized on the model error bound,
+    as in Slotine and Li, *Applied Nonlinear Control*, chapter 7): it is law 2 with every
+    inertial parameter scaled by $\beta$, which shows what model error alone does. The
+    tracking error stays bounded and periodic but does not vanish.
     """
 
     name = "robust"

@@ -1,8 +1,11 @@
 """The report's files from its results: ``index.html`` (a Jinja2 template shipped with the
 package, autoescaped), ``report.md``, ``comparison.csv`` and ``results.json``.
 
-Every number on the page goes through :func:`fmt` (a stated number of significant digits),
-never ``str()`` of a float.
+Every number on the page goes through :func:`fmt` (a stated number of significant digits,
+:data:`DIGITS`; 6 in tables of coefficients and in the errata's evidence), never ``str()``
+of a float. Each law's docstring is shown as the documentation site shows it: Markdown with
+its formulas as MathML (:func:`twolink_pin.mathml.docstring_html`), drawn by the browser
+with no script.
 """
 
 from __future__ import annotations
@@ -11,9 +14,11 @@ from pathlib import Path
 from typing import Any
 
 import jinja2
+import markupsafe
 import numpy as np
 
 from twolink_pin.files import atomic_write, write_json
+from twolink_pin.mathml import docstring_html
 from twolink_pin.studies.comparison import NORMS, SIGNALS, headers
 
 DIGITS = 4
@@ -45,9 +50,7 @@ def evidence_text(evidence: dict[str, Any]) -> str:
         if isinstance(value, (int, float)) and not isinstance(value, bool):
             shown = fmt(value, 6)
         elif isinstance(value, list):
-            shown = np.array2string(
-                np.asarray(value, dtype=float), precision=5, suppress_small=False, max_line_width=100
-            )
+            shown = fmt(value, 6)
         elif isinstance(value, dict):
             shown = ", ".join(f"{k}: {fmt(v, 6)}" for k, v in value.items())
         else:
@@ -66,6 +69,7 @@ def _environment() -> jinja2.Environment:
     )
     env.filters["fmt"] = fmt
     env.filters["evidence"] = evidence_text
+    env.filters["docstring"] = lambda text: markupsafe.Markup(docstring_html(text))
     return env
 
 
@@ -138,6 +142,23 @@ def markdown(r: dict[str, Any]) -> str:
         "",
         r["comparison_markdown"],
     ]
+    identification = r.get("identification")
+    if identification:
+        lines += [
+            "## Identification: why the adaptive estimates are still far from p (beside Fig. 27)",
+            "",
+            "| reference | cond(W) | λ_min per s | slowest averaged time constant [s] | predicted time to 5 % [s] |",
+            "|---|---:|---:|---:|---:|",
+        ]
+        for row in identification["table"]:
+            cells = (
+                row["condition_number"],
+                row["gram_min_eigenvalue_per_s"],
+                row["slowest_time_constant_s"],
+                row["predicted_time_to_5_percent_s"],
+            )
+            lines.append(f"| {row['title']} | " + " | ".join(fmt(x) for x in cells) + " |")
+        lines.append("")
     if r["errata"]:
         lines += ["## Errata", ""]
         for e in r["errata"]:

@@ -1,18 +1,22 @@
 """3-D view of an arm's motion in the browser, with meshcat.
 
-Two ways to look at a run, both built from the same scene:
+Three ways to look at a run, all built from the same scene:
 
 * :func:`write_html` writes one self-contained HTML file (three.js, meshcat's viewer and
   the whole animation inlined; it opens from ``file://`` and makes no network request);
 * :func:`serve` starts a meshcat server on the loopback interface and plays the motion in
-  the browser in real time (:class:`LiveViewer`, a context manager).
+  the browser in real time (:class:`LiveViewer`, a context manager);
+* :func:`inline_animation` shows the page of :func:`write_html` in a notebook's output
+  (an ``<iframe srcdoc>``: it plays in the saved notebook, without a server).
 
 =======================  ======================================================================
 ``motion.py``            the caller's arrays checked and resampled to frames (``_prepare``)
 ``scene.py``             the scene from Pinocchio geometry: arm, ghost, trail, desired path,
                          via markers, floor grid, camera; :func:`visual_model`,
                          :func:`ghost_visual_model`, the node names; the recorded commands
-``html.py``              msgpack packing and the self-contained page: :func:`write_html`
+``html.py``              msgpack packing and the self-contained page: :func:`write_html`,
+                         :func:`scene_page`
+``notebook.py``          the page in a notebook cell: :func:`inline_animation`
 ``server.py``            the live viewer: :func:`serve`, :class:`LiveViewer`
 ``_meshcat_bridge.py``   what leans on meshcat 0.3.2's internals: its server bound to one
                          address, its shutdown, its import
@@ -25,7 +29,8 @@ It is the only part of twolink-pin that imports meshcat, lazily, inside the func
 importing it loads neither meshcat nor a server.
 """
 
-from twolink_pin.visualization.html import write_html
+from twolink_pin.visualization.html import scene_page, write_html
+from twolink_pin.visualization.notebook import InlineAnimation, inline_animation
 from twolink_pin.visualization.scene import (
     ARM_NODE,
     CAMERA_NODE,
@@ -49,8 +54,11 @@ __all__ = [
     "GRID_NODE",
     "TRAIL_NODE",
     "VIA_NODE",
+    "InlineAnimation",
     "LiveViewer",
     "ghost_visual_model",
+    "inline_animation",
+    "scene_page",
     "serve",
     "visual_model",
     "write_html",

@@ -5,7 +5,8 @@ scene command of :func:`~twolink_pin.visualization.scene.scene_commands`, msgpac
 (:func:`pack`) and base64-encoded; as it loads, it hands them in order to
 ``viewer.handle_command_bytearray`` (meshcat's ``static_html`` asks a server for the same
 commands), then sets ``window.sceneLoaded = true``. It opens from ``file://`` and requests
-nothing. The file is written through :func:`twolink_pin.files.atomic_write`.
+nothing. The file is written through :func:`twolink_pin.files.atomic_write`;
+:func:`scene_page` returns the same page as text.
 """
 
 from __future__ import annotations
@@ -107,6 +108,36 @@ def _viewer_js() -> str:
     return source
 
 
+def scene_page(
+    robot: RobotModel,
+    t: npt.ArrayLike,
+    q: npt.ArrayLike,
+    q_des: npt.ArrayLike | None = None,
+    *,
+    via_points: npt.ArrayLike | None = None,
+    fps: float = 25.0,
+    loop: bool = False,
+    title: str = "twolink-pin: arm motion",
+) -> str:
+    """The self-contained HTML page of the animated scene, as text (what :func:`write_html`
+    writes and :func:`~twolink_pin.visualization.notebook.inline_animation` embeds).
+
+    The arguments are :func:`write_html`'s but ``path``; so are the errors it raises.
+
+    Returns:
+        The whole page: the viewer's JavaScript and the scene's commands inlined.
+    """
+    motion = _prepare(robot, t, q, q_des, via_points, fps)
+    scene = scene_commands(robot, motion, loop=loop)
+    encoded = ",\n".join(f'"{base64.b64encode(pack(c)).decode("ascii")}"' for c in scene.commands)
+    return _HTML.format(
+        title=title.replace("&", "&amp;").replace("<", "&lt;"),
+        legend=_legend(motion.q_des is not None, motion.via_points is not None, scene.grid_spacing),
+        viewer_js=_viewer_js(),
+        commands=encoded,
+    )
+
+
 def write_html(
     robot: RobotModel,
     t: npt.ArrayLike,
@@ -153,15 +184,7 @@ def write_html(
         OutputError: ``path`` is a directory or cannot be written.
     """
     target = Path(path)
-    motion = _prepare(robot, t, q, q_des, via_points, fps)
-    scene = scene_commands(robot, motion, loop=loop)
-    encoded = ",\n".join(f'"{base64.b64encode(pack(c)).decode("ascii")}"' for c in scene.commands)
-    page = _HTML.format(
-        title=title.replace("&", "&amp;").replace("<", "&lt;"),
-        legend=_legend(motion.q_des is not None, motion.via_points is not None, scene.grid_spacing),
-        viewer_js=_viewer_js(),
-        commands=encoded,
-    )
+    page = scene_page(robot, t, q, q_des, via_points=via_points, fps=fps, loop=loop, title=title)
     with atomic_write(target) as f:
         f.write(page)
     return target
