@@ -68,6 +68,9 @@ class ReportOptions:
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
             the report's.
+        p0: A parameter file (``twolink-pin identify --save``) the estimates of the laws that
+            estimate start at (:func:`~twolink_pin.identification.seeded_scenario`, mode "p0").
+        model: A parameter file every law's model believes (mode "model").
     """
 
     robot: str | None = None
@@ -80,6 +83,8 @@ class ReportOptions:
     workers: int = 2
     animation: bool = True
     trajectory: str | None = None
+    p0: str | None = None
+    model: str | None = None
 
     def __post_init__(self) -> None:
         if not (
@@ -94,9 +99,17 @@ def _reference(robot: Any, options: ReportOptions) -> Any:
     """The trajectory the runs track: the options' file, else the robot's default."""
     from twolink_pin.trajectory import read_trajectory_file
 
-    return (
+    reference = (
         read_trajectory_file(options.trajectory, robot) if options.trajectory else default_trajectory(robot)
     )
+    if not hasattr(reference, "via_q"):
+        raise InvalidParameterError(
+            "trajectory",
+            options.trajectory,
+            "a via-point trajectory file (the report shows its via points and coefficients); a Fourier "
+            "excitation is for identify --trajectory, simulate, compare and animate",
+        )
+    return reference
 
 
 def _run(
@@ -111,13 +124,27 @@ def _run(
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
     cls = law_class(spec)
-    controller, plant = make_scenario(
-        cls,
-        robot,
-        lam=options.lam if cls.takes("lam") else None,
-        saturate=options.saturate,
-        friction_smoothing=options.friction_smoothing,
-    )
+    seed_file, mode = (options.p0, "p0") if options.p0 else (options.model, "model")
+    if seed_file and (mode == "model" or cls.estimates):
+        from twolink_pin.identification import read_parameter_file, seeded_scenario
+
+        controller, plant = seeded_scenario(
+            cls,
+            robot,
+            read_parameter_file(seed_file, robot),
+            mode,
+            lam=options.lam if cls.takes("lam") else None,
+            saturate=options.saturate,
+            friction_smoothing=options.friction_smoothing,
+        )
+    else:
+        controller, plant = make_scenario(
+            cls,
+            robot,
+            lam=options.lam if cls.takes("lam") else None,
+            saturate=options.saturate,
+            friction_smoothing=options.friction_smoothing,
+        )
     result = simulate(controller, plant, _reference(robot, options), options.config)
     metrics = compute_metrics(result)
     paths = save_simulation_figures(
@@ -238,7 +265,7 @@ def build_report(
     robot = load_robot(options.robot, payload=options.payload)
     is_twolink = robot.name == "twolink"
     specs = laws_to_run(options, is_twolink)
-    steps = 4 + len(specs) + (1 if options.animation else 0)
+    steps = 4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink else 0)
     done = 0
 
     def tick(what: str) -> None:
@@ -286,12 +313,14 @@ def _build(
     with _pool(workers) as pool:
         futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
         traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
+        ident_future = pool.submit(_identification_section, options, str(fig_dir)) if is_twolink else None
         model = facts.model_facts(robot)
         twolink: dict[str, Any] | None = None
         if is_twolink:
-            twolink = {"closed_form_check": facts.twolink_closed_form_check(robot)}
-            if via is not None:
-                twolink["table1"] = facts.table1(robot, via)
+            twolink = {
+                "closed_form_check": facts.twolink_closed_form_check(robot),
+                "table1": None if via is None else facts.table1(robot, via),  # None: another trajectory
+            }
         tick("model and trajectory")
         for name in order:
             runs[name] = futures[name].result()
@@ -308,6 +337,9 @@ def _build(
                 tick("animation")
         traj_figs = traj_future.result()
         tick("trajectory figures")
+        identification = None if ident_future is None else ident_future.result()
+        if ident_future is not None:
+            tick("identification")
     runs = {n: runs[n] for n in names}  # the order asked for
     table = ComparisonTable(
         {n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()}, options.config.duration
@@ -365,6 +397,7 @@ def _build(
         "animation": animation,
         "animated": animated,
         "errata": errata,
+        "identification": identification,
         "versions": facts.versions(),
     }
     if is_twolink:
@@ -381,6 +414,127 @@ def _build(
         twolink["report_table2"] = {n: list(v) for n, v in REPORT_TABLE2.items()}
         twolink["report_table2_columns"] = list(REPORT_TABLE2_COLUMNS)
     return out
+
+
+IDENTIFICATION_NOISE = (1e-5, 0.05)
+"""Noise of the report's identification example: σ_q [rad] (encoder level), σ_τ [N·m]."""
+
+
+def _finite(x: Any) -> Any:
+    """``x`` with non-finite floats as None (results.json is strict JSON)."""
+    if isinstance(x, dict):
+        return {k: _finite(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite(v) for v in x]
+    if isinstance(x, (float, np.floating)):
+        return float(x) if np.isfinite(x) else None
+    return x
+
+
+def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, Any]:
+    """Worker: the report's question answered beside Figure 27 (the twolink only; picklable
+    arguments): why the adaptive estimates are still far from p at the end of the run, the
+    excitations that fix it, and what identification gives from one run of the same length.
+
+    The adaptive runs and the identification need a run of at least one excitation period;
+    shorter reports show the table only."""
+    from twolink_pin.identification import (
+        ExcitationLimits,
+        IdentifiedParameters,
+        add_noise,
+        identify,
+        map_parameters,
+        simulate_log,
+    )
+    from twolink_pin.identification.measures import averaged_adaptation
+    from twolink_pin.plotting.identification import (
+        save_convergence_figure,
+        save_excitation_figures,
+        save_identification_figures,
+    )
+    from twolink_pin.twolink import excitation as twolink_excitation
+
+    robot = load_robot(options.robot, payload=options.payload)
+    duration = options.config.duration
+    section: dict[str, Any] = {
+        "table": twolink_excitation.excitation_table(robot),
+        "duration_s": duration,
+        "period_s": twolink_excitation.PERIOD,
+        "figures": [],
+        "runs": {},
+        "identified": None,
+        "note": None,
+    }
+    if duration < twolink_excitation.PERIOD:
+        section["note"] = (
+            f"runs of {duration:g} s are shorter than one excitation period ({twolink_excitation.PERIOD:g} s): "
+            "the adaptive runs along the excitations and the identification are left out"
+        )
+        return _finite(section)
+    results = twolink_excitation.adaptive_runs(robot, duration=duration)
+    controller = twolink_excitation.report_adaptive(robot).controller
+    p = np.asarray(robot.p, dtype=float)
+    n_p = p.size
+    panels = {}
+    for key, res in results.items():
+        assert res.p_hat is not None
+        p_hat = np.asarray(res.p_hat)[:, :n_p]
+        within = twolink_excitation.time_within(res.t, p_hat, p)
+        averaged = averaged_adaptation(controller, twolink_excitation.trajectories(robot)[key])
+        t_pred = np.linspace(0.0, duration, 301)
+        predicted = averaged.predicted_error(p_hat[0] - p, t_pred)
+        section["runs"][key] = {
+            "title": twolink_excitation.TITLES[key],
+            "p_hat_final": p_hat[-1].tolist(),
+            "relative_error_final": (np.abs(p_hat[-1] - p) / np.abs(p)).tolist(),
+            "time_within_5_percent_s": within,
+        }
+        panels[twolink_excitation.TITLES[key]] = {
+            "t": res.t,
+            "p_hat": p_hat,
+            "p_true": p,
+            "names": list(robot.parameter_map.names),
+            "predicted": (t_pred, predicted),
+            "time_within": within,
+            "note": f"averaged slowest time constant {averaged.slowest_time_constant:.3g} s",
+        }
+    figures = [
+        save_convergence_figure(
+            panels,
+            Path(fig_dir) / "identification_convergence.png",
+            title="the report's adaptive law (K = 120, γ = (0.5, 0.15, 0.6)) along three references — cf. report "
+            "Fig. 27\n|p̂ − p| / |p| (solid: simulated; dotted: averaged model exp(−ΓG t))",
+        )
+    ]
+    log = simulate_log(robot, twolink_excitation.identification_excitation(), duration=duration)
+    noisy = add_noise(log, *IDENTIFICATION_NOISE, seed=0)
+    found = identify(noisy, robot)
+    figures += save_identification_figures(found, fig_dir)
+    limits = ExcitationLimits().resolve(robot)
+    figures += save_excitation_figures(
+        robot,
+        twolink_excitation.identification_excitation(),
+        fig_dir,
+        limits={k: v.tolist() for k, v in limits.items()},
+    )
+    nb = found.size - 2 * robot.nv
+    identified = IdentifiedParameters("report", found.estimate[:nb], found.std[:nb], None)
+    p_identified = map_parameters(robot, identified)
+    inside = found.within()
+    section["identified"] = {
+        "noise": {"q_rad": IDENTIFICATION_NOISE[0], "tau_Nm": IDENTIFICATION_NOISE[1], "seed": 0},
+        "parameters": found.parameters(),
+        "condition_number": found.condition_number,
+        "validation_rms": None if found.validation is None else found.validation.rms.tolist(),
+        "fit_samples": found.fit_samples,
+        "cutoff_hz": found.cutoff_hz,
+        "within_3_sigma": None if inside is None else int(np.sum(inside)),
+        "method": found.method,
+        "p": p_identified.tolist(),
+        "p_relative_error": (np.abs(p_identified - p) / np.abs(p)).tolist(),
+    }
+    section["figures"] = [Path(f).name for f in figures]
+    return _finite(section)
 
 
 def _twolink_errata(

@@ -5,6 +5,7 @@
 ``polynomial.py``           :class:`JointTrajectory`: one polynomial per joint through via points
 ``cartesian.py``            end-effector via points: planar 2R analytic IK or any arm's DLS IK
 ``defaults.py``             each robot's default reference (its profile's, or a swing about home)
+``fourier.py``              :class:`FourierTrajectory`: a periodic finite Fourier series (excitations)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ==========================  ================================================================
 """
@@ -28,10 +29,12 @@ from twolink_pin.trajectory.file import (
     read_trajectory_file,
     write_trajectory_file,
 )
+from twolink_pin.trajectory.fourier import FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
 
 __all__ = [
     "NEUTRAL_AMPLITUDE",
+    "FourierTrajectory",
     "JointTrajectory",
     "Trajectory",
     "TrajectorySample",

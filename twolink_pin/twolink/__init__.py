@@ -4,6 +4,8 @@
 ``lumped_map.py``      the report's parameters (p1, p2, p3) as a parameter map
 ``closed_form.py``     the report's closed-form model: an independent cross-check
 ``errata.py``          where the report is wrong or silent, with the evidence
+``excitation.py``      its stored excitations (identification, adaptation) and why the
+                       report's adaptive estimates are still far from p at 30 s
 =====================  ==================================================================
 
 Nothing outside this package depends on the twolink; the package imports only the generic

@@ -1,0 +1,286 @@
+"""Identified parameters as a file, and the laws they seed: identify, then control with it.
+
+``twolink-pin identify --save FILE.json`` writes the JSON document ``--json`` prints: the robot,
+then ``"parameters"``, one object per parameter with ``name``, ``unit``, ``kind``,
+``estimate``, ``std``, ``relative_std_percent`` and ``true`` (null for measured data), and
+the fit's diagnostics. :func:`read_parameter_file` reads it back for a robot: every base
+parameter of the robot must be there under the name ``twolink-pin info --json`` lists;
+``V1..Vn`` and ``C1..Cn`` (friction) are optional.
+
+A law works in its robot's parameter map ``p``, which for every robot but the twolink *is*
+the base parameters (same names). The twolink's laws use the report's lumped
+``(p1, p2, p3)``; :func:`map_parameters` converts generically: the ``p`` whose regressor
+reproduces the base parameters' torques at random states (least squares, exact when the
+map can express ``β``: for the twolink ``p1 = β1 + β4``, ``p2 = β4``, ``p3 = l1 β2``). A part of
+``β`` the map cannot express (the twolink's ``link2.mcy``) is dropped when it is noise (within
+3σ of 0, or negligible torque), and refused, naming the parameter, when it is significant.
+
+:func:`seeded_scenario` builds a law and its plant from them: ``mode="model"`` (``--model``)
+makes the identified values what the law *believes* (model-based laws' model; adaptive laws'
+``p̂(0) = initial_estimate × p``; a friction-estimating law's friction), ``mode="p0"``
+(``--p0``, laws that estimate) starts the estimates *at* them (initial-estimate factors 1).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from collections.abc import Mapping
+from dataclasses import replace
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from twolink_pin.dynamics import Friction
+from twolink_pin.errors import InputFileError, InvalidParameterError
+from twolink_pin.files import read_input_file
+from twolink_pin.identification.observation import ParameterSet
+from twolink_pin.model import RobotModel
+
+FORMAT = "twolink-pin identified parameters"
+"""The ``format`` field of a parameter file."""
+VERSION = 1
+"""Its version."""
+MAX_PARAMETER_BYTES = 4 << 20
+"""Largest parameter file read (4 MiB)."""
+EXPRESSED_TOLERANCE = 1e-6
+"""A part of β the map cannot express is ignored below this fraction of the torques it acts on."""
+SIGNIFICANCE = 3.0
+"""... or within this many standard deviations of zero."""
+MODES = ("model", "p0")
+"""How identified parameters seed a law (module docstring)."""
+
+
+class IdentifiedParameters(NamedTuple):
+    """Identified values for a robot, read from a parameter file."""
+
+    source: str
+    """The file."""
+    base: np.ndarray
+    """Base parameters ``β̂`` in the robot's base-map order."""
+    base_std: np.ndarray
+    """Their standard deviations (0 where the file gives none)."""
+    friction: Friction | None
+    """Identified friction (negative estimates clipped to 0), or None if the file has none."""
+    notes: tuple[str, ...] = ()
+    """What was adjusted (clipped friction), for the user."""
+
+
+def identification_document(identification: Any, robot: RobotModel) -> dict[str, Any]:
+    """The JSON document of an :class:`~twolink_pin.identification.least_squares.Identification`
+    (what ``identify --json`` prints and ``--save`` writes)."""
+    validation = identification.validation
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "robot": robot.name,
+        "nv": robot.nv,
+        "source": identification.source,
+        "parameters": identification.parameters(),
+        "condition_number": identification.condition_number,
+        "weighted_condition_number": identification.weighted_condition_number,
+        "residual_rms": identification.residual_rms.tolist(),
+        "joint_sigma": identification.joint_sigma.tolist(),
+        "validation_rms": None if validation is None else validation.rms.tolist(),
+        "validation_interval": None
+        if validation is None
+        else [float(validation.t[0]), float(validation.t[-1])],
+        "fit_interval": list(identification.fit_interval),
+        "samples": identification.samples,
+        "fit_samples": identification.fit_samples,
+        "stride": identification.stride,
+        "weighted": identification.weighted,
+        "method": identification.method,
+        "filter": {
+            "type": f"Butterworth order {identification.order}, zero phase (forward-backward)",
+            "cutoff_hz": identification.cutoff_hz,
+            "guard_s": identification.guard,
+            "sampling_hz": 1.0 / identification.dt,
+            "resampled": identification.resampled,
+        },
+        "velocity_check_rms": None
+        if identification.velocity_check is None
+        else identification.velocity_check.tolist(),
+    }
+
+
+def _number(path: str, where: str, value: Any, what: str) -> float:
+    if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value)):
+        raise InputFileError(path, f"{where}: {value!r} is not {what}")
+    return float(value)
+
+
+def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> IdentifiedParameters:
+    """The identified parameters a file gives ``robot`` (see the module docstring).
+
+    Raises:
+        InputFileError: not a readable parameter file, another robot's (joint count or
+            parameter names), a missing base parameter, a value that is not a finite number.
+    """
+    file = str(path)
+    raw = read_input_file(path, MAX_PARAMETER_BYTES, "an identified-parameter file (.json)")
+    try:
+        document = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputFileError(file, f"is not valid JSON: {err}") from None
+    if not isinstance(document, dict) or document.get("format") != FORMAT:
+        raise InputFileError(
+            file,
+            f'is not a parameter file: expected a JSON object with "format": "{FORMAT}" '
+            "(twolink-pin identify --save FILE.json writes one)",
+        )
+    if document.get("nv") != robot.nv:
+        raise InputFileError(
+            file,
+            f"is for an arm of {document.get('nv')} joints ({document.get('robot')}); {robot.name} has {robot.nv}",
+        )
+    rows = document.get("parameters")
+    if not isinstance(rows, list):
+        raise InputFileError(file, 'has no "parameters" list')
+    values: dict[str, tuple[float, float]] = {}
+    for k, row in enumerate(rows):
+        if not isinstance(row, dict) or not isinstance(row.get("name"), str):
+            raise InputFileError(file, f'parameters[{k}]: expected an object with a "name"')
+        name = row["name"]
+        estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), "a finite number")
+        std = row.get("std")
+        sigma = 0.0 if std is None else _number(file, f"parameters[{k}] ({name}).std", std, "a finite number")
+        values[name] = (estimate, abs(sigma))
+    pset = ParameterSet.of(robot, friction=True)
+    base_names = pset.base.names
+    missing = [n for n in base_names if n not in values]
+    if missing:
+        raise InputFileError(
+            file,
+            f"lacks {robot.name}'s base parameter{'s' if len(missing) > 1 else ''} {', '.join(repr(m) for m in missing[:3])}"
+            f"{' …' if len(missing) > 3 else ''} (its parameters are those of twolink-pin info --robot {robot.name} --json; "
+            f"the file has {', '.join(repr(n) for n in list(values)[:4])}{' …' if len(values) > 4 else ''})",
+        )
+    base = np.array([values[n][0] for n in base_names])
+    base_std = np.array([values[n][1] for n in base_names])
+    friction_names = pset.names[pset.base.size :]
+    friction = None
+    notes: list[str] = []
+    present = [n for n in friction_names if n in values]
+    if present and len(present) != len(friction_names):
+        absent = [n for n in friction_names if n not in values]
+        raise InputFileError(file, f"gives some friction coefficients but not {', '.join(absent)}")
+    if present:
+        coefficients = np.array([values[n][0] for n in friction_names])
+        negative = [n for n, x in zip(friction_names, coefficients) if x < 0]
+        if negative:
+            notes.append(f"negative friction estimates {', '.join(negative)} clipped to 0")
+        coefficients = np.maximum(coefficients, 0.0)
+        friction = Friction(tuple(coefficients[: robot.nv]), tuple(coefficients[robot.nv :]))
+    return IdentifiedParameters(file, base, base_std, friction, tuple(notes))
+
+
+def _stacked(robot: RobotModel, matrix: np.ndarray, samples: int = 40, seed: int = 7) -> np.ndarray:
+    """``Y_π matrix`` stacked at seeded random states within the joint limits."""
+    import pinocchio as pin
+
+    model = robot.model
+    data = model.createData()
+    lower = np.where(np.isfinite(model.lowerPositionLimit), model.lowerPositionLimit, -np.pi)
+    upper = np.where(np.isfinite(model.upperPositionLimit), model.upperPositionLimit, np.pi)
+    rng = np.random.default_rng(seed)
+    rows = []
+    for _ in range(samples):
+        q = rng.uniform(np.maximum(lower, -np.pi), np.minimum(upper, np.pi))
+        v, a = rng.uniform(-2.0, 2.0, (2, model.nv))
+        rows.append(pin.computeJointTorqueRegressor(model, data, q, v, a) @ matrix)
+    return np.vstack(rows)
+
+
+def map_parameters(robot: RobotModel, identified: IdentifiedParameters) -> np.ndarray:
+    """The robot's map parameters ``p`` that the identified base parameters give (module
+    docstring).
+
+    Raises:
+        InvalidParameterError: ``β̂`` has a part the map cannot express that is significant
+            (beyond :data:`SIGNIFICANCE` σ and :data:`EXPRESSED_TOLERANCE` of the torques).
+    """
+    pset = ParameterSet.of(robot)
+    if robot.parameter_map.names == pset.base.names:
+        return np.array(identified.base, dtype=float)
+    A_beta = _stacked(robot, pset.base.matrix)
+    A_p = _stacked(robot, robot.parameter_map.matrix)
+    L = np.linalg.lstsq(A_p, A_beta, rcond=None)[0]  # p = L β
+    unexplained = A_beta - A_p @ L  # what of each β column the map cannot produce
+    _, s, Vt = np.linalg.svd(unexplained, full_matrices=False)
+    directions = Vt[s > 1e-9 * max(float(np.linalg.svd(A_beta, compute_uv=False)[0]), 1e-300)]
+    torques = A_beta @ identified.base
+    scale = float(np.linalg.norm(torques)) or 1.0
+    for d in directions:
+        value = float(d @ identified.base)
+        sigma = float(np.sqrt(np.sum((d * identified.base_std) ** 2)))
+        effect = float(np.linalg.norm(unexplained @ (d * value))) / scale
+        if effect > EXPRESSED_TOLERANCE and abs(value) > SIGNIFICANCE * sigma:
+            main = int(np.argmax(np.abs(d)))
+            name = pset.base.names[main]
+            raise InvalidParameterError(
+                f"{identified.source}: {name}",
+                f"{identified.base[main]:.6g} ± {identified.base_std[main]:.2g} {pset.base.units[main]}",
+                f"a value {robot.name}'s parameter map ({', '.join(robot.parameter_map.names)}) can express: it has "
+                f"no such parameter, and this one is {abs(value) / max(sigma, 1e-300):.1f} σ from 0 "
+                f"(its torques are {100 * effect:.2g} % of the model's)",
+            )
+    expressible = identified.base - directions.T @ (directions @ identified.base)  # the rest is noise
+    return L @ expressible
+
+
+def seeded_scenario(
+    law: Any,
+    robot: RobotModel,
+    identified: IdentifiedParameters,
+    mode: str,
+    *,
+    lam: float | None = None,
+    gains: Mapping[str, Any] | None = None,
+    saturate: bool = False,
+    friction_smoothing: float = 0.0,
+) -> Any:
+    """:func:`~twolink_pin.scenario.make_scenario` with the identified parameters as the law's
+    belief (``mode="model"``) or its estimates' start (``mode="p0"``); the plant stays the
+    true robot (with the profile's friction for a friction-estimating law).
+
+    Raises:
+        InvalidParameterError: an unknown mode, ``p0`` for a law that estimates nothing, or
+            parameters the robot's map cannot express (:func:`map_parameters`).
+    """
+    from twolink_pin.scenario import law_class, make_scenario
+
+    if mode not in MODES:
+        raise InvalidParameterError("mode", mode, f"one of {', '.join(MODES)}")
+    cls = law_class(law)
+    if mode == "p0" and not cls.estimates:
+        raise InvalidParameterError(
+            "--p0",
+            identified.source,
+            f"a law that estimates parameters ('{cls.name}' estimates none: give its model with --model FILE)",
+        )
+    p = map_parameters(robot, identified)
+    changes = dict(gains or {})
+    if mode == "p0":
+        for name in ("initial_estimate", "friction_initial_estimate"):
+            if cls.takes(name):
+                changes.setdefault(name, 1.0)
+    scenario = make_scenario(
+        cls,
+        robot,
+        lam=lam,
+        gains=changes,
+        saturate=saturate,
+        friction_smoothing=friction_smoothing,
+        model_parameters=p,
+    )
+    if "friction" in cls.estimates and identified.friction is not None:
+        believed = identified.friction
+        plant_friction = scenario.plant.friction
+        if plant_friction is not None and plant_friction.smoothing:
+            believed = replace(believed, smoothing=plant_friction.smoothing)
+        estimating: Any = cls  # a friction-estimating law takes the friction it believes
+        controller = estimating(robot, scenario.controller.gains, model_parameters=p, friction=believed)
+        scenario = scenario._replace(controller=controller)
+    return scenario
