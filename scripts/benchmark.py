@@ -13,6 +13,12 @@ adaptive laws at most 18×; the batch at most 1.0× per simulation. Then the bat
 scaling from N = 1 to 10 000 runs with 1 and 2 threads, the peak memory of sweeps of 1 000
 and 10 000 runs (each in a fresh process), and the wall time of ``twolink-pin report``.
 
+Last, sweep throughput on Dask (``--sweep-only`` runs just this part; ``--quick`` alone
+skips it): runs/s of the same pd sweep in-process, on a LocalCluster of 1 worker and of 2
+workers, for the twolink and the UR5 at several horizons, the ratio 2 workers / 1 worker
+and the shortest horizon from which it reaches 1.6×; and the client's peak memory at
+100 000 runs of 0.05 s (against 10 000: bounded), in-process and with ``--workers 2``.
+
 Batch and sweep timings use shorter simulations where N is large (noted in the output):
 the cost per step is constant, so seconds per 30-s simulation = elapsed × 30 / duration / N.
 
@@ -21,11 +27,13 @@ Usage::
     .venv/bin/python scripts/benchmark.py            # full: 10-20 minutes
     .venv/bin/python scripts/benchmark.py --quick    # smoke test: seconds, numbers rough
     .venv/bin/python scripts/benchmark.py --json     # also a JSON line at the end
+    .venv/bin/python scripts/benchmark.py --sweep-only [--quick]   # Dask throughput, client memory
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import os
@@ -207,6 +215,152 @@ def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
     }
 
 
+# -- sweep throughput on Dask ---------------------------------------------------------------------
+
+SWEEP_HORIZONS = {"twolink": (0.05, 0.2, 1.0, 3.0), "ur5": (0.05, 0.2, 1.0)}
+"""Horizons [s] of the throughput sweeps, per robot."""
+SWEEP_BUDGET = {"twolink": 1500.0, "ur5": 300.0}
+"""Simulated run-seconds per measurement (samples = budget / horizon, at least 500)."""
+TARGET_SPEEDUP = 1.6
+"""The issue's 2-worker target: >= 1.6x the 1-worker throughput (2 cores)."""
+
+
+def _throughput_study(samples: int, duration: float) -> Any:
+    from twolink_pin.studies.sweep import SweepConfig
+
+    return SweepConfig("pd", samples, seed=1, q0_spread=0.05, simulation=SimulationConfig(duration=duration))
+
+
+_CLIENT_CHILD = """
+import sys, tracemalloc
+from twolink_pin import default_trajectory, load_robot
+from twolink_pin.simulation import SimulationConfig
+from twolink_pin.studies.sweep import SweepConfig, run_sweep
+
+def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask workers are other processes)
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith("VmHWM")) / 1024
+
+if __name__ == "__main__":
+    samples, duration, out, workers = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
+    robot = load_robot(); trajectory = default_trajectory(robot)
+    config = SweepConfig("pd", samples, seed=1, q0_spread=0.05, simulation=SimulationConfig(duration=duration))
+    before = high_water_mib()
+    tracemalloc.start()
+    output = run_sweep(config, robot, trajectory, out, plot=True, workers=workers or None)
+    traced = tracemalloc.get_traced_memory()[1]
+    print(before, high_water_mib(), traced / 2**20, output.seconds)
+"""
+
+
+def _client_memory(samples: int, duration: float, workers: int, out: str) -> dict[str, float]:
+    """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0)."""
+    done = subprocess.run(
+        [sys.executable, "-c", _CLIENT_CHILD, str(samples), str(duration), out, str(workers)],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    before, peak, traced, seconds = (float(x) for x in done.stdout.split())
+    return {
+        "samples": samples,
+        "workers": workers,
+        "rss_before_mib": before,
+        "rss_peak_mib": peak,
+        "python_peak_mib": traced,
+        "seconds": seconds,
+    }
+
+
+def sweep_section(quick: bool) -> dict[str, Any]:
+    """Sweep throughput in-process / 1 / 2 workers and the client's memory (see the docstring)."""
+    import tempfile
+
+    from twolink_pin.studies import cluster
+    from twolink_pin.studies.sweep import run_sweep
+
+    if not cluster.available():
+        print(f"\nsweep throughput: skipped, Dask is not installed ({cluster.INSTALL_HINT})")
+        return {}
+    horizons = {"twolink": (0.05,), "ur5": (0.05,)} if quick else SWEEP_HORIZONS
+    budget = {"twolink": 20.0, "ur5": 2.0} if quick else SWEEP_BUDGET
+    least = 40 if quick else 500
+    repeats = 1 if quick else 3
+    rows: list[dict[str, Any]] = []
+    starts: dict[str, float] = {}
+    with tempfile.TemporaryDirectory() as tmp, contextlib.ExitStack() as stack:
+        engines: dict[str, Any] = {}
+        for count in (1, 2):
+            started = time.perf_counter()
+            engines[f"{count}w"] = stack.enter_context(cluster.open_cluster(workers=count))
+            starts[f"{count}w"] = time.perf_counter() - started
+        print(
+            f"\nsweep throughput, pd, ±0.05 rad initial error (runs/s over the runs and the streaming of the rows, "
+            f"best of {repeats} interleaved; chunks auto; LocalCluster start excluded: 1 worker {starts['1w']:.1f} s, 2 workers {starts['2w']:.1f} s; "
+            f"load average {[round(x, 2) for x in os.getloadavg()]})"
+        )
+        print(
+            f"  {'robot':8s} {'horizon':>8s} {'runs':>6s} {'chunk 1w/2w':>12s} {'in-process':>11s} {'1 worker':>9s} "
+            f"{'2 workers':>10s} {'2w/1w':>6s}"
+        )
+        for name, chosen in horizons.items():
+            robot = load_robot(name)
+            trajectory = default_trajectory(robot)
+            for engine in engines.values():  # warm-up: each worker loads the robot's code paths once
+                run_sweep(
+                    _throughput_study(4, 0.01),
+                    robot,
+                    trajectory,
+                    f"{tmp}/warm",
+                    plot=False,
+                    client=engine.client,
+                )
+            for duration in chosen:
+                samples = max(least, round(budget[name] / duration))
+                study = _throughput_study(samples, duration)
+                row: dict[str, Any] = {"robot": name, "duration": duration, "samples": samples}
+                for _ in range(repeats):  # interleaved; the best of each: the least disturbed by other load
+                    for mode, engine in (("in_process", None), *engines.items()):
+                        client = None if engine is None else engine.client
+                        output = run_sweep(
+                            study, robot, trajectory, f"{tmp}/{mode}", plot=False, client=client
+                        )
+                        row[mode] = max(row.get(mode, 0.0), samples / output.seconds)
+                        row[f"chunk_{mode}"] = output.chunk
+                row["speedup"] = row["2w"] / row["1w"]
+                rows.append(row)
+                print(
+                    f"  {name:8s} {duration:6.2f} s {samples:6d} {row['chunk_1w']:>5d}/{row['chunk_2w']:<6d} "
+                    f"{row['in_process']:9.1f}/s {row['1w']:7.1f}/s {row['2w']:8.1f}/s {row['speedup']:5.2f}x"
+                )
+    reached = {}
+    for name in horizons:
+        good = [r["duration"] for r in rows if r["robot"] == name and r["speedup"] >= TARGET_SPEEDUP]
+        reached[name] = min(good) if good else None
+        where = f"from {reached[name]:g} s horizons on" if good else "at none of the horizons measured"
+        print(f"  {name}: 2 workers reach {TARGET_SPEEDUP:g}x the 1-worker throughput {where}")
+    memory = []
+    sizes = (500,) if quick else (10_000, 100_000)
+    print("\nclient memory of a pd sweep of 0.05-s runs (fresh process, VmHWM; figure on; chunks auto)")
+    with tempfile.TemporaryDirectory() as tmp:
+        for samples in sizes:
+            for workers in (0, 2):
+                mem = _client_memory(samples, 0.05, workers, os.path.join(tmp, f"{samples}-{workers}"))
+                memory.append(mem)
+                label = "in-process" if workers == 0 else "--workers 2 (client only)"
+                print(
+                    f"  {label:26s} {samples:6d} runs: peak RSS {mem['rss_peak_mib']:7.1f} MiB (after imports "
+                    f"{mem['rss_before_mib']:6.1f} MiB), Python allocations peak {mem['python_peak_mib']:6.1f} MiB, "
+                    f"{mem['seconds']:.1f} s"
+                )
+    return {
+        "sweep_throughput": rows,
+        "sweep_speedup_from": reached,
+        "cluster_start_seconds": starts,
+        "client_memory": memory,
+    }
+
+
 def _batch_case(spec: str, robot: Any, n: int) -> tuple[Any, Any, np.ndarray]:
     """One law object for N runs (per-run initial offsets ± 0.1 rad) and its plant."""
     controller, plant = make_scenario(spec, robot)
@@ -227,6 +381,9 @@ def main(argv: list[str] | None = None) -> int:
         "--repeats", type=int, default=None, help="repeats per single-run timing (default 5; quick 1)"
     )
     parser.add_argument("--json", action="store_true", help="also print the results as one JSON line")
+    parser.add_argument(
+        "--sweep-only", action="store_true", help="only the sweep throughput on Dask and the client's memory"
+    )
     args = parser.parse_args(argv)
     quick = args.quick
     repeats = args.repeats or (1 if quick else 5)
@@ -239,6 +396,13 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.sweep_only:
+        results.update(sweep_section(quick))
+        results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
+        print(f"\nload average at the end {results['machine']['load_average_end']}")
+        if args.json:
+            print(json.dumps(results))
+        return 0
 
     # -- the baseline ----------------------------------------------------------------------
     n = round(single_duration / DT)
@@ -406,6 +570,10 @@ def main(argv: list[str] | None = None) -> int:
             seconds = time.perf_counter() - start
         results["report_seconds"] = seconds
         print(f"\nreport: `twolink-pin report` in a fresh process {seconds:.1f} s (target 15 s)")
+    if quick:
+        print("\nsweep throughput on Dask: skipped with --quick (--sweep-only --quick runs it small)")
+    else:
+        results.update(sweep_section(quick))
     results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
     print(f"\nload average at the end {results['machine']['load_average_end']}")
     if args.json:

@@ -1,5 +1,7 @@
-"""Tests of twolink_pin.studies.sweep: reproducibility bit for bit (whatever the chunks and
-threads; each run's case from its own seed), the summary against numpy on the written rows,
+"""Tests of twolink_pin.studies.sweep (and .parquet): reproducibility bit for bit (whatever the
+chunks and threads; each run's case from its own seed) of the CSV, JSON and Parquet tables,
+the Parquet dataset equal to the CSV with the sweep's configuration and units in its metadata
+and nulls for missing values, the automatic chunk rule, the summary against numpy on the written rows,
 divergent cases counted rather than fatal, each row being the run it describes, a user's law
 by file, a user's folder never overwritten, and the ``sweep`` command's parser and output.
 """
@@ -13,6 +15,9 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.dataset as ds
+import pyarrow.parquet as pq
 import pytest
 
 from twolink_pin.cli import build_parser
@@ -24,7 +29,17 @@ from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
 from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
-from twolink_pin.studies.sweep import PERCENTILES, Cases, GainRange, SweepConfig, _chunk_law, run_sweep
+from twolink_pin.studies.parquet import METADATA_KEY, read_columns, read_metadata
+from twolink_pin.studies.sweep import (
+    PERCENTILES,
+    Cases,
+    GainRange,
+    SweepConfig,
+    _chunk_law,
+    auto_chunk,
+    run_sweep,
+    sweep_metadata,
+)
 from twolink_pin.trajectory import build_trajectory
 
 ROBOT = load_robot()
@@ -51,11 +66,26 @@ def _study(**changes) -> SweepConfig:  # type: ignore[no-untyped-def]
     return replace(base, **changes)
 
 
+def _table(out: Path) -> pa.Table:
+    return ds.dataset(out / "runs", format="parquet").to_table().sort_by("run")
+
+
 def test_seeded_sweeps_are_reproducible_bit_for_bit_whatever_the_chunks_and_threads(tmp_path: Path) -> None:
     run_sweep(_study(), ROBOT, TRAJECTORY, tmp_path / "a", plot=False)
     run_sweep(_study(chunk=12, threads=1), ROBOT, TRAJECTORY, tmp_path / "b", plot=False)
-    for name in ("runs.csv", "runs.json", "summary.json"):
-        assert (tmp_path / "a" / name).read_bytes() == (tmp_path / "b" / name).read_bytes(), name
+    run_sweep(_study(chunk=None), ROBOT, TRAJECTORY, tmp_path / "auto", plot=False)
+    for other in ("b", "auto"):
+        for name in ("runs.csv", "runs.json", "summary.json"):
+            assert (tmp_path / "a" / name).read_bytes() == (tmp_path / other / name).read_bytes(), name
+        a, b = _table(tmp_path / "a"), _table(tmp_path / other)
+        assert a.equals(b, check_metadata=True)
+        for name in a.column_names:
+            column_a, column_b = a.column(name).to_numpy(), b.column(name).to_numpy()
+            assert column_a.tobytes() == column_b.tobytes(), name
+    assert (
+        len(list((tmp_path / "a" / "runs").iterdir())) == 3
+        and len(list((tmp_path / "b" / "runs").iterdir())) == 1
+    )
     run_sweep(_study(seed=8), ROBOT, TRAJECTORY, tmp_path / "c", plot=False)
     assert (tmp_path / "a" / "runs.csv").read_bytes() != (tmp_path / "c" / "runs.csv").read_bytes()
 
@@ -85,6 +115,74 @@ def test_summary_statistics_are_numpy_percentiles_of_the_rows(tmp_path: Path) ->
     assert [r["rms_e1"] for r in json_rows] == [float(r["rms_e1"]) for r in rows]
 
 
+def test_rows_stream_to_a_parquet_dataset_with_the_sweep_in_its_metadata(tmp_path: Path) -> None:
+    """One file per chunk under runs/; read as one dataset it is the CSV, value for value;
+    every file carries the sweep's configuration (JSON) and every column its unit."""
+    study = _study()
+    output = run_sweep(study, ROBOT, TRAJECTORY, tmp_path, plot=False)
+    parts = sorted(p.name for p in (tmp_path / "runs").iterdir())
+    assert parts == ["part-0000000.parquet", "part-0000005.parquet", "part-0000010.parquet"]
+    assert tmp_path / "runs" in output.files and output.chunk == 5 and output.engine == "in-process"
+    table = ds.dataset(tmp_path / "runs", format="parquet").to_table()
+    assert table.column("run").to_pylist() == list(range(12))  # the files sort in run order
+    rows = _rows(tmp_path / "runs.csv")
+    assert table.column_names == list(rows[0])
+    for name in table.column_names:
+        values = table.column(name).to_pylist()
+        if name in ("limit_exceeded", "diverged"):
+            assert values == [r[name] == "1" for r in rows], name
+        elif name == "run":
+            assert values == [int(r[name]) for r in rows]
+        else:
+            assert values == [None if r[name] == "nan" else float(r[name]) for r in rows], name
+    schema = table.schema
+    assert schema.field("run").type == pa.int64() and schema.field("diverged").type == pa.bool_()
+    units = {
+        name: schema.field(name).metadata[b"unit"].decode()
+        for name in ("q0_offset1", "rms_edot2", "gain_kp", "gain_kd2", "diverged_at", "peak_command1")
+    }
+    assert units == {
+        "q0_offset1": "rad",
+        "rms_edot2": "rad/s",
+        "gain_kp": "N·m/rad",
+        "gain_kd2": "N·m·s/rad",
+        "diverged_at": "s",
+        "peak_command1": "N·m",
+    }
+    expected = sweep_metadata(study, ROBOT, PDFeedforward, TRAJECTORY)
+    for part in (tmp_path / "runs").iterdir():
+        assert json.loads(pq.read_schema(part).metadata[METADATA_KEY]) == expected
+    metadata = read_metadata(tmp_path / "runs")
+    assert metadata == expected and metadata["seed"] == 7 and metadata["samples"] == 12
+    assert metadata["gains"] == {"kp": [100.0, 400.0], "kd2": [20.0, 80.0]} and metadata["controller"] == "pd"
+    assert metadata["q0_offset"] == [0.1, -0.1] and metadata["dt"] == SHORT.dt and "chunk" not in metadata
+    assert (
+        metadata["trajectory"]["via_q"] == np.asarray(TRAJECTORY.via_q).tolist()
+    )  # the reference it tracked
+
+
+def test_columns_are_read_back_in_run_order_every_kth_and_a_missing_chunk_is_refused(tmp_path: Path) -> None:
+    run_sweep(_study(), ROBOT, TRAJECTORY, tmp_path, plot=False)
+    rows = _rows(tmp_path / "runs.csv")
+    columns = read_columns(tmp_path / "runs", ["run", "rms_e1", "diverged"], every=3)
+    assert columns["run"].tolist() == [0, 3, 6, 9] and columns["diverged"].dtype == bool
+    assert columns["rms_e1"].tolist() == [float(rows[i]["rms_e1"]) for i in (0, 3, 6, 9)]
+    (tmp_path / "runs" / "part-0000005.parquet").unlink()
+    with pytest.raises(InvalidParameterError, match="the 12 runs of its sweep, got 7"):
+        read_columns(tmp_path / "runs", ["rms_e1"])
+    with pytest.raises(
+        InvalidParameterError,
+        match=r"path = '.*nothing' is invalid: expected a sweep's runs/ folder \(part-\*\.parquet files\)",
+    ):
+        read_metadata(tmp_path / "nothing")
+
+
+def test_the_automatic_chunk_is_min_n_1000_in_process_and_four_per_worker_on_a_cluster() -> None:
+    assert [auto_chunk(n) for n in (1, 300, 1000, 5000)] == [1, 300, 1000, 1000]
+    assert [auto_chunk(n, 2) for n in (100, 300, 4000, 10_000)] == [100, 250, 500, 1000]
+    assert auto_chunk(100_000, 64) == 391 and auto_chunk(1000, 64) == 250
+
+
 def test_divergent_cases_are_counted_not_fatal(tmp_path: Path) -> None:
     """Kd up to 600 with dt = 5 ms: RK4 goes unstable above Kd ≈ 300, for those cases only."""
     study = _study(
@@ -99,6 +197,9 @@ def test_divergent_cases_are_counted_not_fatal(tmp_path: Path) -> None:
     assert 0 < output.summary["diverged"] == len(diverged) < 10
     assert all(float(r["gain_kd"]) > 200 for r in diverged)
     assert all(r["rms_e1"] == "nan" and float(r["diverged_at"]) > 0 for r in diverged)
+    table = _table(tmp_path)  # missing values are nulls in the dataset (SQL's aggregates skip them)
+    assert table.column("rms_e1").null_count == len(diverged) == table.column("diverged").to_numpy().sum()
+    assert table.column("diverged_at").null_count == 10 - len(diverged)
     kept = np.array([float(r["rms_e1"]) for r in rows if r["diverged"] == "0"])
     assert output.summary["metrics"]["rms_e1"]["median"] == np.median(kept)
     assert (tmp_path / "distributions.png").stat().st_size > 10_000
@@ -232,6 +333,7 @@ def test_sweep_command_prints_json_and_a_progress_bar(
     captured = capsys.readouterr()
     payload = json.loads(captured.out)
     assert payload["runs"] == 4 and payload["diverged"] == 0 and payload["gains"] == {"lam": [2.0, 8.0]}
+    assert payload["engine"] == "in-process" and payload["chunk"] == 4 and args.chunk is None  # auto
     assert "100%" in captured.err and "4/4" in captured.err  # the progress display, on stderr
     assert len(_rows(tmp_path / "runs.csv")) == 4
 
@@ -242,10 +344,14 @@ def test_sweep_command_text_summary(tmp_path: Path, capsys: pytest.CaptureFixtur
     assert cmd_sweep(args) == 0
     out = capsys.readouterr().out
     assert out.startswith("sweep adaptive on twolink: 3 runs in ")
+    assert "\n  ran in-process, in chunks of 3 runs\n" in out
     assert "p_hat_final_p3" in out and f"wrote {tmp_path / 'summary.json'}" in out
 
 
-@pytest.mark.parametrize("bad", [["--gain", "kp"], ["--param-error", "1.5"], ["--samples", "0"]])
+@pytest.mark.parametrize(
+    "bad",
+    [["--gain", "kp"], ["--param-error", "1.5"], ["--samples", "0"], ["--chunk", "some"], ["--chunk", "0"]],
+)
 def test_sweep_command_refuses_bad_options(bad: list[str], capsys: pytest.CaptureFixture[str]) -> None:
     with pytest.raises(SystemExit) as info:
         _parser().parse_args(["sweep", "pd", "--samples", "3", *bad])
