@@ -1,12 +1,15 @@
 # twolink-pin: the two commands of the quick start.
 #   make demo   creates .venv, installs the package, runs the main job into out/
-#   make test   installs the test extras (and headless Chromium), runs ruff and the whole suite
+#   make test   installs the test extras (and headless Chromium), runs ruff and the whole suite,
+#               which builds the documentation site in strict mode and executes the tutorial
+#   make docs   installs the docs extra, builds the site into site/ (strict: any warning fails)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= out
+TEST_WORKERS ?= 2
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test docs lint bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -21,12 +24,21 @@ $(VENV)/.installed-test: pyproject.toml $(VENV)/.installed scripts/install_brows
 	bash scripts/install_browser.sh
 	touch $@
 
+$(VENV)/.installed-docs: pyproject.toml $(VENV)/.installed
+	$(BIN)/python -m pip install -q -e '.[docs]'
+	touch $@
+
 demo: $(VENV)/.installed
 	$(BIN)/twolink-pin report --out $(OUT)
 
+# tests/test_docs.py runs the same strict build as `make docs` (into a temporary folder),
+# on the tutorial that tests/test_tutorial.py has just executed on a fresh kernel.
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check .
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(TEST_WORKERS)
+
+docs: $(VENV)/.installed-docs
+	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict -d site
 
 lint: $(VENV)/.installed-test
 	$(BIN)/python -m pip install -q -e '.[dev]'
@@ -38,4 +50,4 @@ bench: $(VENV)/.installed
 	$(BIN)/python scripts/benchmark.py
 
 clean:
-	rm -rf $(VENV) $(OUT) .pytest_cache .ruff_cache .hypothesis
+	rm -rf $(VENV) $(OUT) site .pytest_cache .ruff_cache .hypothesis

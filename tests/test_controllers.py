@@ -329,18 +329,18 @@ def test_a_new_law_registers_itself_and_a_taken_name_is_refused() -> None:
         (
             lambda: PDGains(kp=(-350.0, 300.0), kd=1.0),
             "kp[0]",
-            "kp[0] = -350.0 is invalid: expected finite numbers > 0 [N·m/rad]",
+            "kp[0] = -350.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) [N·m/rad]",
         ),
         (
             lambda: PDGains(kp=1.0, kd=(40.0, 0.0)),
             "kd[1]",
-            "kd[1] = 0.0 is invalid: expected finite numbers > 0 [N·m·s/rad]",
+            "kd[1] = 0.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) [N·m·s/rad]",
         ),
         (lambda: SlotineLiGains(k=(-40.0, 50.0)), "k[0]", "k[0] = -40.0 is invalid"),
         (
             lambda: SlotineLiGains(lam=float("nan")),
             "lam",
-            "lam = nan is invalid: expected a finite number > 0 [1/s]",
+            "lam = nan is invalid: expected a finite number > 0 (from 1e-12 to 1e+12) [1/s]",
         ),
         (lambda: SlotineLiGains(lam=-5.0), "lam", "lam = -5.0 is invalid"),
         (lambda: AdaptiveGains(gamma=(0.5, -0.15, 0.6)), "gamma[1]", "gamma[1] = -0.15 is invalid"),
@@ -357,7 +357,7 @@ def test_a_new_law_registers_itself_and_a_taken_name_is_refused() -> None:
         (
             lambda: WrongModelGains(model_scale=-0.5),
             "model_scale",
-            "model_scale = -0.5 is invalid: expected a finite number >= 0 (or one per run)",
+            "model_scale = -0.5 is invalid: expected a finite number >= 0 (0, or from 1e-12 to 1e+12) (or one per run)",
         ),
         (lambda: PDGains(kp=True, kd=1.0), "kp", "kp = True is invalid"),
         (lambda: PDGains(kp="high", kd=1.0), "kp", "kp = 'high' is invalid"),

@@ -2,7 +2,8 @@
 from URDF, on Pinocchio.
 
 Data flows one way: model → kinematics / trajectory → dynamics → controllers → plant →
-simulation → metrics → studies → plotting / visualization / report / cli. Quick use::
+simulation → metrics → studies, identification → plotting / visualization / report / cli.
+Quick use::
 
     from twolink_pin import load_robot, default_trajectory, make_scenario, simulate, compute_metrics
     robot = load_robot()                       # the twolink, p = (3.4, 0.4, 0.3)
@@ -52,6 +53,16 @@ from twolink_pin.errors import (
     TwolinkPinError,
     UnreachableTargetError,
 )
+from twolink_pin.identification import (
+    Identification,
+    IdentificationOptions,
+    RunLog,
+    excitation_trajectory,
+    identify,
+    optimise_excitation,
+    read_log,
+    simulate_log,
+)
 from twolink_pin.metrics import BatchMetrics, Metrics, RunningMetrics, compute_metrics
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
 from twolink_pin.plant import Plant
@@ -59,6 +70,7 @@ from twolink_pin.scenario import Scenario, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (
+    FourierTrajectory,
     JointTrajectory,
     Trajectory,
     TrajectorySample,
@@ -68,6 +80,7 @@ from twolink_pin.trajectory import (
     default_trajectory,
     read_trajectory_file,
 )
+from twolink_pin.twolink import excitation as _twolink_excitation  # noqa: F401  # registers its stored excitation
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
 
 __version__ = "0.2.0"
@@ -84,8 +97,11 @@ __all__ = [
     "Controller",
     "ControllerError",
     "ControllerSpecError",
+    "FourierTrajectory",
     "Friction",
     "Gains",
+    "Identification",
+    "IdentificationOptions",
     "InvalidParameterError",
     "InvalidURDFError",
     "InverseKinematicsError",
@@ -98,6 +114,7 @@ __all__ = [
     "PDGains",
     "Plant",
     "RobotModel",
+    "RunLog",
     "RunningMetrics",
     "Scenario",
     "SimulationConfig",
@@ -118,18 +135,23 @@ __all__ = [
     "coriolis_matrix",
     "default_trajectory",
     "example_robot_urdf",
+    "excitation_trajectory",
     "forward_dynamics",
     "gain",
+    "identify",
     "inverse_dynamics",
     "load_controller",
     "load_robot",
     "make_scenario",
     "mass_matrix",
     "model_torque",
+    "optimise_excitation",
+    "read_log",
     "read_trajectory_file",
     "regressor",
     "simulate",
     "simulate_batch",
+    "simulate_log",
     "terms_for",
     "twolink_urdf_path",
 ]

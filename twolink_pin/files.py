@@ -107,6 +107,26 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
         raise
 
 
+@contextlib.contextmanager
+def removed_on_failure(folder: str | os.PathLike[str]) -> Iterator[Path]:
+    """A block that may create ``folder`` (and its missing parents): if the block fails, the
+    folders it created are removed again when they are still empty (a full disk or a
+    read-only file then leaves nothing behind)."""
+    path = Path(folder)
+    missing = []
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        missing.append(probe)
+        probe = probe.parent
+    try:
+        yield path
+    except BaseException:
+        for created in missing:  # deepest first
+            with contextlib.suppress(OSError):
+                created.rmdir()
+        raise
+
+
 def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
     """Write ``obj`` as indented JSON, atomically."""
     text = json.dumps(obj, indent=2, allow_nan=False)
@@ -116,20 +136,49 @@ def write_json(path: str | os.PathLike[str], obj: Any) -> Path:
     return Path(path)
 
 
+MANIFEST_PREFIX = "entry: "
+"""Lines of a marker file that name an entry the command wrote into its folder."""
+
+
 def _is_ours(folder: Path, marker: str) -> bool:
     try:
-        entries = list(folder.iterdir())
+        entries = sorted(p.name for p in folder.iterdir())
     except OSError as exc:
         raise OutputError(str(folder), f"cannot be listed ({_reason(exc)})") from exc
-    return not entries or (folder / marker).is_file()
+    if not entries:
+        return True
+    if marker not in entries or not (folder / marker).is_file():
+        return False
+    try:
+        text = (folder / marker).read_text(encoding="utf-8", errors="replace")
+    except OSError as exc:
+        raise OutputError(str(folder / marker), f"cannot be read ({_reason(exc)})") from exc
+    listed = {line[len(MANIFEST_PREFIX) :] for line in text.splitlines() if line.startswith(MANIFEST_PREFIX)}
+    if not listed:
+        return True  # a marker from before manifests: the whole folder is ours
+    foreign = [name for name in entries if name != marker and name not in listed]
+    if foreign:
+        raise OutputError(
+            str(folder),
+            f"holds {foreign[0]!r}, which this command did not write; refusing to replace the folder (and lose "
+            "it) — move it out, or give a new or empty directory",
+        )
+    return True
 
 
 def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
-    """``path`` if an output folder may be written there: absent, empty, or holding
-    ``marker`` (written by the same command before). Raises :class:`OutputError` otherwise."""
+    """``path`` if an output folder may be written there: absent, empty, or one the same
+    command wrote (holding ``marker``, which lists what it wrote: a folder that also holds
+    anything else is refused). Raises :class:`OutputError` otherwise."""
     out = Path(path)
+    if not str(path):
+        raise OutputError("''", "is an empty path; expected a folder name")
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise OutputError(str(out), "exists and is not a directory")
+    if out.exists() and not os.access(out, os.W_OK | os.X_OK):
+        raise OutputError(
+            str(out), "is not writable (its permissions); refusing to replace it with a writable folder"
+        )
     if out.exists() and not _is_ours(out, marker):
         raise OutputError(
             str(out),
@@ -161,7 +210,11 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
     try:
         os.chmod(stage, 0o777 & ~_umask())
         yield stage
-        (stage / marker).write_text(note or f"written by twolink-pin ({marker})\n", encoding="utf-8")
+        written = sorted(p.name for p in stage.iterdir() if p.name != marker)
+        manifest = "".join(f"{MANIFEST_PREFIX}{name}\n" for name in written)
+        (stage / marker).write_text(
+            (note or f"written by twolink-pin ({marker})\n") + manifest, encoding="utf-8"
+        )
         check_output_directory(out, marker)  # still ours after the work
         old = None
         if out.exists():

@@ -24,7 +24,12 @@ from twolink_pin.model import RobotModel
 
 
 def _check_q(robot: RobotModel, q: np.ndarray) -> np.ndarray:
-    q = np.asarray(q, dtype=float)
+    if not isinstance(robot, RobotModel):
+        raise InvalidParameterError("robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)")
+    try:
+        q = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError("q", q, f"{robot.nq} joint angles [rad]") from None
     if q.shape != (robot.nq,):
         raise InvalidParameterError("q", q.tolist(), f"shape ({robot.nq},) but got {q.shape}")
     if not np.all(np.isfinite(q)):
@@ -58,7 +63,12 @@ def joint_positions(robot: RobotModel, q: np.ndarray) -> np.ndarray:
         Shape (F, njoints, 3): the ``njoints − 1`` moving joints in order, then the end
         effector (shape (njoints, 3) for a single configuration).
     """
-    configurations = np.asarray(q, dtype=float)
+    if not isinstance(robot, RobotModel):
+        raise InvalidParameterError("robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)")
+    try:
+        configurations = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError("q", q, f"configurations of shape (F, {robot.nq}) [rad]") from None
     single = configurations.ndim == 1
     configurations = np.atleast_2d(configurations)
     if configurations.shape[1] != robot.nq or not np.all(np.isfinite(configurations)):
@@ -111,6 +121,8 @@ def _require_2r(robot: RobotModel) -> None:
     """Raise unless ``robot`` is a planar 2R arm in the sense of the analytic IK: its end
     effector at ``(L1 cos q1 + L2 cos(q1 + q2), L1 sin q1 + L2 sin(q1 + q2))`` in the base's
     x-y plane (checked numerically at eight seeded configurations, to 1e-9 m)."""
+    if not isinstance(robot, RobotModel):
+        raise InvalidParameterError("robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)")
     if robot.nv != 2 or robot.nq != 2:
         raise InvalidParameterError(
             "robot", robot.name, f"a planar 2R arm (nv = 2) for the analytic IK; it has nv = {robot.nv}"
@@ -149,7 +161,12 @@ def inverse_kinematics(
         InvalidParameterError: if ``target`` is not two finite numbers.
     """
     _require_2r(robot)
-    xy = np.asarray(target, dtype=float)
+    if not (isinstance(tol, (int, float)) and not isinstance(tol, bool) and math.isfinite(tol) and tol >= 0):
+        raise InvalidParameterError("tol", tol, "a finite distance >= 0 m")
+    try:
+        xy = np.asarray(target, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError("target", target, "two finite coordinates (x, y) [m]") from None
     if xy.shape != (2,) or not np.all(np.isfinite(xy)):
         raise InvalidParameterError(
             "target", np.asarray(target).tolist(), "two finite coordinates (x, y) [m]"
@@ -236,7 +253,12 @@ def solve_position(
             ``min_singular_value`` [m/rad].
         InvalidParameterError: ``target`` is not 2 or 3 finite numbers, or ``q_seed`` not nq.
     """
-    goal = np.asarray(target, dtype=float)
+    try:
+        goal = np.asarray(target, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            "target", target, "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
+        ) from None
     if goal.shape not in ((2,), (3,)) or not np.all(np.isfinite(goal)):
         raise InvalidParameterError(
             "target", np.asarray(target).tolist(), "2 (x, y) or 3 (x, y, z) finite coordinates [m]"

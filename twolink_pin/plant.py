@@ -29,6 +29,12 @@ class Plant:
     """
 
     def __init__(self, robot: RobotModel, friction: Friction | None = None, saturate: bool = False) -> None:
+        if not isinstance(robot, RobotModel):
+            raise InvalidParameterError(
+                "robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)"
+            )
+        if friction is not None and not isinstance(friction, Friction):
+            raise InvalidParameterError("friction", type(friction).__name__, "a twolink_pin Friction or None")
         if friction is not None and len(friction.viscous) != robot.nv:
             raise InvalidParameterError(
                 "friction", friction, f"viscous and coulomb of length nv = {robot.nv}"

@@ -15,7 +15,7 @@ from typing import Any, NamedTuple
 
 from twolink_pin.controllers import Controller, load_controller
 from twolink_pin.dynamics import Friction
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError
 from twolink_pin.model import RobotModel
 from twolink_pin.plant import Plant
 
@@ -85,7 +85,15 @@ def make_scenario(
             "gain", unknown[0], f"one of the gains of '{cls.name}': {', '.join(cls.Gains.field_names())}"
         )
     presets = {k: v for k, v in robot.gain_presets.get(cls.name, {}).items() if k in cls.Gains.field_names()}
-    gains_obj = cls.Gains(**{**presets, **changes})
+    try:
+        gains_obj = cls.Gains(**{**presets, **changes})
+    except TwolinkPinError:
+        raise
+    except Exception as exc:  # a user's gains class whose checks raised
+        raise ControllerSpecError(
+            f"{cls.__module__}:{cls.__qualname__}",
+            f"its gains {cls.Gains.__name__} could not be built: {type(exc).__name__}: {str(exc)[:300]}",
+        ) from exc
     if friction is None and "friction" in cls.estimates and robot.profile.friction is not None:
         viscous, coulomb = robot.profile.friction
         friction = Friction(viscous, coulomb, smoothing=friction_smoothing)
@@ -94,5 +102,13 @@ def make_scenario(
     kwargs: dict[str, Any] = {}
     if "friction" in cls.estimates:
         kwargs["friction"] = friction
-    controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
+    try:
+        controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
+    except TwolinkPinError:
+        raise
+    except Exception as exc:  # a user's law whose constructor (or scaled_gains) raised
+        raise ControllerSpecError(
+            f"{cls.__module__}:{cls.__qualname__}",
+            f"could not be built on {robot.name}: {type(exc).__name__}: {str(exc)[:300]}",
+        ) from exc
     return Scenario(controller, Plant(robot, friction=friction, saturate=saturate))

@@ -15,6 +15,7 @@ unexpected exception (a bug) is one line with exit status 1, or its traceback wi
 
 from __future__ import annotations
 
+import argparse
 import signal
 import sys
 import threading
@@ -33,10 +34,55 @@ def _terminate(signum: int, frame: object) -> None:
     raise Terminated
 
 
+MAX_LINE = 1000
+"""Longest error line printed [characters]."""
+MAX_PATH_TEXT = 4096
+"""Longest path (or other text) accepted on the command line [characters]."""
+
+
+def _option_names(parser: argparse.ArgumentParser, command: str) -> dict[str, str]:
+    """dest → how the user spelled it (``--out``, ``CONTROLLER``) for ``command``'s options."""
+    names: dict[str, str] = {}
+    for action in parser._actions:
+        if isinstance(action, argparse._SubParsersAction):
+            for sub in action.choices[command]._actions:
+                names[sub.dest] = (
+                    sub.option_strings[0] if sub.option_strings else (sub.metavar or sub.dest).upper()
+                )
+    return names
+
+
+def _check_texts(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """Refuse, before any work, option values no file or name can have: empty, holding a NUL
+    byte, or longer than :data:`MAX_PATH_TEXT` (paths and names reach the OS as they are)."""
+    names = _option_names(parser, args.command)
+    for dest, value in vars(args).items():
+        values = value if isinstance(value, list) else [value]
+        for text in values:
+            if not isinstance(text, str) or dest in ("command", "argv"):
+                continue
+            problem = (
+                "an empty value"
+                if not text
+                else "a NUL byte"
+                if "\0" in text
+                else f"too long ({len(text)} characters)"
+                if len(text) > MAX_PATH_TEXT
+                else None
+            )
+            if problem:
+                shown = text if len(text) <= 80 else text[:60] + "…"
+                parser.error(
+                    f"argument {names.get(dest, dest)}: {shown!r} is {problem}; expected a path or name "
+                    f"(1 to {MAX_PATH_TEXT} characters, no NUL)"
+                )
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``twolink-pin`` console script."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    _check_texts(parser, args)
     args.argv = list(sys.argv[1:] if argv is None else argv)
     previous = None
     if threading.current_thread() is threading.main_thread():
@@ -78,9 +124,16 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _say(line: str) -> None:
+    """``line`` on stderr; nothing if stderr is closed (never on stdout instead: with fd 2
+    closed at start-up Python sets ``sys.stderr`` to None, and ``print(file=None)`` would
+    write to stdout)."""
+    if sys.stderr is None:
+        return
+    if len(line) > MAX_LINE:  # a long path or value echoed in a message: keep its start and end
+        line = line[: MAX_LINE - 260] + " … " + line[-250:]
     try:
         print(line, file=sys.stderr, flush=True)
-    except OSError:
+    except (OSError, ValueError):
         pass
 
 

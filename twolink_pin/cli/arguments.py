@@ -12,8 +12,9 @@ import re
 from collections.abc import Callable
 from typing import Any
 
-NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
-"""A negative number in any float spelling (``-1``, ``-.5``, ``-1e-3``): a value, not an option."""
+NUMBER = re.compile(r"^-((\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE)
+"""A negative number in any float spelling (``-1``, ``-.5``, ``-1e-3``, ``-inf``): a value (which
+the option's type then checks), not an option."""
 MAX_TEXT = 200
 """Longest option value echoed back in an error message."""
 
@@ -66,15 +67,23 @@ def whole(low: int, high: int) -> Callable[[str], int]:
     return parse
 
 
+MAX_GAIN = 1e12
+"""Largest gain accepted on the command line (any unit)."""
+
+
 def gain_range(text: str) -> Any:
-    """``NAME=LO:HI`` as a :class:`~twolink_pin.studies.sweep.GainRange`."""
+    """``NAME=LO:HI`` as a :class:`~twolink_pin.studies.sweep.GainRange`, both bounds within
+    ±:data:`MAX_GAIN`."""
     from twolink_pin.errors import InvalidParameterError
     from twolink_pin.studies.sweep import GainRange
 
     try:
-        return GainRange.parse(text)
+        parsed = GainRange.parse(text)
     except InvalidParameterError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
+    if max(abs(parsed.low), abs(parsed.high)) > MAX_GAIN:
+        raise argparse.ArgumentTypeError(f"expected LO and HI within ±{MAX_GAIN:g}, got {_shown(text)}")
+    return parsed
 
 
 def port(text: str) -> int:

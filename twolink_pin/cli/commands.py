@@ -19,10 +19,11 @@ from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
+    from twolink_pin.identification import IdentifiedParameters
     from twolink_pin.metrics import Metrics
     from twolink_pin.model import RobotModel
     from twolink_pin.simulation import SimulationConfig, SimulationResult
-    from twolink_pin.trajectory import JointTrajectory
+    from twolink_pin.trajectory import Trajectory
 
 
 def _robot(args: argparse.Namespace) -> RobotModel:
@@ -31,7 +32,7 @@ def _robot(args: argparse.Namespace) -> RobotModel:
     return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
 
 
-def _trajectory(args: argparse.Namespace, robot: RobotModel) -> JointTrajectory:
+def _trajectory(args: argparse.Namespace, robot: RobotModel) -> Trajectory:
     """The reference of ``--trajectory FILE``, else the robot's default."""
     from twolink_pin.trajectory import default_trajectory, read_trajectory_file
 
@@ -78,8 +79,24 @@ def _gain_values(texts: list[str]) -> dict[str, Any]:
     return gains
 
 
+def _identified(args: argparse.Namespace, robot: RobotModel) -> tuple[IdentifiedParameters | None, str]:
+    """The parameter file of ``--p0`` or ``--model`` (read once per command) and which it was."""
+    mode = "p0" if getattr(args, "p0", None) else "model" if getattr(args, "model", None) else ""
+    if not mode:
+        return None, ""
+    cached = getattr(args, "identified_parameters", None)
+    if cached is None:
+        from twolink_pin.identification import read_parameter_file
+
+        cached = read_parameter_file(getattr(args, mode), robot)
+        args.identified_parameters = cached
+        for note in cached.notes:
+            print(f"twolink-pin: note: {cached.source}: {note}", file=sys.stderr)
+    return cached, mode
+
+
 def _run_one(
-    args: argparse.Namespace, spec: str, robot: RobotModel, trajectory: JointTrajectory | None = None
+    args: argparse.Namespace, spec: str, robot: RobotModel, trajectory: Trajectory | None = None
 ) -> SimulationResult:
     from twolink_pin.scenario import law_class, make_scenario
     from twolink_pin.simulation import simulate
@@ -88,14 +105,30 @@ def _run_one(
     lam = args.lam
     if lam is not None and not cls.takes("lam") and getattr(args, "lambda_optional", False):
         lam = None  # compare/report: λ applies to the laws that have one
-    controller, plant = make_scenario(
-        cls,
-        robot,
-        lam=lam,
-        gains=_gain_values(getattr(args, "gain", []) or []),
-        saturate=args.saturate,
-        friction_smoothing=_smoothing(args),
-    )
+    identified, mode = _identified(args, robot)
+    several = getattr(args, "lambda_optional", False)  # compare: --p0 seeds the laws that estimate
+    if identified is not None and (mode == "model" or cls.estimates or not several):
+        from twolink_pin.identification import seeded_scenario
+
+        controller, plant = seeded_scenario(
+            cls,
+            robot,
+            identified,
+            mode,
+            lam=lam,
+            gains=_gain_values(getattr(args, "gain", []) or []),
+            saturate=args.saturate,
+            friction_smoothing=_smoothing(args),
+        )
+    else:
+        controller, plant = make_scenario(
+            cls,
+            robot,
+            lam=lam,
+            gains=_gain_values(getattr(args, "gain", []) or []),
+            saturate=args.saturate,
+            friction_smoothing=_smoothing(args),
+        )
     reference = trajectory if trajectory is not None else _trajectory(args, robot)
     return simulate(controller, plant, reference, _config(args))
 
@@ -157,6 +190,13 @@ def cmd_info(args: argparse.Namespace) -> int:
         if robot.payload <= 0:
             raise InvalidParameterError(
                 "--payload", robot.payload, "a mass > 0 kg to write a payload variant"
+            )
+        target = Path(args.write_urdf)
+        if target.exists() and target.resolve() == Path(robot.urdf_path).resolve():
+            raise InvalidParameterError(
+                "--write-urdf",
+                args.write_urdf,
+                "a file other than the robot's own URDF (it would be replaced)",
             )
         written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
         payload["urdf_written"] = str(written)
@@ -290,17 +330,22 @@ def cmd_ik(args: argparse.Namespace) -> int:
 
 def cmd_trajectory(args: argparse.Namespace) -> int:
     from twolink_pin.feasibility import check_torques
-    from twolink_pin.trajectory import default_via_points
+    from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, default_via_points
 
     robot = _robot(args)
     traj = _trajectory(args, robot)
     via = default_via_points(robot) if not args.trajectory else None
     check = check_torques(robot, traj)
+    if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
+        return _fourier_trajectory(args, robot, traj, check)
+    assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
     figures: list[str] = []
     if args.plot:
+        from twolink_pin.files import removed_on_failure
         from twolink_pin.plotting import save_trajectory_figures
 
-        figures = [str(p) for p in save_trajectory_figures(robot, traj, check, Path(args.plot))]
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_trajectory_figures(robot, traj, check, folder)]
     payload = {
         "times": traj.times.tolist(),
         "via_xy": None if via is None else [list(p) for p in via.xy],
@@ -322,6 +367,281 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
     lines.append(check.verdict())
     lines += [f"figure {f}" for f in figures]
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:
+    """``trajectory`` for a Fourier-series file: its coefficients, bounds and torque check."""
+    from twolink_pin.identification.measures import excitation_measures
+
+    measures = excitation_measures(robot, traj)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_excitation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_excitation_figures(robot, traj, folder, check=check)]
+    q_bound, v_bound, a_bound = traj.bounds
+    payload = {
+        "fourier": traj.as_dict(),
+        "bandwidth_hz": traj.bandwidth,
+        "bounds": {"q_minus_offset": q_bound.tolist(), "v": v_bound.tolist(), "a": a_bound.tolist()},
+        "condition_number": measures.condition_number,
+        "gram_min_eigenvalue_per_s": measures.gram_min_eigenvalue_per_s,
+        "peak_torque": check.peak.tolist(),
+        "peak_time": check.peak_time.tolist(),
+        "torque_limits": check.limits.tolist(),
+        "margin": check.margin.tolist(),
+        "within_limits": check.within_limits,
+        "figures": figures,
+    }
+    lines = [
+        f"Fourier series: period {traj.period:g} s, {traj.harmonics} harmonics (up to {traj.bandwidth:.3g} Hz)",
+        f"offsets q0 {fmt(traj.offset)} rad; bounds |q − q0| <= {fmt(q_bound, 3)} rad, |q̇| <= {fmt(v_bound, 3)} rad/s, "
+        f"|q̈| <= {fmt(a_bound, 3)} rad/s²",
+        f"cond(W) of the base parameters and friction over a period: {measures.condition_number:.4g}",
+        f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s",
+        check.verdict(),
+    ]
+    lines += [f"figure {f}" for f in figures]
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def _excitation(robot: RobotModel) -> tuple[Trajectory, str]:
+    """The robot's excitation and where it came from (stored, or optimised now)."""
+    from twolink_pin.identification.excitation import _STORED, _is_catalog_robot, excitation_trajectory
+
+    stored = robot.name in _STORED and robot.payload == 0 and _is_catalog_robot(robot)
+    if not stored:
+        print(
+            f"twolink-pin: optimising an excitation for {robot.name} (none is stored): this can take minutes; "
+            "save one with twolink-pin excite --out FILE and pass --trajectory FILE",
+            file=sys.stderr,
+            flush=True,
+        )
+    return excitation_trajectory(robot), "stored excitation" if stored else "excitation optimised now"
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    from twolink_pin.files import write_json
+    from twolink_pin.identification import (
+        IdentificationOptions,
+        ZeroPhaseFilter,
+        add_noise,
+        identification_document,
+        identify,
+        read_log,
+        simulate_log,
+        write_log,
+    )
+    from twolink_pin.identification.simulated import DEFAULT_DT
+
+    robot = _robot(args)
+    if args.data:
+        given = [
+            name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None
+        ]
+        if given:
+            raise InvalidParameterError(
+                given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
+            )
+        log = read_log(args.data, robot.nv)
+        reference = f"data {args.data}"
+        if args.reference:
+            from dataclasses import replace
+
+            from twolink_pin.trajectory import read_trajectory_file
+
+            log = replace(log, reference=read_trajectory_file(args.reference, robot))
+            reference += f", reference {args.reference}"
+    else:
+        from twolink_pin.trajectory import read_trajectory_file
+
+        if args.reference:
+            raise InvalidParameterError(
+                "--reference", args.reference, "a file only with --data (a simulated run knows its reference)"
+            )
+        if args.trajectory:
+            trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
+            reference = f"trajectory {args.trajectory}"
+        else:
+            trajectory, reference = _excitation(robot)
+        log = simulate_log(
+            robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
+        )
+    log = add_noise(log, args.noise_q, args.noise_tau, args.seed)
+    options = IdentificationOptions(
+        zero_phase=ZeroPhaseFilter(args.cutoff, args.order, reversal_guard=args.reversal_guard),
+        friction=not args.no_friction,
+        validation=args.validation,
+        weighted=not args.ols,
+        instruments=not args.no_instruments,
+    )
+    result = identify(log, robot, options)
+    document = identification_document(result, robot)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_identification_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_identification_figures(result, folder)]
+    if args.save:
+        write_json(args.save, document)
+    if args.save_data:
+        write_log(args.save_data, log)
+    within = result.within(3.0)
+    document |= {
+        "reference": reference,
+        "noise": {"q_rad": args.noise_q, "tau_Nm": args.noise_tau, "seed": args.seed},
+        "within_3_sigma": None if within is None else within.tolist(),
+        "figures": figures,
+        "saved": args.save,
+        "data_saved": args.save_data,
+    }
+    lines = [
+        f"identified {result.size} parameters of {robot.name} from {log.source}",
+        f"  {reference}; {result.fit_samples} samples fitted (every {result.stride}th valid one of {result.samples}, "
+        f"{result.fit_interval[0]:.3g}–{result.fit_interval[1]:.3g} s)"
+        + (
+            ""
+            if result.validation is None
+            else f"; validation {result.validation.t[0]:.3g}–{result.validation.t[-1]:.3g} s"
+        ),
+        f"  {'weighted ' if result.weighted else ''}{result.method}"
+        + (" (instruments: the reference motion's regressor)" if result.method != "least squares" else ""),
+        f"  filter: zero-phase Butterworth order {result.order}, cut-off {result.cutoff_hz:g} Hz at "
+        f"{1 / result.dt:.6g} Hz; {result.guard:.3g} s dropped at each end"
+        + (" (log resampled to a uniform grid)" if result.resampled else ""),
+        f"  {'parameter':44s} {'estimate':>14s} {'± σ':>10s} {'σ/|θ|':>8s}"
+        + (f" {'true':>14s}" if result.true is not None else ""),
+    ]
+    for row in result.parameters():
+        name = f"{row['name']} [{row['unit']}]"
+        rel = "—" if row["relative_std_percent"] is None else f"{row['relative_std_percent']:.3g}%"
+        true = "" if row["true"] is None else f" {row['true']:14.8g}"
+        lines.append(f"  {name[:44]:44s} {row['estimate']:14.8g} {row['std']:10.3g} {rel:>8s}{true}")
+    lines.append(
+        f"  condition number {result.condition_number:.4g} (weighted {result.weighted_condition_number:.4g}); "
+        f"residual RMS {fmt(result.residual_rms, 4)} N·m"
+        + ("" if result.validation is None else f"; validation RMS {fmt(result.validation.rms, 4)} N·m")
+    )
+    if within is not None:
+        lines.append(f"  true values within ±3σ: {int(within.sum())} of {within.size}")
+    lines += [f"  figure {f}" for f in figures]
+    if args.save:
+        lines.append(f"  parameters saved to {args.save} (use with --p0 / --model)")
+    if args.save_data:
+        lines.append(f"  log saved to {args.save_data}")
+    emit(args, document, "\n".join(lines))
+    return 0
+
+
+def cmd_excite(args: argparse.Namespace) -> int:
+    from twolink_pin.identification import ExcitationDesign, ExcitationLimits, optimise_excitation
+    from twolink_pin.identification.measures import averaged_adaptation, excitation_measures
+    from twolink_pin.trajectory import default_trajectory, write_trajectory_file
+
+    robot = _robot(args)
+    if Path(args.out).suffix.lower() not in (".json", ".toml"):
+        raise InvalidParameterError("--out", args.out, "a trajectory file name ending in .json or .toml")
+    limits = ExcitationLimits(
+        position_margin=args.position_margin,
+        velocity_fraction=args.velocity_fraction,
+        acceleration=args.acceleration,
+        torque_fraction=args.torque_fraction,
+    )
+    design = ExcitationDesign(
+        harmonics=args.harmonics,
+        period=args.period,
+        criterion=args.criterion,
+        samples=args.samples,
+        starts=args.starts,
+        max_iterations=args.max_iterations,
+        seed=args.seed,
+        limits=limits,
+    )
+    excitation = optimise_excitation(robot, design)
+    written = write_trajectory_file(args.out, excitation.trajectory)
+    default = excitation_measures(robot, default_trajectory(robot))
+    payload: dict[str, Any] = {
+        "robot": robot.name,
+        "file": str(written),
+        "criterion": excitation.criterion,
+        "condition_number": excitation.measures.condition_number,
+        "gram_min_eigenvalue": excitation.measures.gram_min_eigenvalue,
+        "gram_min_eigenvalue_per_s": excitation.measures.gram_min_eigenvalue_per_s,
+        "default_trajectory_condition_number": default.condition_number,
+        "default_trajectory_gram_min_eigenvalue_per_s": default.gram_min_eigenvalue_per_s,
+        "parameters": list(excitation.measures.names),
+        "seconds": excitation.seconds,
+        "iterations": excitation.iterations,
+        "evaluations": excitation.evaluations,
+        "starts": excitation.starts,
+        "seed": design.seed,
+        "success": excitation.success,
+        "message": excitation.message,
+        "design": {"harmonics": design.harmonics, "period_s": design.period, "samples": design.samples},
+        "limits": excitation.limits,
+        "peaks": excitation.peaks,
+        "fourier": excitation.trajectory.as_dict(),
+    }
+    if robot.name == "twolink":
+        payload["report_condition_number"] = default.condition_number
+    try:
+        from twolink_pin.scenario import make_scenario
+
+        law = make_scenario("adaptive", robot).controller
+        payload["adaptive_slowest_time_constant_s"] = averaged_adaptation(
+            law, excitation.trajectory
+        ).slowest_time_constant
+        payload["default_trajectory_adaptive_slowest_time_constant_s"] = averaged_adaptation(
+            law, default_trajectory(robot)
+        ).slowest_time_constant
+    except InvalidParameterError:  # pragma: no cover - the built-in adaptive law always applies
+        pass
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_excitation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [
+                str(p)
+                for p in save_excitation_figures(
+                    robot, excitation.trajectory, folder, limits=excitation.limits
+                )
+            ]
+    payload["figures"] = figures
+    which = "the report's trajectory" if robot.name == "twolink" else "the default trajectory"
+    lines = [
+        f"excitation for {robot.name} ({design.criterion}): {design.harmonics} harmonics, period {design.period:g} s "
+        f"-> {written}",
+        f"  optimiser: SLSQP from {design.starts} seeded starts (seed {design.seed}), {excitation.iterations} iterations, "
+        f"{excitation.evaluations} evaluations, {excitation.seconds:.1f} s; {excitation.message}"
+        + (
+            ""
+            if excitation.success
+            else " (NOT converged to a feasible point: more --max-iterations or --starts)"
+        ),
+        f"  cond(W) of {len(excitation.measures.names)} parameters (base + friction) over a period: "
+        f"{excitation.measures.condition_number:.4g}; {which}: {default.condition_number:.4g}",
+        f"  smallest Gram eigenvalue per second {excitation.measures.gram_min_eigenvalue_per_s:.4g}; {which}: "
+        f"{default.gram_min_eigenvalue_per_s:.4g}",
+    ]
+    if "adaptive_slowest_time_constant_s" in payload:
+        lines.append(
+            f"  adaptive law's slowest averaged time constant {payload['adaptive_slowest_time_constant_s']:.4g} s; "
+            f"{which}: {payload['default_trajectory_adaptive_slowest_time_constant_s']:.4g} s"
+        )
+    peaks = excitation.peaks
+    lines.append(
+        f"  peaks |q̇| {fmt(peaks['v_max'], 3)} rad/s, |q̈| {fmt(peaks['a_max'], 3)} rad/s², |τ| {fmt(peaks['tau_max'], 3)} N·m"
+    )
+    lines += [f"  figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))
     return 0
 
@@ -353,9 +673,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     payload = _result_payload(result, metrics)
     figures: list[str] = []
     if args.plot:
+        from twolink_pin.files import removed_on_failure
         from twolink_pin.plotting import save_simulation_figures
 
-        figures = [str(p) for p in save_simulation_figures(result, Path(args.plot))]
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_simulation_figures(result, folder)]
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
@@ -440,9 +762,37 @@ def cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+RUN_OPTIONS = frozenset(
+    {
+        "--duration",
+        "--dt",
+        "--lambda",
+        "--q0-offset",
+        "--saturate",
+        "--method",
+        "--control-period",
+        "--friction-smoothing",
+        "--gain",
+        "--p0",
+        "--model",
+    }
+)
+"""Options that shape a run: meaningless with ``animate --from`` (a saved run)."""
+
+
 def cmd_animate(args: argparse.Namespace) -> int:
     import signal
 
+    if args.from_file:
+        typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
+        ignored = sorted(typed & RUN_OPTIONS)
+        if args.controller is not None or ignored:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
+                + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
+            )
     robot = _robot(args)
     reference = _trajectory(args, robot)
     if args.from_file:
@@ -463,7 +813,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
         result = _run_one(args, args.controller, robot, reference)
     from twolink_pin.kinematics import joint_positions
 
-    points = joint_positions(robot, reference.via_q)[:, -1, :]  # the end effector's via points
+    via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
+    points = None if via_q is None else joint_positions(robot, via_q)[:, -1, :]  # the end effector's
     if args.html:
         from twolink_pin.visualization import write_html
 
@@ -517,6 +868,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         workers=args.workers,
         animation=not args.no_animation,
         trajectory=args.trajectory,
+        p0=args.p0,
+        model=args.model,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
     bar = progress_bar(1, "step", "report")
@@ -540,10 +893,18 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
+    from twolink_pin.studies import cluster
     from twolink_pin.studies.sweep import SweepConfig, run_sweep
-    from twolink_pin.trajectory import default_trajectory
 
+    if (args.workers is not None or args.scheduler is not None) and not cluster.available():
+        option = "--workers" if args.workers is not None else "--scheduler"
+        print(
+            f"twolink-pin: error: {option} needs Dask, which is not installed: {cluster.INSTALL_HINT}",
+            file=sys.stderr,
+        )
+        return 1
     robot = _robot(args)
+    trajectory = _trajectory(args, robot)
     config = SweepConfig(
         controller=args.controller,
         samples=args.samples,
@@ -558,30 +919,45 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         chunk=args.chunk,
         threads=args.threads,
     )
-    bar = progress_bar(config.samples, "run", f"sweep {config.controller}")
+    bars: list[Any] = []  # shown from the first runs on: its rate and ETA leave out a cluster's start
 
     def progress(done: int, total: int) -> None:
-        bar.update(done - bar.n)
+        if not bars:
+            bars.append(progress_bar(config.samples, "run", f"sweep {config.controller}"))
+        bars[0].update(done - bars[0].n)
+
+    def notify(line: str) -> None:
+        if bars:
+            bars[0].write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr, flush=True)
 
     try:
         output = run_sweep(
             config,
             robot,
-            default_trajectory(robot),
+            trajectory,
             args.out,
             progress=progress,
             keep_trajectories=args.keep_trajectories,
             plot=not args.no_plot,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            timeout=args.connect_timeout,
+            notify=notify,
         )
     finally:
-        bar.close()
+        if bars:
+            bars[0].close()
     summary = output.summary
     if args.json:
-        emit(args, {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}, "")
+        payload = {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}
+        emit(args, {**payload, "engine": output.engine, "chunk": output.chunk}, "")
         return 0
     lines = [
         f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
         f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
+        f"  ran {'' if output.engine == 'in-process' else 'on '}{output.engine}, in chunks of {output.chunk} runs",
         f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
     ]
     for name, stat in summary["metrics"].items():

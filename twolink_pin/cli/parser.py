@@ -52,7 +52,8 @@ def add_robot_options(p: argparse.ArgumentParser, json_flag: bool = True) -> Non
 
 TRAJECTORY_HELP = (
     "the reference: a TOML or JSON file of via points, joint (times, joints [rad]) or end-effector "
-    "(times, positions [m]); default: the robot's own"
+    "(times, positions [m]), or a Fourier series (a fourier table: twolink-pin excite writes one); "
+    "default: the robot's own"
 )
 
 
@@ -117,9 +118,50 @@ def add_gain_option(p: argparse.ArgumentParser) -> None:
     )
 
 
+def add_identified_options(p: argparse.ArgumentParser, several: bool = False) -> None:
+    """``--p0 FILE`` / ``--model FILE``: a parameter file of ``twolink-pin identify --save``."""
+    laws = "the laws that estimate parameters (others run as usual)" if several else "a law that estimates"
+    group = p.add_mutually_exclusive_group()
+    group.add_argument(
+        "--p0",
+        metavar="FILE",
+        default=None,
+        help=f"start the estimates of {laws} at the identified parameters of FILE (twolink-pin identify --save)",
+    )
+    group.add_argument(
+        "--model",
+        metavar="FILE",
+        default=None,
+        help="the law's model believes the identified parameters of FILE (adaptive laws: p̂(0) = "
+        "initial_estimate × them; friction-estimating laws: their friction too)",
+    )
+
+
+def chunk_size(high: int) -> Any:
+    """``sweep --chunk``: ``auto`` (None) or a whole number from 1 to ``high``."""
+    number = whole(1, high)
+
+    def parse(text: str) -> int | None:
+        return None if text.strip().lower() == "auto" else number(text)
+
+    return parse
+
+
+def scheduler_option(text: str) -> str:
+    """``sweep --scheduler``: a Dask scheduler's address, normalised (``tcp://HOST:PORT``)."""
+    from twolink_pin.errors import InvalidParameterError
+    from twolink_pin.studies.cluster import scheduler_address
+
+    try:
+        return scheduler_address(text)
+    except InvalidParameterError as exc:
+        raise argparse.ArgumentTypeError(f"expected {exc.expected}, got {text[:MAX_TEXT]!r}") from None
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The ``twolink-pin`` argument parser."""
     from twolink_pin.cli import commands as c
+    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
     from twolink_pin.studies.sweep import MAX_CHUNK, MAX_SAMPLES
 
     parser = Parser(
@@ -184,6 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
     add_gain_option(p)
+    add_identified_options(p)
     p.add_argument("--plot", metavar="DIR", help="write the run's figures into DIR")
     p.add_argument("--save", metavar="FILE.npz", help="save the result (for animate --from)")
     add_robot_options(p)
@@ -199,6 +242,7 @@ def build_parser() -> argparse.ArgumentParser:
         help=f"{CONTROLLER_HELP} (default: every built-in law)",
     )
     add_sim_options(p)
+    add_identified_options(p, several=True)
     p.add_argument(
         "--out", default="out/compare", metavar="DIR", help="output directory (default out/compare)"
     )
@@ -210,6 +254,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("controller", nargs="?", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
     add_gain_option(p)
+    add_identified_options(p)
     p.add_argument(
         "--from", dest="from_file", metavar="FILE.npz", help="animate a saved result (simulate --save)"
     )
@@ -228,6 +273,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
     add_sim_options(p)
+    add_identified_options(p, several=True)
     p.add_argument(
         "--controller",
         dest="controllers",
@@ -284,14 +330,42 @@ def build_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
     p.add_argument(
-        "--threads", type=whole(1, 256), default=None, help="threads of the batch engine (default all cores)"
+        "--threads",
+        type=whole(1, 256),
+        default=None,
+        help="threads of the batch engine per chunk (default all cores in-process, 1 per Dask task)",
     )
     p.add_argument(
         "--chunk",
-        type=whole(1, MAX_CHUNK),
-        default=1000,
+        type=chunk_size(MAX_CHUNK),
+        default=None,
+        metavar="N|auto",
+        help=f"runs per batch, one Dask task each (1 to {MAX_CHUNK}; default auto: min(N, 1000) in-process, "
+        "about 4 chunks per worker within 250..1000 on a cluster)",
+    )
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--workers",
+        type=whole(1, MAX_WORKERS),
+        default=None,
         metavar="N",
-        help=f"runs per batch (1 to {MAX_CHUNK}, default 1000)",
+        help=f"run on a Dask LocalCluster of N worker processes on this machine, bound to 127.0.0.1 "
+        f"(1 to {MAX_WORKERS}; needs twolink-pin[cluster])",
+    )
+    where.add_argument(
+        "--scheduler",
+        type=scheduler_option,
+        default=None,
+        metavar="ADDRESS",
+        help="run on the Dask scheduler at tcp://HOST:PORT or tls://HOST:PORT (see docs/cluster.md; "
+        "needs twolink-pin[cluster])",
+    )
+    p.add_argument(
+        "--connect-timeout",
+        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
+        default=CONNECT_TIMEOUT,
+        metavar="S",
+        help=f"seconds for the scheduler to answer and have a worker (default {CONNECT_TIMEOUT:g})",
     )
     p.add_argument(
         "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
@@ -300,4 +374,165 @@ def build_parser() -> argparse.ArgumentParser:
     add_sim_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_sweep)
+
+    add_identification_commands(sub, c)
     return parser
+
+
+def add_identification_commands(sub: Any, c: Any) -> None:
+    """``identify`` and ``excite``."""
+    from twolink_pin.identification.data import MAX_LOG_BYTES
+    from twolink_pin.identification.filtering import DEFAULT_CUTOFF_HZ, DEFAULT_ORDER
+
+    p = sub.add_parser(
+        "identify",
+        help="identify the base parameters and joint friction from a run: simulated along the robot's "
+        "excitation (or --trajectory FILE), or a log of yours (--data FILE)",
+    )
+    source = p.add_mutually_exclusive_group()
+    add_trajectory_option(source)
+    source.add_argument(
+        "--data",
+        metavar="FILE",
+        help=f"a logged run: CSV (header t, q1..qn, tau1..taun, optional v1..vn) or NPZ (t, q, tau, optional v), "
+        f"up to {MAX_LOG_BYTES >> 20} MiB",
+    )
+    p.add_argument(
+        "--duration",
+        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
+        default=None,
+        help="simulated run [s] (default: 4 periods of the trajectory)",
+    )
+    p.add_argument(
+        "--dt",
+        type=bounded(0.0, 0.1, low_open=True, unit="s"),
+        default=None,
+        help="simulated run's RK4 step and log spacing [s] (default 0.0005: a 2-kHz log)",
+    )
+    p.add_argument(
+        "--noise-q",
+        type=bounded(0.0, 1.0, unit="rad"),
+        default=0.0,
+        metavar="RAD",
+        help="add white Gaussian noise of this standard deviation to the logged q [rad]",
+    )
+    p.add_argument(
+        "--noise-tau",
+        type=bounded(0.0, 1e4, unit="N·m"),
+        default=0.0,
+        metavar="NM",
+        help="add white Gaussian noise of this standard deviation to the logged τ [N·m]",
+    )
+    p.add_argument("--seed", type=whole(0, 2**63 - 1), default=0, help="seed of the noise (default 0)")
+    p.add_argument(
+        "--cutoff",
+        type=bounded(0.0, 1e5, low_open=True, unit="Hz"),
+        default=DEFAULT_CUTOFF_HZ,
+        metavar="HZ",
+        help=f"cut-off of the zero-phase Butterworth filter [Hz] (default {DEFAULT_CUTOFF_HZ:g})",
+    )
+    p.add_argument(
+        "--order",
+        type=whole(1, 8),
+        default=DEFAULT_ORDER,
+        help=f"Butterworth order (default {DEFAULT_ORDER})",
+    )
+    p.add_argument(
+        "--validation",
+        type=bounded(0.0, 0.9, unit=""),
+        default=0.25,
+        metavar="FRAC",
+        help="fraction of the run, at its end, kept for validation (default 0.25)",
+    )
+    p.add_argument("--no-friction", action="store_true", help="identify the base parameters only")
+    p.add_argument(
+        "--reversal-guard",
+        action="store_true",
+        help="also drop samples near velocity reversals (for logs whose accelerations jump there: friction "
+        "not compensated by the controller)",
+    )
+    p.add_argument(
+        "--reference",
+        metavar="FILE",
+        help="with --data: the trajectory file the arm tracked (time as in the log); its regressor is the "
+        "instrument of an instrumental-variables estimate, free of the bias position noise causes",
+    )
+    p.add_argument(
+        "--no-instruments",
+        action="store_true",
+        help="least squares even when the reference is known (a simulated run's excitation, or --reference)",
+    )
+    p.add_argument("--ols", action="store_true", help="ordinary least squares (default: Gautier's weighted)")
+    p.add_argument("--plot", metavar="DIR", help="write the figures (validation torques, estimates) into DIR")
+    p.add_argument("--save", metavar="FILE.json", help="write the identified parameters (for --p0 / --model)")
+    p.add_argument("--save-data", metavar="FILE", help="write the log used (.csv or .npz, after any noise)")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_identify)
+
+    p = sub.add_parser(
+        "excite",
+        help="an optimised excitation: a Fourier-series trajectory of minimal condition number (or fastest "
+        "adaptation) within the joint, velocity, acceleration and torque limits",
+    )
+    p.add_argument("--out", required=True, metavar="FILE", help="trajectory file to write (.json or .toml)")
+    p.add_argument(
+        "--criterion",
+        choices=("condition", "adaptation"),
+        default="condition",
+        help="minimise cond(W) of the base parameters and friction (default), or maximise the slowest "
+        "averaged adaptation rate of the robot's adaptive law",
+    )
+    p.add_argument("--harmonics", type=whole(1, 20), default=5, help="harmonics per joint (default 5)")
+    p.add_argument(
+        "--period",
+        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
+        default=10.0,
+        help="period [s]: the base frequency is 1/period (default 10)",
+    )
+    p.add_argument(
+        "--samples",
+        type=whole(10, 100_000),
+        default=100,
+        help="instants per period of the criterion (default 100)",
+    )
+    p.add_argument(
+        "--starts", type=whole(1, 50), default=3, help="random starts of the optimiser (default 3)"
+    )
+    p.add_argument(
+        "--max-iterations",
+        type=whole(1, 100_000),
+        default=200,
+        help="SLSQP iterations per start (default 200)",
+    )
+    p.add_argument("--seed", type=whole(0, 2**63 - 1), default=0, help="seed of the starts (default 0)")
+    p.add_argument(
+        "--velocity-fraction",
+        type=bounded(0.0, 1.0, low_open=True, unit=""),
+        default=0.5,
+        metavar="F",
+        help="|q̇| within F × the URDF velocity limit (default 0.5)",
+    )
+    p.add_argument(
+        "--acceleration",
+        type=bounded(0.0, 1e4, low_open=True, unit="rad/s²"),
+        default=10.0,
+        metavar="A",
+        help="|q̈| within A [rad/s²] (default 10; URDFs give no acceleration limit)",
+    )
+    p.add_argument(
+        "--torque-fraction",
+        type=bounded(0.0, 1.0, low_open=True, unit=""),
+        default=0.8,
+        metavar="F",
+        help="|τ| within F × the URDF effort limit (default 0.8)",
+    )
+    p.add_argument(
+        "--position-margin",
+        type=bounded(0.0, 0.49, unit=""),
+        default=0.05,
+        metavar="F",
+        help="keep F of each joint's range free at each end (default 0.05)",
+    )
+    p.add_argument("--plot", metavar="DIR", help="write the excitation's figure into DIR")
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_excite)

@@ -87,8 +87,18 @@ def _spec(f: Any) -> GainSpec:
     return spec
 
 
+GAIN_RANGE = (1e-12, 1e12)
+"""Smallest and largest magnitude of a nonzero gain (any unit): beyond them a gain is a typo,
+and its products (``1/γ``, ``K s``) overflow."""
+
+
 def _expected(spec: GainSpec) -> str:
-    sign = {"positive": " > 0", "nonnegative": " >= 0", "any": ""}[spec.bound]
+    low, high = GAIN_RANGE
+    sign = {
+        "positive": f" > 0 (from {low:g} to {high:g})",
+        "nonnegative": f" >= 0 (0, or from {low:g} to {high:g})",
+        "any": f" within ±{high:g}",
+    }[spec.bound]
     unit = f" [{spec.unit}]" if spec.unit else ""
     return {
         "scalar": f"a finite number{sign}{unit} (or one per run)",
@@ -112,10 +122,12 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     if array.ndim not in allowed or array.size == 0:
         raise InvalidParameterError(name, value, f"{_expected(spec)} (got shape {array.shape})")
     bad = ~np.isfinite(array)
-    if spec.bound == "positive":
-        bad |= ~(array > 0)
-    elif spec.bound == "nonnegative":
-        bad |= ~(array >= 0)
+    with np.errstate(invalid="ignore"):
+        bad |= ~(np.abs(array) <= GAIN_RANGE[1])
+        if spec.bound == "positive":
+            bad |= ~(array >= GAIN_RANGE[0])
+        elif spec.bound == "nonnegative":
+            bad |= ~((array == 0) | (array >= GAIN_RANGE[0]))
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
         where = f"{name}[{', '.join(map(str, index))}]" if index else name

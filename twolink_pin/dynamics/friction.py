@@ -27,6 +27,15 @@ class Friction:
     smoothing: float = 0.0
 
     def __post_init__(self) -> None:
+        for name in ("viscous", "coulomb"):
+            values = getattr(self, name)
+            if isinstance(values, (str, bytes)) or not all(
+                isinstance(x, (int, float, np.floating, np.integer)) and not isinstance(x, bool)
+                for x in np.ravel(np.asarray(values, dtype=object))
+            ):
+                raise InvalidParameterError(name, values, "numbers >= 0, one per joint")
+        if not isinstance(self.smoothing, (int, float)) or isinstance(self.smoothing, bool):
+            raise InvalidParameterError("smoothing", self.smoothing, "a finite velocity >= 0 rad/s")
         if len(self.viscous) != len(self.coulomb):
             raise InvalidParameterError(
                 "coulomb", self.coulomb, f"one value per joint, like viscous (length {len(self.viscous)})"
@@ -69,7 +78,18 @@ def friction_regressor(v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
     Returns:
         Shape (nv, 2 nv), or (N, nv, 2 nv) for batch input.
     """
-    v = np.asarray(v, dtype=float)
+    if not (isinstance(smoothing, (int, float)) and math.isfinite(smoothing) and smoothing >= 0):
+        raise InvalidParameterError("smoothing", smoothing, "a finite velocity >= 0 rad/s")
+    try:
+        v = np.asarray(v, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError("v", v, "joint velocities [rad/s], shape (nv,) or (N, nv)") from None
+    if v.ndim not in (1, 2) or v.shape[-1] == 0 or not np.all(np.isfinite(v)):
+        raise InvalidParameterError(
+            "v",
+            v.tolist() if v.size <= 12 else f"shape {v.shape}",
+            "finite joint velocities [rad/s], shape (nv,) or (N, nv)",
+        )
     sign = smooth_sign(v, smoothing)
     nv = v.shape[-1]
     out = np.zeros((*v.shape, 2 * nv))

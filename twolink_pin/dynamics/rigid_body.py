@@ -141,6 +141,12 @@ def joint_inertia(model: pin.Model, q: np.ndarray | None = None) -> np.ndarray:
     """``diag M(q)`` [kg·m²] at ``q`` [rad] (default Pinocchio's neutral configuration),
     armature included: the inertia each joint moves, the scale robot-derived default gains
     use (at the robot's home, :attr:`~twolink_pin.model.RobotModel.home`)."""
+    if not isinstance(model, pin.Model):
+        raise InvalidParameterError("model", type(model).__name__, "a pinocchio.Model (robot.model)")
+    if q is not None:
+        q = np.asarray(q, dtype=float)
+        if q.shape != (model.nq,) or not np.all(np.isfinite(q)):
+            raise InvalidParameterError("q", q.tolist(), f"{model.nq} finite joint positions [rad]")
     data = model.createData()
     M = pin.crba(model, data, pin.neutral(model) if q is None else np.asarray(q, dtype=float))
     return np.array(np.diag(M), dtype=float)

@@ -68,6 +68,10 @@ def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
         InvalidURDFError: an unknown name (the message lists the valid ones).
     """
     text = DEFAULT_ROBOT if robot is None else os.fspath(robot)
+    if "\0" in text or not text:
+        raise InvalidURDFError(
+            repr(text)[:80], "robot", "expected a robot name or a path (non-empty, no NUL byte)"
+        )
     if text in CATALOG:
         return CATALOG[text]()
     path = Path(text)

@@ -18,8 +18,9 @@ from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.files import atomic_write
 from twolink_pin.model.urdf_validation import validate_urdf_file
 
-POINT_MASS_INERTIA = 1e-9
-"""Tiny isotropic inertia [kg·m²] that keeps the point mass's inertia positive definite."""
+POINT_MASS_INERTIA = 0.0
+"""Inertia [kg·m²] of the point mass about its centre: none, as in ``load_robot(payload=m)``
+(a URDF inertia of all zeros with a mass > 0 is a point mass)."""
 
 
 def payload_urdf(urdf: str | os.PathLike[str], payload: float, link: str = "ee_link") -> str:

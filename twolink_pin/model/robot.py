@@ -317,6 +317,10 @@ def load_robot(
         and payload >= 0
     ):
         raise InvalidParameterError("payload", payload, "a finite mass >= 0 kg")
+    if robot is not None and not isinstance(robot, (str, os.PathLike)):
+        raise InvalidParameterError(
+            "robot", type(robot).__name__, "a robot name (twolink-pin robots) or a path to a URDF file"
+        )
     path, profile = resolve(robot)
     model = _build_model(path, profile)
     _check_home(model, profile, path)

@@ -38,7 +38,8 @@ Checks, in order:
    any other work, so a huge file is rejected quickly);
 3. every link and joint has a unique, non-empty ``name``;
 4. every ``<inertial>`` (at most one per link): ``<mass value>`` finite and > 0 [kg]
-   (or exactly 0 with an all-zero inertia: an explicitly massless frame link);
+   (or exactly 0 with an all-zero inertia: an explicitly massless frame link; a mass > 0
+   with an all-zero inertia is a point mass);
    ``<inertia>`` with the six attributes ``ixx ixy ixz iyy iyz izz`` finite [kg·m²], the
    matrix positive definite and its principal moments satisfying the triangle
    inequality; ``<origin xyz rpy>`` if present three finite numbers each [m], [rad];
@@ -103,6 +104,15 @@ AXIS_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "continuous", "
 
 _LIMIT_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "continuous", "prismatic"})
 _BOUNDED_JOINT_TYPES: Final[frozenset[str]] = frozenset({"revolute", "prismatic"})
+
+MAX_MASS: Final[float] = 1e6
+"""Heaviest link accepted [kg]: a thousand tonnes is a unit mix-up, and far heavier masses
+overflow the joint-space inertia (1e308 kg gives inf)."""
+MAX_INERTIA: Final[float] = 1e8
+"""Largest principal moment of inertia accepted [kg·m²] (for the same reasons)."""
+MAX_DEPTH: Final[int] = 64
+"""Deepest element nesting accepted (a URDF is 4 or 5 deep; Pinocchio's XML reader stops,
+with lines on stderr, at a few hundred)."""
 
 TRIANGLE_RTOL: Final[float] = 1e-12
 """Relative tolerance of the triangle inequality on principal moments.
@@ -202,6 +212,17 @@ def _parse(text: str | bytes, path: str) -> ET.Element:
         ) from None
 
 
+def _depth(root: ET.Element) -> int:
+    deepest, stack = 1, [(root, 1)]
+    while stack:
+        element, level = stack.pop()
+        deepest = max(deepest, level)
+        if deepest > MAX_DEPTH:
+            return deepest
+        stack.extend((child, level + 1) for child in element)
+    return deepest
+
+
 def _validate_robot(robot: ET.Element, path: str) -> None:
     if robot.tag != "robot":
         raise InvalidURDFError(path, f"<{robot.tag}>", f"root element is <{robot.tag}>; expected <robot>")
@@ -224,6 +245,12 @@ def _validate_robot(robot: ET.Element, path: str) -> None:
         )
     if not links:
         raise InvalidURDFError(path, _ROBOT, "contains no <link>; expected at least one link")
+    if not (robot.get("name") or "").strip():
+        raise InvalidURDFError(path, _ROBOT, 'has no name; expected <robot name="...">')
+    if _depth(robot) > MAX_DEPTH:
+        raise InvalidURDFError(
+            path, _ROBOT, f"nests elements more than {MAX_DEPTH} deep; expected a URDF (4 or 5 levels)"
+        )
 
     link_names = _names(links, "link", path)
     joint_names = _names(joints, "joint", path)
@@ -282,8 +309,16 @@ def _check_link(link: ET.Element, where: str, path: str) -> None:
         return  # An explicitly massless link (mass 0, inertia 0), common for frame links.
     if value is None or not value > 0.0:
         raise InvalidURDFError(path, f"{where}<mass>", f'mass value="{raw}" must be a finite number > 0 kg')
+    if value > MAX_MASS:
+        raise InvalidURDFError(
+            path,
+            f"{where}<mass>",
+            f'mass value="{raw}" is more than {MAX_MASS:g} kg; expected an arm\'s link',
+        )
 
-    _check_inertia(inertial.find("inertia"), f"{where}<inertia>", path)
+    inertia = inertial.find("inertia")
+    if not (inertia is not None and _is_zero_inertia(inertia)):  # all zeros: a point mass, fine
+        _check_inertia(inertia, f"{where}<inertia>", path)
     _check_origin(inertial.find("origin"), f"{where}<origin>", path)
 
 
@@ -339,6 +374,12 @@ def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
             "expected all > 0",
         )
     small, middle, large = (float(m) for m in moments)
+    if large > MAX_INERTIA:
+        raise InvalidURDFError(
+            path,
+            where,
+            f"principal moment {large:.6g} kg m^2 is more than {MAX_INERTIA:g}; expected an arm's link",
+        )
     if large > (small + middle) * (1.0 + TRIANGLE_RTOL):
         raise InvalidURDFError(
             path,
@@ -429,7 +470,11 @@ def _check_limit(limit: ET.Element, joint_type: str, where: str, path: str) -> N
     for attribute in ("effort", "velocity"):
         raw = limit.get(attribute)
         if raw is None:
-            continue
+            raise InvalidURDFError(
+                path,
+                where,
+                f"{attribute} is missing; URDF requires <limit effort=... velocity=...> ({units[attribute]}; 0 for none)",
+            )
         value = _finite_float(raw)
         if value is None or not value >= 0.0:
             raise InvalidURDFError(

@@ -133,7 +133,8 @@ def integrate(
         plant: The arm all runs drive.
         trajectory: The reference.
         config: Duration, step, control period (``method`` is not used: RK4).
-        q0, v0: Initial positions [rad] and velocities [rad/s], shape (N, nv).
+        q0: Initial positions [rad], shape (N, nv).
+        v0: Initial velocities [rad/s], shape (N, nv).
         z0: Initial law state, shape (N, nz).
         record: Keep every sample (:attr:`EngineRun.record`).
         observer: Receives each block of samples.

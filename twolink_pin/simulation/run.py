@@ -16,10 +16,15 @@ from twolink_pin.trajectory import Trajectory
 
 
 def check_setup(controller: Controller, plant: Plant, trajectory: Trajectory) -> None:
-    """Raise unless the law, the plant and the reference are for the same number of joints."""
-    nv = plant.robot.nv
+    """Raise unless the law, the plant and the reference are what they must be, for the same
+    number of joints."""
     if not isinstance(controller, Controller):
         raise InvalidParameterError("controller", type(controller).__name__, "a twolink_pin Controller")
+    if not isinstance(plant, Plant):
+        raise InvalidParameterError("plant", type(plant).__name__, "a twolink_pin Plant")
+    if not isinstance(trajectory, Trajectory):
+        raise InvalidParameterError("trajectory", type(trajectory).__name__, "a twolink_pin Trajectory")
+    nv = plant.robot.nv
     if controller.robot.nv != nv:
         raise InvalidParameterError(
             "controller",
@@ -72,6 +77,8 @@ def simulate(
         ControllerError: the law raised, or returned the wrong shape or a non-finite torque.
     """
     config = config if config is not None else SimulationConfig()
+    if not isinstance(config, SimulationConfig):
+        raise InvalidParameterError("config", type(config).__name__, "a SimulationConfig or None")
     check_setup(controller, plant, trajectory)
     runs = controller.runs
     if runs not in (None, 1):

@@ -13,11 +13,21 @@ or through end-effector positions of the robot's end-effector frame (solved by
     positions = [[0.45, 0.10, 0.40], ...]       # m: (x, y, z), or (x, y) for a planar arm
     seed = [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]   # rad, optional IK seed (default: home)
 
+or a periodic finite Fourier series (:class:`~twolink_pin.trajectory.fourier.FourierTrajectory`,
+Swevers et al. 1997; what ``twolink-pin excite`` writes), a table of its own::
+
+    [fourier]
+    period = 10.0                               # s: base frequency 1 / period
+    harmonics = 5                               # optional: N, checked against a and b
+    a = [[...5 values...], [...]]               # rad/s, sine coefficients, nv rows of N
+    b = [[...5 values...], [...]]               # rad/s, cosine coefficients, nv rows of N
+    offset = [0.0, 0.5]                         # rad, mean position per joint
+
 A JSON file has the same keys. The file is read as a bounded regular file; every value is
 checked against the robot: the number of joints, finite and strictly increasing times,
 joint values within the joint limits (the message names the value and the limit), the
 last via point equal to the first (the reference repeats every period), and the sampled
-trajectory within the limits between via points too.
+trajectory within the limits between via points too (a Fourier trajectory: over a period).
 """
 
 from __future__ import annotations
@@ -32,11 +42,12 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import InputFileError, InvalidParameterError
+from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError
 from twolink_pin.files import read_input_file
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
+from twolink_pin.trajectory.fourier import MAX_HARMONICS, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
 
 if sys.version_info >= (3, 11):
@@ -56,6 +67,8 @@ CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
 KEYS = frozenset({"times", "joints", "positions", "period", "seed"})
+FOURIER_KEYS = frozenset({"period", "harmonics", "a", "b", "offset"})
+"""Keys of a ``fourier`` table."""
 
 
 def _load(path: Path) -> dict[str, Any]:
@@ -81,7 +94,16 @@ def _load(path: Path) -> dict[str, Any]:
     return document
 
 
+def _only_numbers(value: Any) -> bool:
+    """Whether ``value`` is a number or nested lists of numbers (``true`` and ``"0.5"`` are not)."""
+    if isinstance(value, list):
+        return all(_only_numbers(v) for v in value)
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
 def _numbers(path: Path, key: str, value: Any, shape: str) -> np.ndarray:
+    if not _only_numbers(value):
+        raise InvalidParameterError(f"{path}: {key}", value, f"numbers (not booleans or strings): {shape}")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
@@ -121,7 +143,9 @@ def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str
         )
 
 
-def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> JointTrajectory:
+def read_trajectory_file(
+    path: str | os.PathLike[str], robot: RobotModel
+) -> JointTrajectory | FourierTrajectory:
     """The trajectory a TOML or JSON file describes for ``robot`` (see the module docstring).
 
     Raises:
@@ -132,6 +156,8 @@ def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> Joi
     """
     file = Path(os.fspath(path))
     document = _load(file)
+    if "fourier" in document:
+        return _fourier_trajectory(file, document, robot)
     unknown = sorted(set(document) - KEYS)
     if unknown:
         raise InvalidParameterError(
@@ -153,7 +179,9 @@ def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> Joi
             f"strictly increasing times: > times[{k}] = {times[k]:g} s",
         )
     period = document.get("period")
-    if period is not None and not (isinstance(period, (int, float)) and math.isfinite(period)):
+    if period is not None and not (
+        isinstance(period, (int, float)) and not isinstance(period, bool) and math.isfinite(period)
+    ):
         raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
     given = [key for key in ("joints", "positions") if key in document]
     if len(given) != 1:
@@ -195,7 +223,10 @@ def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> Joi
                     f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
                 )
             check_within_limits(robot, seed[None, :], f"{file}: seed")
-        via_q = cartesian_via_q(robot, points, seed)
+        try:
+            via_q = cartesian_via_q(robot, points, seed)
+        except InverseKinematicsError as err:
+            raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
     closing = float(np.abs(via_q[-1] - via_q[0]).max())
     if closing > CLOSURE_TOLERANCE:
         raise InvalidParameterError(
@@ -214,10 +245,94 @@ def read_trajectory_file(path: str | os.PathLike[str], robot: RobotModel) -> Joi
     return trajectory
 
 
-def write_trajectory_file(path: str | os.PathLike[str], trajectory: JointTrajectory) -> Path:
-    """Write ``trajectory``'s joint via points as a JSON trajectory file (atomically)."""
-    from twolink_pin.files import write_json
+def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel) -> FourierTrajectory:
+    """The Fourier trajectory of a file's ``fourier`` table (see the module docstring)."""
+    others = sorted(set(document) - {"fourier"})
+    if others:
+        raise InvalidParameterError(
+            f"{file}: {others[0]}", document[others[0]], "no other key beside a 'fourier' table"
+        )
+    table = document["fourier"]
+    if not isinstance(table, dict):
+        raise InvalidParameterError(f"{file}: fourier", table, "a table with period, a, b and offset")
+    unknown = sorted(set(table) - FOURIER_KEYS)
+    if unknown:
+        raise InvalidParameterError(
+            f"{file}: fourier.{unknown[0]}", table[unknown[0]], f"only the keys {sorted(FOURIER_KEYS)}"
+        )
+    for key in ("period", "a", "b", "offset"):
+        if key not in table:
+            raise InvalidParameterError(
+                f"{file}: fourier.{key}", None, "a value (period [s], a, b [rad/s], offset [rad])"
+            )
+    period = table["period"]
+    if isinstance(period, bool) or not (
+        isinstance(period, (int, float)) and math.isfinite(period) and period > 0
+    ):
+        raise InvalidParameterError(f"{file}: fourier.period", period, "a finite period > 0 s")
+    a = _numbers(file, "fourier.a", table["a"], f"{robot.nv} rows of N sine coefficients [rad/s]")
+    if a.ndim != 2 or a.shape[0] != robot.nv or not 1 <= a.shape[1] <= MAX_HARMONICS:
+        raise InvalidParameterError(
+            f"{file}: fourier.a",
+            f"shape {a.shape}",
+            f"{robot.nv} rows (one per joint of {robot.name}) of 1 to {MAX_HARMONICS} coefficients [rad/s]",
+        )
+    b = _numbers(file, "fourier.b", table["b"], f"{robot.nv} rows of N cosine coefficients [rad/s]")
+    if b.shape != a.shape:
+        raise InvalidParameterError(f"{file}: fourier.b", f"shape {b.shape}", f"shape {a.shape} like a")
+    offset = _numbers(file, "fourier.offset", table["offset"], f"{robot.nv} mean positions [rad]")
+    if offset.shape != (robot.nv,):
+        raise InvalidParameterError(
+            f"{file}: fourier.offset", table["offset"], f"{robot.nv} mean joint positions [rad]"
+        )
+    harmonics = table.get("harmonics", a.shape[1])
+    if isinstance(harmonics, bool) or harmonics != a.shape[1]:
+        raise InvalidParameterError(
+            f"{file}: fourier.harmonics",
+            harmonics,
+            f"the number of coefficients per row of a and b ({a.shape[1]})",
+        )
+    trajectory = FourierTrajectory(float(period), a, b, offset)
+    t = np.linspace(0.0, trajectory.period, LIMIT_SAMPLES)
+    q = trajectory.sample(t).q
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    over = (q < lower) | (q > upper)
+    if over.any():
+        k, j = (int(i) for i in np.argwhere(over)[0])
+        raise InvalidParameterError(
+            f"{file}: fourier",
+            f"q{j + 1}({t[k]:.4g} s) = {q[k, j]:.6g} rad",
+            f"a motion within joint {j + 1}'s limits [{lower[j]:g}, {upper[j]:g}] rad over the period "
+            "(smaller coefficients, or an offset further from the limit)",
+        )
+    return trajectory
 
+
+def write_trajectory_file(
+    path: str | os.PathLike[str], trajectory: JointTrajectory | FourierTrajectory
+) -> Path:
+    """Write ``trajectory`` as a trajectory file (atomically): its joint via points, or a
+    Fourier trajectory's ``fourier`` table; TOML if ``path`` ends in ``.toml``, else JSON."""
+    from twolink_pin.files import atomic_write, write_json
+
+    toml = Path(os.fspath(path)).suffix.lower() == ".toml"
+    if isinstance(trajectory, FourierTrajectory):
+        table = trajectory.as_dict()
+        if not toml:
+            return write_json(path, {"fourier": table})
+        with atomic_write(path) as f:
+            f.write("# a periodic finite Fourier series: a, b [rad/s], offset [rad], period [s]\n")
+            f.write("[fourier]\n")
+            for key, value in table.items():
+                f.write(f"{key} = {json.dumps(value)}\n")
+        return Path(os.fspath(path))
+    if toml:
+        with atomic_write(path) as f:
+            f.write("# joint via points: times [s], joints [rad], period [s]\n")
+            f.write(f"times = {json.dumps(trajectory.times.tolist())}\n")
+            f.write(f"joints = {json.dumps(trajectory.via_q.tolist())}\n")
+            f.write(f"period = {json.dumps(trajectory.period)}\n")
+        return Path(os.fspath(path))
     return write_json(
         path,
         {

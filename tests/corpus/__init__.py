@@ -1,0 +1,1 @@
+"""The bad-input corpus of ``twolink-pin``: cases (``cases.py``) and how they run (``runner.py``)."""
