@@ -9,7 +9,9 @@ closed-form M and C (no Pinocchio, no numpy per stage), timed in the same run an
 interleaved with the others. The issue's targets are printed beside: single runs of pd,
 computed-torque and robust at most 12× the baseline (MuJoCo 4.0 with a Python controller
 at every RK4 stage on this job, as measured in the issue: 1.35 s against 0.111 s), the
-adaptive laws at most 18×; the batch at most 1.0× per simulation. Then the batch engine's
+adaptive laws at most 18×; the batch at most 1.0× per simulation. The UR5 (pd, computed-torque,
+adaptive) beside it: a single run and the batch at N = 1000, against the same baseline
+(``--ur5-only`` runs just that). Then the batch engine's
 scaling from N = 1 to 10 000 runs with 1 and 2 threads, the peak memory of sweeps of 1 000
 and 10 000 runs (each in a fresh process), and the wall time of ``twolink-pin report``.
 
@@ -28,6 +30,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --quick    # smoke test: seconds, numbers rough
     .venv/bin/python scripts/benchmark.py --json     # also a JSON line at the end
     .venv/bin/python scripts/benchmark.py --sweep-only [--quick]   # Dask throughput, client memory
+    .venv/bin/python scripts/benchmark.py --ur5-only [--quick]     # the UR5 against the baseline
 """
 
 from __future__ import annotations
@@ -368,6 +371,59 @@ def _batch_case(spec: str, robot: Any, n: int) -> tuple[Any, Any, np.ndarray]:
     return controller, plant, offsets
 
 
+UR5_LAWS = ("pd", "computed-torque", "adaptive")
+"""The laws timed on the UR5 (6 joints, 10 x 6 base parameters + friction for the adaptive law)."""
+
+
+def ur5_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats: int) -> dict[str, Any]:
+    """The UR5 beside the twolink: seconds per 30-s simulation of a single run (law at every
+    stage) and of the batch at N = 1000 per simulation, each timed interleaved with the
+    twolink's pure-Python baseline (``baseline``, ``scale`` to 30 s) and given as a ratio to it."""
+    ur5 = load_robot("ur5")
+    reference = default_trajectory(ur5)
+    single_duration = 0.2 if quick else 2.0
+    batch_n = 100 if quick else 1000
+    batch_duration = 0.02 if quick else 0.2
+    rng = np.random.default_rng(0)
+    offsets = rng.uniform(-0.05, 0.05, (batch_n, ur5.nv))
+    single_config = SimulationConfig(duration=single_duration, dt=DT, q0_offset=0.05)
+    batch_config = SimulationConfig(duration=batch_duration, dt=DT)
+    base_times: list[float] = []
+    single: dict[str, list[float]] = {spec: [] for spec in UR5_LAWS}
+    batch: dict[str, list[float]] = {spec: [] for spec in UR5_LAWS}
+    scenarios = {spec: make_scenario(spec, ur5) for spec in UR5_LAWS}
+    for _ in range(repeats):
+        base_times.append(_timed(baseline) * scale)
+        for spec, (law, plant) in scenarios.items():
+            single[spec].append(
+                _timed(lambda c=law, p=plant: simulate(c, p, reference, single_config))
+                * FULL
+                / single_duration
+            )
+    for _ in range(1 if quick else 2):
+        base_times.append(_timed(baseline) * scale)
+        for spec, (law, plant) in scenarios.items():
+            elapsed = _timed(
+                lambda c=law, p=plant: simulate_batch(
+                    c, p, reference, batch_config, q0_offsets=offsets, threads=2
+                )
+            )
+            batch[spec].append(elapsed * FULL / batch_duration / batch_n)
+    base = min(base_times)
+    print(
+        f"\nthe UR5 (6 joints) beside the twolink: seconds per 30-s simulation and ratio to the twolink's "
+        f"baseline ({base:.3f} s, min of {len(base_times)} interleaved; single: {single_duration:g} s simulated, "
+        f"min of {repeats}; batch: N = {batch_n}, {batch_duration:g} s simulated, 2 threads, per simulation)"
+    )
+    print(f"  {'law':24s} {'single (per stage)':>20s} {'batch per sim':>20s}")
+    rows = {}
+    for spec in UR5_LAWS:
+        cells = [min(single[spec]), min(batch[spec])]
+        rows[spec] = {"single": cells[0], "batch_per_sim": cells[1]}
+        print(f"  {spec:24s} " + " ".join(f"{x:10.3f} s {x / base:6.2f}x" for x in cells))
+    return {"ur5": {"baseline_seconds": base, "batch_n": batch_n, "seconds": rows}}
+
+
 def _verdict(ratio: float, target: float | None) -> str:
     if target is None:
         return ""
@@ -383,6 +439,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--json", action="store_true", help="also print the results as one JSON line")
     parser.add_argument(
         "--sweep-only", action="store_true", help="only the sweep throughput on Dask and the client's memory"
+    )
+    parser.add_argument(
+        "--ur5-only", action="store_true", help="only the UR5's single run and batch against the baseline"
     )
     args = parser.parse_args(argv)
     quick = args.quick
@@ -414,6 +473,11 @@ def main(argv: list[str] | None = None) -> int:
         return baseline_pd(trajectory, robot.p, pd_gains, q0, v0, DT, n)
 
     scale = FULL / single_duration
+    if args.ur5_only:
+        results.update(ur5_section(baseline, scale, quick, repeats))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     Q, _, _ = baseline()
     controller, plant = make_scenario("pd", robot)
     check = simulate(controller, plant, trajectory, SimulationConfig(duration=single_duration, dt=DT))
@@ -501,6 +565,7 @@ def main(argv: list[str] | None = None) -> int:
         "duration": batch_duration,
         "seconds": {_label(k): v for k, v in batch.items()},
     }
+    results.update(ur5_section(baseline, scale, quick, repeats))
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)

@@ -396,3 +396,34 @@ def test_three_joint_arm_single_and_batch_agree(arm3: tuple[RobotModel, JointTra
     single = simulate(law, plant, trajectory, config)
     batch = simulate_batch(law, plant, trajectory, config, runs=2, record=True)
     _assert_run_equals(single, batch, 1)
+
+
+def test_both_batch_regressors_equal_pinocchios_regressor_on_the_ur5() -> None:
+    """The UR5's 36 base-parameter columns, run by run (the default for many columns) and from
+    2 RNEA per column over polarisation forests of at most FOREST_NV joints: both equal
+    ``computeJointTorqueRegressor(q, v, a) P`` at w = v, and ``Y p₀`` is RNEA at any w
+    (the Christoffel form against Pinocchio's Coriolis matrix)."""
+    from twolink_pin.simulation.terms import FOREST_NV, _Regressor, _RegressorByRun
+
+    ur5 = load_robot("ur5")
+    model, P = ur5.model, ur5.parameter_map.matrix
+    rng = np.random.default_rng(3)
+    q, v, w, a = (rng.uniform(-1.5, 1.5, (5, ur5.nv)) for _ in range(4))
+    by_run = np.stack(_RegressorByRun(model, ur5.parameter_map)(q, v, v, a), axis=2)
+    forest = _Regressor(model, ur5.parameter_map, 1, 5)
+    assert forest.terms is not None and all(2 * k * ur5.nv <= FOREST_NV for k, _, _ in forest.terms.groups)
+    by_rnea = np.stack(forest(q, v, v, a), axis=2)
+    data = model.createData()
+    for i in range(5):
+        expected = pin.computeJointTorqueRegressor(model, data, q[i], v[i], a[i]) @ P
+        scale = max(1.0, float(np.abs(expected).max()))
+        assert np.abs(by_run[i] - expected).max() <= TOL * scale
+        assert np.abs(by_rnea[i] - expected).max() <= TOL * scale
+    p0 = ur5.parameter_map.values(model)
+    tau = np.einsum("nij,j->ni", np.stack(_RegressorByRun(model, ur5.parameter_map)(q, v, w, a), axis=2), p0)
+    for i in range(5):
+        M = pin.crba(model, data, q[i])
+        M = np.triu(M) + np.triu(M, 1).T
+        C = pin.computeCoriolisMatrix(model, data, q[i], v[i])
+        g = pin.computeGeneralizedGravity(model, data, q[i])
+        assert np.abs(tau[i] - (M @ a[i] + C @ w[i] + g)).max() <= TOL * max(1.0, float(np.abs(tau[i]).max()))
