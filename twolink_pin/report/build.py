@@ -311,9 +311,12 @@ def _build(
     animation = None
     workers = min(options.workers, len(order) + 1)
     with _pool(workers) as pool:
+        # The identification's runs first: they are the longest tasks (3 adaptive runs and a
+        # logged run of 30 s), so the laws' runs fill the other worker meanwhile.
+        reused = "adaptive" in names and _reuses_adaptive_run(options)
+        ident_futures = _submit_identification(pool, options, str(fig_dir), reused) if is_twolink else None
         futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
         traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
-        ident_future = pool.submit(_identification_section, options, str(fig_dir)) if is_twolink else None
         model = facts.model_facts(robot)
         twolink: dict[str, Any] | None = None
         if is_twolink:
@@ -337,8 +340,21 @@ def _build(
                 tick("animation")
         traj_figs = traj_future.result()
         tick("trajectory figures")
-        identification = None if ident_future is None else ident_future.result()
-        if ident_future is not None:
+        identification = None
+        if ident_futures is not None:
+            runs_future, fit_future = ident_futures
+            excitation_runs = {key: f.result() for key, f in runs_future.items()}
+            if reused:  # the report's own adaptive run is the one along its trajectory
+                result = runs["adaptive"][0]
+                assert result.p_hat is not None
+                own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
+                excitation_runs = {"report": own, **excitation_runs}
+            identification = _identification_section(
+                options,
+                str(fig_dir),
+                excitation_runs,
+                None if fit_future is None else fit_future.result(),
+            )
             tick("identification")
     runs = {n: runs[n] for n in names}  # the order asked for
     table = ComparisonTable(
@@ -431,13 +447,50 @@ def _finite(x: Any) -> Any:
     return x
 
 
-def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, Any]:
-    """Worker: the report's question answered beside Figure 27 (the twolink only; picklable
-    arguments): why the adaptive estimates are still far from p at the end of the run, the
-    excitations that fix it, and what identification gives from one run of the same length.
+def _reuses_adaptive_run(options: ReportOptions) -> bool:
+    """Whether the report's ``adaptive`` run is exactly the identification section's run
+    along the report's trajectory (same law, gains, p̂(0), reference and simulation)."""
+    from twolink_pin.simulation import SimulationConfig
 
-    The adaptive runs and the identification need a run of at least one excitation period;
-    shorter reports show the table only."""
+    return (
+        options.trajectory is None
+        and options.p0 is None
+        and options.model is None
+        and options.lam is None
+        and not options.saturate
+        and options.friction_smoothing == 0.0
+        and options.config == SimulationConfig(duration=options.config.duration)
+    )
+
+
+def _submit_identification(
+    pool: Any, options: ReportOptions, fig_dir: str, reused: bool
+) -> tuple[dict[str, Any], Any] | None:
+    """Submit the identification section's tasks: the report's adaptive law along each
+    reference (one task each; not along the report's trajectory when ``reused``: the
+    report's own adaptive run is that one) and the identification from a logged run."""
+    from twolink_pin.twolink import excitation as twolink_excitation
+
+    if options.config.duration < twolink_excitation.PERIOD:
+        return {}, None
+    keys = [key for key in twolink_excitation.TRAJECTORIES if not (reused and key == "report")]
+    runs = {key: pool.submit(_excitation_run, options, key) for key in keys}
+    return runs, pool.submit(_identification_fit, options, fig_dir)
+
+
+def _excitation_run(options: ReportOptions, key: str) -> tuple[np.ndarray, np.ndarray]:
+    """Worker: the report's adaptive law along the reference ``key``: ``(t [s], p̂)``."""
+    from twolink_pin.twolink import excitation as twolink_excitation
+
+    robot = load_robot(options.robot, payload=options.payload)
+    result = twolink_excitation.adaptive_runs(robot, duration=options.config.duration, keys=(key,))[key]
+    assert result.p_hat is not None
+    return np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size]
+
+
+def _identification_fit(options: ReportOptions, fig_dir: str) -> tuple[list[str], dict[str, Any]]:
+    """Worker: identification from one noisy logged run along the identification excitation,
+    its figures and its numbers."""
     from twolink_pin.identification import (
         ExcitationLimits,
         IdentifiedParameters,
@@ -446,12 +499,59 @@ def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, A
         map_parameters,
         simulate_log,
     )
-    from twolink_pin.identification.measures import averaged_adaptation
-    from twolink_pin.plotting.identification import (
-        save_convergence_figure,
-        save_excitation_figures,
-        save_identification_figures,
+    from twolink_pin.plotting.identification import save_excitation_figures, save_identification_figures
+    from twolink_pin.twolink import excitation as twolink_excitation
+
+    robot = load_robot(options.robot, payload=options.payload)
+    p = np.asarray(robot.p, dtype=float)
+    log = simulate_log(
+        robot, twolink_excitation.identification_excitation(), duration=options.config.duration
     )
+    noisy = add_noise(log, *IDENTIFICATION_NOISE, seed=0)
+    found = identify(noisy, robot)
+    figures = list(save_identification_figures(found, fig_dir))
+    limits = ExcitationLimits().resolve(robot)
+    figures += save_excitation_figures(
+        robot,
+        twolink_excitation.identification_excitation(),
+        fig_dir,
+        limits={k: v.tolist() for k, v in limits.items()},
+    )
+    nb = found.size - 2 * robot.nv
+    identified = IdentifiedParameters("report", found.estimate[:nb], found.std[:nb], None)
+    p_identified = map_parameters(robot, identified)
+    inside = found.within()
+    numbers = {
+        "noise": {"q_rad": IDENTIFICATION_NOISE[0], "tau_Nm": IDENTIFICATION_NOISE[1], "seed": 0},
+        "parameters": found.parameters(),
+        "condition_number": found.condition_number,
+        "validation_rms": None if found.validation is None else found.validation.rms.tolist(),
+        "fit_samples": found.fit_samples,
+        "cutoff_hz": found.cutoff_hz,
+        "within_3_sigma": None if inside is None else int(np.sum(inside)),
+        "method": found.method,
+        "p": p_identified.tolist(),
+        "p_relative_error": (np.abs(p_identified - p) / np.abs(p)).tolist(),
+    }
+    return [str(f) for f in figures], numbers
+
+
+def _identification_section(
+    options: ReportOptions,
+    fig_dir: str,
+    runs: dict[str, tuple[np.ndarray, np.ndarray]] | None = None,
+    fit: tuple[list[str], dict[str, Any]] | None = None,
+) -> dict[str, Any]:
+    """The report's question answered beside Figure 27 (the twolink only): why the adaptive
+    estimates are still far from p at the end of the run, the excitations that fix it, and
+    what identification gives from one run of the same length. ``runs`` (key → (t, p̂)) and
+    ``fit`` are the results of :func:`_excitation_run` and :func:`_identification_fit`, run
+    here when not given.
+
+    The adaptive runs and the identification need a run of at least one excitation period;
+    shorter reports show the table only."""
+    from twolink_pin.identification.measures import averaged_adaptation
+    from twolink_pin.plotting.identification import save_convergence_figure
     from twolink_pin.twolink import excitation as twolink_excitation
 
     robot = load_robot(options.robot, payload=options.payload)
@@ -471,15 +571,15 @@ def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, A
             "the adaptive runs along the excitations and the identification are left out"
         )
         return _finite(section)
-    results = twolink_excitation.adaptive_runs(robot, duration=duration)
+    if not runs:
+        runs = {key: _excitation_run(options, key) for key in twolink_excitation.TRAJECTORIES}
+    if fit is None:
+        fit = _identification_fit(options, fig_dir)
     controller = twolink_excitation.report_adaptive(robot).controller
     p = np.asarray(robot.p, dtype=float)
-    n_p = p.size
     panels = {}
-    for key, res in results.items():
-        assert res.p_hat is not None
-        p_hat = np.asarray(res.p_hat)[:, :n_p]
-        within = twolink_excitation.time_within(res.t, p_hat, p)
+    for key, (t, p_hat) in runs.items():
+        within = twolink_excitation.time_within(t, p_hat, p)
         averaged = averaged_adaptation(controller, twolink_excitation.trajectories(robot)[key])
         t_pred = np.linspace(0.0, duration, 301)
         predicted = averaged.predicted_error(p_hat[0] - p, t_pred)
@@ -490,7 +590,7 @@ def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, A
             "time_within_5_percent_s": within,
         }
         panels[twolink_excitation.TITLES[key]] = {
-            "t": res.t,
+            "t": t,
             "p_hat": p_hat,
             "p_true": p,
             "names": list(robot.parameter_map.names),
@@ -504,35 +604,10 @@ def _identification_section(options: ReportOptions, fig_dir: str) -> dict[str, A
             Path(fig_dir) / "identification_convergence.png",
             title="the report's adaptive law (K = 120, γ = (0.5, 0.15, 0.6)) along three references — cf. report "
             "Fig. 27\n|p̂ − p| / |p| (solid: simulated; dotted: averaged model exp(−ΓG t))",
-        )
+        ),
+        *fit[0],
     ]
-    log = simulate_log(robot, twolink_excitation.identification_excitation(), duration=duration)
-    noisy = add_noise(log, *IDENTIFICATION_NOISE, seed=0)
-    found = identify(noisy, robot)
-    figures += save_identification_figures(found, fig_dir)
-    limits = ExcitationLimits().resolve(robot)
-    figures += save_excitation_figures(
-        robot,
-        twolink_excitation.identification_excitation(),
-        fig_dir,
-        limits={k: v.tolist() for k, v in limits.items()},
-    )
-    nb = found.size - 2 * robot.nv
-    identified = IdentifiedParameters("report", found.estimate[:nb], found.std[:nb], None)
-    p_identified = map_parameters(robot, identified)
-    inside = found.within()
-    section["identified"] = {
-        "noise": {"q_rad": IDENTIFICATION_NOISE[0], "tau_Nm": IDENTIFICATION_NOISE[1], "seed": 0},
-        "parameters": found.parameters(),
-        "condition_number": found.condition_number,
-        "validation_rms": None if found.validation is None else found.validation.rms.tolist(),
-        "fit_samples": found.fit_samples,
-        "cutoff_hz": found.cutoff_hz,
-        "within_3_sigma": None if inside is None else int(np.sum(inside)),
-        "method": found.method,
-        "p": p_identified.tolist(),
-        "p_relative_error": (np.abs(p_identified - p) / np.abs(p)).tolist(),
-    }
+    section["identified"] = fit[1]
     section["figures"] = [Path(f).name for f in figures]
     return _finite(section)
 
