@@ -4,7 +4,7 @@
 ``base.py``                 :class:`Trajectory` (what the engine samples), :class:`TrajectorySample`
 ``polynomial.py``           :class:`JointTrajectory`: one polynomial per joint through via points
 ``cartesian.py``            end-effector via points: planar 2R analytic IK or any arm's DLS IK
-``defaults.py``             each robot's default reference (its profile's, or a swing about home)
+``defaults.py``             each robot's default reference (its profile's, or a swing about home), :func:`build_trajectory`
 ``fourier.py``              :class:`FourierTrajectory`: a periodic finite Fourier series (excitations)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ==========================  ================================================================
@@ -13,12 +13,12 @@
 from twolink_pin.trajectory.base import Trajectory, TrajectorySample
 from twolink_pin.trajectory.cartesian import (
     ViaPoints,
-    build_trajectory,
     cartesian_trajectory,
     cartesian_via_q,
 )
 from twolink_pin.trajectory.defaults import (
     NEUTRAL_AMPLITUDE,
+    build_trajectory,
     default_trajectory,
     default_via_points,
     home_configuration,

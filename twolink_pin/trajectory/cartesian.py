@@ -10,7 +10,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError, InverseKinematicsError
-from twolink_pin.kinematics import inverse_kinematics, solve_position
+from twolink_pin.kinematics import solve_position
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.polynomial import JointTrajectory, check_period, check_times
 
@@ -46,28 +46,12 @@ class ViaPoints:
             raise InvalidParameterError("boundary_order", self.boundary_order, "an integer from 0 to 6")
 
 
-def build_trajectory(robot: RobotModel, via: ViaPoints | None = None) -> JointTrajectory:
-    """Trajectory through end-effector via points of a planar 2R arm (IK branch
-    ``via.branch``); default: the robot's own trajectory
-    (:func:`~twolink_pin.trajectory.default_trajectory`).
-
-    Raises:
-        UnreachableTargetError: a via point is outside the reachable annulus.
-    """
-    if via is None:
-        from twolink_pin.trajectory.defaults import default_trajectory
-
-        return default_trajectory(robot)
-    via_q = np.array([inverse_kinematics(robot, xy)[via.branch] for xy in via.xy])
-    return JointTrajectory.from_via_q(via.times, via_q, via.period, via.boundary_order)
-
-
 def cartesian_via_q(
     robot: RobotModel, points: Sequence[Sequence[float]] | np.ndarray, seed: np.ndarray | None = None
 ) -> np.ndarray:
     """Joint via points [rad], shape (n, nv), reaching each end-effector point [m] in turn:
     the first from ``seed`` (default the robot's home, see
-    :func:`~twolink_pin.trajectory.defaults.home_configuration`), each next from the one
+    :attr:`~twolink_pin.model.RobotModel.home`), each next from the one
     before, so that the arm stays on one IK branch; a point equal to the first gets the
     first's configuration (a redundant arm could reach it in another).
 
@@ -75,9 +59,7 @@ def cartesian_via_q(
         InverseKinematicsError: a point is out of reach or reached only at a singular
             configuration; the message says which point (0-based) and why.
     """
-    from twolink_pin.trajectory.defaults import home_configuration
-
-    q = home_configuration(robot) if seed is None else np.asarray(seed, dtype=float)
+    q = robot.home if seed is None else np.asarray(seed, dtype=float)
     rows: list[np.ndarray] = []
     for k, point in enumerate(points):
         if k > 0 and np.array_equal(np.asarray(point, dtype=float), np.asarray(points[0], dtype=float)):

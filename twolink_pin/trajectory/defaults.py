@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
-from twolink_pin.trajectory.cartesian import ViaPoints, build_trajectory, cartesian_trajectory
+from twolink_pin.trajectory.cartesian import ViaPoints, cartesian_trajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
 
 NEUTRAL_AMPLITUDE = 0.4
@@ -76,3 +77,17 @@ def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
     signs = np.where(np.arange(robot.nv) % 2 == 0, 1.0, -1.0)
     via_q = home + np.outer(shape, signs * amplitude)
     return JointTrajectory.from_via_q(times, via_q)
+
+
+def build_trajectory(robot: RobotModel, via: ViaPoints | None = None) -> JointTrajectory:
+    """Trajectory through end-effector via points of a planar 2R arm (IK branch
+    ``via.branch``); default: the robot's own trajectory
+    (:func:`~twolink_pin.trajectory.default_trajectory`).
+
+    Raises:
+        UnreachableTargetError: a via point is outside the reachable annulus.
+    """
+    if via is None:
+        return default_trajectory(robot)
+    via_q = np.array([inverse_kinematics(robot, xy)[via.branch] for xy in via.xy])
+    return JointTrajectory.from_via_q(via.times, via_q, via.period, via.boundary_order)
