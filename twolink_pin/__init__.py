@@ -82,8 +82,7 @@ from twolink_pin.trajectory import (
 )
 from twolink_pin.twolink import excitation as _twolink_excitation  # noqa: F401  # registers its stored excitation
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
-
-__version__ = "0.2.0"
+from twolink_pin.version import __version__ as __version__
 
 __all__ = [
     "CONTROLLERS",

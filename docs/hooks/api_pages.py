@@ -63,9 +63,9 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("twolink", "The twolink", "Everything specific to the course report's arm.", ("twolink",)),
     (
         "files",
-        "Files, errors, arrays, math",
-        "The one writer, the exceptions, read-only arrays, LaTeX → MathML.",
-        ("files", "errors", "arrays", "mathml"),
+        "Files, errors, arrays, math, version",
+        "The one writer, the exceptions, read-only arrays, LaTeX → MathML, the version.",
+        ("files", "errors", "arrays", "mathml", "version"),
     ),
 )
 """``(page, title, one line, modules under twolink_pin)`` in the navigation's order."""

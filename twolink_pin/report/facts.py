@@ -95,10 +95,10 @@ def versions() -> dict[str, str]:
     """Versions of what made the report."""
     import pinocchio
 
-    import twolink_pin
+    from twolink_pin.version import __version__
 
     return {
-        "twolink_pin": twolink_pin.__version__,
+        "twolink_pin": __version__,
         "pinocchio": pinocchio.__version__,
         "numpy": np.__version__,
         "matplotlib": importlib.metadata.version("matplotlib"),  # plotting is the only importer

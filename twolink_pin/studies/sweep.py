@@ -387,10 +387,10 @@ def environment() -> tuple[tuple[str, str], ...]:
     """The versions a run's numbers depend on: twolink-pin, numpy, Pinocchio."""
     import pinocchio
 
-    import twolink_pin
+    from twolink_pin.version import __version__
 
     return (
-        ("twolink-pin", str(twolink_pin.__version__)),
+        ("twolink-pin", __version__),
         ("numpy", str(np.__version__)),
         ("pinocchio", str(pinocchio.__version__)),
     )
@@ -788,11 +788,11 @@ def sweep_metadata(
     """The sweep's configuration as written into every Parquet file (JSON): everything the
     rows depend on (the reference ``trajectory`` too, when given), nothing about where or in
     which chunks they ran."""
-    import twolink_pin
+    from twolink_pin.version import __version__
 
     nominal = joint_offsets("q0_offset", config.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
     return {
-        "twolink_pin": str(twolink_pin.__version__),
+        "twolink_pin": __version__,
         "controller": cls.name,
         "controller_spec": config.controller,
         "robot": robot.name,
