@@ -131,6 +131,11 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
     assert results["twolink"] is None and results["errata"] == []
     html = (tmp_path / "r" / "index.html").read_text()
     assert "table1" not in html and "table2-report" not in html and "Errata" not in html
+    # the sections it has are numbered 1, 2, 3 ... with no gap where the report's would be
+    numbers = [int(n) for n in re.findall(r'<h2 id="[^"]+">(\d+)\. ', html)]
+    assert numbers == list(range(1, 7)), numbers
+    nav = re.search(r"<nav>(.*?)</nav>", html, re.S)
+    assert nav is not None and re.findall(r'">(\d+) ', nav[1]) == [str(n) for n in numbers]
 
 
 def test_refuses_a_directory_that_is_not_a_report(tmp_path: Path) -> None:
