@@ -100,7 +100,7 @@ class DaskProcesses:
             "1",
             *local,
         ]
-        worker += ["--preload", "twolink_pin.studies.cluster", *([] if self.nanny else ["--no-nanny"])]
+        worker += ["--preload", "twolink_pin.studies.sweep", *([] if self.nanny else ["--no-nanny"])]
         for _ in range(self.count):
             self.workers.append(subprocess.Popen(worker, stdout=self.log, stderr=self.log, cwd=cwd))
         with self.client() as client:

@@ -177,16 +177,16 @@ def _handshake(address: str, timeout: float) -> None:
 
 
 def dask_setup(worker: Any) -> None:
-    """Preload of workers (``dask worker --preload twolink_pin.studies.cluster``, and the
-    LocalCluster's): import the sweep code before the first task; in a LocalCluster's
-    workers also leave Ctrl-C to the client, which kills them (a terminal sends SIGINT to
-    the whole process group)."""
+    """Preload hook of workers (Dask calls it when the worker starts with ``--preload`` of a
+    module that has it: this one, or :mod:`twolink_pin.studies.sweep`, which re-exports it so
+    that the sweep's code is imported before the first task): in a LocalCluster's workers,
+    leave Ctrl-C to the client, which kills them (a terminal sends SIGINT to the whole
+    process group)."""
     import os
     import signal
 
     if os.environ.get(LOCAL_WORKER) == "1" and threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-    import twolink_pin.studies.sweep  # noqa: F401
 
 
 def _call(fn: Callable[..., Any], topic: str, index: int, args: tuple[Any, ...]) -> tuple[str, Any]:
@@ -384,7 +384,10 @@ def _dashboard(link: str | None) -> str | None:
 
 @contextlib.contextmanager
 def open_cluster(
-    scheduler: str | None = None, workers: int | None = None, timeout: float = CONNECT_TIMEOUT
+    scheduler: str | None = None,
+    workers: int | None = None,
+    timeout: float = CONNECT_TIMEOUT,
+    preload: Sequence[str] = (),
 ) -> Iterator[DaskEngine]:
     """A :class:`DaskEngine` on ``scheduler``, or on a new LocalCluster of ``workers``
     processes; closed (pending tasks cancelled, the LocalCluster stopped) on exit.
@@ -394,6 +397,9 @@ def open_cluster(
         workers: Worker processes of a LocalCluster on 127.0.0.1, 1 to :data:`MAX_WORKERS`
             (one thread each).
         timeout: Seconds for the scheduler to answer and to have at least one worker, > 0.
+        preload: Modules a LocalCluster's workers import when they start (the code their
+            tasks run; each may have a ``dask_setup`` hook, see :func:`dask_setup`); default
+            this one.
 
     Raises:
         InvalidParameterError: both or neither of ``scheduler`` and ``workers``, or a bad value.
@@ -435,7 +441,7 @@ def open_cluster(
                 host="127.0.0.1",
                 scheduler_port=0,
                 dashboard_address="127.0.0.1:0",
-                preload=["twolink_pin.studies.cluster"],
+                preload=list(preload) or [__name__],
                 env={LOCAL_WORKER: "1"},
             )
             client = Client(cluster, set_as_default=False)

@@ -68,6 +68,9 @@ from twolink_pin.simulation import SimulationConfig
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError
+from twolink_pin.studies.cluster import (
+    dask_setup as dask_setup,  # the workers' preload hook (--preload this module)
+)
 from twolink_pin.studies.parquet import (
     FLAGS,
     RUNS_FOLDER,
@@ -919,7 +922,7 @@ def run_sweep(
         elif scheduler is not None or workers is not None:
             from twolink_pin.studies.cluster import open_cluster
 
-            engine = stack.enter_context(open_cluster(scheduler, workers, timeout))
+            engine = stack.enter_context(open_cluster(scheduler, workers, timeout, preload=(__name__,)))
             if notify is not None:
                 notify(f"sweep on {engine.description}")
                 if engine.dashboard:
