@@ -598,7 +598,7 @@ def _identification_section(
             "time_within": within,
             "note": f"averaged slowest time constant {averaged.slowest_time_constant:.3g} s",
         }
-    figures = [
+    figures: list[str | Path] = [
         save_convergence_figure(
             panels,
             Path(fig_dir) / "identification_convergence.png",
