@@ -897,6 +897,21 @@ def test_distribution_figure_histograms(tmp_path: Path) -> None:
     assert int(np.isnan(a).sum()) == 3
 
 
+def test_distribution_figure_of_values_equal_but_for_rounding(tmp_path: Path) -> None:
+    """A metric equal in every run but for the last bits (a UR5 sweep's peak torque: numpy's
+    "auto" bins cannot cut a range of 1e-14 at 150 and raised): one bin holding every run;
+    a tiny but real spread still gets numpy's bins."""
+    rows = {
+        "peak τ1 [N·m]": 150.0 + np.array([0.0, 2.8e-14, 5.7e-14, 0.0]),
+        "RMS e1 [rad]": 1e-7 * np.array([1.0, 1.1, 1.3, 1.2]),
+    }
+    fig = _distribution_figure(rows)
+    rounding, tiny = (ax for ax in fig.axes if ax.get_visible())
+    assert len(rounding.patches) == 1 and rounding.patches[0].get_height() == 4
+    assert len(tiny.patches) > 1 and sum(p.get_height() for p in tiny.patches) == 4
+    _assert_png(plotting.save_distribution_figure(rows, tmp_path / "d.png"), tuple(fig.get_size_inches()))
+
+
 def test_distribution_figure_rejects_empty_input(tmp_path: Path) -> None:
     with pytest.raises(InvalidParameterError, match="at least one metric"):
         plotting.save_distribution_figure({}, tmp_path / "x.png")

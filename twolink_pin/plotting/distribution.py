@@ -23,6 +23,21 @@ DEFAULT_TITLE = "Distribution of metrics over the sweep"
 """Title of a distribution figure when none is given."""
 
 
+def _bins(x: np.ndarray) -> np.ndarray:
+    """numpy's ``"auto"`` bin edges of ``x``; or, when its spread is rounding (a metric equal
+    in every run but for the last bits, whose range numpy cannot cut into finite bins), one
+    bin of ±5 % about the value, wide enough to be seen."""
+    scale = float(np.max(np.abs(x)))
+    if float(np.ptp(x)) > 1e-9 * scale:
+        try:
+            return np.histogram_bin_edges(x, bins="auto")
+        except ValueError:  # "too many bins for data range"
+            pass
+    centre = float(np.median(x))
+    half = max(0.05 * abs(centre), float(np.ptp(x)), 1e-12)
+    return np.array([centre - half, centre + half])
+
+
 def _distribution_figure(rows: Mapping[str, np.ndarray], title: str | None = None) -> Figure:
     """Histograms of each metric in ``rows`` (one subplot each), median and mean marked.
 
@@ -44,8 +59,10 @@ def _distribution_figure(rows: Mapping[str, np.ndarray], title: str | None = Non
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax, (name, x) in zip(axes, values.items()):
         finite = x[np.isfinite(x)]
-        bins = "auto" if np.ptp(finite) > 0 else 1
-        ax.hist(finite, bins=bins, color=ACTUAL_COLOR, alpha=0.75, edgecolor="white")
+        edges = _bins(finite)
+        ax.hist(finite, bins=edges, color=ACTUAL_COLOR, alpha=0.75, edgecolor="white")
+        if edges.size == 2:  # one value: no offset notation for its tiny spread
+            ax.ticklabel_format(axis="x", useOffset=False)
         median, mean = float(np.median(finite)), float(np.mean(finite))
         ax.axvline(median, color="black", lw=1.4, label=f"median {median:.3g}")
         ax.axvline(mean, color=ERROR_COLOR, lw=1.2, ls="--", label=f"mean {mean:.3g}")
