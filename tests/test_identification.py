@@ -518,6 +518,18 @@ def test_a_parameter_file_of_another_robot_is_refused(tmp_path: Path, twolink) -
 # --------------------------------------------------------------------------- the CLI
 
 
+def test_cli_identify_says_when_the_3_sigma_count_tests_nothing(capsys: pytest.CaptureFixture[str]) -> None:
+    """On noise-free simulated data σ is rounding and filtering: the ±3σ count says so; with
+    torque noise it is a test of σ and carries no such note."""
+    short = ["identify", "--duration", "12", "--dt", "0.001"]
+    assert main(short) == 0
+    clean = capsys.readouterr().out.splitlines()[-1]
+    assert clean.startswith("  true values within ±3σ:") and "noise-free data" in clean
+    assert main([*short, "--noise-tau", "0.05"]) == 0
+    noisy = capsys.readouterr().out.splitlines()[-1]
+    assert noisy.startswith("  true values within ±3σ:") and "noise-free" not in noisy
+
+
 def test_cli_identify_json_and_p0(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     """identify --json is clean JSON with parameters (name, estimate, std, true) and the
     condition number; the saved file seeds simulate --p0; a CSV error is one line, exit 2."""

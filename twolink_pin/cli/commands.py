@@ -530,7 +530,16 @@ def cmd_identify(args: argparse.Namespace) -> int:
         + ("" if result.validation is None else f"; validation RMS {fmt(result.validation.rms, 4)} N·m")
     )
     if within is not None:
-        lines.append(f"  true values within ±3σ: {int(within.sum())} of {within.size}")
+        noise_free = args.data is None and not args.noise_q and not args.noise_tau
+        lines.append(
+            f"  true values within ±3σ: {int(within.sum())} of {within.size}"
+            + (
+                " (noise-free data: σ and the errors are rounding and filtering, not a test of σ; "
+                "add --noise-q/--noise-tau)"
+                if noise_free
+                else ""
+            )
+        )
     lines += [f"  figure {f}" for f in figures]
     if args.save:
         lines.append(f"  parameters saved to {args.save} (use with --p0 / --model)")
