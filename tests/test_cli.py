@@ -80,6 +80,24 @@ def test_simulate_gain_option_sets_one_value_or_one_per_joint(capsys: pytest.Cap
     assert json.loads(out)["metrics"]["max"]["tau"][0] >= 35 - 1e-9
 
 
+def test_simulate_last_period_line_says_when_the_run_is_shorter_than_a_period(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The twolink's reference repeats every 4 s: a 2-s run's "last period" is the whole run,
+    its max |e| the 0.1-rad initial offset, and the line says so; an 8-s run's is the
+    steady state, printed to 4 significant digits (not as 0.00000000)."""
+    assert main(["simulate", "pd", "--duration", "2"]) == 0
+    short = next(line for line in capsys.readouterr().out.splitlines() if "last period" in line)
+    assert (
+        short
+        == "  last period max |e| (0.1, 0.1) rad (the run is shorter than one 4-s period: over the whole run)"
+    )
+    assert main(["simulate", "pd", "--duration", "8"]) == 0
+    long = next(line for line in capsys.readouterr().out.splitlines() if "last period" in line)
+    values = [float(x) for x in long.split("(")[1].split(")")[0].split(",")]
+    assert "shorter" not in long and all(0 < v < 1e-6 for v in values), long
+
+
 def test_simulate_json_short_pd_run(capsys: pytest.CaptureFixture[str]) -> None:
     code, out, _ = run(capsys, "simulate", "pd", "--duration", "0.5", "--json")
     data = json.loads(out)

@@ -696,7 +696,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
-        f"  last period max |e| {fmt(metrics.final_period_max_abs_e, 8)} rad",
+        f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
+        + (
+            f" (the run is shorter than one {result.reference_period:g}-s period: over the whole run)"
+            if result.duration < result.reference_period
+            else ""
+        ),
     ]
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
         if over:
