@@ -138,6 +138,28 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
     assert nav is not None and re.findall(r'">(\d+) ', nav[1]) == [str(n) for n in numbers]
 
 
+def test_the_identification_section_can_be_left_out(tmp_path: Path) -> None:
+    """--no-identification (ReportOptions.identification=False): no section, no link in the
+    navigation, no entry in results.json; left in, a 1-s report still has its table."""
+    short = {
+        "config": SimulationConfig(duration=1.0),
+        "workers": 1,
+        "animation": False,
+        "controllers": ("pd",),
+    }
+    results = build_report(tmp_path / "without", ReportOptions(identification=False, **short))
+    html = (tmp_path / "without" / "index.html").read_text()
+    assert results["identification"] is None and 'id="identification"' not in html
+    assert 'href="#identification"' not in html
+    results = build_report(tmp_path / "with", ReportOptions(**short))
+    html = (tmp_path / "with" / "index.html").read_text()
+    assert (
+        results["identification"]["table"]
+        and 'id="identification"' in html
+        and 'href="#identification"' in html
+    )
+
+
 def test_refuses_a_directory_that_is_not_a_report(tmp_path: Path) -> None:
     target = tmp_path / "mine"
     target.mkdir()

@@ -881,6 +881,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         controllers=None if args.controllers is None else tuple(args.controllers),
         workers=args.workers,
         animation=not args.no_animation,
+        identification=not args.no_identification,
         trajectory=args.trajectory,
         p0=args.p0,
         model=args.model,

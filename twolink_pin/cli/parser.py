@@ -286,6 +286,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--workers", type=whole(1, 64), default=2, help="processes for the runs (1 to 64, default 2)"
     )
     p.add_argument("--no-animation", action="store_true", help="skip the 3-D animation")
+    p.add_argument(
+        "--no-identification",
+        action="store_true",
+        help="skip the twolink's identification section (beside Fig. 27; ~6 s of the report's time)",
+    )
     add_robot_options(p)
     p.set_defaults(func=c.cmd_report)
 

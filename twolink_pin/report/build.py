@@ -64,6 +64,9 @@ class ReportOptions:
             the course report's five on the twolink, every built-in law elsewhere.
         workers: Processes for the runs and figures (1: in this process), 1 to 64.
         animation: Whether to write the self-contained animation.
+        identification: Whether the twolink's report has its identification section (beside
+            Fig. 27: the adaptive law along two excitations and an identification; about
+            14 s of CPU: without it the report takes 11–13 s on 2 cores instead of 17–19 s).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
@@ -82,6 +85,7 @@ class ReportOptions:
     controllers: tuple[str, ...] | None = None
     workers: int = 2
     animation: bool = True
+    identification: bool = True
     trajectory: str | None = None
     p0: str | None = None
     model: str | None = None
@@ -265,7 +269,9 @@ def build_report(
     robot = load_robot(options.robot, payload=options.payload)
     is_twolink = robot.name == "twolink"
     specs = laws_to_run(options, is_twolink)
-    steps = 4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink else 0)
+    steps = (
+        4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink and options.identification else 0)
+    )
     done = 0
 
     def tick(what: str) -> None:
@@ -314,7 +320,11 @@ def _build(
         # The identification's runs first: they are the longest tasks (3 adaptive runs and a
         # logged run of 30 s), so the laws' runs fill the other worker meanwhile.
         reused = "adaptive" in names and _reuses_adaptive_run(options)
-        ident_futures = _submit_identification(pool, options, str(fig_dir), reused) if is_twolink else None
+        ident_futures = (
+            _submit_identification(pool, options, str(fig_dir), reused)
+            if is_twolink and options.identification
+            else None
+        )
         futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
         traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
         model = facts.model_facts(robot)
