@@ -200,22 +200,19 @@ print(before, high_water_mib(), traced / 2**20, output.seconds)
 """
 
 
-def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
-    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations."""
+def _child_memory(script: str, *args: object) -> dict[str, float]:
+    """Run a sweep ``script`` in a fresh process; its printed peak RSS before / after the sweep,
+    Python allocations' peak [MiB] and the sweep's seconds."""
     done = subprocess.run(
-        [sys.executable, "-c", _SWEEP_CHILD, str(samples), str(duration), out],
-        capture_output=True,
-        text=True,
-        check=True,
+        [sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True, check=True
     )
     before, peak, traced, seconds = (float(x) for x in done.stdout.split())
-    return {
-        "samples": samples,
-        "rss_before_mib": before,
-        "rss_peak_mib": peak,
-        "python_peak_mib": traced,
-        "seconds": seconds,
-    }
+    return {"rss_before_mib": before, "rss_peak_mib": peak, "python_peak_mib": traced, "seconds": seconds}
+
+
+def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
+    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations."""
+    return {"samples": samples, **_child_memory(_SWEEP_CHILD, samples, duration, out)}
 
 
 # -- sweep throughput on Dask ---------------------------------------------------------------------
@@ -258,20 +255,10 @@ if __name__ == "__main__":
 
 def _client_memory(samples: int, duration: float, workers: int, out: str) -> dict[str, float]:
     """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0)."""
-    done = subprocess.run(
-        [sys.executable, "-c", _CLIENT_CHILD, str(samples), str(duration), out, str(workers)],
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    before, peak, traced, seconds = (float(x) for x in done.stdout.split())
     return {
         "samples": samples,
         "workers": workers,
-        "rss_before_mib": before,
-        "rss_peak_mib": peak,
-        "python_peak_mib": traced,
-        "seconds": seconds,
+        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers),
     }
 
 
