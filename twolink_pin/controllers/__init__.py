@@ -17,7 +17,7 @@
 
 from __future__ import annotations
 
-from twolink_pin.controllers.base import CONTROLLERS, Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.base import CONTROLLERS, Controller, FrameTerms, LawInput, LawOutput, Terms
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.pd import PDFeedforward, PDGains
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
@@ -35,6 +35,7 @@ __all__ = [
     "AdaptiveGains",
     "ComputedTorque",
     "Controller",
+    "FrameTerms",
     "Gains",
     "LawInput",
     "LawOutput",

@@ -18,7 +18,9 @@ Write the law with numpy broadcasting and it never needs to know N.
 
 The Pinocchio quantities a law needs are asked of the :class:`Terms` object the engine
 passes in — it evaluates them for all N runs at once (one ``pin.rnea`` for a single run,
-``rneaInParallel`` over a ``ModelPool`` for a batch). A law never calls Pinocchio itself.
+``rneaInParallel`` over a ``ModelPool`` for a batch): the model term, the regressor, and
+``M̂``, ``ĝ``, ``Ĉ q̇ + ĝ``, ``M̂⁻¹ b`` and a frame's pose, Jacobian and ``J̇ q̇`` on the
+law's believed model. A law never calls Pinocchio itself.
 
 Notation (report): ``e = q − q_d``, ``ė = q̇ − q̇_d``, ``s = ė + λ e``,
 ``q̇_r = q̇_d − λ e``, ``q̈_r = q̈_d − λ ė``.
@@ -71,6 +73,25 @@ class LawOutput(NamedTuple):
     """``ż``, shape (N, nz); ``None`` for a law without state."""
 
 
+class FrameTerms(NamedTuple):
+    """A frame's pose and first-order kinematics for N runs (:meth:`Terms.frame`).
+
+    Convention: Pinocchio's ``LOCAL_WORLD_ALIGNED`` — velocities of the frame's origin,
+    expressed in the world's axes; in every 6-vector the linear part comes first
+    (``[v; ω]``, ``[a; α]``).
+    """
+
+    position: np.ndarray
+    """The frame's origin in the world [m], shape (N, 3)."""
+    rotation: np.ndarray
+    """The frame's orientation (its axes in world coordinates), shape (N, 3, 3)."""
+    jacobian: np.ndarray
+    """``J`` with ``[ṗ; ω] = J q̇`` [m/rad; 1], shape (N, 6, nv)."""
+    drift: np.ndarray
+    """``J̇ q̇`` [m/s²; rad/s²], shape (N, 6): the frame's classical acceleration at
+    ``q̈ = 0``, so that ``[p̈; ω̇] = J q̈ + J̇ q̇``."""
+
+
 class Terms(Protocol):
     """The Pinocchio quantities a law may ask for, evaluated by the engine for all N runs.
 
@@ -92,6 +113,32 @@ class Terms(Protocol):
     def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
         """``[diag(q̇), diag(sgn q̇)]`` per run, shape (N, nv, 2 nv): ``f(q̇) = Y_f (V, C)``;
         ``tanh(q̇/smoothing)`` for the sign when ``smoothing > 0`` [rad/s]."""
+        ...
+
+    def mass(self, q: np.ndarray) -> np.ndarray:
+        """``M̂(q)`` [kg·m² for revolute joints], symmetric, shape (N, nv, nv), on the
+        controller's model (Pinocchio's CRBA)."""
+        ...
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        """``ĝ(q)`` [N·m], shape (N, nv), on the controller's model."""
+        ...
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """``Ĉ(q, q̇) q̇ + ĝ(q)`` [N·m], shape (N, nv), on the controller's model
+        (Pinocchio's ``nonLinearEffects``)."""
+        ...
+
+    def solve_mass(self, q: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """``M̂(q)⁻¹ b``, shape (N, nv) for ``b`` of shape (N, nv) or (N, nv, k) for
+        (N, nv, k): a linear solve on ``M̂`` (LU), never an explicit inverse."""
+        ...
+
+    def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
+        """Pose, Jacobian and ``J̇ q̇`` of ``frame`` (default: the robot's end effector),
+        ``LOCAL_WORLD_ALIGNED``, linear rows first (see :class:`FrameTerms`). Pure
+        kinematics: the same on every model of the robot. A ``(1, nv)`` argument gives
+        ``(1, …)`` results (e.g. the reference's frame)."""
         ...
 
 

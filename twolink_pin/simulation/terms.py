@@ -20,6 +20,9 @@
   on the UR5 and the Panda than 2 RNEA per column); the forests are cut into groups of at
   most :data:`FOREST_NV` joints (Pinocchio's ``Data`` grows as nv³).
 
+``mass``, ``gravity``, ``bias``, ``solve_mass`` and ``frame`` are one Pinocchio algorithm per
+run on the believed model (:mod:`twolink_pin.simulation.rigid_terms`).
+
 Every run's numbers are computed by the same code whatever N and whichever runs share its
 batch (element-wise numpy, one Pinocchio evaluation per column), so a batch equals N
 single runs to rounding and a run's result does not depend on how a sweep is chunked.
@@ -43,6 +46,7 @@ from twolink_pin.model.parameters import (
     model_with_parameters,
     with_inertial_parameters,
 )
+from twolink_pin.simulation.rigid_terms import RigidBodyTerms, RigidBodyTermsMixin
 
 if TYPE_CHECKING:
     from twolink_pin.controllers import Controller
@@ -126,7 +130,7 @@ class _PairInputs:
         return b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :]
 
 
-class SingleRunTerms:
+class SingleRunTerms(RigidBodyTermsMixin):
     """:class:`~twolink_pin.controllers.Terms` for one run (arrays of shape (1, nv))."""
 
     def __init__(self, controller: Controller) -> None:
@@ -141,6 +145,7 @@ class SingleRunTerms:
         self._inputs = _PairInputs(robot.nv)
         self._n_pi = N_BODY_PARAMETERS * (model.njoints - 1)
         self._P = np.ascontiguousarray(robot.parameter_map.matrix)
+        self._rigid = RigidBodyTerms(robot, p)
 
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         nv = self._nv
@@ -327,7 +332,7 @@ def _close(a: np.ndarray, b: np.ndarray) -> bool:
     return bool(np.abs(a - b).max() <= 1e-10 * scale)
 
 
-class BatchTerms:
+class BatchTerms(RigidBodyTermsMixin):
     """:class:`~twolink_pin.controllers.Terms` for N runs advanced together."""
 
     def __init__(self, controller: Controller, runs: int, threads: int) -> None:
@@ -340,6 +345,7 @@ class BatchTerms:
         self._map = robot.parameter_map
         self._regressor: _Regressor | _RegressorByRun | None = None
         p = controller.model_parameters
+        self._rigid = RigidBodyTerms(robot, p)
         self._p_rows: np.ndarray | None = None
         self._shared: _PolarisedTerms | None = None
         if p is not None and p.ndim == 2 and p.shape[0] > 1:

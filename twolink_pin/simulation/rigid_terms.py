@@ -1,0 +1,192 @@
+"""The rigid-body terms of :class:`~twolink_pin.controllers.Terms` beyond the model term:
+``mass``, ``gravity``, ``bias``, ``solve_mass`` and ``frame``, for one run or N.
+
+Each is one Pinocchio algorithm per run, on the controller's believed model (its robot, or
+the robot with its ``model_parameters``, one model per run when the runs believe different
+parameters, built the first time a law asks):
+
+==============  ================================================================
+``mass``        ``pin.crba`` (upper triangle), symmetrised
+``gravity``     ``pin.computeGeneralizedGravity``
+``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
+``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
+                LU with pivoting: no inverse is formed)
+``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
+                then ``getFrameJacobian`` and ``getFrameClassicalAcceleration`` in
+                ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model)
+==============  ================================================================
+
+A batch computes every run with the same calls as a single run, so a batch equals N
+single runs bit for bit. The runs are looped over in Python: these terms cost about
+N × (one Pinocchio call + 2 µs) per evaluation.
+
+:class:`RigidBodyTermsMixin` gives :class:`~twolink_pin.simulation.terms.SingleRunTerms`
+and :class:`~twolink_pin.simulation.terms.BatchTerms` these methods; they set
+``self._rigid`` to a :class:`RigidBodyTerms`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.controllers.base import FrameTerms
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.model import RobotModel
+from twolink_pin.model.parameters import model_with_parameters
+
+WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+"""The one convention of :meth:`RigidBodyTerms.frame`."""
+
+
+class RigidBodyTerms:
+    """M̂, ĝ, Ĉq̇ + ĝ, M̂⁻¹b and frame kinematics on a controller's model, for N runs.
+
+    Args:
+        robot: The robot (kinematics, parameter map, end-effector frame).
+        parameters: The believed parameters ``p``: None (the robot's own), shape (n_p,)
+            or (1, n_p) for every run, or (N, n_p) one row per run.
+    """
+
+    def __init__(self, robot: RobotModel, parameters: np.ndarray | None) -> None:
+        self._robot = robot
+        self._kinematics = robot.model
+        self._kinematics_data = robot.model.createData()
+        self._nv = robot.nv
+        p = None if parameters is None else np.asarray(parameters, dtype=float)
+        if p is not None and p.ndim == 2 and p.shape[0] == 1:
+            p = p[0]
+        self._p = p
+        self._models: list[pin.Model] | None = None
+        self._data: pin.Data | None = None
+        self._frames: dict[str | None, int] = {None: robot.ee_frame_id}
+        self._zero = np.zeros(robot.nv)
+
+    # -- models ------------------------------------------------------------------------
+
+    def _dynamics(self) -> tuple[list[pin.Model], pin.Data]:
+        if self._models is None:
+            robot, p = self._robot, self._p
+            if p is None:
+                self._models = [robot.model]
+            elif p.ndim == 1:
+                self._models = [model_with_parameters(robot.model, robot.parameter_map, p)]
+            else:
+                self._models = [model_with_parameters(robot.model, robot.parameter_map, row) for row in p]
+            self._data = self._models[0].createData()
+        assert self._data is not None
+        return self._models, self._data
+
+    def _rows(self, *arrays: np.ndarray) -> tuple[int, list[pin.Model], pin.Data]:
+        models, data = self._dynamics()
+        n = max(max(np.shape(a)[0] for a in arrays), len(models))
+        if len(models) > 1 and any(np.shape(a)[0] not in (1, n) for a in arrays):
+            raise InvalidParameterError(
+                "q", f"shape {np.shape(arrays[0])}", f"one row, or one per run ({len(models)})"
+            )
+        return n, models, data
+
+    def _states(self, q: np.ndarray, n: int) -> np.ndarray:
+        q = np.asarray(q, dtype=float)
+        if q.ndim == 1:
+            q = q[None]
+        return np.broadcast_to(q, (n, self._nv))
+
+    # -- terms -------------------------------------------------------------------------
+
+    def mass(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        n, models, data = self._rows(q)
+        Q = self._states(q, n)
+        out = np.empty((n, self._nv, self._nv))
+        for i in range(n):
+            M = pin.crba(models[i % len(models)], data, Q[i])
+            out[i] = np.triu(M) + np.triu(M, 1).T
+        return out
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        q = np.atleast_2d(q)
+        n, models, data = self._rows(q)
+        Q = self._states(q, n)
+        out = np.empty((n, self._nv))
+        for i in range(n):
+            out[i] = pin.computeGeneralizedGravity(models[i % len(models)], data, Q[i])
+        return out
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        q, v = np.atleast_2d(q), np.atleast_2d(v)
+        n, models, data = self._rows(q, v)
+        Q, V = self._states(q, n), self._states(v, n)
+        out = np.empty((n, self._nv))
+        for i in range(n):
+            out[i] = pin.nonLinearEffects(models[i % len(models)], data, Q[i], V[i])
+        return out
+
+    def solve_mass(self, q: np.ndarray, b: np.ndarray) -> np.ndarray:
+        b = np.asarray(b, dtype=float)
+        if b.ndim not in (2, 3) or b.shape[1] != self._nv:
+            raise InvalidParameterError(
+                "b",
+                f"shape {b.shape}",
+                f"(N, {self._nv}) or (N, {self._nv}, k): one vector or matrix per run",
+            )
+        M = self.mass(q)
+        n = max(M.shape[0], b.shape[0])
+        M = np.broadcast_to(M, (n, self._nv, self._nv))
+        if b.ndim == 2:
+            return np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0]
+        return np.linalg.solve(M, np.broadcast_to(b, (n, *b.shape[1:])))
+
+    def frame_id(self, frame: str | None) -> int:
+        """Index of ``frame`` in the model (None: the end effector)."""
+        fid = self._frames.get(frame)
+        if fid is None:
+            model = self._kinematics
+            if not isinstance(frame, str) or not model.existFrame(frame):
+                names = [f.name for f in model.frames]
+                raise InvalidParameterError("frame", frame, f"a frame of {self._robot.name}: one of {names}")
+            fid = int(model.getFrameId(frame))
+            self._frames[frame] = fid
+        return fid
+
+    def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
+        fid = self.frame_id(frame)
+        q, v = np.atleast_2d(q), np.atleast_2d(v)
+        n = max(q.shape[0], v.shape[0])
+        Q, V = self._states(q, n), self._states(v, n)
+        model, data, zero = self._kinematics, self._kinematics_data, self._zero
+        position = np.empty((n, 3))
+        rotation = np.empty((n, 3, 3))
+        jacobian = np.empty((n, 6, self._nv))
+        drift = np.empty((n, 6))
+        for i in range(n):
+            pin.forwardKinematics(model, data, Q[i], V[i], zero)
+            pin.computeJointJacobians(model, data)
+            placement = pin.updateFramePlacement(model, data, fid)
+            position[i] = placement.translation
+            rotation[i] = placement.rotation
+            jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
+            drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
+        return FrameTerms(position, rotation, jacobian, drift)
+
+
+class RigidBodyTermsMixin:
+    """The five rigid-body methods of :class:`~twolink_pin.controllers.Terms`, delegated
+    to ``self._rigid`` (a :class:`RigidBodyTerms`)."""
+
+    _rigid: RigidBodyTerms
+
+    def mass(self, q: np.ndarray) -> np.ndarray:
+        return self._rigid.mass(q)
+
+    def gravity(self, q: np.ndarray) -> np.ndarray:
+        return self._rigid.gravity(q)
+
+    def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        return self._rigid.bias(q, v)
+
+    def solve_mass(self, q: np.ndarray, b: np.ndarray) -> np.ndarray:
+        return self._rigid.solve_mass(q, b)
+
+    def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
+        return self._rigid.frame(q, v, frame)
