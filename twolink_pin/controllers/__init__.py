@@ -17,7 +17,15 @@
 
 from __future__ import annotations
 
-from twolink_pin.controllers.base import CONTROLLERS, Controller, FrameTerms, LawInput, LawOutput, Terms
+from twolink_pin.controllers.base import (
+    CONTROLLERS,
+    Controller,
+    FrameTerms,
+    LawInput,
+    LawOutput,
+    StateVariable,
+    Terms,
+)
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.pd import PDFeedforward, PDGains
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
@@ -42,6 +50,7 @@ __all__ = [
     "PDFeedforward",
     "PDGains",
     "SlotineLiGains",
+    "StateVariable",
     "Terms",
     "WrongModel",
     "WrongModelGains",

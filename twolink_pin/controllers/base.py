@@ -8,7 +8,11 @@ A law subclasses :class:`Controller`, states its law in the class docstring, dec
 * ``Gains`` — its gains class (:mod:`twolink_pin.controllers.gains`: defaults and units);
 * ``estimates`` — which parameters its internal state ``z`` estimates, in order:
   ``"inertial"`` (the robot's parameter map ``p``) and/or ``"friction"`` (viscous then
-  Coulomb coefficient per joint); empty for a law without state;
+  Coulomb coefficient per joint); empty for a law without estimates;
+* optionally, state of any other kind (an integrator, a filter): it overrides
+  :meth:`Controller.state_variables` (names, units, kinds — after ``super()``'s estimates)
+  and :meth:`Controller.initial_state` (the values). Estimates are one case of state: the
+  whole of ``z`` is recorded (``SimulationResult.state``), the estimates also as ``p_hat``;
 
 and implements **one** method, :meth:`Controller.compute`, that maps a :class:`LawInput`
 (time, state, reference) to a :class:`LawOutput` (torque τ and, for a law with state, ż).
@@ -35,7 +39,7 @@ from typing import Any, ClassVar, Generic, NamedTuple, Protocol, TypeVar
 import numpy as np
 
 from twolink_pin.controllers.gains import Gains as GainsBase
-from twolink_pin.controllers.gains import _spec, check_width, runs_of
+from twolink_pin.controllers.gains import _spec, as_matrix, check_width, runs_of
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -43,6 +47,18 @@ ESTIMATES = ("inertial", "friction")
 """Kinds of parameters a law may estimate, in the order they appear in ``z``."""
 FRICTION_UNITS = {"viscous": "N·m·s/rad", "coulomb": "N·m"}
 """Units of the friction coefficients."""
+
+
+class StateVariable(NamedTuple):
+    """One entry of a law's internal state ``z`` (see :meth:`Controller.state_variables`)."""
+
+    name: str
+    """Short name, e.g. ``"p1"`` or ``"∫e1"``."""
+    unit: str
+    """SI unit, e.g. ``"kg·m²"`` or ``"rad·s"``."""
+    kind: str
+    """``"inertial"`` or ``"friction"`` for an estimate (:data:`ESTIMATES`), else the law's
+    own word (e.g. ``"integral"``, ``"filter"``)."""
 
 
 class LawInput(NamedTuple):
@@ -272,10 +288,34 @@ class Controller(abc.ABC, Generic[G]):
             kinds += [kind] * size
         return tuple(kinds)
 
+    def state_variables(self) -> tuple[StateVariable, ...]:
+        """What ``z`` holds, in order: the estimates (:attr:`parameter_names`) by default.
+
+        A law with other state overrides this and appends its entries to ``super()``'s
+        (and overrides :meth:`initial_state` to give their values)::
+
+            def state_variables(self):
+                return super().state_variables() + tuple(
+                    StateVariable(f"∫e{j + 1}", "rad·s", "integral") for j in range(self.robot.nv)
+                )
+        """
+        return tuple(
+            StateVariable(name, unit, kind)
+            for name, unit, kind in zip(
+                self.parameter_names, self.parameter_units, self.parameter_kinds, strict=True
+            )
+        )
+
     @property
     def state_size(self) -> int:
         """``nz``: size of the law's internal state."""
-        return len(self.parameter_names)
+        return len(self.state_variables())
+
+    @property
+    def estimate_columns(self) -> np.ndarray:
+        """Indices in ``z`` of the estimated parameters (kinds in :data:`ESTIMATES`)."""
+        kinds = [v.kind for v in self.state_variables()]
+        return np.array([i for i, kind in enumerate(kinds) if kind in ESTIMATES], dtype=int)
 
     @property
     def runs(self) -> int | None:
@@ -336,16 +376,26 @@ class Controller(abc.ABC, Generic[G]):
                     f"gains.{absent[0]}", None, f"a value: {type(self).__name__} derives no default for it"
                 )
             gains = dataclasses.replace(gains, **{name: derived[name] for name in missing})
+        matrices = {}
         for f in dataclasses.fields(gains):
             spec = _spec(f)
             value = getattr(gains, f.name)
-            if spec.per == "joint":
+            if spec.matrix and value is not None:
+                width = {"joint": self.robot.nv, "estimate": len(self.parameter_names), "axis": 3}[spec.per]
+                value = matrices[f.name] = as_matrix(value, width)
+                check_width(f.name, value, width, f"per {spec.per}")
+            elif spec.per == "joint":
                 check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")
             elif spec.per == "estimate":
                 check_width(
-                    f.name, value, self.state_size, f"per estimated parameter: {self.parameter_names}"
+                    f.name,
+                    value,
+                    len(self.parameter_names),
+                    f"per estimated parameter: {self.parameter_names}",
                 )
-        return gains
+            elif spec.per == "axis":
+                check_width(f.name, value, 3, "per world axis x, y, z")
+        return dataclasses.replace(gains, **matrices) if matrices else gains
 
     def _check_parameters(self, p: Any) -> np.ndarray | None:
         if p is None:

@@ -17,6 +17,13 @@ arrays, which keeps numpy on its fast path for N = 1. Any field may also hold on
 as ``(N, 1)``) — so that one law object drives N runs of a batch with N gain sets: the
 law's arithmetic broadcasts, it never sees N.
 
+A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size k:
+``"joint"`` nv, ``"estimate"`` the estimates, ``"axis"`` the 3 world axes): a number s
+(``s I``), k numbers (a diagonal), a symmetric positive-definite ``(k, k)`` matrix, or one
+such matrix per run ``(N, k, k)`` — checked (symmetry to 1e-12 relative, Cholesky), and
+stored as ``(1, k, k)`` or ``(N, k, k)`` once the law knows k: the law applies it with
+``np.matvec(K, e)``.
+
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
 from the robot (its ``scaled_gains``), or the robot's profile supplies one
 (:attr:`twolink_pin.model.RobotModel.gain_presets`, e.g. the course report's gains for
@@ -33,7 +40,7 @@ import numpy as np
 
 from twolink_pin.errors import InvalidParameterError
 
-SHAPES = ("scalar", "joint", "estimate")
+SHAPES = ("scalar", "joint", "estimate", "axis")
 """What one value of a gain is for."""
 BOUNDS = ("positive", "nonnegative", "any")
 """Sign constraints a gain may declare."""
@@ -50,9 +57,19 @@ class GainSpec(NamedTuple):
     """One of :data:`BOUNDS`."""
     doc: str
     """One-line description."""
+    matrix: bool = False
+    """A matrix gain (see the module docstring)."""
 
 
-def gain(default: Any, *, per: str = "scalar", unit: str = "", bound: str = "positive", doc: str = "") -> Any:
+def gain(
+    default: Any,
+    *,
+    per: str = "scalar",
+    unit: str = "",
+    bound: str = "positive",
+    doc: str = "",
+    matrix: bool = False,
+) -> Any:
     """A gains field with its default, shape, unit and sign constraint.
 
     Args:
@@ -62,6 +79,8 @@ def gain(default: Any, *, per: str = "scalar", unit: str = "", bound: str = "pos
         unit: SI unit, e.g. ``"N·m/rad"``.
         bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0) or ``"any"``.
         doc: One-line description (shown by the CLI and the report).
+        matrix: A symmetric positive-definite matrix gain of size k given by ``per``
+            (``"joint"``, ``"estimate"`` or ``"axis"``); ``bound`` is then "positive".
     """
     if per not in SHAPES:
         raise ValueError(f"per must be one of {SHAPES}, got {per!r}")
@@ -69,7 +88,9 @@ def gain(default: Any, *, per: str = "scalar", unit: str = "", bound: str = "pos
         raise ValueError(f"bound must be one of {BOUNDS}, got {bound!r}")
     if default is None and per == "scalar":
         raise ValueError("a scalar gain needs a default value")
-    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc)})
+    if matrix and (per == "scalar" or bound != "positive"):
+        raise ValueError("a matrix gain is per joint, estimate or axis, and positive definite")
+    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc, matrix)})
 
 
 def spec_of(gains_type: type[Gains] | Gains, name: str) -> GainSpec:
@@ -104,10 +125,68 @@ def _expected(spec: GainSpec) -> str:
         "scalar": f"a finite number{sign}{unit} (or one per run)",
         "joint": f"finite numbers{sign}{unit}: one for every joint or one per joint (or a row per run)",
         "estimate": f"finite numbers{sign}{unit}: one for every estimated parameter or one each (or a row per run)",
+        "axis": f"finite numbers{sign}{unit}: one for every axis or one per axis x, y, z (or a row per run)",
     }[spec.per]
 
 
+MATRIX_EXPECTED = (
+    "a symmetric positive-definite matrix gain{unit}: a number s (s I), k numbers (a diagonal), "
+    "a (k, k) matrix, or one (k, k) matrix per run (N, k, k)"
+)
+
+
+def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
+    expected = MATRIX_EXPECTED.format(unit=f" [{spec.unit}]" if spec.unit else "")
+    if isinstance(value, bool):
+        raise InvalidParameterError(name, value, expected)
+    try:
+        array = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(name, value, expected) from None
+    if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
+        raise InvalidParameterError(name, f"array of shape {array.shape}", expected)
+    if not np.all(np.isfinite(array)) or not np.all(np.abs(array) <= GAIN_RANGE[1]):
+        raise InvalidParameterError(
+            name, array.tolist() if array.size <= 36 else f"shape {array.shape}", expected
+        )
+    if array.ndim < 2:
+        low = array.min()
+        if not low >= GAIN_RANGE[0]:
+            raise InvalidParameterError(name, array.tolist(), expected)
+        if array.ndim == 0:
+            return float(array)
+        array = np.diag(array)
+    stack = array.reshape(-1, *array.shape[-2:])
+    for i, matrix in enumerate(stack):
+        where = f"{name}[{i}]" if array.ndim == 3 else name
+        shown = matrix.tolist() if matrix.size <= 36 else f"a {matrix.shape} matrix"
+        scale = float(np.abs(matrix).max())
+        if np.abs(matrix - matrix.T).max() > 1e-12 * scale:
+            raise InvalidParameterError(where, shown, f"{expected}; it is not symmetric")
+        try:
+            np.linalg.cholesky(matrix)
+        except np.linalg.LinAlgError:
+            low = float(np.linalg.eigvalsh(matrix).min())
+            raise InvalidParameterError(
+                where, shown, f"{expected}; it is not positive definite (smallest eigenvalue {low:.3g})"
+            ) from None
+    stack = np.ascontiguousarray(stack)
+    stack.setflags(write=False)
+    return stack
+
+
+def as_matrix(value: Any, k: int) -> np.ndarray:
+    """A validated matrix gain as ``(1, k, k)`` or ``(N, k, k)`` (a number s: ``s I``)."""
+    if isinstance(value, float):
+        out = value * np.eye(k)[None]
+        out.setflags(write=False)
+        return out
+    return np.asarray(value)
+
+
 def _validate(name: str, value: Any, spec: GainSpec) -> Any:
+    if value is not None and spec.matrix:
+        return _validate_matrix(name, value, spec)
     if value is None:
         if spec.per == "scalar":
             raise InvalidParameterError(name, value, _expected(spec))
@@ -187,7 +266,7 @@ class Gains:
 def runs_of(value: Any) -> int | None:
     """The number of runs a validated gain value holds (its leading axis), or None if it
     is the same for every run."""
-    if isinstance(value, np.ndarray) and value.ndim == 2 and value.shape[0] > 1:
+    if isinstance(value, np.ndarray) and value.ndim in (2, 3) and value.shape[0] > 1:
         return int(value.shape[0])
     return None
 
@@ -204,6 +283,12 @@ def check_width(name: str, value: Any, width: int, what: str) -> None:
     """Raise unless ``value`` (validated) is a scalar, ``width`` values, or per run one or
     ``width`` values (shape ``(N, 1)`` or ``(N, width)``)."""
     if value is None or isinstance(value, float):
+        return
+    if value.ndim == 3:  # a matrix gain
+        if value.shape[1:] != (width, width):
+            raise InvalidParameterError(
+                name, f"matrices of shape {value.shape[1:]}", f"({width}, {width}) matrices ({what})"
+            )
         return
     if value.shape[1] not in (1, width):
         rows = value.tolist()

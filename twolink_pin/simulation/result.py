@@ -53,6 +53,13 @@ class SimulationResult:
     """``"inertial"`` or ``"friction"`` for each estimated parameter."""
     robot: str = ""
     """Name of the robot simulated."""
+    state: np.ndarray | None = field(repr=False, default=None)
+    """The law's whole internal state ``z`` (estimates, integrators, filters …), shape
+    (K, nz), for a law with state; else None."""
+    state_names: tuple[str, ...] = ()
+    """Name of each entry of ``state``."""
+    state_units: tuple[str, ...] = ()
+    """SI unit of each entry of ``state``."""
 
     @property
     def duration(self) -> float:

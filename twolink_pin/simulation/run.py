@@ -61,6 +61,16 @@ def estimated_truth(controller: Controller, plant: Plant) -> np.ndarray | None:
     return np.concatenate(parts) if parts else None
 
 
+def state_labels(controller: Controller, nz: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Names and units of the law's ``nz`` state entries (``z1``, … and no unit for a law
+    whose declared :meth:`~twolink_pin.controllers.Controller.state_variables` do not
+    describe its state, e.g. one that overrides only ``state_size``)."""
+    variables = controller.state_variables()
+    if len(variables) != nz:
+        return tuple(f"z{i + 1}" for i in range(nz)), ("",) * nz
+    return tuple(v.name for v in variables), tuple(v.unit for v in variables)
+
+
 def simulate(
     controller: Controller,
     plant: Plant,
@@ -112,6 +122,9 @@ def simulate(
     z = samples.z[:, 0, :]
     estimates = controller.state_size > 0 and controller.estimates
     true = estimated_truth(controller, plant)
+    names, units = state_labels(controller, z.shape[1])
+    columns = controller.estimate_columns if estimates else None
+    p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
     return SimulationResult(
         controller=controller.name,
         method=config.method,
@@ -127,7 +140,7 @@ def simulate(
         torque_limits=readonly(plant.limits),
         saturate=plant.saturate,
         reference_period=trajectory.period,
-        p_hat=readonly(z) if estimates else None,
+        p_hat=readonly(p_hat) if p_hat is not None else None,
         p_true=readonly_or_none(true) if estimates else None,
         parameter_names=controller.parameter_names if estimates else (),
         control_period=None
@@ -136,4 +149,7 @@ def simulate(
         parameter_units=controller.parameter_units if estimates else (),
         parameter_kinds=controller.parameter_kinds if estimates else (),
         robot=plant.robot.name,
+        state=readonly(z) if z.shape[1] else None,
+        state_names=names,
+        state_units=units,
     )

@@ -118,7 +118,13 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
                 kwargs[key] = float(value)
             elif key == "saturate":
                 kwargs[key] = bool(value)
-            elif key in ("parameter_names", "parameter_units", "parameter_kinds"):
+            elif key in (
+                "parameter_names",
+                "parameter_units",
+                "parameter_kinds",
+                "state_names",
+                "state_units",
+            ):
                 kwargs[key] = tuple(str(x) for x in value)
             else:
                 array = np.array(value, dtype=float)

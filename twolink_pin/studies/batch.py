@@ -24,7 +24,7 @@ from twolink_pin.metrics import BatchMetrics, RunningMetrics
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
-from twolink_pin.simulation.run import check_setup, initial_state
+from twolink_pin.simulation.run import check_setup, initial_state, state_labels
 from twolink_pin.simulation.terms import check_parallel, threads_for
 from twolink_pin.trajectory import Trajectory
 
@@ -75,6 +75,15 @@ class BatchResult:
     """Commanded torque [N·m], shape (N, K, nv), only with ``record=True``."""
     p_hat: np.ndarray | None = field(repr=False, default=None)
     """Parameter estimates, shape (N, K, n_p), only with ``record=True``."""
+    state_final: np.ndarray | None = field(repr=False, default=None)
+    """The law's whole state ``z`` at the end, shape (N, nz) (NaN if diverged); None for a
+    law without state."""
+    state: np.ndarray | None = field(repr=False, default=None)
+    """The law's whole state, shape (N, K, nz), only with ``record=True``."""
+    state_names: tuple[str, ...] = ()
+    """Name of each state entry."""
+    state_units: tuple[str, ...] = ()
+    """SI unit of each state entry."""
 
     @property
     def n_runs(self) -> int:
@@ -195,11 +204,19 @@ def simulate_batch(
     )
     dead = ~np.isnan(run.diverged_at)
     estimates = controller.state_size > 0 and bool(controller.estimates)
+    nz = run.z_final.shape[1]
+    state_final = run.z_final.copy()
+    state_final[dead] = np.nan
+    columns = controller.estimate_columns if estimates else None
+    whole = columns is not None and len(columns) == nz
     p_hat_final = None
-    if estimates:
-        p_hat_final = run.z_final.copy()
-        p_hat_final[dead] = np.nan
+    if columns is not None:
+        p_hat_final = state_final if whole else state_final[:, columns]
+    names, units = state_labels(controller, nz)
     rec = run.record
+    p_hat = None
+    if rec is not None and columns is not None:
+        p_hat = rec.z.transpose(1, 0, 2) if whole else rec.z[:, :, columns].transpose(1, 0, 2)
     return BatchResult(
         controller=controller.name,
         dt=dt,
@@ -220,5 +237,9 @@ def simulate_batch(
         q=readonly(rec.q.transpose(1, 0, 2)) if rec is not None else None,
         v=readonly(rec.v.transpose(1, 0, 2)) if rec is not None else None,
         tau_command=readonly(rec.tau_command.transpose(1, 0, 2)) if rec is not None else None,
-        p_hat=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and estimates else None,
+        p_hat=readonly_or_none(p_hat),
+        state_final=readonly(state_final) if nz else None,
+        state=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and nz else None,
+        state_names=names,
+        state_units=units,
     )
