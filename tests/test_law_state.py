@@ -113,6 +113,9 @@ def test_matrix_gain_forms() -> None:
     np.testing.assert_array_equal(law.gains.kp, np.diag([300.0, 250.0])[None])
     np.testing.assert_array_equal(law.gains.kd, 7.0 * np.eye(2)[None])
     assert law.runs is None
+    per_run = IntegralLaw(ROBOT, MatrixGains(kd=np.array([[7.0], [9.0]])))
+    np.testing.assert_array_equal(per_run.gains.kd, np.stack([7.0 * np.eye(2), 9.0 * np.eye(2)]))
+    assert per_run.runs == 2
 
 
 @pytest.mark.parametrize(

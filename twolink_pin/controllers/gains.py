@@ -20,7 +20,7 @@ law's arithmetic broadcasts, it never sees N.
 A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size k:
 ``"joint"`` nv, ``"estimate"`` the estimates, ``"axis"`` the 3 world axes): a number s
 (``s I``), k numbers (a diagonal), a symmetric positive-definite ``(k, k)`` matrix, or one
-such matrix per run ``(N, k, k)`` — checked (symmetry to 1e-12 relative, Cholesky), and
+such matrix per run ``(N, k, k)`` (or one number per run, ``(N, 1)``: a sweep's draws) — checked (symmetry to 1e-12 relative, Cholesky), and
 stored as ``(1, k, k)`` or ``(N, k, k)`` once the law knows k: the law applies it with
 ``np.matvec(K, e)``.
 
@@ -143,6 +143,8 @@ def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
         raise InvalidParameterError(name, value, expected) from None
+    if array.ndim == 2 and array.shape[1] == 1:  # one number per run (a sweep's draws): s_r I
+        array = array[:, :, None]
     if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
         raise InvalidParameterError(name, f"array of shape {array.shape}", expected)
     if not np.all(np.isfinite(array)) or not np.all(np.abs(array) <= GAIN_RANGE[1]):
@@ -178,10 +180,12 @@ def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
 def as_matrix(value: Any, k: int) -> np.ndarray:
     """A validated matrix gain as ``(1, k, k)`` or ``(N, k, k)`` (a number s: ``s I``)."""
     if isinstance(value, float):
-        out = value * np.eye(k)[None]
-        out.setflags(write=False)
-        return out
-    return np.asarray(value)
+        value = np.array(value).reshape(1, 1, 1)
+    array = np.asarray(value)
+    if array.shape[1:] == (1, 1) and k != 1:
+        array = array * np.eye(k)
+        array.setflags(write=False)
+    return array
 
 
 def _validate(name: str, value: Any, spec: GainSpec) -> Any:
