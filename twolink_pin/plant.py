@@ -3,6 +3,9 @@
 ``q̈ = ABA(q, q̇, sat(τ) − f(q̇))`` where ``f`` is the optional joint friction
 (:class:`twolink_pin.dynamics.Friction`; Pinocchio ignores URDF friction) and ``sat``
 clips to the URDF torque limits when ``saturate`` is on (off by default, as in the report).
+A plant may also push back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
+sensor noise, a delay; none by default); the engine then runs
+:mod:`twolink_pin.simulation.events`.
 :meth:`Plant.applied_torque` and :meth:`Plant.motor_torque` work on one state ``(nv,)`` or
 on N runs ``(N, nv)``; the engine evaluates ABA itself for all runs at once
 (:mod:`twolink_pin.simulation.forward`).
@@ -13,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.dynamics import ABA_CONVENTION, Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
@@ -28,7 +32,17 @@ class Plant:
             limit are never clipped).
     """
 
-    def __init__(self, robot: RobotModel, friction: Friction | None = None, saturate: bool = False) -> None:
+    def __init__(
+        self,
+        robot: RobotModel,
+        friction: Friction | None = None,
+        saturate: bool = False,
+        *,
+        wrench: Wrench | None = None,
+        payload_step: PayloadStep | None = None,
+        sensor_noise: SensorNoise | None = None,
+        delay: int = 0,
+    ) -> None:
         if not isinstance(robot, RobotModel):
             raise InvalidParameterError(
                 "robot", type(robot).__name__, "a RobotModel (twolink_pin.load_robot)"
@@ -47,6 +61,36 @@ class Plant:
         self.saturate = saturate
         self.limits = np.array(robot.torque_limits, dtype=float)
         self.limits.setflags(write=False)
+        for name, value, kind in (
+            ("wrench", wrench, Wrench),
+            ("payload_step", payload_step, PayloadStep),
+            ("sensor_noise", sensor_noise, SensorNoise),
+        ):
+            if value is not None and not isinstance(value, kind):
+                raise InvalidParameterError(
+                    name, value, f"a twolink_pin.disturbances.{kind.__name__} or None"
+                )
+        if wrench is not None and wrench.frame is not None and not robot.model.existFrame(wrench.frame):
+            raise InvalidParameterError(
+                "wrench.frame",
+                wrench.frame,
+                f"a frame of {robot.name}: {[f.name for f in robot.model.frames]}",
+            )
+        self.wrench = wrench
+        """External wrench on a frame over a time window (:mod:`twolink_pin.disturbances`)."""
+        self.payload_step = payload_step
+        """Payload picked up at a time (the law not told)."""
+        self.sensor_noise = sensor_noise
+        """Noise on the q, q̇ the law measures."""
+        self.delay = check_delay(delay)
+        """Steps between a measurement and the torque it produces."""
+
+    @property
+    def has_events(self) -> bool:
+        """Whether the plant pushes back: a wrench, a payload step, sensor noise or a delay."""
+        return (
+            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise)) or self.delay > 0
+        )
 
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
         """Motor torque actually applied [N·m]: ``tau`` clipped to the limits if saturating."""

@@ -130,7 +130,9 @@ def _run_one(
             friction_smoothing=_smoothing(args),
         )
     reference = trajectory if trajectory is not None else _trajectory(args, robot)
-    return simulate(controller, plant, reference, _config(args))
+    from twolink_pin.cli.disturbance_options import plant_with_disturbances
+
+    return simulate(controller, plant_with_disturbances(plant, args), reference, _config(args))
 
 
 def cmd_info(args: argparse.Namespace) -> int:

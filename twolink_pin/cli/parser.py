@@ -6,6 +6,7 @@ import argparse
 from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
+from twolink_pin.cli.disturbance_options import add_disturbance_options
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -229,6 +230,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_identified_options(p)
     p.add_argument("--plot", metavar="DIR", help="write the run's figures into DIR")
     p.add_argument("--save", metavar="FILE.npz", help="save the result (for animate --from)")
+    add_disturbance_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_simulate)
 

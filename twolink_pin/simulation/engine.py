@@ -143,6 +143,23 @@ def integrate(
             run instead of parking it.
         progress: Called as ``progress(steps_done, steps_total)`` after each block.
     """
+    if plant.has_events:  # a plant that pushes back: its own loop, this one stays as it was
+        from twolink_pin.simulation.events import integrate_events
+
+        return integrate_events(
+            controller,
+            plant,
+            trajectory,
+            config,
+            q0,
+            v0,
+            z0,
+            record=record,
+            observer=observer,
+            threads=threads,
+            stop_on_divergence=stop_on_divergence,
+            progress=progress,
+        )
     runs, nv = q0.shape
     nz = z0.shape[1]
     name = controller.name

@@ -112,6 +112,10 @@ def simulate(
         ).record
         assert samples is not None
     else:
+        if plant.has_events:
+            raise InvalidParameterError(
+                "method", config.method, "'rk4' with a wrench, payload step, sensor noise or delay"
+            )
         friction = plant.friction
         if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
             raise InvalidParameterError(

@@ -1,0 +1,147 @@
+"""The options of a plant that pushes back: ``--wrench``, ``--payload-step``,
+``--sensor-noise``, ``--noise-seed``, ``--delay`` (:mod:`twolink_pin.disturbances`).
+
+Each value type raises :class:`argparse.ArgumentTypeError` naming the value and the expected
+form (one line on stderr, exit 2); :func:`plant_with_disturbances` puts them on the plant a
+command built.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from typing import TYPE_CHECKING, Any
+
+from twolink_pin.cli.arguments import MAX_TEXT, finite, whole
+from twolink_pin.disturbances import PayloadStep, Wrench
+from twolink_pin.errors import TwolinkPinError
+
+if TYPE_CHECKING:  # the parser imports this module: Pinocchio only when a plant is built
+    from twolink_pin.plant import Plant
+
+MAX_FORCE = 1e6
+"""Largest force [N] or moment [N·m] accepted on the command line."""
+MAX_MASS = 1e4
+"""Largest payload step accepted on the command line [kg]."""
+MAX_DELAY = 100_000
+"""Largest delay accepted on the command line [steps]."""
+
+
+def _shown(text: str) -> str:
+    return repr(text if len(text) <= MAX_TEXT else text[:MAX_TEXT] + "…")
+
+
+def wrench(text: str) -> Wrench:
+    """``FX,FY,FZ[,MX,MY,MZ][@T0:T1]`` [N, N·m, s], world-aligned, on the end effector; without
+    ``@`` for the whole run, ``T1`` empty for "until the end"."""
+    expected = f"FX,FY,FZ[,MX,MY,MZ][@T0:T1] in N, N·m and s (e.g. 0,0,-20@1:2), got {_shown(text)}"
+    values, _, window = text.partition("@")
+    parts = values.split(",")
+    if len(parts) not in (3, 6):
+        raise argparse.ArgumentTypeError(f"expected 3 or 6 numbers: {expected}")
+    try:
+        force = tuple(finite(x) for x in parts)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected finite numbers: {expected}") from None
+    if any(abs(x) > MAX_FORCE for x in force):
+        raise argparse.ArgumentTypeError(f"expected forces and moments within ±{MAX_FORCE:g}: {expected}")
+    start, stop = 0.0, math.inf
+    if window:
+        first, colon, last = window.partition(":")
+        if not colon:
+            raise argparse.ArgumentTypeError(f"expected a window T0:T1: {expected}")
+        try:
+            start = finite(first) if first else 0.0
+            stop = finite(last) if last else math.inf
+        except argparse.ArgumentTypeError:
+            raise argparse.ArgumentTypeError(f"expected times T0:T1: {expected}") from None
+    try:
+        return Wrench(force, start, stop)
+    except TwolinkPinError as exc:
+        raise argparse.ArgumentTypeError(f"{exc}: {expected}") from None
+
+
+def payload_step(text: str) -> PayloadStep:
+    """``KG@T``: a point mass [kg] picked up at time T [s]."""
+    expected = f"KG@T: a mass in (0, {MAX_MASS:g}] kg and a time >= 0 s (e.g. 2@5), got {_shown(text)}"
+    mass, at, time = text.partition("@")
+    if not at:
+        raise argparse.ArgumentTypeError(f"expected {expected}")
+    try:
+        value, when = finite(mass), finite(time)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected {expected}") from None
+    if not (0 < value <= MAX_MASS and when >= 0):
+        raise argparse.ArgumentTypeError(f"expected {expected}")
+    return PayloadStep(value, when)
+
+
+def sensor_noise(text: str) -> tuple[float, float]:
+    """``SIGMA_Q[,SIGMA_V]`` [rad, rad/s] (σ_v default 0)."""
+    expected = f"SIGMA_Q[,SIGMA_V]: standard deviations >= 0 in rad and rad/s, got {_shown(text)}"
+    parts = text.split(",")
+    if len(parts) not in (1, 2):
+        raise argparse.ArgumentTypeError(f"expected {expected}")
+    try:
+        values = [finite(x) for x in parts]
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected {expected}") from None
+    if any(not 0 <= x <= 1e3 for x in values):
+        raise argparse.ArgumentTypeError(f"expected {expected} (at most 1000)")
+    return values[0], values[1] if len(values) == 2 else 0.0
+
+
+def add_disturbance_options(p: argparse.ArgumentParser) -> None:
+    """The plant's events, on a command that simulates."""
+    p.add_argument(
+        "--wrench",
+        type=wrench,
+        metavar="FX,FY,FZ[,MX,MY,MZ]@T0:T1",
+        help="external force [N] (and moment [N·m]) on the end effector, world axes, from T0 to T1 [s]",
+    )
+    p.add_argument(
+        "--payload-step",
+        type=payload_step,
+        metavar="KG@T",
+        help="a point mass [kg] picked up at the end effector at time T [s] (the law is not told)",
+    )
+    p.add_argument(
+        "--sensor-noise",
+        type=sensor_noise,
+        metavar="SIGMA_Q[,SIGMA_V]",
+        help="Gaussian noise [rad, rad/s] on the q and q̇ the law measures (seeded: --noise-seed)",
+    )
+    p.add_argument(
+        "--noise-seed", type=whole(0, 2**63 - 1), default=0, help="seed of the sensor noise (default 0)"
+    )
+    p.add_argument(
+        "--delay",
+        type=whole(0, MAX_DELAY),
+        default=0,
+        metavar="STEPS",
+        help="steps between a measurement and the torque it produces (default 0)",
+    )
+
+
+def plant_with_disturbances(plant: Plant, args: Any) -> Plant:
+    """``plant`` with the events ``args`` asks for (the same plant when none)."""
+    from twolink_pin.disturbances import SensorNoise
+    from twolink_pin.plant import Plant
+
+    wrench_value = getattr(args, "wrench", None)
+    payload = getattr(args, "payload_step", None)
+    noise = getattr(args, "sensor_noise", None)
+    delay = getattr(args, "delay", 0) or 0
+    if wrench_value is None and payload is None and noise is None and not delay:
+        return plant
+    return Plant(
+        plant.robot,
+        plant.friction,
+        plant.saturate,
+        wrench=wrench_value,
+        payload_step=payload,
+        sensor_noise=None
+        if noise is None
+        else SensorNoise(noise[0], noise[1], seed=getattr(args, "noise_seed", 0)),
+        delay=delay,
+    )
