@@ -149,7 +149,7 @@ def _events_plant() -> Plant:
     )
 
 
-@pytest.mark.parametrize("law", ["pd", "adaptive"])
+@pytest.mark.parametrize("law", ["pd", "adaptive", "pid"])
 def test_batch_equals_single_runs_with_every_event(law: str) -> None:
     cls = load_controller(law)
     offsets = np.array([[0.1, -0.1], [0.0, 0.0], [-0.05, 0.2]])

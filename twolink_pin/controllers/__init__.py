@@ -10,6 +10,11 @@
 ``wrong_model.py``     ``robust`` — :class:`WrongModel` (Slotine–Li on β × the model)
 ``adaptive.py``        ``adaptive`` — :class:`Adaptive` (Slotine–Li adaptive)
 ``adaptive_friction``  ``adaptive-friction`` — :class:`AdaptiveFriction` (+ friction)
+``pd_gravity.py``      ``pd-gravity`` — :class:`PDGravity` (PD + ĝ)
+``pid.py``             ``pid`` — :class:`PID` (integral state, anti-windup)
+``task_space.py``      what the task-space laws share (task rows, pose error, Λ, null space)
+``osc.py``             ``osc`` — :class:`OperationalSpace` (Khatib)
+``impedance.py``       ``impedance`` — :class:`Impedance` (Cartesian impedance + ĝ)
 =====================  ============================================================
 """
 
@@ -32,11 +37,16 @@ from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorq
 from twolink_pin.controllers.wrong_model import WrongModel, WrongModelGains
 from twolink_pin.controllers.adaptive import Adaptive, AdaptiveGains
 from twolink_pin.controllers.adaptive_friction import AdaptiveFriction, AdaptiveFrictionGains
+from twolink_pin.controllers.pd_gravity import PDGravity, PDGravityGains
+from twolink_pin.controllers.pid import PID, PIDGains
+from twolink_pin.controllers.osc import OperationalSpace, OSCGains
+from twolink_pin.controllers.impedance import Impedance, ImpedanceGains
 from twolink_pin.controllers.loading import available_controllers, load_controller
 
 __all__ = [
     "CONTROLLERS",
     "DEFAULT_LAMBDA",
+    "PID",
     "Adaptive",
     "AdaptiveFriction",
     "AdaptiveFrictionGains",
@@ -45,10 +55,17 @@ __all__ = [
     "Controller",
     "FrameTerms",
     "Gains",
+    "Impedance",
+    "ImpedanceGains",
     "LawInput",
     "LawOutput",
+    "OSCGains",
+    "OperationalSpace",
     "PDFeedforward",
     "PDGains",
+    "PDGravity",
+    "PDGravityGains",
+    "PIDGains",
     "SlotineLiGains",
     "StateVariable",
     "Terms",

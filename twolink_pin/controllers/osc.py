@@ -1,0 +1,117 @@
+"""Operational-space control (Khatib): the end effector's pose error made a linear system."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.task_space import (
+    TaskInertia,
+    block_gain,
+    null_space_torque,
+    pose_error,
+    task_rows,
+)
+from twolink_pin.model import RobotModel
+
+TASK_FREQUENCY = 10.0
+"""ω [rad/s] of the default task gains ``K = ω² I``, ``D = 2 ω I`` (critical damping)."""
+POSTURE_FREQUENCY = 5.0
+"""ω [rad/s] of the default posture gains (half the task's)."""
+
+
+@dataclass(frozen=True, eq=False)
+class OSCGains(Gains):
+    r"""Gains of :class:`OperationalSpace`: acceleration-level, so the same on every robot.
+    Each task gain is a number (times I), 3 numbers (a diagonal) or a symmetric
+    positive-definite 3 × 3 matrix in world axes (or one per run).
+
+    Attributes:
+        kp: Position stiffness $K_p$ [1/s²]; default $\omega^2$, $\omega$ = 10 rad/s.
+        kd: Position damping $D_p$ [1/s]; default $2\omega$.
+        kp_rot: Orientation stiffness $K_o$ [1/s²]; default $\omega^2$.
+        kd_rot: Orientation damping $D_o$ [1/s]; default $2\omega$.
+        kp_null: Posture stiffness per joint [1/s²]; default $\omega_n^2$, $\omega_n$ = 5 rad/s.
+        kd_null: Posture damping per joint [1/s]; default $2\omega_n$.
+    """
+
+    kp: Any = gain(TASK_FREQUENCY**2, per="axis", matrix=True, unit="1/s²", doc="position stiffness Kp")
+    kd: Any = gain(2 * TASK_FREQUENCY, per="axis", matrix=True, unit="1/s", doc="position damping Dp")
+    kp_rot: Any = gain(
+        TASK_FREQUENCY**2, per="axis", matrix=True, unit="1/s²", doc="orientation stiffness Ko"
+    )
+    kd_rot: Any = gain(2 * TASK_FREQUENCY, per="axis", matrix=True, unit="1/s", doc="orientation damping Do")
+    kp_null: Any = gain(POSTURE_FREQUENCY**2, per="joint", unit="1/s²", doc="posture stiffness")
+    kd_null: Any = gain(2 * POSTURE_FREQUENCY, per="joint", unit="1/s", doc="posture damping")
+
+
+class OperationalSpace(Controller[OSCGains]):
+    r"""Operational-space control with a posture task in the dynamically consistent null space:
+
+    $$\tau = J^\top \Lambda \big(\ddot x_d - D \dot e - K e - \dot J \dot q\big)
+    + \hat C \dot q + \hat g + N^\top \hat M \big(\ddot q_d - K_n e_q - D_n \dot e_q\big)$$
+
+    $$\Lambda = (J \hat M^{-1} J^\top)^{-1}, \qquad
+    N^\top = I - J^\top \Lambda J \hat M^{-1}$$
+
+    with the frame's pose error $e = (p - p_d,\ \log(R R_d^\top))$, $\dot e = J \dot q - \dot x_d$,
+    and the joint error $e_q = q - q_d$. With the exact model, $\ddot x = J \ddot q + \dot J
+    \dot q$ gives the decoupled task dynamics $\ddot e_p + D_p \dot e_p + K_p e_p = 0$ for the
+    position (exactly) and $\dot{\tilde\omega} + D_o \tilde\omega + K_o e_o = 0$ for the
+    orientation ($\tilde\omega = \omega - \omega_d$; $\dot e_o = \tilde\omega$ to first order);
+    the posture torque produces no task acceleration, $J \hat M^{-1} N^\top = 0$. The desired
+    pose, twist and acceleration are the forward kinematics of the joint reference
+    ($x_d = f(q_d)$, $\dot x_d = J(q_d) \dot q_d$, $\ddot x_d = J(q_d) \ddot q_d + \dot J \dot q_d$),
+    which also serves as the posture. Khatib, "A unified approach for motion and force
+    control of robot manipulators: the operational space formulation", *IEEE J. Robotics and
+    Automation* 3(1), 1987; null space: Khatib, *Int. J. Robotics Research* 14(1), 1995.
+
+    Choices (see :mod:`twolink_pin.controllers.task_space`): the task is the full pose when
+    the frame can move in 6 DOF, else the position along the axes it can move (the twolink:
+    x, y); near a singularity $\Lambda$ is damped and the law warns
+    (:class:`~twolink_pin.controllers.task_space.SingularityWarning`, counted in
+    ``damped_evaluations``). Without redundancy ($k = n_v$) there is no posture task.
+    """
+
+    name = "osc"
+    title = "operational-space control (Khatib)"
+    Gains = OSCGains
+
+    def __init__(self, robot: RobotModel, gains: OSCGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        self.rows = task_rows(robot)
+        """The controlled rows of the world-aligned 6-D task (0–2 position, 3–5 orientation)."""
+        g = self.gains
+        self._K = block_gain(g.kp, g.kp_rot, self.rows)
+        self._D = block_gain(g.kd, g.kd_rot, self.rows)
+        self._redundant = len(self.rows) < robot.nv
+        self._inertia = TaskInertia(self.name)
+
+    @property
+    def damped_evaluations(self) -> int:
+        """Evaluations at which the task inertia was damped (near a singularity)."""
+        return self._inertia.damped
+
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        rows = self.rows
+        f = terms.frame(x.q, x.v)
+        d = terms.frame(x.q_des, x.v_des)
+        J = f.jacobian[:, rows]
+        x_dot_des = np.matvec(d.jacobian, x.v_des)[:, rows]
+        x_ddot_des = (np.matvec(d.jacobian, x.a_des) + d.drift)[:, rows]
+        e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
+        e_dot = np.matvec(J, x.v) - x_dot_des
+        desired = x_ddot_des - np.matvec(self._D, e_dot) - np.matvec(self._K, e)
+        MinvJt = terms.solve_mass(x.q, np.swapaxes(J, -1, -2))
+        Lam = self._inertia(np.matmul(J, MinvJt), x.t)
+        tau = np.vecmat(np.matvec(Lam, desired - f.drift[:, rows]), J) + terms.bias(x.q, x.v)
+        if self._redundant:
+            g = self.gains
+            posture = x.a_des - g.kp_null * (x.q - x.q_des) - g.kd_null * (x.v - x.v_des)
+            tau0 = np.matvec(terms.mass(x.q), posture)
+            tau = tau + null_space_torque(J, MinvJt, Lam, tau0)
+        return LawOutput(tau)
