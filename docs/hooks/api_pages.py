@@ -41,9 +41,9 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "simulation",
         "Plant and simulation",
         "The simulated arm, a law with its plant, and the engine.",
-        ("plant", "scenario", "simulation"),
+        ("plant", "disturbances", "scenario", "simulation"),
     ),
-    ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics",)),
+    ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),
     (
         "identification",

@@ -381,9 +381,16 @@ class Controller(abc.ABC, Generic[G]):
             spec = _spec(f)
             value = getattr(gains, f.name)
             if spec.matrix and value is not None:
-                width = {"joint": self.robot.nv, "estimate": len(self.parameter_names), "axis": 3}[spec.per]
+                width, what = {
+                    "joint": (self.robot.nv, f"per joint, nv = {self.robot.nv}"),
+                    "estimate": (
+                        len(self.parameter_names),
+                        f"per estimated parameter: {self.parameter_names}",
+                    ),
+                    "axis": (3, "per world axis x, y, z"),
+                }[spec.per]
                 value = matrices[f.name] = as_matrix(value, width)
-                check_width(f.name, value, width, f"per {spec.per}")
+                check_width(f.name, value, width, what)
             elif spec.per == "joint":
                 check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")
             elif spec.per == "estimate":

@@ -1,0 +1,52 @@
+"""Task-space errors and metrics against the twolink's closed-form kinematics and Pinocchio's log3."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from conftest_sim import ROBOT, TRAJECTORY
+
+from twolink_pin.controllers import PDFeedforward
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.model import load_robot
+from twolink_pin.plant import Plant
+from twolink_pin.simulation import SimulationConfig, simulate
+from twolink_pin.task_metrics import task_errors, task_metrics
+from twolink_pin.twolink import closed_form
+
+
+def test_twolink_errors_and_metrics_are_the_closed_form() -> None:
+    result = simulate(PDFeedforward(ROBOT), Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.5))
+    q, qd = np.asarray(result.q), np.asarray(result.q_des)
+    l1, l2 = ROBOT.link_lengths
+    errors = task_errors(ROBOT, q, qd)
+    planar = closed_form.forward_kinematics(q, l1, l2) - closed_form.forward_kinematics(qd, l1, l2)
+    np.testing.assert_allclose(errors.position[:, :2], planar, atol=1e-12)
+    np.testing.assert_allclose(errors.position[:, 2], 0.0, atol=1e-12)
+    turn = np.angle(np.exp(1j * ((q[:, 0] + q[:, 1]) - (qd[:, 0] + qd[:, 1]))))
+    np.testing.assert_allclose(errors.orientation[:, 2], turn, atol=1e-9)
+    np.testing.assert_allclose(errors.orientation[:, :2], 0.0, atol=1e-12)
+    m = task_metrics(result, ROBOT)
+    distance = 1e3 * np.linalg.norm(planar, axis=1)
+    assert m.position_rms_mm == pytest.approx(np.sqrt(np.mean(distance**2)), rel=1e-9)
+    assert m.position_max_mm == pytest.approx(distance.max(), rel=1e-9)
+    assert m.position_last_period_max_mm == m.position_max_mm  # the run is shorter than a period
+    assert m.orientation_max_deg == pytest.approx(np.degrees(np.abs(turn).max()), rel=1e-6)
+    assert m.position_max_mm > 1.0  # the run starts 0.1 rad off
+
+
+def test_orientation_error_is_pinocchios_log3_on_the_panda() -> None:
+    panda = load_robot("panda")
+    rng = np.random.default_rng(1)
+    q, qd = rng.uniform(-2, 2, (2, 20, 7))
+    errors = task_errors(panda, q, qd)
+    data = panda.model.createData()
+    for k in range(20):
+        pin.framesForwardKinematics(panda.model, data, q[k])
+        R = data.oMf[panda.ee_frame_id].rotation.copy()
+        pin.framesForwardKinematics(panda.model, data, qd[k])
+        Rd = data.oMf[panda.ee_frame_id].rotation.copy()
+        np.testing.assert_allclose(errors.orientation[k], pin.log3(R @ Rd.T), atol=1e-9)
+    with pytest.raises(InvalidParameterError, match="frame"):
+        task_errors(panda, q, qd, frame="nope")
