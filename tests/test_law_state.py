@@ -153,3 +153,18 @@ def test_a_matrix_gain_is_a_matrix_product() -> None:
     tau = law.compute(LawInput(0.0, q, v, z, qd, vd, ad), terms).tau
     expected = terms.model(q, v, vd, ad) - (q - qd) @ kp.T - 40.0 * (v - vd) - 50.0 * z
     np.testing.assert_allclose(tau, expected, rtol=1e-12, atol=1e-12)
+
+
+def test_the_laws_state_gets_its_own_figure_with_its_names_and_units() -> None:
+    from twolink_pin.plotting.run import _simulation_figures
+
+    result = simulate(IntegralLaw(ROBOT), Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.2))
+    figures = _simulation_figures(result)
+    (ax,) = figures["state"].axes
+    assert ax.get_ylabel() == "state [rad·s]"
+    lines = ax.get_lines()
+    assert [line.get_label() for line in lines] == ["I1", "I2"]
+    assert result.state is not None
+    np.testing.assert_array_equal(lines[1].get_ydata(), result.state[:, 1])
+    adaptive = simulate(Adaptive(ROBOT), Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.05))
+    assert "state" not in _simulation_figures(adaptive)  # estimates have their own figures

@@ -19,6 +19,7 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ``parameters.py``    the parameter-error figures: a curve per parameter for a few (the
                      twolink), norms over time and a bar pair per parameter for many (the
                      base parameters of a 6- or 7-joint arm)
+``state.py``         the figure of a law's own state (integrators, filters), per unit
 ``distribution.py``  :func:`save_distribution_figure`: histograms of metrics over a sweep
 ``cartesian.py``     :func:`save_end_effector_figure`: the end-effector path and its distance
                      to the desired one

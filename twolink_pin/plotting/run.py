@@ -216,7 +216,8 @@ def _simulation_figures(
         Suffix → figure: ``theta{i}`` for each joint, then ``theta{i}dot``, ``torque``, and
         for runs with parameter estimates ``param_error`` (the parameters whose
         ``parameter_kinds`` entry is ``"inertial"``) and ``friction_error`` (``"friction"``),
-        each only when it has a parameter.
+        each only when it has a parameter; ``state`` for a law with other state (an
+        integrator, a filter: :mod:`twolink_pin.plotting.state`).
 
     Raises:
         InvalidParameterError: ``figure_numbers`` is not a mapping of key → positive
@@ -238,6 +239,11 @@ def _simulation_figures(
     figures["torque"] = _torque_figure(result, numbers, heading)
     if result.p_error is not None:
         figures |= _parameter_figures(result, numbers, heading)
+    from twolink_pin.plotting.state import state_figure
+
+    state = state_figure(result, heading)
+    if state is not None:
+        figures["state"] = state
     return figures
 
 
@@ -267,7 +273,8 @@ def save_simulation_figures(
       arm) shows instead the normalised error ``‖p̂ − p‖ / ‖p‖`` of each unit over time and
       the error of each parameter at the start and the end as bars, labelled ``β<k>``
       (:func:`twolink_pin.plotting.parameters._parameter_summary_figure`). Relative errors
-      only where ``|p_i|`` is at least 1 % of the largest ``|p_j|`` of its unit.
+      only where ``|p_i|`` is at least 1 % of the largest ``|p_j|`` of its unit;
+    * a law with state other than estimates (``pid``'s integrals): ``<prefix>_state.png``.
 
     Args:
         result: A simulation result (read only).
