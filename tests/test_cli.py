@@ -115,8 +115,8 @@ def test_simulate_json_short_pd_run(capsys: pytest.CaptureFixture[str]) -> None:
         (["fk", "nan", "0"], "expected a finite number, got 'nan'"),
         (["simulate", "pd", "--duration", "0"], "expected a number in (0, 1e+06] s, got '0'"),
         (
-            ["simulate", "pid"],
-            "controller 'pid': no law of that name; registered laws are pd, computed-torque",
+            ["simulate", "lqr"],
+            "controller 'lqr': no law of that name; registered laws are pd, computed-torque",
         ),
         (
             ["simulate", "pd", "--lambda", "3"],
