@@ -9,13 +9,15 @@ Each event against an independent construction:
 * the delay: the command applied at step k is the law's output at the state of step k − d;
 * after a payload step the adaptive law re-converges and computed torque does not;
 * a batch equals N single runs with every event at once;
-* the CLI options give the library's run, and bad values one line and exit 2.
+* the CLI options (``simulate``, ``compare``) give the library's run, and bad values one
+  line and exit 2.
 """
 
 from __future__ import annotations
 
 import functools
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -237,3 +239,14 @@ def test_cli_refuses_bad_values_in_one_line(
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and option in err and "Traceback" not in err
+
+
+def test_compare_takes_the_plants_events(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    argv = ["compare", "pd", "pid", "--duration", "0.2", "--no-plot", "--out", str(tmp_path / "c")]
+    argv += ["--wrench", "3,-2,0@0.05:", "--json"]
+    assert main(argv) == 0
+    payload = json.loads(capsys.readouterr().out)
+    plant = Plant(ROBOT, wrench=Wrench((3.0, -2.0, 0.0), 0.05))
+    for law in ("pd", "pid"):
+        expected = compute_metrics(simulate(_law(law), plant, TRAJECTORY, SimulationConfig(duration=0.2)))
+        np.testing.assert_allclose(payload["controllers"][law]["rms"]["e"], expected.rms.e, rtol=1e-12)

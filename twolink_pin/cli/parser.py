@@ -249,6 +249,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--out", default="out/compare", metavar="DIR", help="output directory (default out/compare)"
     )
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    add_disturbance_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_compare)
 
