@@ -448,7 +448,20 @@ def cmd_identify(args: argparse.Namespace) -> int:
             raise InvalidParameterError(
                 given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
             )
-        log = read_log(args.data, robot.nv)
+        from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
+
+        bag_summary = None
+        if is_bag(args.data):
+            joints = [str(n) for n in robot.model.names[1:]]
+            log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
+        else:
+            if args.topic or args.torque_topic:
+                raise InvalidParameterError(
+                    "--topic" if args.topic else "--torque-topic",
+                    args.topic or args.torque_topic,
+                    "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
+                )
+            log = read_log(args.data, robot.nv)
         reference = f"data {args.data}"
         if args.reference:
             from dataclasses import replace
@@ -460,9 +473,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
     else:
         from twolink_pin.trajectory import read_trajectory_file
 
-        if args.reference:
+        bag_summary = None
+        if args.reference or args.topic or args.torque_topic:
+            flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
             raise InvalidParameterError(
-                "--reference", args.reference, "a file only with --data (a simulated run knows its reference)"
+                flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
             )
         if args.trajectory:
             trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
@@ -502,7 +517,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         "saved": args.save,
         "data_saved": args.save_data,
     }
-    lines = [
+    lines = [] if bag_summary is None else bag_summary.lines()
+    lines += [
         f"identified {result.size} parameters of {robot.name} from {log.source}",
         f"  {reference}; {result.fit_samples} samples fitted (every {result.stride}th valid one of {result.samples}, "
         f"{result.fit_interval[0]:.3g}–{result.fit_interval[1]:.3g} s)"

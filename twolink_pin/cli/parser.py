@@ -400,7 +400,20 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         "--data",
         metavar="FILE",
         help=f"a logged run: CSV (header t, q1..qn, tau1..taun, optional v1..vn) or NPZ (t, q, tau, optional v), "
-        f"up to {MAX_LOG_BYTES >> 20} MiB",
+        f"up to {MAX_LOG_BYTES >> 20} MiB; or a ROS bag of sensor_msgs/JointState (a ROS 2 bag folder, .db3, "
+        ".mcap, or a ROS 1 .bag)",
+    )
+    p.add_argument(
+        "--topic",
+        default=None,
+        help="with a bag: the joint-state topic (default /joint_states); joints matched to the model by name",
+    )
+    p.add_argument(
+        "--torque-topic",
+        default=None,
+        metavar="TOPIC",
+        help="with a bag: commanded torques (JointState effort or Float64MultiArray in the model's joint order) "
+        "instead of the joint states' effort",
     )
     p.add_argument(
         "--duration",

@@ -6,6 +6,8 @@ and the command line use it, never the reverse.
 =======================  ===================================================================
 ``data.py``              :class:`RunLog` (t, q, (q̇), τ); CSV / NPZ reading with row and column
                          in every error, writing, measurement noise
+``bags.py``              ROS 2 / ROS 1 bags of ``sensor_msgs/JointState`` (rosbags): joints by
+                         name, resampled onto one grid, drops and gaps reported
 ``filtering.py``         zero-phase Butterworth filter, 5-point differences: q̇, q̈ from q; τ
                          and the Coulomb column filtered alike; samples dropped near the ends
 ``observation.py``       :class:`ParameterSet` (base parameters + friction) and the
