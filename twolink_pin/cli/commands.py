@@ -497,6 +497,13 @@ def cmd_identify(args: argparse.Namespace) -> int:
     )
     result = identify(log, robot, options)
     document = identification_document(result, robot)
+    physical_lines: list[str] = []
+    if args.physical:
+        from twolink_pin.identification.physical import compare_physical
+
+        physical_document, physical_lines = compare_physical(log, robot, options, result)
+        document["parameters"] = physical_document.pop("parameters")  # what --save gives --model
+        document["physical"] = physical_document
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure
@@ -556,6 +563,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                 else ""
             )
         )
+    lines += physical_lines
     lines += [f"  figure {f}" for f in figures]
     if args.save:
         lines.append(f"  parameters saved to {args.save} (use with --p0 / --model)")

@@ -416,6 +416,12 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         "instead of the joint states' effort",
     )
     p.add_argument(
+        "--physical",
+        action="store_true",
+        help="physically consistent fit: every link's pseudo-inertia positive semidefinite and friction >= 0 "
+        "(cvxpy + Clarabel), compared with the unconstrained fit on the validation period",
+    )
+    p.add_argument(
         "--duration",
         type=bounded(0.0, 3600.0, low_open=True, unit="s"),
         default=None,

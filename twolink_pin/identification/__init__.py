@@ -14,6 +14,8 @@ and the command line use it, never the reverse.
                          observation matrix ``W`` with ``τ = W θ``
 ``least_squares.py``     :func:`identify`: Gautier's weighted least squares, standard
                          deviations, condition number, residuals, the validation period
+``physical.py``          physically consistent fit (every link's pseudo-inertia ⪰ 0, friction
+                         ⪰ 0; cvxpy + Clarabel) and how far base parameters are from physical
 ``measures.py``          how a trajectory excites: ``cond(W)``, the Gram matrix, and the
                          averaged adaptation rates of an adaptive law
 ``excitation.py``        :func:`optimise_excitation`: Swevers' Fourier excitation, optimised
