@@ -94,7 +94,9 @@ def poor_run(arm, tmp_path_factory):
 
     out = io.StringIO()
     with contextlib.redirect_stdout(out):
-        assert main([*common, "--physical", "--json", "--save", str(folder / "physical.json")]) == 0
+        physical = ["--physical", "--json", "--save", str(folder / "physical.json")]
+        physical += ["--write-urdf", str(folder / "identified.urdf"), "--save-data", str(folder / "log.npz")]
+        assert main([*common, *physical]) == 0
         assert main([*common, "--save", str(folder / "raw.json")]) == 0
     document, _ = json.JSONDecoder().raw_decode(out.getvalue())
     return document, folder
@@ -154,3 +156,29 @@ def test_model_file_with_impossible_parameters_is_refused_by_file_and_link(
     assert len(err.splitlines()) == 1
     assert str(raw) in err and "link 'link2'" in err and "pseudo-inertia positive semidefinite" in err
     assert main([*base, "--model", str(physical)]) == 0
+
+
+def test_written_urdf_validates_loads_and_predicts_the_identified_torques(arm, poor_run) -> None:
+    """``--write-urdf``: the project's validator passes it; loaded back (Pinocchio from the file,
+    friction from its <dynamics>), its torques on the validation period equal the identified
+    model's to 1e-9 (relative to the torque scale); ``simulate computed-torque --urdf`` and
+    ``info --urdf`` run on it."""
+    from twolink_pin.dynamics import Friction
+    from twolink_pin.identification import read_log
+    from twolink_pin.model.urdf_validation import validate_urdf_file
+    from twolink_pin.model.urdf_write import joint_friction
+
+    document, folder = poor_run
+    urdf = folder / "identified.urdf"
+    validate_urdf_file(urdf)
+    loaded = load_robot(urdf)
+    names = [str(n) for n in loaded.model.names[1:]]
+    friction = Friction(*joint_friction(urdf, names))
+    theta_file = ParameterSet.of(loaded).true_values(loaded.model, friction)
+    theta = np.array([r["estimate"] for r in document["parameters"]])
+    log = read_log(folder / "log.npz", arm.nv)
+    mine = validation_of(log, arm, theta).tau_predicted
+    theirs = validation_of(log, loaded, theta_file).tau_predicted
+    assert np.max(np.abs(mine - theirs)) < 1e-9 * np.max(np.abs(mine))
+    assert main(["simulate", "computed-torque", "--urdf", str(urdf), "--duration", "0.05"]) == 0
+    assert main(["info", "--urdf", str(urdf), "--json"]) == 0

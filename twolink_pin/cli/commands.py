@@ -336,6 +336,13 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     traj = _trajectory(args, robot)
     via = default_via_points(robot) if not args.trajectory else None
     check = check_torques(robot, traj)
+    if args.save:
+        from twolink_pin.trajectory.file import write_trajectory_file
+
+        if Path(args.save).suffix.lower() not in (".json", ".toml"):
+            raise InvalidParameterError("--save", args.save, "a trajectory file name ending in .json or .toml")
+        write_trajectory_file(args.save, traj)  # type: ignore[arg-type]
+        print(f"reference saved to {args.save} (read by --trajectory and --reference)", file=sys.stderr)
     if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
         return _fourier_trajectory(args, robot, traj, check)
     assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
@@ -498,12 +505,22 @@ def cmd_identify(args: argparse.Namespace) -> int:
     result = identify(log, robot, options)
     document = identification_document(result, robot)
     physical_lines: list[str] = []
+    fit = None
     if args.physical:
         from twolink_pin.identification.physical import compare_physical
 
-        physical_document, physical_lines = compare_physical(log, robot, options, result)
+        physical_document, physical_lines, fit = compare_physical(log, robot, options, result)
         document["parameters"] = physical_document.pop("parameters")  # what --save gives --model
         document["physical"] = physical_document
+    if args.write_urdf:
+        from twolink_pin.identification.physical import write_identified_urdf
+
+        write_identified_urdf(args.write_urdf, robot, result.estimate, options.friction, fit)
+        document["urdf_written"] = args.write_urdf
+        physical_lines.append(
+            f"  URDF with the identified inertias{' and friction (<dynamics>)' if options.friction else ''} "
+            f"written to {args.write_urdf} (use with --robot/--urdf)"
+        )
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure

@@ -218,6 +218,11 @@ def build_parser() -> argparse.ArgumentParser:
         "trajectory", help="the robot's reference trajectory, its coefficients and the torque check"
     )
     p.add_argument("--plot", metavar="DIR", help="write the trajectory's figures as PNG into DIR")
+    p.add_argument(
+        "--save",
+        metavar="FILE",
+        help="write the reference as a trajectory file (.json or .toml) that --trajectory and --reference read",
+    )
     add_trajectory_option(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_trajectory)
@@ -490,6 +495,12 @@ def add_identification_commands(sub: Any, c: Any) -> None:
     p.add_argument("--plot", metavar="DIR", help="write the figures (validation torques, estimates) into DIR")
     p.add_argument("--save", metavar="FILE.json", help="write the identified parameters (for --p0 / --model)")
     p.add_argument("--save-data", metavar="FILE", help="write the log used (.csv or .npz, after any noise)")
+    p.add_argument(
+        "--write-urdf",
+        metavar="OUT.urdf",
+        help="write the robot's URDF with the identified inertias and friction (<dynamics damping friction>); "
+        "the estimates must be physically consistent (--physical makes them so)",
+    )
     add_robot_options(p)
     p.set_defaults(func=c.cmd_identify)
 

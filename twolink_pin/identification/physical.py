@@ -42,6 +42,11 @@ from twolink_pin.model import RobotModel
 from twolink_pin.model.base_parameters import BaseParameterMap, body_name
 from twolink_pin.model.parameters import N_BODY_PARAMETERS
 
+MARGIN = 1e-6
+"""The constrained fit asks ``J_i ⪰ MARGIN 𝟙`` [kg·m²], not just ``⪰ 0``: a body strictly inside
+the physical set, whose inertia about its centre of mass is positive definite and within the
+triangle inequality by ``2 MARGIN`` (what a URDF and its validator need; on the boundary the
+solver's 1e-8 would leave it to rounding)."""
 TIE = 0.01
 """Validation RMS values within this fraction of each other are a tie."""
 TOLERANCE = 1e-7
@@ -130,16 +135,19 @@ class Consistency:
         )
 
 
-def consistency(robot: RobotModel, base_map: BaseParameterMap, beta: np.ndarray) -> Consistency:
+def consistency(
+    robot: RobotModel, base_map: BaseParameterMap, beta: np.ndarray, margin: float = 0.0
+) -> Consistency:
     """Whether some physical standard parameters give the base parameters ``beta`` (module
-    docstring); per link the least violation of ``J_i ⪰ 0`` they must have."""
+    docstring); per link the least violation of ``J_i ⪰ 0`` they must have. With ``margin`` > 0
+    the links are pushed up to ``J_i ⪰ margin 𝟙`` where ``beta`` allows (``s_i <= margin``)."""
     import cvxpy as cp
 
     bodies = robot.model.njoints - 1
     Js = [cp.Variable((4, 4), symmetric=True) for _ in range(bodies)]
     s = cp.Variable(bodies)
     pi = cp.hstack([p for J in Js for p in _parameters_of(J)])
-    constraints = [base_map.combination @ pi == np.asarray(beta, dtype=float), s <= 0]
+    constraints = [base_map.combination @ pi == np.asarray(beta, dtype=float), s <= margin]
     constraints += [Js[i] - s[i] * np.eye(4) >> 0 for i in range(bodies)]
     _solve(cp.Problem(cp.Maximize(cp.sum(s)), constraints))
     scale = max(1.0, float(np.max(np.abs(beta)))) if np.size(beta) else 1.0
@@ -189,7 +197,7 @@ def physical_fit(
     f = cp.Variable(nf) if nf else None
     beta = base_map.combination @ pi
     theta = cp.hstack([beta, f]) if f is not None else beta
-    constraints = [J >> 0 for J in Js] + ([f >= 0] if f is not None else [])
+    constraints = [J - MARGIN * np.eye(4) >> 0 for J in Js] + ([f >= 0] if f is not None else [])
     _solve(cp.Problem(cp.Minimize(cp.sum_squares(L @ (theta - estimate))), constraints))
     standard = np.asarray(pi.value, dtype=float)
     beta_star = np.asarray(base_map.combination @ standard, dtype=float)  # exactly B π: the URDF's β
@@ -214,8 +222,9 @@ def compare_physical(
     are infeasible, by how much), the constrained fit, and both on the validation period.
 
     Returns:
-        ``(document, lines)``: the JSON part (``"parameters"`` holds the constrained estimates
-        with the unconstrained σ, in the rows of ``result.parameters()``) and the text.
+        ``(document, lines, fit)``: the JSON part (``"parameters"`` holds the constrained
+        estimates with the unconstrained σ, in the rows of ``result.parameters()``), the text,
+        and the fit.
     """
     from twolink_pin.identification.least_squares import Identification, IdentificationOptions, validation_of
     from twolink_pin.identification.observation import ParameterSet
@@ -278,4 +287,71 @@ def compare_physical(
         "better_on_validation": verdict,
         "parameters": rows,
     }
-    return document, lines
+    return document, lines, fit
+
+
+def write_identified_urdf(
+    path: str,
+    robot: RobotModel,
+    estimate: np.ndarray,
+    friction: bool,
+    fit: PhysicalFit | None = None,
+) -> tuple[str, np.ndarray]:
+    """Write ``robot``'s URDF with identified inertias (and friction) to ``path``, atomically:
+    the standard parameters of ``fit`` (``--physical``), else physical standard parameters
+    giving the estimate's base parameters exactly (an SDP then a projection onto ``B π = β̂``).
+
+    Returns:
+        ``(text, θ)``: the file's text and the θ = (β, V, C) it holds.
+
+    Raises:
+        InvalidParameterError: the estimate is physically impossible (the links named: use
+            ``--physical``) or on the boundary of the physical set.
+    """
+    from twolink_pin.files import atomic_write
+    from twolink_pin.model.urdf_validation import validate_urdf_string
+    from twolink_pin.model.urdf_write import urdf_with_inertias
+
+    pset_base = (
+        BaseParameterMap(robot.model)
+        if not isinstance(robot.parameter_map, BaseParameterMap)
+        else robot.parameter_map
+    )
+    nb = pset_base.size
+    if fit is not None:
+        standard, theta = fit.standard, fit.theta
+    else:
+        beta = np.asarray(estimate[:nb], dtype=float)
+        check = consistency(robot, pset_base, beta, margin=MARGIN)
+        if not check.feasible:
+            raise InvalidParameterError(
+                "--write-urdf", path, f"physically consistent estimates: {check.describe()} (add --physical)"
+            )
+        B = pset_base.combination
+        standard = check.standard + np.linalg.pinv(B) @ (beta - B @ check.standard)
+        least = min(
+            float(
+                np.linalg.eigvalsh(
+                    pseudo_inertia(standard[N_BODY_PARAMETERS * i : N_BODY_PARAMETERS * (i + 1)])
+                )[0]
+            )
+            for i in range(robot.model.njoints - 1)
+        )
+        if least < 0.5 * MARGIN:
+            raise InvalidParameterError(
+                "--write-urdf",
+                path,
+                f"estimates strictly inside the physical set (a link's pseudo-inertia has λ_min {least:.3g} kg·m², "
+                f"on the boundary: no URDF body has it; add --physical, which keeps {MARGIN:g} from it)",
+            )
+        theta = np.asarray(estimate, dtype=float).copy()
+        if friction:
+            theta[nb:] = np.maximum(theta[nb:], 0.0)
+    coefficients = (theta[nb : nb + robot.nv], theta[nb + robot.nv :]) if friction else None
+    text = urdf_with_inertias(
+        robot.urdf_path.read_text(encoding="utf-8"), robot.model, standard, coefficients
+    )
+    validate_urdf_string(text, path)
+    with atomic_write(path) as f:
+        f.write(text)
+    return text, theta
