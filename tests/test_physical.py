@@ -107,6 +107,10 @@ def test_poorly_excited_log_least_squares_is_impossible_and_physical_is_not(arm,
     are PSD to the solver's accuracy, its friction ≥ 0, and it is at least as close to the
     estimate (in the weighted least-squares metric) as the true parameters, a feasible point."""
     document, _ = poor_run
+    (warning,) = document["warnings"]  # cond(W) ≈ 1.3e3: the poorly determined parameters named
+    assert "condition number" in warning and "> 100" in warning and "twolink-pin excite" in warning
+    worst = max(document["parameters"], key=lambda r: r["relative_std_percent"] or 0)["name"]
+    assert worst in warning
     physical = document["physical"]
     assert "link2" in physical["unconstrained_infeasible_links"]
     assert min(physical["unconstrained_least_eigenvalue"].values()) < -0.1

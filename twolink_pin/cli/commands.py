@@ -340,7 +340,9 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         from twolink_pin.trajectory.file import write_trajectory_file
 
         if Path(args.save).suffix.lower() not in (".json", ".toml"):
-            raise InvalidParameterError("--save", args.save, "a trajectory file name ending in .json or .toml")
+            raise InvalidParameterError(
+                "--save", args.save, "a trajectory file name ending in .json or .toml"
+            )
         write_trajectory_file(args.save, traj)  # type: ignore[arg-type]
         print(f"reference saved to {args.save} (read by --trajectory and --reference)", file=sys.stderr)
     if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
@@ -469,6 +471,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
                     "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
                 )
             log = read_log(args.data, robot.nv)
+        from twolink_pin.identification.diagnostics import check_log
+
+        check_log(log, robot)
         reference = f"data {args.data}"
         if args.reference:
             from dataclasses import replace
@@ -580,6 +585,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
                 else ""
             )
         )
+    from twolink_pin.identification.diagnostics import fit_warnings
+
+    warnings = fit_warnings(result)
+    document["warnings"] = warnings
+    lines += [f"  {w}" for w in warnings]
     lines += physical_lines
     lines += [f"  figure {f}" for f in figures]
     if args.save:

@@ -8,6 +8,8 @@ and the command line use it, never the reverse.
                          in every error, writing, measurement noise
 ``bags.py``              ROS 2 / ROS 1 bags of ``sensor_msgs/JointState`` (rosbags): joints by
                          name, resampled onto one grid, drops and gaps reported
+``diagnostics.py``       what is wrong with a log (units, a still joint) and a poorly
+                         conditioned fit, said as such
 ``filtering.py``         zero-phase Butterworth filter, 5-point differences: q̇, q̈ from q; τ
                          and the Coulomb column filtered alike; samples dropped near the ends
 ``observation.py``       :class:`ParameterSet` (base parameters + friction) and the
