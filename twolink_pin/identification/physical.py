@@ -34,6 +34,7 @@ estimate towards the boundary), which they do not contain.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -217,7 +218,7 @@ def physical_fit(
 
 def compare_physical(
     log: object, robot: RobotModel, options: object, result: object
-) -> tuple[dict, list[str]]:
+) -> tuple[dict[str, Any], list[str], PhysicalFit]:
     """The ``--physical`` part of ``identify``: the unconstrained fit's consistency (which links
     are infeasible, by how much), the constrained fit, and both on the validation period.
 
