@@ -273,3 +273,20 @@ def test_ur5_mcap_bag_gives_the_npz_estimates(tmp_path: Path) -> None:
     bag = write_bag(tmp_path / "ur5", ur5, trajectory, 20.0, 5e-4, "mcap", seed=1)
     log, _ = read_bag(bag, joint_names(ur5))
     assert relative(identify(log, ur5, options).estimate, reference) < 1e-6
+
+
+def test_broken_bags_and_pipes_are_refused_before_reading(tmp_path: Path) -> None:
+    """Bytes that are not a bag, a FIFO named like one (which would block the reader), a folder
+    without metadata.yaml: each one error naming the path and what was expected."""
+    import os
+
+    garbage = tmp_path / "garbage.mcap"
+    garbage.write_bytes(b"not a bag at all")
+    with pytest.raises(InputFileError, match=r"garbage.mcap: is not a readable ROS bag"):
+        read_bag(garbage, ["joint1"])
+    pipe = tmp_path / "pipe.bag"
+    os.mkfifo(pipe)
+    with pytest.raises(InputFileError, match=r"pipe.bag: is not a regular file .*expected a ROS bag"):
+        read_bag(pipe, ["joint1"])
+    with pytest.raises(InputFileError, match=r"folder without metadata.yaml"):
+        read_bag(tmp_path, ["joint1"])

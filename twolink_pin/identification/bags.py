@@ -62,6 +62,8 @@ DEFAULT_TOPIC = "/joint_states"
 """Topic of the joint states when none is given."""
 BAG_SUFFIXES = (".db3", ".mcap", ".bag")
 """File suffixes read as bags (a folder with ``metadata.yaml`` is a ROS 2 bag too)."""
+MAX_BAG_BYTES = 16 << 30
+"""Largest bag file read (16 GiB)."""
 GAP_STEPS = 1.5
 """A step between stamps longer than this many grid steps is a gap (messages dropped)."""
 MAX_GAP_STEPS = 10.0
@@ -275,20 +277,29 @@ def read_bag(
     """
     from scipy.interpolate import CubicSpline
 
+    from twolink_pin.files import check_input_file
+
     file = Path(os.fspath(path))
     root, storage = _bag_root(file)
     where = str(file)
     names = list(joint_names)
+    stored = [p for p in root.iterdir() if p.suffix.lower() in BAG_SUFFIXES] if root.is_dir() else [root]
+    for part in stored:  # a FIFO or a device named *.bag would block the reader: refused before it opens
+        check_input_file(part, MAX_BAG_BYTES, "a ROS bag")
     try:
         reader = _open(root)
         reader.open()
-    except Exception as exc:  # rosbags raises its own errors for unreadable bags
+        try:
+            states = _read_topic(reader, where, topic, JOINT_STATE)
+            commands = (
+                _read_topic(reader, where, torque_topic, JOINT_STATE + MULTI_ARRAY) if torque_topic else []
+            )
+        finally:
+            reader.close()
+    except InputFileError:
+        raise
+    except Exception as exc:  # rosbags raises its own errors (and sqlite3's, struct's) for broken bags
         raise InputFileError(where, f"is not a readable ROS bag ({type(exc).__name__}: {exc})") from None
-    try:
-        states = _read_topic(reader, where, topic, JOINT_STATE)
-        commands = _read_topic(reader, where, torque_topic, JOINT_STATE + MULTI_ARRAY) if torque_topic else []
-    finally:
-        reader.close()
     if len(states) < MIN_SAMPLES:
         raise InputFileError(
             where, f"has {len(states)} messages on {topic}; identification needs at least {MIN_SAMPLES}"
