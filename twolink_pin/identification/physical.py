@@ -266,7 +266,10 @@ def compare_physical(
     if rms["unconstrained"] is not None and rms["physical"] is not None:
         u, p = rms["unconstrained"], rms["physical"]
         total_u, total_p = float(np.sqrt(np.mean(u**2))), float(np.sqrt(np.mean(p**2)))
-        if abs(total_p - total_u) <= TIE * max(total_u, total_p):
+        if not changed:
+            verdict = "same"
+            said = "the constraints are inactive: the unconstrained estimate is physical already"
+        elif abs(total_p - total_u) <= TIE * max(total_u, total_p):
             verdict = "tie"
             said = (
                 f"no measurable difference (within {100 * TIE:g} %): the constraints moved the estimate along "
