@@ -417,6 +417,42 @@ def _verdict(ratio: float, target: float | None) -> str:
     return f" (target <= {target:g}x: {'met' if ratio <= target else 'NOT met'})"
 
 
+def identification_section(quick: bool) -> dict[str, Any]:
+    """``identify`` on the UR5 (48 parameters) from a noisy log along its stored excitation
+    (tests/fixtures/ur5_excitation.json), and the ``--physical`` fit on top; the simulated run
+    that makes the log is not timed."""
+    from pathlib import Path
+
+    from twolink_pin.identification import IdentificationOptions, add_noise, identify, simulate_log
+    from twolink_pin.identification.physical import compare_physical
+    from twolink_pin.trajectory import read_trajectory_file
+
+    ur5 = load_robot("ur5")
+    fixture = Path(__file__).resolve().parents[1] / "tests" / "fixtures" / "ur5_excitation.json"
+    duration = 8.0 if quick else 20.0
+    log = add_noise(simulate_log(ur5, read_trajectory_file(fixture, ur5), duration=duration), 1e-5, 0.05, 0)
+    options = IdentificationOptions()
+    start = time.perf_counter()
+    result = identify(log, ur5, options)
+    seconds_identify = time.perf_counter() - start
+    start = time.perf_counter()
+    compare_physical(log, ur5, options, result)
+    seconds_physical = time.perf_counter() - start
+    print(
+        f"\nidentify on the UR5 ({result.size} parameters, {duration:g}-s log at 2 kHz along its stored excitation, "
+        f"{result.fit_samples} samples fitted): {seconds_identify:.2f} s; --physical fit on top "
+        f"(consistency SDPs, the constrained fit, the validation period): {seconds_physical:.2f} s"
+    )
+    return {
+        "identify_ur5": {
+            "duration": duration,
+            "parameters": result.size,
+            "seconds": seconds_identify,
+            "physical_seconds": seconds_physical,
+        }
+    }
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="short runs and few repeats (smoke test)")
@@ -430,6 +466,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--ur5-only", action="store_true", help="only the UR5's single run and batch against the baseline"
     )
+    parser.add_argument(
+        "--identify-only", action="store_true", help="only identify on the UR5 and its --physical fit"
+    )
     args = parser.parse_args(argv)
     quick = args.quick
     repeats = args.repeats or (1 if quick else 5)
@@ -442,6 +481,11 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.identify_only:
+        results.update(identification_section(quick))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.sweep_only:
         results.update(sweep_section(quick))
         results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
@@ -553,6 +597,7 @@ def main(argv: list[str] | None = None) -> int:
         "seconds": {_label(k): v for k, v in batch.items()},
     }
     results.update(ur5_section(baseline, scale, quick, repeats))
+    results.update(identification_section(quick))
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)

@@ -338,6 +338,15 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     traj = _trajectory(args, robot)
     via = default_via_points(robot) if not args.trajectory else None
     check = check_torques(robot, traj)
+    if args.save:
+        from twolink_pin.trajectory.file import write_trajectory_file
+
+        if Path(args.save).suffix.lower() not in (".json", ".toml"):
+            raise InvalidParameterError(
+                "--save", args.save, "a trajectory file name ending in .json or .toml"
+            )
+        write_trajectory_file(args.save, traj)  # type: ignore[arg-type]
+        print(f"reference saved to {args.save} (read by --trajectory and --reference)", file=sys.stderr)
     if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
         return _fourier_trajectory(args, robot, traj, check)
     assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
@@ -450,7 +459,23 @@ def cmd_identify(args: argparse.Namespace) -> int:
             raise InvalidParameterError(
                 given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
             )
-        log = read_log(args.data, robot.nv)
+        from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
+
+        bag_summary = None
+        if is_bag(args.data):
+            joints = [str(n) for n in robot.model.names[1:]]
+            log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
+        else:
+            if args.topic or args.torque_topic:
+                raise InvalidParameterError(
+                    "--topic" if args.topic else "--torque-topic",
+                    args.topic or args.torque_topic,
+                    "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
+                )
+            log = read_log(args.data, robot.nv)
+        from twolink_pin.identification.diagnostics import check_log
+
+        check_log(log, robot)
         reference = f"data {args.data}"
         if args.reference:
             from dataclasses import replace
@@ -462,9 +487,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
     else:
         from twolink_pin.trajectory import read_trajectory_file
 
-        if args.reference:
+        bag_summary = None
+        if args.reference or args.topic or args.torque_topic:
+            flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
             raise InvalidParameterError(
-                "--reference", args.reference, "a file only with --data (a simulated run knows its reference)"
+                flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
             )
         if args.trajectory:
             trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
@@ -484,6 +511,23 @@ def cmd_identify(args: argparse.Namespace) -> int:
     )
     result = identify(log, robot, options)
     document = identification_document(result, robot)
+    physical_lines: list[str] = []
+    fit = None
+    if args.physical:
+        from twolink_pin.identification.physical import compare_physical
+
+        physical_document, physical_lines, fit = compare_physical(log, robot, options, result)
+        document["parameters"] = physical_document.pop("parameters")  # what --save gives --model
+        document["physical"] = physical_document
+    if args.write_urdf:
+        from twolink_pin.identification.physical import write_identified_urdf
+
+        write_identified_urdf(args.write_urdf, robot, result.estimate, options.friction, fit)
+        document["urdf_written"] = args.write_urdf
+        physical_lines.append(
+            f"  URDF with the identified inertias{' and friction (<dynamics>)' if options.friction else ''} "
+            f"written to {args.write_urdf} (use with --robot/--urdf)"
+        )
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure
@@ -504,7 +548,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         "saved": args.save,
         "data_saved": args.save_data,
     }
-    lines = [
+    lines = [] if bag_summary is None else bag_summary.lines()
+    lines += [
         f"identified {result.size} parameters of {robot.name} from {log.source}",
         f"  {reference}; {result.fit_samples} samples fitted (every {result.stride}th valid one of {result.samples}, "
         f"{result.fit_interval[0]:.3g}–{result.fit_interval[1]:.3g} s)"
@@ -542,6 +587,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
                 else ""
             )
         )
+    from twolink_pin.identification.diagnostics import fit_warnings
+
+    warnings = fit_warnings(result)
+    document["warnings"] = warnings
+    lines += [f"  {w}" for w in warnings]
+    lines += physical_lines
     lines += [f"  figure {f}" for f in figures]
     if args.save:
         lines.append(f"  parameters saved to {args.save} (use with --p0 / --model)")

@@ -219,6 +219,11 @@ def build_parser() -> argparse.ArgumentParser:
         "trajectory", help="the robot's reference trajectory, its coefficients and the torque check"
     )
     p.add_argument("--plot", metavar="DIR", help="write the trajectory's figures as PNG into DIR")
+    p.add_argument(
+        "--save",
+        metavar="FILE",
+        help="write the reference as a trajectory file (.json or .toml) that --trajectory and --reference read",
+    )
     add_trajectory_option(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_trajectory)
@@ -403,7 +408,26 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         "--data",
         metavar="FILE",
         help=f"a logged run: CSV (header t, q1..qn, tau1..taun, optional v1..vn) or NPZ (t, q, tau, optional v), "
-        f"up to {MAX_LOG_BYTES >> 20} MiB",
+        f"up to {MAX_LOG_BYTES >> 20} MiB; or a ROS bag of sensor_msgs/JointState (a ROS 2 bag folder, .db3, "
+        ".mcap, or a ROS 1 .bag)",
+    )
+    p.add_argument(
+        "--topic",
+        default=None,
+        help="with a bag: the joint-state topic (default /joint_states); joints matched to the model by name",
+    )
+    p.add_argument(
+        "--torque-topic",
+        default=None,
+        metavar="TOPIC",
+        help="with a bag: commanded torques (JointState effort or Float64MultiArray in the model's joint order) "
+        "instead of the joint states' effort",
+    )
+    p.add_argument(
+        "--physical",
+        action="store_true",
+        help="physically consistent fit: every link's pseudo-inertia positive semidefinite and friction >= 0 "
+        "(cvxpy + Clarabel), compared with the unconstrained fit on the validation period",
     )
     p.add_argument(
         "--duration",
@@ -474,6 +498,12 @@ def add_identification_commands(sub: Any, c: Any) -> None:
     p.add_argument("--plot", metavar="DIR", help="write the figures (validation torques, estimates) into DIR")
     p.add_argument("--save", metavar="FILE.json", help="write the identified parameters (for --p0 / --model)")
     p.add_argument("--save-data", metavar="FILE", help="write the log used (.csv or .npz, after any noise)")
+    p.add_argument(
+        "--write-urdf",
+        metavar="OUT.urdf",
+        help="write the robot's URDF with the identified inertias and friction (<dynamics damping friction>); "
+        "the estimates must be physically consistent (--physical makes them so)",
+    )
     add_robot_options(p)
     p.set_defaults(func=c.cmd_identify)
 

@@ -6,12 +6,18 @@ and the command line use it, never the reverse.
 =======================  ===================================================================
 ``data.py``              :class:`RunLog` (t, q, (q̇), τ); CSV / NPZ reading with row and column
                          in every error, writing, measurement noise
+``bags.py``              ROS 2 / ROS 1 bags of ``sensor_msgs/JointState`` (rosbags): joints by
+                         name, resampled onto one grid, drops and gaps reported
+``diagnostics.py``       what is wrong with a log (units, a still joint) and a poorly
+                         conditioned fit, said as such
 ``filtering.py``         zero-phase Butterworth filter, 5-point differences: q̇, q̈ from q; τ
                          and the Coulomb column filtered alike; samples dropped near the ends
 ``observation.py``       :class:`ParameterSet` (base parameters + friction) and the
                          observation matrix ``W`` with ``τ = W θ``
 ``least_squares.py``     :func:`identify`: Gautier's weighted least squares, standard
                          deviations, condition number, residuals, the validation period
+``physical.py``          physically consistent fit (every link's pseudo-inertia ⪰ 0, friction
+                         ⪰ 0; cvxpy + Clarabel) and how far base parameters are from physical
 ``measures.py``          how a trajectory excites: ``cond(W)``, the Gram matrix, and the
                          averaged adaptation rates of an adaptive law
 ``excitation.py``        :func:`optimise_excitation`: Swevers' Fourier excitation, optimised

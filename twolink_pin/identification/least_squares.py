@@ -173,6 +173,9 @@ class Identification:
     method: str = "least squares"
     """``"least squares"`` or ``"instrumental variables"`` (the reference motion's regressor
     as instruments)."""
+    gram: np.ndarray | None = field(default=None, repr=False)
+    """``W_wᵀ W_w`` of the fitted rows weighted by ``1 / joint_sigma`` (the metric of the
+    weighted least squares: ``‖y_w − W_w θ‖² = (θ − θ̂)ᵀ G (θ − θ̂) + const``), shape (n_θ, n_θ)."""
 
     @property
     def relative_std(self) -> np.ndarray:
@@ -386,7 +389,23 @@ def identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | No
         source=log.source,
         weighted=opts.weighted,
         method="least squares" if Z is None else "instrumental variables",
+        gram=weighted.T @ weighted,
     )
+
+
+def validation_of(
+    log: RunLog, robot: RobotModel, theta: np.ndarray, options: IdentificationOptions | None = None
+) -> Validation | None:
+    """The validation period of ``log`` (as :func:`identify` splits it) predicted by any ``θ``
+    (e.g. a constrained estimate), or None without one."""
+    opts = options if options is not None else IdentificationOptions()
+    if opts.validation <= 0:
+        return None
+    pset = ParameterSet.of(robot, friction=opts.friction)
+    filtered = filter_log(log, opts.zero_phase)
+    t = filtered.t
+    split = t[0] + (1.0 - opts.validation) * (t[-1] - t[0])
+    return _validation(filtered, robot, pset, np.asarray(theta, dtype=float), split, opts.zero_phase.guard)
 
 
 def _instruments(

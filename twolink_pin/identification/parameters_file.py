@@ -116,7 +116,8 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
 
     Raises:
         InputFileError: not a readable parameter file, another robot's (joint count or
-            parameter names), a missing base parameter, a value that is not a finite number.
+            parameter names), a missing base parameter, a value that is not a finite number,
+            base parameters no physical masses and inertias give (the link named).
     """
     file = str(path)
     raw = read_input_file(path, MAX_PARAMETER_BYTES, "an identified-parameter file (.json)")
@@ -159,6 +160,7 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
         )
     base = np.array([values[n][0] for n in base_names])
     base_std = np.array([values[n][1] for n in base_names])
+    _refuse_unphysical(file, robot, pset, base)
     friction_names = pset.names[pset.base.size :]
     friction = None
     notes: list[str] = []
@@ -174,6 +176,28 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
         coefficients = np.maximum(coefficients, 0.0)
         friction = Friction(tuple(coefficients[: robot.nv]), tuple(coefficients[robot.nv :]))
     return IdentifiedParameters(file, base, base_std, friction, tuple(notes))
+
+
+def _refuse_unphysical(file: str, robot: RobotModel, pset: ParameterSet, base: np.ndarray) -> None:
+    """Refuse base parameters that no physical masses and inertias give (the file holds base
+    parameters, so this asks whether *some* standard parameters with every link's
+    pseudo-inertia ⪰ 0 reproduce them: :func:`~twolink_pin.identification.physical.consistency`)."""
+    from twolink_pin.identification.physical import consistency
+
+    check = consistency(robot, pset.base, base)
+    if not check.feasible:
+        link, least = next(
+            (n, s) for n, s in zip(check.links, check.least_eigenvalue) if s < -check.tolerance
+        )
+        others = [n for n in check.infeasible if n != link]
+        raise InputFileError(
+            file,
+            f"link '{link}': physically impossible base parameters: no mass, centre of mass and inertia make its "
+            f"pseudo-inertia positive semidefinite (its least eigenvalue is {least:.3g} kg·m² at best; Wensing, Kim & "
+            f"Slotine 2017)"
+            + (f"; also {', '.join(others)}" if others else "")
+            + ": identify --physical gives parameters that are",
+        )
 
 
 def _stacked(robot: RobotModel, matrix: np.ndarray, samples: int = 40, seed: int = 7) -> np.ndarray:

@@ -9,6 +9,7 @@
 ``base_parameters.py``      the identifiable base parameters of any model (Gautier's QR)
 ``urdf_validation.py``      checks a URDF before Pinocchio sees it
 ``payload.py``              payload variants written as URDF (yourdfpy)
+``urdf_write.py``           a URDF with other inertias and joint friction written in
 ==========================  ================================================================
 """
 
