@@ -9,8 +9,9 @@ loads with Pinocchio's library); importing this module sets the wait policy:
   machine whose cores are busy with other work (two batches, a sweep beside a notebook)
   those spinning threads take the cores the working ones need and a batch became 4–12×
   slower than on one thread. Passive threads sleep: at worst a wake-up per region.
-  If Pinocchio was imported before ``twolink_pin``, the policy cannot be changed any more
-  (a :class:`RuntimeWarning` says so, unless the user chose the policy).
+  If Pinocchio was imported before ``twolink_pin``, the policy cannot be changed any more:
+  set ``OMP_WAIT_POLICY=PASSIVE`` in the environment then (the default thread count
+  accounts for spinning threads: see below).
 * :func:`default_threads` is the thread count a batch uses when none is given: the
   ``TWOLINK_PIN_THREADS`` environment variable if set, else the cores this process may
   run on (``os.sched_getaffinity``) — all of them when the wait policy is passive, else
@@ -24,7 +25,6 @@ from __future__ import annotations
 
 import os
 import sys
-import warnings
 
 from twolink_pin.errors import InvalidParameterError
 
@@ -40,15 +40,8 @@ def set_passive_wait() -> bool:
     chosen = os.environ.get(WAIT_POLICY_VARIABLE)
     if chosen is not None:
         return chosen.strip().upper() == "PASSIVE"
-    if "pinocchio" in sys.modules:
-        warnings.warn(
-            "pinocchio was imported before twolink_pin: its OpenMP threads keep the active (spinning) wait "
-            f"policy, which slows batches down on a busy machine; set {WAIT_POLICY_VARIABLE}=PASSIVE in the "
-            "environment, or import twolink_pin first",
-            RuntimeWarning,
-            stacklevel=3,
-        )
-        return False
+    if "pinocchio" in sys.modules:  # too late: OpenMP has read its environment (no warning: isort
+        return False  # puts `import pinocchio` first in most scripts; the thread count adapts instead)
     os.environ[WAIT_POLICY_VARIABLE] = "PASSIVE"
     return True
 
