@@ -31,6 +31,12 @@ Usage::
     .venv/bin/python scripts/benchmark.py --json     # also a JSON line at the end
     .venv/bin/python scripts/benchmark.py --sweep-only [--quick]   # Dask throughput, client memory
     .venv/bin/python scripts/benchmark.py --ur5-only [--quick]     # the UR5 against the baseline
+    .venv/bin/python scripts/benchmark.py --shared-only [--quick]  # two batches at once; 200-run sweep, 2 workers
+
+A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
+processes, at the default thread count, at 1 and at 2 threads, per simulation against the
+baseline (the default must not be slower than one thread); and the 200-run twolink sweep
+in-process against ``--workers 2`` (cluster start included).
 """
 
 from __future__ import annotations
@@ -46,13 +52,13 @@ import subprocess
 import sys
 import time
 from collections.abc import Callable
+from importlib.metadata import version
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pinocchio as pin
 
-from twolink_pin import (
+from twolink_pin import (  # first, before pinocchio loads: OpenMP's passive wait policy (twolink_pin.openmp)
     SimulationConfig,
     default_trajectory,
     load_robot,
@@ -60,6 +66,7 @@ from twolink_pin import (
     simulate,
     simulate_batch,
 )
+from twolink_pin.openmp import available_cores
 from twolink_pin.simulation import default_threads
 from twolink_pin.trajectory import JointTrajectory
 
@@ -169,10 +176,11 @@ def _machine() -> dict[str, Any]:
         pass
     return {
         "cpu": cpu,
-        "cores": default_threads(),
+        "cores": available_cores(),
+        "default_threads": default_threads(),
         "python": platform.python_version(),
         "numpy": np.__version__,
-        "pinocchio": pin.__version__,
+        "pinocchio": version("pin"),
         "system": f"{platform.system()} {platform.release()}",
         "load_average": [round(x, 2) for x in os.getloadavg()],
     }
@@ -351,6 +359,135 @@ def sweep_section(quick: bool) -> dict[str, Any]:
     }
 
 
+# -- a shared machine: two batches at once; a 200-run sweep in-process against 2 workers -------------
+
+_CONTENDER = """
+import sys, time
+import numpy as np
+from twolink_pin import default_trajectory, load_robot, make_scenario, simulate_batch
+from twolink_pin.simulation import SimulationConfig
+
+threads = None if sys.argv[1] == "default" else int(sys.argv[1])
+robot = load_robot(); trajectory = default_trajectory(robot)
+controller, plant = make_scenario("pd", robot)
+offsets = np.random.default_rng(0).uniform(-0.1, 0.1, (1000, robot.nv))
+config = SimulationConfig(duration=0.2)
+simulate_batch(controller, plant, trajectory, SimulationConfig(duration=0.01), q0_offsets=offsets,
+               threads=threads, progress=False)  # warm-up
+print("ready", flush=True)
+sys.stdin.readline()  # go: both copies start together
+start = time.perf_counter()
+batch = simulate_batch(controller, plant, trajectory, config, q0_offsets=offsets, threads=threads, progress=False)
+print(time.perf_counter() - start, batch.threads, flush=True)
+"""
+CONTENTION_N, CONTENTION_DURATION = 1000, 0.2
+"""The issue's contention case: pd, N = 1000, 0.2 s simulated."""
+
+
+def _two_at_once(threads: str) -> tuple[list[float], int]:
+    """Two copies of the pd batch started together (each in its own process, both ready
+    first); their seconds per 30-s simulation and the thread count they used."""
+    children = [
+        subprocess.Popen(
+            [sys.executable, "-c", _CONTENDER, threads],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        for _ in range(2)
+    ]
+    try:
+        for child in children:  # the readiness line of each, then go for both
+            assert child.stdout is not None and child.stdout.readline().strip() == "ready"
+        for child in children:
+            assert child.stdin is not None
+            child.stdin.write("go\n")
+            child.stdin.flush()
+        outputs = [child.communicate()[0].split() for child in children]
+    finally:
+        for child in children:
+            if child.poll() is None:
+                child.kill()
+    scale = FULL / CONTENTION_DURATION / CONTENTION_N
+    return [float(out[0]) * scale for out in outputs], int(outputs[0][1])
+
+
+def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) -> dict[str, Any]:
+    """Two copies of the batch at once, at the default thread count, 1 and 2 threads, per
+    simulation against the baseline timed in between (the issue: default 6.2 s, 1 thread
+    0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
+    rows: dict[str, list[float]] = {"default": [], "1": [], "2": []}
+    used = 0
+    base_times = []
+    for _ in range(repeats):  # interleaved: load drift hits all alike
+        base_times.append(_timed(baseline))
+        for threads in rows:
+            seconds, count = _two_at_once(threads)
+            rows[threads].append(max(seconds))  # the slower copy: what the user waits for
+            used = count if threads == "default" else used
+    base = min(base_times) * scale
+    print(
+        f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {CONTENTION_DURATION:g} s simulated, "
+        f"separate processes started together); seconds per 30-s simulation of the slower copy, min of {repeats} "
+        f"(median), ratio to the baseline ({base:.3f} s) of this section; load average "
+        f"{[round(x, 2) for x in os.getloadavg()]}"
+    )
+    for threads, times in rows.items():
+        label = (
+            f"default ({used} thread{'s' if used != 1 else ''})"
+            if threads == "default"
+            else f"{threads} thread(s)"
+        )
+        best = min(times)
+        print(f"  {label:22s} {best:8.4f} s {best / base:7.3f}x   (median {statistics.median(times):.4f} s)")
+    verdict = min(rows["default"]) <= min(rows["1"]) * 1.1
+    print(f"  default not slower than 1 thread when shared (within 10 %): {'met' if verdict else 'NOT met'}")
+    return {
+        "contention": {
+            "baseline_seconds": base,
+            "default_threads": used,
+            "seconds_per_sim": {k: min(v) for k, v in rows.items()},
+            "median_seconds_per_sim": {k: statistics.median(v) for k, v in rows.items()},
+        }
+    }
+
+
+SWEEP_200 = 200
+"""Runs of the issue's sweep (in-process 36.9 s against 46.7 s on ``--workers 2``: one chunk)."""
+
+
+def sweep_200_section(duration: float = 30.0) -> dict[str, Any]:
+    """The twolink pd sweep of 200 runs of ``duration``: in-process against ``--workers 2``
+    (LocalCluster start included, as the command line pays it)."""
+    import tempfile
+
+    from twolink_pin.studies import cluster
+    from twolink_pin.studies.sweep import run_sweep
+
+    if not cluster.available():
+        print(f"\nsweep of {SWEEP_200} runs: skipped, Dask is not installed ({cluster.INSTALL_HINT})")
+        return {}
+    robot = load_robot()
+    trajectory = default_trajectory(robot)
+    study = _throughput_study(SWEEP_200, duration)
+    seconds: dict[str, float] = {}
+    chunks: dict[str, int] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, workers in (("in_process", None), ("workers_2", 2)):
+            start = time.perf_counter()
+            output = run_sweep(study, robot, trajectory, f"{tmp}/{label}", plot=False, workers=workers)
+            seconds[label] = time.perf_counter() - start
+            chunks[label] = output.chunk
+    print(
+        f"\nsweep of {SWEEP_200} twolink pd runs of {duration:g} s (wall, cluster start included; load average "
+        f"{[round(x, 2) for x in os.getloadavg()]}): in-process {seconds['in_process']:.1f} s "
+        f"({SWEEP_200 / seconds['in_process']:.1f} runs/s, chunk {chunks['in_process']}), --workers 2 "
+        f"{seconds['workers_2']:.1f} s ({SWEEP_200 / seconds['workers_2']:.1f} runs/s, chunks of "
+        f"{chunks['workers_2']}): {seconds['in_process'] / seconds['workers_2']:.2f}x"
+    )
+    return {"sweep_200": {"duration": duration, "seconds": seconds, "chunk": chunks}}
+
+
 def _batch_case(spec: str, robot: Any, n: int) -> tuple[Any, Any, np.ndarray]:
     """One law object for N runs (per-run initial offsets ± 0.1 rad) and its plant."""
     controller, plant = make_scenario(spec, robot)
@@ -392,7 +529,7 @@ def ur5_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats:
         for spec, (law, plant) in scenarios.items():
             elapsed = _timed(
                 lambda c=law, p=plant: simulate_batch(
-                    c, p, reference, batch_config, q0_offsets=offsets, threads=2
+                    c, p, reference, batch_config, q0_offsets=offsets, threads=2, progress=False
                 )
             )
             batch[spec].append(elapsed * FULL / batch_duration / batch_n)
@@ -469,6 +606,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--identify-only", action="store_true", help="only identify on the UR5 and its --physical fit"
     )
+    parser.add_argument(
+        "--shared-only",
+        action="store_true",
+        help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
+    )
     args = parser.parse_args(argv)
     quick = args.quick
     repeats = args.repeats or (1 if quick else 5)
@@ -504,6 +646,13 @@ def main(argv: list[str] | None = None) -> int:
         return baseline_pd(trajectory, robot.p, pd_gains, q0, v0, DT, n)
 
     scale = FULL / single_duration
+    if args.shared_only:
+        results.update(contention_section(baseline, scale, repeats))
+        if not quick:
+            results.update(sweep_200_section())
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.ur5_only:
         results.update(ur5_section(baseline, scale, quick, repeats))
         if args.json:
@@ -547,7 +696,7 @@ def main(argv: list[str] | None = None) -> int:
         for spec, (law, plant_b, offsets) in batch_cases.items():
             elapsed = _timed(
                 lambda c=law, p=plant_b, o=offsets: simulate_batch(
-                    c, p, trajectory, config, q0_offsets=o, threads=2
+                    c, p, trajectory, config, q0_offsets=o, threads=2, progress=False
                 )
             )
             batch_times[spec].append(elapsed * FULL / batch_duration / batch_n)
@@ -612,7 +761,9 @@ def main(argv: list[str] | None = None) -> int:
         row: dict[str, float] = {"n": size, "duration": duration}
         for count in (1, 2):
             start = time.perf_counter()
-            simulate_batch(law, plant_s, trajectory, config, q0_offsets=offsets, threads=count)
+            simulate_batch(
+                law, plant_s, trajectory, config, q0_offsets=offsets, threads=count, progress=False
+            )
             row[f"threads_{count}"] = (time.perf_counter() - start) * FULL / duration / size
         scaling.append(row)
         used = max(1, min(2, size // 256))
@@ -623,6 +774,7 @@ def main(argv: list[str] | None = None) -> int:
             + note
         )
     results["batch_scaling"] = scaling
+    results.update(contention_section(baseline, scale, 1 if quick else 3))
 
     # -- sweep memory ---------------------------------------------------------------------------------
     sweep_sizes = (100, 1000) if quick else (1000, 10000)
@@ -645,7 +797,7 @@ def main(argv: list[str] | None = None) -> int:
             )
     results["sweep_memory"] = memory
 
-    # -- the one-command report (target: <= 15 s on a 2-core machine) ---------------------------
+    # -- the one-command report (target: <= 10 s on a 2-core machine) ---------------------------
     if quick:
         print("\nreport: skipped with --quick")
     else:
@@ -666,10 +818,11 @@ def main(argv: list[str] | None = None) -> int:
             )
             seconds = time.perf_counter() - start
         results["report_seconds"] = seconds
-        print(f"\nreport: `twolink-pin report` in a fresh process {seconds:.1f} s (target 15 s)")
+        print(f"\nreport: `twolink-pin report` in a fresh process {seconds:.1f} s (target 10 s)")
     if quick:
         print("\nsweep throughput on Dask: skipped with --quick (--sweep-only --quick runs it small)")
     else:
+        results.update(sweep_200_section())
         results.update(sweep_section(quick))
     results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
     print(f"\nload average at the end {results['machine']['load_average_end']}")

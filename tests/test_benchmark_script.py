@@ -52,3 +52,6 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
         "sliding-mode (example)",
     }
     assert any("targets" in x for x in lines)
+    contention = results["contention"]  # two batches at once: default, 1 and 2 threads
+    assert set(contention["seconds_per_sim"]) == {"default", "1", "2"}
+    assert all(x > 0 for x in contention["seconds_per_sim"].values()) and contention["default_threads"] >= 1

@@ -207,7 +207,7 @@ def test_in_process_a_local_cluster_and_a_scheduler_give_identical_tables(
         captured = capsys.readouterr()
         payload = json.loads(captured.out)  # the whole of stdout: one JSON document
         assert payload["engine"] == f"scheduler {scheduler.address}" and payload["diverged"] == 42
-        assert payload["chunk"] == (7 if chunk == "7" else 250)  # auto: 300 runs, 2 workers -> >= 250
+        assert payload["chunk"] == (7 if chunk == "7" else 150)  # auto: 300 runs, 2 workers -> 2 of 150
         assert "300/300" in captured.err  # the progress display, on stderr
         assert_identical(reference, out)
 

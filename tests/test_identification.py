@@ -383,6 +383,18 @@ def test_averaged_adaptation_matches_the_gram_formula(twolink) -> None:
     assert averaged.slowest_time_constant > 100  # the report's trajectory: minutes
 
 
+def test_the_predicted_error_on_a_grid_is_the_eigen_solution_of_the_averaged_system(twolink) -> None:
+    """p̃(t) = V exp(−Λ t) V⁻¹ p̃(0) (Γ G diagonalised; a second method), on the evenly spaced
+    grid a figure uses (stepped) and at scattered times (one expm each)."""
+    controller = make_scenario("adaptive", twolink).controller
+    averaged = averaged_adaptation(controller, default_trajectory(twolink), samples=400)
+    rates, vectors = np.linalg.eig(averaged.rate_matrix)
+    initial = np.array([0.3, -0.2, 0.1])
+    for t in (np.linspace(0.0, 600.0, 301), np.array([7.0, 0.5, 250.0]), np.linspace(2.0, 3.0, 2)):
+        expected = (vectors @ (np.exp(-np.outer(t, rates)) * np.linalg.solve(vectors, initial)).T).T.real
+        np.testing.assert_allclose(averaged.predicted_error(initial, t), expected, rtol=1e-9, atol=1e-13)
+
+
 def test_friction_puts_a_floor_under_the_condition_number(twolink) -> None:
     """Joint j's viscous and Coulomb columns (q̇_j, sgn q̇_j on the same rows) have cosine
     c_j = mean|q̇_j| / rms(q̇_j); by interlacing cond(W) ≥ √((1+c)/(1−c)) for any column

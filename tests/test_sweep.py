@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import argparse
 import csv
+import heapq
 import json
+import math
 from dataclasses import replace
 from pathlib import Path
 
@@ -178,9 +180,29 @@ def test_columns_are_read_back_in_run_order_every_kth_and_a_missing_chunk_is_ref
 
 
 def test_the_automatic_chunk_is_min_n_1000_in_process_and_four_per_worker_on_a_cluster() -> None:
-    assert [auto_chunk(n) for n in (1, 300, 1000, 5000)] == [1, 300, 1000, 1000]
-    assert [auto_chunk(n, 2) for n in (100, 300, 4000, 10_000)] == [100, 250, 500, 1000]
-    assert auto_chunk(100_000, 64) == 391 and auto_chunk(1000, 64) == 250
+    assert [auto_chunk(n) for n in (1, 300, 1000, 1200, 5000)] == [1, 300, 1000, 600, 1000]
+    assert [auto_chunk(n, 2) for n in (100, 200, 300, 4000, 10_000)] == [50, 100, 150, 500, 1000]
+    assert auto_chunk(100_000, 64) == 391 and auto_chunk(1000, 64) == 8
+
+
+@pytest.mark.parametrize("workers", [None, 1, 2, 3, 8, 64])
+def test_every_worker_has_a_chunk_from_the_start_and_the_last_finishes_near_the_ideal(
+    workers: int | None,
+) -> None:
+    """The issue's case: 200 runs on 2 workers made one chunk, so one worker did everything.
+    Chunks handed out in order to whichever worker is free (as Dask does) must end within
+    4/3 of the even split ``ceil(N / workers)`` runs per worker (the rest of a whole number
+    of runs per chunk)."""
+    slots = workers or 1
+    for n in (*range(1, 40), 199, 200, 201, 999, 1000, 1001, 1200, 2500, 9999, 123_457):
+        chunk = auto_chunk(n, workers)
+        sizes = [min(chunk, n - s) for s in range(0, n, chunk)]
+        assert 1 <= chunk <= 1000, (n, chunk)
+        assert len(sizes) >= min(n, slots), (n, workers, sizes)  # no worker idle from the start
+        busy = [0] * slots
+        for size in sizes:
+            heapq.heapreplace(busy, busy[0] + size)
+        assert max(busy) <= 4 / 3 * math.ceil(n / slots) or workers is None, (n, workers, chunk)
 
 
 def test_divergent_cases_are_counted_not_fatal(tmp_path: Path) -> None:

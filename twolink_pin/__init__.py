@@ -11,8 +11,12 @@ Quick use::
     controller, plant = make_scenario("adaptive", robot)
     result = simulate(controller, plant, trajectory)
     print(compute_metrics(result).rms.e)       # RMS tracking error per joint [rad]
+
+OpenMP's wait policy is set here, before anything below imports Pinocchio (see
+:mod:`twolink_pin.openmp`): ``OMP_WAIT_POLICY=PASSIVE`` unless the user set it.
 """
 
+from twolink_pin import openmp as _openmp  # noqa: F401  # first: sets the wait policy before pinocchio loads
 from twolink_pin.controllers import (
     CONTROLLERS,
     Adaptive,

@@ -346,15 +346,16 @@ def build_parser() -> argparse.ArgumentParser:
         "--threads",
         type=whole(1, 256),
         default=None,
-        help="threads of the batch engine per chunk (default all cores in-process, 1 per Dask task)",
+        help="threads of the batch engine per chunk (default the cores this process may use, or "
+        "TWOLINK_PIN_THREADS, in-process; 1 per Dask task)",
     )
     p.add_argument(
         "--chunk",
         type=chunk_size(MAX_CHUNK),
         default=None,
         metavar="N|auto",
-        help=f"runs per batch, one Dask task each (1 to {MAX_CHUNK}; default auto: min(N, 1000) in-process, "
-        "about 4 chunks per worker within 250..1000 on a cluster)",
+        help=f"runs per batch, one Dask task each (1 to {MAX_CHUNK}; default auto: equal chunks of at most 1000 "
+        "in-process; on a cluster about 4 per worker within 250..1000, never fewer chunks than workers)",
     )
     where = p.add_mutually_exclusive_group()
     where.add_argument(

@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Literal
 
+import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -108,6 +109,14 @@ def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tu
 def _save(fig: Figure, path: Path) -> Path:
     """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default)."""
     fmt = path.suffix[1:].lower() or "png"
+    engine = fig.get_layout_engine()
+    if engine is not None and fig.axes:
+        # The layout once, then one plain draw: with a layout engine set, savefig draws the
+        # whole figure twice (a first pass with drawing disabled that runs the layout, then
+        # the real one). Same layout, same pixels (checked byte for byte).
+        engine.execute(fig)
+        with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+            fig.set_layout_engine(None)  # None (not "none", a placeholder savefig still pre-draws for)
     with atomic_write(path, "wb") as f:
         fig.savefig(f, format=fmt, dpi=DPI)
     return path

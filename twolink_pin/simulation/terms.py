@@ -30,13 +30,13 @@ single runs to rounding and a run's result does not depend on how a sweep is chu
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin import openmp
 from twolink_pin.dynamics import friction_regressor, polarisation_forest, polarisation_pair
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.model.parameters import (
@@ -82,11 +82,9 @@ def check_parallel() -> None:
 
 
 def default_threads() -> int:
-    """Cores available to this process (the default thread count)."""
-    try:
-        return len(os.sched_getaffinity(0))
-    except AttributeError:  # not on Linux
-        return os.cpu_count() or 1
+    """The default thread count: ``TWOLINK_PIN_THREADS`` if set, else the cores this process
+    may use less those other work keeps busy (:func:`twolink_pin.openmp.default_threads`)."""
+    return openmp.default_threads()
 
 
 def threads_for(runs: int, threads: int | None) -> int:

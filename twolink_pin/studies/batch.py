@@ -11,7 +11,7 @@ O(N) unless ``record=True``: the engine hands each block of samples to
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -26,6 +26,7 @@ from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state, state_labels
 from twolink_pin.simulation.terms import check_parallel, threads_for
+from twolink_pin.studies.progress import Progress, progress_callback
 from twolink_pin.trajectory import Trajectory
 
 
@@ -145,7 +146,7 @@ def simulate_batch(
     v0_offsets: np.ndarray | Sequence[Sequence[float]] | None = None,
     threads: int | None = None,
     record: bool = False,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Progress = None,
 ) -> BatchResult:
     """Run N copies of ``controller`` on ``plant`` along ``trajectory``, all together.
 
@@ -159,10 +160,13 @@ def simulate_batch(
         runs: N, when nothing else says it.
         q0_offsets: ``q(0) − q_d(0)`` per run [rad], shape (N, nv).
         v0_offsets: ``q̇(0) − q̇_d(0)`` per run [rad/s], shape (N, nv).
-        threads: Threads for Pinocchio's parallel algorithms; default all cores, at most
-            one per 256 runs.
+        threads: Threads for Pinocchio's parallel algorithms; default (None) the cores this
+            process may use that other work leaves free, or ``TWOLINK_PIN_THREADS`` if set
+            (:mod:`twolink_pin.openmp`); at most one per 256 runs either way.
         record: Keep every run's trajectory (memory N × K × nv × 8 bytes per signal).
-        progress: Called as ``progress(steps_done, steps_total)`` after each block.
+        progress: Called as ``progress(steps_done, steps_total)`` after each block; None
+            (default): a tqdm bar on stderr if it is a terminal, once the batch has run 2 s;
+            True: that bar always; False: nothing (:mod:`twolink_pin.studies.progress`).
 
     Raises:
         InvalidParameterError: inconsistent N, bad offsets, ``method != "rk4"``.
@@ -189,19 +193,20 @@ def simulate_batch(
     steps = config.steps
     dt = config.duration / steps
     observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
-    run = integrate(
-        controller,
-        plant,
-        trajectory,
-        config,
-        ref0.q + q0_off,
-        ref0.v + v0_off,
-        z0,
-        record=record,
-        observer=observer,
-        threads=used,
-        progress=progress,
-    )
+    with progress_callback(progress, n) as shown:
+        run = integrate(
+            controller,
+            plant,
+            trajectory,
+            config,
+            ref0.q + q0_off,
+            ref0.v + v0_off,
+            z0,
+            record=record,
+            observer=observer,
+            threads=used,
+            progress=shown,
+        )
     dead = ~np.isnan(run.diverged_at)
     estimates = controller.state_size > 0 and bool(controller.estimates)
     nz = run.z_final.shape[1]

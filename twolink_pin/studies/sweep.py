@@ -104,17 +104,29 @@ progress display that moves, and little lost when a worker dies."""
 
 
 def auto_chunk(samples: int, workers: int | None = None) -> int:
-    """The chunk size (runs per task) when none is given.
+    """The chunk size (runs per task) when none is given: chunks of (nearly) equal size, so
+    that no worker or thread is left with a short last chunk.
 
-    In-process (``workers`` None): ``min(N, 1000)`` — one batch as large as the engine
-    profits from; progress comes from inside the chunk. On a cluster of ``workers`` worker
-    threads: ``ceil(N / (4 · workers))`` (:data:`CHUNKS_PER_WORKER` chunks each), within
-    ``[min(N, 250), 1000]`` (:data:`MIN_AUTO_CHUNK`, :data:`AUTO_CHUNK`).
+    In-process (``workers`` None): ``ceil(N / ceil(N / 1000))`` — batches as large as the
+    engine profits from (at most :data:`AUTO_CHUNK`), the runs split evenly (1200 runs: two
+    of 600, both large enough for every thread, instead of 1000 and 200); progress comes
+    from inside the chunk. On a cluster of ``workers`` worker threads: about
+    :data:`CHUNKS_PER_WORKER` chunks each, of at least :data:`MIN_AUTO_CHUNK` runs — but
+    never fewer chunks than workers (while N allows it), so that every worker has runs from
+    the start (200 runs on 2 workers: two chunks of 100, not one of 200) — at most
+    :data:`AUTO_CHUNK`, and a number of chunks that is a multiple of ``workers`` when the
+    chunks are few (no last round with one worker busy and the others idle).
     """
     if workers is None:
-        return min(samples, AUTO_CHUNK)
-    target = math.ceil(samples / (CHUNKS_PER_WORKER * max(1, workers)))
-    return max(min(samples, MIN_AUTO_CHUNK), min(target, AUTO_CHUNK))
+        return math.ceil(samples / math.ceil(samples / AUTO_CHUNK))
+    workers = max(1, workers)
+    target = math.ceil(samples / (CHUNKS_PER_WORKER * workers))
+    floor = min(MIN_AUTO_CHUNK, max(1, samples // workers))
+    size = max(floor, min(target, AUTO_CHUNK))
+    count = math.ceil(samples / size)
+    if count < CHUNKS_PER_WORKER * workers:  # few chunks: whole rounds of every worker
+        count = min(samples, math.ceil(count / workers) * workers)
+    return math.ceil(samples / count)
 
 
 @dataclass(frozen=True)
