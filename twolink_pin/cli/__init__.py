@@ -3,7 +3,7 @@
 ==============  ===================================================================
 ``parser.py``   commands and options
 ``arguments.py`` the argument types that check numbers against their bounds
-``commands.py`` one function per command, each a thin shell over the library
+``commands/``   one module per family of commands, each command a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr
 ==============  ===================================================================
 

@@ -1,0 +1,278 @@
+"""``simulate``, ``compare``, ``animate``, ``report``: one law or several, run and shown."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import threading
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from twolink_pin.cli.commands.common import (
+    _config,
+    _robot,
+    _run_one,
+    _smoothing,
+    _trajectory,
+)
+from twolink_pin.cli.output import emit, fmt, progress_bar
+from twolink_pin.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from twolink_pin.metrics import Metrics
+    from twolink_pin.simulation import SimulationResult
+
+
+def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any]:
+    return {
+        "controller": result.controller,
+        "robot": result.robot,
+        "duration": result.duration,
+        "dt": result.dt,
+        "metrics": metrics.as_dict(),
+        "peak_torque": np.abs(result.tau).max(axis=0).tolist(),
+        "peak_command": np.abs(result.tau_command).max(axis=0).tolist(),
+        "torque_limits": result.torque_limits.tolist(),
+        "limit_exceeded": result.limit_exceeded.tolist(),
+        "limit_exceeded_at": result.first_exceeded_at,
+        "parameter_names": list(result.parameter_names),
+        "p_true": None if result.p_true is None else result.p_true.tolist(),
+        "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
+    }
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from twolink_pin.metrics import compute_metrics
+
+    robot = _robot(args)
+    result = _run_one(args, args.controller, robot)
+    metrics = compute_metrics(result)
+    payload = _result_payload(result, metrics)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting import save_simulation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_simulation_figures(result, folder)]
+    if args.save:
+        from twolink_pin.simulation.storage import save_result
+
+        save_result(result, args.save)
+    payload["figures"] = figures
+    lines = [
+        f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
+        f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
+        f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
+        f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
+        + (
+            f" (the run is shorter than one {result.reference_period:g}-s period: over the whole run)"
+            if result.duration < result.reference_period
+            else ""
+        ),
+    ]
+    for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
+        if over:
+            lines.append(
+                f"  joint {j + 1}: commanded torque exceeded its {result.torque_limits[j]:g} N·m limit "
+                f"(first at t = {at:.3f} s, by up to {result.limit_excess[j]:.3g} N·m"
+                + (
+                    ", clipped by the plant)"
+                    if result.saturate
+                    else "; not saturated: add --saturate to clip)"
+                )
+            )
+    if not np.isfinite(result.torque_limits).any():
+        lines.append("  no effort limits in the model: torques are not checked against limits")
+    if result.p_hat is not None and result.p_true is not None:
+        if len(result.parameter_names) <= 8:
+            lines.append(f"  p_hat(end) {fmt(result.p_hat[-1])}  true {fmt(result.p_true)}")
+        else:
+            err = np.abs(result.p_hat[-1] - result.p_true)
+            lines.append(
+                f"  {len(result.parameter_names)} estimates; max |p_hat − p| at the end {err.max():.4g}"
+            )
+    lines += [f"  figure {f}" for f in figures]
+    if args.save:
+        lines.append(f"  saved {args.save}")
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from twolink_pin.controllers import CONTROLLERS
+    from twolink_pin.files import output_directory
+    from twolink_pin.scenario import law_class
+    from twolink_pin.studies.comparison import run_comparison
+
+    robot = _robot(args)
+    specs = args.controllers or [
+        n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
+    ]
+    names = [law_class(s).name for s in specs]
+    if len(set(names)) != len(names):
+        raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
+    by_name = dict(zip(names, specs))
+    args.lambda_optional = True
+    reference = _trajectory(args, robot)
+    with output_directory(args.out, ".twolink-pin-compare") as stage:
+        bar = progress_bar(len(names), "run", "compare")
+
+        def on_result(name: str, result: SimulationResult) -> None:
+            if not args.no_plot:
+                from twolink_pin.plotting import save_simulation_figures
+
+                save_simulation_figures(
+                    result, stage / "figures", prefix=name, title=law_class(by_name[name]).title
+                )
+
+        def progress(name: str, result: SimulationResult | None) -> None:
+            if result is not None:
+                bar.update(1)
+            else:
+                bar.set_postfix_str(name)
+
+        try:
+            table = run_comparison(
+                lambda n: _run_one(args, by_name[n], robot, reference), names, progress, on_result
+            )
+        finally:
+            bar.close()
+        files = [Path(args.out) / p.name for p in table.write(stage)]
+    payload = table.as_dict() | {"files": [str(f) for f in files]}
+    emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
+    return 0
+
+
+RUN_OPTIONS = frozenset(
+    {
+        "--duration",
+        "--dt",
+        "--lambda",
+        "--q0-offset",
+        "--saturate",
+        "--method",
+        "--control-period",
+        "--friction-smoothing",
+        "--gain",
+        "--p0",
+        "--model",
+    }
+)
+"""Options that shape a run: meaningless with ``animate --from`` (a saved run)."""
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    import signal
+
+    if args.from_file:
+        typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
+        ignored = sorted(typed & RUN_OPTIONS)
+        if args.controller is not None or ignored:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
+                + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
+            )
+    robot = _robot(args)
+    reference = _trajectory(args, robot)
+    if args.from_file:
+        from twolink_pin.simulation.storage import load_result
+
+        result = load_result(args.from_file)
+        if result.q.shape[1] != robot.nq:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                f"a result for {robot.name} (nq = {robot.nq}); it has {result.q.shape[1]} joints",
+            )
+    elif args.controller is None:
+        raise InvalidParameterError(
+            "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
+        )
+    else:
+        result = _run_one(args, args.controller, robot, reference)
+    from twolink_pin.kinematics import joint_positions
+
+    via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
+    points = None if via_q is None else joint_positions(robot, via_q)[:, -1, :]  # the end effector's
+    if args.html:
+        from twolink_pin.visualization import write_html
+
+        path = write_html(
+            robot, result.t, result.q, result.q_des, path=args.html, via_points=points, loop=args.loop
+        )
+        emit(args, {"html": str(path), "controller": result.controller}, f"animation written to {path}")
+        return 0
+    from twolink_pin.visualization import serve
+
+    def _stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, _stop)  # a service manager's stop shuts down as cleanly as Ctrl-C
+    with serve(
+        robot,
+        result.t,
+        result.q,
+        result.q_des,
+        via_points=points,
+        host=args.host,
+        port=args.port,
+        loop=args.loop,
+        open_browser=not args.no_browser,
+        quiet=True,
+    ) as viewer:
+        emit(
+            args,
+            {"url": viewer.url, "host": viewer.host, "port": viewer.port},
+            f"meshcat viewer at {viewer.url}",
+        )
+        print("press Ctrl-C to stop", file=sys.stderr, flush=True)
+        try:
+            threading.Event().wait()
+        except KeyboardInterrupt:
+            print("stopping the viewer", file=sys.stderr)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from twolink_pin.report import ReportOptions, build_report
+
+    options = ReportOptions(
+        robot=args.robot,
+        payload=args.payload,
+        config=_config(args),
+        lam=args.lam,
+        saturate=args.saturate,
+        friction_smoothing=_smoothing(args),
+        controllers=None if args.controllers is None else tuple(args.controllers),
+        workers=args.workers,
+        animation=not args.no_animation,
+        identification=not args.no_identification,
+        trajectory=args.trajectory,
+        p0=args.p0,
+        model=args.model,
+    )
+    command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
+    bar = progress_bar(1, "step", "report")
+
+    def progress(what: str, done: int, total: int) -> None:
+        bar.total = total
+        bar.set_postfix_str(what)
+        bar.update(done - bar.n)
+
+    try:
+        results = build_report(args.out, options, progress=progress, command_line=command)
+    finally:
+        bar.close()
+    index = Path(args.out) / "index.html"
+    emit(
+        args,
+        {"index": str(index), "total_seconds": results["total_seconds"]},
+        f"report written to {index} in {results['total_seconds']:.1f} s",
+    )
+    return 0
