@@ -27,6 +27,7 @@ from twolink_pin.errors import ControllerSpecError, InvalidParameterError, Outpu
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.parquet import METADATA_KEY, read_columns, read_metadata
@@ -53,17 +54,20 @@ def _rows(path: Path) -> list[dict[str, str]]:
 
 
 def _study(**changes) -> SweepConfig:  # type: ignore[no-untyped-def]
-    base = SweepConfig(
-        "pd",
-        samples=12,
-        seed=7,
-        q0_spread=0.1,
-        param_error=0.2,
-        gains=(GainRange("kp", 100.0, 400.0), GainRange("kd2", 20.0, 80.0)),
-        simulation=SHORT,
-        chunk=5,
+    run = RunSpec(
+        law=changes.pop("controller", "pd"),
+        simulation=changes.pop("simulation", SHORT),
+        lam=changes.pop("lam", None),
     )
-    return replace(base, **changes)
+    base = {
+        "samples": 12,
+        "seed": 7,
+        "q0_spread": 0.1,
+        "param_error": 0.2,
+        "gains": (GainRange("kp", 100.0, 400.0), GainRange("kd2", 20.0, 80.0)),
+        "chunk": 5,
+    }
+    return SweepConfig(run, **(base | changes))
 
 
 def _table(out: Path) -> pa.Table:
@@ -241,7 +245,9 @@ def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None
     )
     np.testing.assert_array_equal(law.gains.kd[:, 0], 40.0)
     np.testing.assert_array_equal(law.gains.kd[:, 1], cases.gains["kd2"])
-    robust = replace(study, controller="robust", gains=(GainRange("model_scale", 0.2, 0.3),))
+    robust = replace(
+        study, run=RunSpec(law="robust", simulation=SHORT), gains=(GainRange("model_scale", 0.2, 0.3),)
+    )
     built = _chunk_law(robust, ROBOT, Cases(robust, ROBOT, 0, 12), make_scenario("robust", ROBOT).controller)
     assert isinstance(built, WrongModel) and np.all(
         (built.gains.model_scale >= 0.2) & (built.gains.model_scale <= 0.3)
@@ -256,7 +262,11 @@ def test_a_users_law_from_a_file_sweeps_like_a_built_in_one(tmp_path: Path) -> N
         gains=(GainRange("ks", 1.0, 5.0), GainRange("phi", 0.02, 0.1)),
     )
     output = run_sweep(
-        replace(study, simulation=SimulationConfig(duration=0.3)), ROBOT, TRAJECTORY, tmp_path, plot=False
+        replace(study, run=replace(study.run, simulation=SimulationConfig(duration=0.3))),
+        ROBOT,
+        TRAJECTORY,
+        tmp_path,
+        plot=False,
     )
     assert output.summary["controller"] == "sliding-mode" and output.summary["diverged"] == 0
     rows = _rows(tmp_path / "runs.csv")

@@ -106,6 +106,13 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         metavar="EPS",
         help="ε [rad/s] of tanh(v/ε) for Coulomb friction (default: exact sgn with rk4, 1e-3 with adaptive)",
     )
+    p.add_argument(
+        "--plant-friction",
+        choices=("law", "on", "off"),
+        default="law",
+        help="the robot's friction in the plant: of the laws that estimate friction (law, default), of every "
+        "law (on), of none (off)",
+    )
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
@@ -115,6 +122,18 @@ def add_gain_option(p: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="set a gain of the law: one value for all joints or comma-separated per joint, e.g. kp=200 or kd=30,40 (repeatable)",
+    )
+
+
+def add_law_gain_option(p: argparse.ArgumentParser) -> None:
+    """``--gain LAW.NAME=VALUE`` of the commands that run several laws."""
+    p.add_argument(
+        "--gain",
+        action="append",
+        default=[],
+        metavar="LAW.NAME=VALUE",
+        help="set a gain of one law: one value for all joints or comma-separated per joint, e.g. pd.kp=200 or "
+        "computed-torque.kd=30,40 (repeatable)",
     )
 
 
@@ -243,6 +262,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_sim_options(p)
     add_identified_options(p, several=True)
+    add_law_gain_option(p)
     p.add_argument(
         "--out", default="out/compare", metavar="DIR", help="output directory (default out/compare)"
     )
@@ -273,6 +293,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
     add_sim_options(p)
+    add_law_gain_option(p)
     add_identified_options(p, several=True)
     p.add_argument(
         "--controller",

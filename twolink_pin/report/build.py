@@ -21,7 +21,7 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +33,7 @@ from twolink_pin.files import output_directory
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import law_class, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.simulation.config import joint_offsets
@@ -54,12 +55,13 @@ class ReportOptions:
     """What the report runs.
 
     Attributes:
+        run: The runs' common description (:class:`~twolink_pin.run_spec.RunSpec`, shared by
+            the laws: each law's own with :meth:`~twolink_pin.run_spec.RunSpec.for_law`):
+            simulation settings, λ of the laws that have one, per-law gains, the plant, an
+            identified-parameter file (``p0``: the estimates of the laws that estimate start
+            there; ``model``: every law's model believes it).
         robot: A catalog name or a URDF path; None for the twolink.
         payload: End-effector payload [kg].
-        config: Simulation settings of every run.
-        lam: λ [1/s] of the laws that have one (None: their default).
-        saturate: Clip torques at the URDF limits in every plant.
-        friction_smoothing: ε [rad/s] of the friction sign (0: exact sgn).
         controllers: The laws to run (names, ``file.py:Class``, ``module:Class``); None for
             the course report's five on the twolink, every built-in law elsewhere.
         workers: Processes for the runs and figures (1: in this process), 1 to 64.
@@ -71,24 +73,46 @@ class ReportOptions:
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
             the report's.
-        p0: A parameter file (``twolink-pin identify --save``) the estimates of the laws that
-            estimate start at (:func:`~twolink_pin.identification.seeded_scenario`, mode "p0").
-        model: A parameter file every law's model believes (mode "model").
     """
 
+    run: RunSpec = field(default_factory=lambda: RunSpec(shared=True))
     robot: str | None = None
     payload: float = 0.0
-    config: SimulationConfig = field(default_factory=SimulationConfig)
-    lam: float | None = None
-    saturate: bool = False
-    friction_smoothing: float = 0.0
     controllers: tuple[str, ...] | None = None
     workers: int = 2
     animation: bool = True
     identification: bool = True
     trajectory: str | None = None
-    p0: str | None = None
-    model: str | None = None
+
+    @property
+    def config(self) -> SimulationConfig:
+        """The simulation settings of every run."""
+        return self.run.simulation
+
+    @property
+    def lam(self) -> float | None:
+        """λ [1/s] of the laws that have one (None: their default)."""
+        return self.run.lam
+
+    @property
+    def saturate(self) -> bool:
+        """Whether every plant clips torques at the URDF limits."""
+        return self.run.plant.saturate
+
+    @property
+    def friction_smoothing(self) -> float:
+        """ε [rad/s] of the friction sign."""
+        return self.run.friction_smoothing
+
+    @property
+    def p0(self) -> str | None:
+        """The parameter file the estimates start at, if any."""
+        return self.run.parameters if self.run.parameters_use == "p0" else None
+
+    @property
+    def model(self) -> str | None:
+        """The parameter file every law's model believes, if any."""
+        return self.run.parameters if self.run.parameters_use == "model" else None
 
     def __post_init__(self) -> None:
         if not (
@@ -97,6 +121,10 @@ class ReportOptions:
             and 1 <= self.workers <= MAX_WORKERS
         ):
             raise InvalidParameterError("workers", self.workers, f"a whole number from 1 to {MAX_WORKERS}")
+        if not isinstance(self.run, RunSpec):
+            raise InvalidParameterError("run", type(self.run).__name__, "a RunSpec")
+        if not self.run.shared:  # one description for several laws: λ and p0 go where they apply
+            object.__setattr__(self, "run", replace(self.run, shared=True))
 
 
 def _reference(robot: Any, options: ReportOptions) -> Any:
@@ -128,27 +156,7 @@ def _run(
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
     cls = law_class(spec)
-    seed_file, mode = (options.p0, "p0") if options.p0 else (options.model, "model")
-    if seed_file and (mode == "model" or cls.estimates):
-        from twolink_pin.identification import read_parameter_file, seeded_scenario
-
-        controller, plant = seeded_scenario(
-            cls,
-            robot,
-            read_parameter_file(seed_file, robot),
-            mode,
-            lam=options.lam if cls.takes("lam") else None,
-            saturate=options.saturate,
-            friction_smoothing=options.friction_smoothing,
-        )
-    else:
-        controller, plant = make_scenario(
-            cls,
-            robot,
-            lam=options.lam if cls.takes("lam") else None,
-            saturate=options.saturate,
-            friction_smoothing=options.friction_smoothing,
-        )
+    controller, plant = options.run.for_law(spec).build(robot)
     result = simulate(controller, plant, _reference(robot, options), options.config)
     metrics = compute_metrics(result)
     paths = save_simulation_figures(
@@ -269,6 +277,7 @@ def build_report(
     robot = load_robot(options.robot, payload=options.payload)
     is_twolink = robot.name == "twolink"
     specs = laws_to_run(options, is_twolink)
+    options.run.check_law_gains(specs)
     steps = (
         4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink and options.identification else 0)
     )
@@ -416,6 +425,7 @@ def _build(
             "saturate": options.saturate,
             "friction_smoothing": options.friction_smoothing,
         },
+        "run": options.run.as_dict(),
         "controllers": controllers,
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),

@@ -4,7 +4,7 @@ the law of a chunk, the chunk size. The study as a whole: :mod:`twolink_pin.stud
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,7 +13,8 @@ from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.scenario import law_class, make_scenario
+from twolink_pin.run_spec import RunSpec
+from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig
 from twolink_pin.simulation.config import joint_offsets
 
@@ -106,38 +107,60 @@ class SweepConfig:
     results are the same. Nor is the chunking.
 
     Attributes:
-        controller: The law: a registered name, ``file.py:Class`` or ``module:Class``.
+        run: The run every case varies: the law (a registered name, ``file.py:Class`` or
+            ``module:Class``), its fixed gains, ``λ``, the plant, the simulation (duration,
+            step, control period, nominal ``q0_offset``; ``rk4`` only).
         samples: Number of runs N, 1 to :data:`MAX_SAMPLES`.
         seed: Seed of the draws, >= 0.
         q0_spread: Half-width of the uniform initial position error around the nominal
             ``simulation.q0_offset`` [rad], >= 0.
         param_error: Half-width of the relative parameter error δ, in [0, 1).
         gains: Gain ranges.
-        simulation: Duration, step, control period, nominal ``q0_offset``; ``rk4`` only.
-        lam: ``λ`` [1/s] for a law with one (None: its default).
-        saturate: Clip torques at the URDF limits in the plant.
-        friction_smoothing: ε [rad/s] of the friction sign.
         chunk: Runs advanced together (one task on a cluster; bounds memory), 1 to
             :data:`MAX_CHUNK`; None: :func:`auto_chunk`.
         threads: Threads of the batch engine per chunk (None: all cores in-process, one
             per task on a cluster — a worker process per core is the way to use cores there).
     """
 
-    controller: str
+    run: RunSpec
     samples: int
     seed: int = 0
     q0_spread: float = 0.0
     param_error: float = 0.0
     gains: tuple[GainRange, ...] = ()
-    simulation: SimulationConfig = field(default_factory=SimulationConfig)
-    lam: float | None = None
-    saturate: bool = False
-    friction_smoothing: float = 0.0
     chunk: int | None = None
     threads: int | None = None
 
+    @property
+    def controller(self) -> str:
+        """The law's reference, as given."""
+        law = self.run.law
+        return law if isinstance(law, str) else f"{law.__module__}:{law.__qualname__}" if law else ""
+
+    @property
+    def simulation(self) -> SimulationConfig:
+        """The run's simulation settings."""
+        return self.run.simulation
+
+    @property
+    def lam(self) -> float | None:
+        """``λ`` [1/s] (None: the law's default)."""
+        return self.run.lam
+
+    @property
+    def saturate(self) -> bool:
+        """Whether the plant clips torques."""
+        return self.run.plant.saturate
+
+    @property
+    def friction_smoothing(self) -> float:
+        """ε [rad/s] of the friction sign."""
+        return self.run.friction_smoothing
+
     def __post_init__(self) -> None:
-        cls = law_class(self.controller)
+        if not isinstance(self.run, RunSpec) or self.run.law is None:
+            raise InvalidParameterError("run", self.run, "a RunSpec of one law")
+        cls = self.run.law_class()
         for name, bound in (("samples", MAX_SAMPLES), ("chunk", MAX_CHUNK)):
             value = getattr(self, name)
             if name == "chunk" and value is None:

@@ -3,6 +3,7 @@ and the summary statistics over them."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -13,7 +14,7 @@ from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.scenario import Scenario, make_scenario
+from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.studies.sweep_cases import Cases, SweepConfig, _chunk_law, gain_target
 from twolink_pin.trajectory import Trajectory
@@ -175,9 +176,7 @@ class _Prepared:
             trajectory,
             record,
         )
-        self.base: Scenario = make_scenario(
-            cls, robot, lam=config.lam, saturate=config.saturate, friction_smoothing=config.friction_smoothing
-        )
+        self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
         nv = robot.nv
         if record:
             kept = config.samples * (config.simulation.steps + 1) * 3 * nv

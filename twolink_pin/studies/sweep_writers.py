@@ -174,6 +174,7 @@ def sweep_metadata(
         "control_period": config.simulation.control_period,
         "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
         "trajectory": _trajectory_metadata(trajectory),
+        "run": config.run.as_dict(),
     }
 
 

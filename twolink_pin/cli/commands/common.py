@@ -12,6 +12,7 @@ from twolink_pin.errors import InvalidParameterError
 if TYPE_CHECKING:
     from twolink_pin.identification import IdentifiedParameters
     from twolink_pin.model import RobotModel
+    from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationConfig, SimulationResult
     from twolink_pin.trajectory import Trajectory
 
@@ -43,13 +44,6 @@ def _config(args: argparse.Namespace) -> SimulationConfig:
     )
 
 
-def _smoothing(args: argparse.Namespace) -> float:
-    smoothing = args.friction_smoothing
-    if smoothing is None:
-        smoothing = 1e-3 if args.method == "adaptive" else 0.0
-    return float(smoothing)
-
-
 def _gain_values(texts: list[str]) -> dict[str, Any]:
     """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}``."""
     from twolink_pin.cli.arguments import finite
@@ -69,55 +63,61 @@ def _gain_values(texts: list[str]) -> dict[str, Any]:
     return gains
 
 
-def _identified(args: argparse.Namespace, robot: RobotModel) -> tuple[IdentifiedParameters | None, str]:
-    """The parameter file of ``--p0`` or ``--model`` (read once per command) and which it was."""
-    mode = "p0" if getattr(args, "p0", None) else "model" if getattr(args, "model", None) else ""
-    if not mode:
-        return None, ""
-    cached = getattr(args, "identified_parameters", None)
-    if cached is None:
-        from twolink_pin.identification import read_parameter_file
+def _law_gains(texts: list[str]) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
+    """compare/report ``--gain LAW.NAME=VALUE`` → per-law gains; a text without ``LAW.`` is refused."""
+    per_law: dict[str, dict[str, Any]] = {}
+    for text in texts:
+        name, sep, _ = text.partition("=")
+        law, dot, gain = name.strip().rpartition(".")
+        if not (sep and dot and law and gain):
+            raise InvalidParameterError("--gain", text, "LAW.NAME=VALUE with several laws, e.g. pd.kp=200")
+        per_law.setdefault(law, {}).update(_gain_values([f"{gain}={text.partition('=')[2]}"]))
+    return tuple((law, tuple(g.items())) for law, g in per_law.items())
 
-        cached = read_parameter_file(getattr(args, mode), robot)
-        args.identified_parameters = cached
-        for note in cached.notes:
-            print(f"twolink-pin: note: {cached.source}: {note}", file=sys.stderr)
-    return cached, mode
+
+def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool = True) -> RunSpec:
+    """The run the arguments describe, built once per command (``law`` None: the common part
+    of several laws' runs, as ``compare`` and ``report`` give them; ``fixed_gains`` False: the
+    command's ``--gain`` is not a fixed gain, as the sweep's ranges)."""
+    from twolink_pin.run_spec import PlantOptions, RunSpec
+
+    several = law is None
+    texts = (getattr(args, "gain", []) or []) if fixed_gains else []
+    mode = "p0" if getattr(args, "p0", None) else "model" if getattr(args, "model", None) else ""
+    return RunSpec(
+        law=law,
+        gains=() if several else tuple(_gain_values(texts).items()),
+        law_gains=_law_gains(texts) if several else (),
+        lam=args.lam,
+        plant=PlantOptions(
+            friction=getattr(args, "plant_friction", None) or "law",
+            saturate=args.saturate,
+            friction_smoothing=args.friction_smoothing,
+        ),
+        parameters=getattr(args, mode) if mode else None,
+        parameters_use=mode,
+        simulation=_config(args),
+        shared=several,
+    )
+
+
+def _identified(spec: RunSpec, robot: RobotModel) -> IdentifiedParameters | None:
+    """The parameter file of ``--p0`` or ``--model``, read once per command (its notes on stderr)."""
+    identified = spec.read_parameters(robot)
+    if identified is not None:
+        for note in identified.notes:
+            print(f"twolink-pin: note: {identified.source}: {note}", file=sys.stderr)
+    return identified
 
 
 def _run_one(
-    args: argparse.Namespace, spec: str, robot: RobotModel, trajectory: Trajectory | None = None
+    spec: RunSpec,
+    robot: RobotModel,
+    reference: Trajectory,
+    identified: IdentifiedParameters | None = None,
 ) -> SimulationResult:
-    from twolink_pin.scenario import law_class, make_scenario
+    """One law's run (``spec`` of one law: :meth:`RunSpec.for_law` of a shared one)."""
     from twolink_pin.simulation import simulate
 
-    cls = law_class(spec)
-    lam = args.lam
-    if lam is not None and not cls.takes("lam") and getattr(args, "lambda_optional", False):
-        lam = None  # compare/report: λ applies to the laws that have one
-    identified, mode = _identified(args, robot)
-    several = getattr(args, "lambda_optional", False)  # compare: --p0 seeds the laws that estimate
-    if identified is not None and (mode == "model" or cls.estimates or not several):
-        from twolink_pin.identification import seeded_scenario
-
-        controller, plant = seeded_scenario(
-            cls,
-            robot,
-            identified,
-            mode,
-            lam=lam,
-            gains=_gain_values(getattr(args, "gain", []) or []),
-            saturate=args.saturate,
-            friction_smoothing=_smoothing(args),
-        )
-    else:
-        controller, plant = make_scenario(
-            cls,
-            robot,
-            lam=lam,
-            gains=_gain_values(getattr(args, "gain", []) or []),
-            saturate=args.saturate,
-            friction_smoothing=_smoothing(args),
-        )
-    reference = trajectory if trajectory is not None else _trajectory(args, robot)
-    return simulate(controller, plant, reference, _config(args))
+    controller, plant = spec.build(robot, identified)
+    return simulate(controller, plant, reference, spec.simulation)

@@ -8,9 +8,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import (
-    _robot,
-)
+from twolink_pin.cli.commands.common import _robot
 from twolink_pin.cli.output import emit, fmt
 from twolink_pin.errors import InvalidParameterError
 

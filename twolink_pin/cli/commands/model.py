@@ -9,10 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.cli.commands.common import (
-    _robot,
-    _trajectory,
-)
+from twolink_pin.cli.commands.common import _robot, _trajectory
 from twolink_pin.cli.output import emit, fmt
 from twolink_pin.errors import InvalidParameterError
 

@@ -11,19 +11,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.cli.commands.common import (
-    _config,
-    _robot,
-    _run_one,
-    _smoothing,
-    _trajectory,
-)
+from twolink_pin.cli.commands.common import _identified, _robot, _run_one, _trajectory, run_spec
 from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
     from twolink_pin.metrics import Metrics
+    from twolink_pin.model import RobotModel
+    from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationResult
+    from twolink_pin.trajectory import Trajectory
 
 
 def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any]:
@@ -46,11 +43,23 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     from twolink_pin.metrics import compute_metrics
+    from twolink_pin.run_spec import gains_used, plant_description
+    from twolink_pin.simulation import simulate
+    from twolink_pin.simulation.config import joint_offsets
 
     robot = _robot(args)
-    result = _run_one(args, args.controller, robot)
+    spec = run_spec(args, args.controller)
+    scenario = spec.build(robot, _identified(spec, robot))
+    result = simulate(*scenario, _trajectory(args, robot), spec.simulation)
     metrics = compute_metrics(result)
     payload = _result_payload(result, metrics)
+    q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
+    payload |= {
+        "gains": gains_used(scenario.controller),
+        "plant": plant_description(scenario),
+        "q0_offset": q0_offset.tolist(),
+        "run": spec.as_dict(),
+    }
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure
@@ -61,10 +70,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
-        save_result(result, args.save)
+        save_result(result, args.save, record=_record(args, spec))
     payload["figures"] = figures
     lines = [
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
+        f"  gains {scenario.controller.gains.describe()}",
+        f"  plant {payload['plant']}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
         f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
@@ -116,7 +127,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     if len(set(names)) != len(names):
         raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
     by_name = dict(zip(names, specs))
-    args.lambda_optional = True
+    shared = run_spec(args)
+    shared.check_law_gains(specs)
+    identified = _identified(shared, robot)
     reference = _trajectory(args, robot)
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(names), "run", "compare")
@@ -137,7 +150,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
         try:
             table = run_comparison(
-                lambda n: _run_one(args, by_name[n], robot, reference), names, progress, on_result
+                lambda n: _run_one(shared.for_law(by_name[n]), robot, reference, identified),
+                names,
+                progress,
+                on_result,
             )
         finally:
             bar.close()
@@ -157,6 +173,7 @@ RUN_OPTIONS = frozenset(
         "--method",
         "--control-period",
         "--friction-smoothing",
+        "--plant-friction",
         "--gain",
         "--p0",
         "--model",
@@ -178,24 +195,17 @@ def cmd_animate(args: argparse.Namespace) -> int:
                 "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
                 + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
             )
-    robot = _robot(args)
-    reference = _trajectory(args, robot)
     if args.from_file:
-        from twolink_pin.simulation.storage import load_result
-
-        result = load_result(args.from_file)
-        if result.q.shape[1] != robot.nq:
-            raise InvalidParameterError(
-                "--from",
-                args.from_file,
-                f"a result for {robot.name} (nq = {robot.nq}); it has {result.q.shape[1]} joints",
-            )
+        robot, reference, result = _saved_run(args)
     elif args.controller is None:
         raise InvalidParameterError(
             "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
         )
     else:
-        result = _run_one(args, args.controller, robot, reference)
+        robot = _robot(args)
+        reference = _trajectory(args, robot)
+        spec = run_spec(args, args.controller)
+        result = _run_one(spec, robot, reference, _identified(spec, robot))
     from twolink_pin.kinematics import joint_positions
 
     via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
@@ -243,19 +253,14 @@ def cmd_report(args: argparse.Namespace) -> int:
     from twolink_pin.report import ReportOptions, build_report
 
     options = ReportOptions(
+        run=run_spec(args),
         robot=args.robot,
         payload=args.payload,
-        config=_config(args),
-        lam=args.lam,
-        saturate=args.saturate,
-        friction_smoothing=_smoothing(args),
         controllers=None if args.controllers is None else tuple(args.controllers),
         workers=args.workers,
         animation=not args.no_animation,
         identification=not args.no_identification,
         trajectory=args.trajectory,
-        p0=args.p0,
-        model=args.model,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
     bar = progress_bar(1, "step", "report")
@@ -276,3 +281,48 @@ def cmd_report(args: argparse.Namespace) -> int:
         f"report written to {index} in {results['total_seconds']:.1f} s",
     )
     return 0
+
+
+def _record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
+    """What a saved result records beside its arrays: the robot (as given: a catalog name or a
+    URDF path), its payload, the trajectory file and the run's spec."""
+    from pathlib import Path as _Path
+
+    robot = args.robot
+    if robot is not None and (robot.endswith(".urdf") or "/" in robot):
+        robot = str(_Path(robot).resolve())
+    trajectory = getattr(args, "trajectory", None)
+    return {
+        "robot": robot,
+        "payload": args.payload,
+        "trajectory": None if trajectory is None else str(_Path(trajectory).resolve()),
+        "run": spec.as_dict(),
+    }
+
+
+def _saved_run(args: argparse.Namespace) -> tuple[RobotModel, Trajectory, SimulationResult]:
+    """``animate --from FILE``: the result, on the robot and reference it records (``--robot``,
+    ``--payload``, ``--trajectory`` given: those); a file that records no robot: the catalog
+    robot of its name, else ``--robot``."""
+    from twolink_pin.model import catalog, load_robot
+    from twolink_pin.simulation.storage import load_record, load_result
+    from twolink_pin.trajectory import default_trajectory, read_trajectory_file
+
+    result = load_result(args.from_file)
+    record = load_record(args.from_file) or {}
+    source = args.robot
+    payload = args.payload
+    if source is None:
+        source = record.get("robot") or (result.robot if result.robot in catalog.CATALOG else None)
+        if "payload" in record and payload == 0.0:
+            payload = float(record["payload"])
+    robot = load_robot(source, payload=payload)
+    if result.q.shape[1] != robot.nq:
+        raise InvalidParameterError(
+            "--from",
+            args.from_file,
+            f"a result for {robot.name} (nq = {robot.nq}); it has {result.q.shape[1]} joints",
+        )
+    path = args.trajectory or record.get("trajectory")
+    reference = read_trajectory_file(path, robot) if path else default_trajectory(robot)
+    return robot, reference, result

@@ -6,12 +6,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import (
-    _config,
-    _robot,
-    _smoothing,
-    _trajectory,
-)
+from twolink_pin.cli.commands.common import _robot, _trajectory, run_spec
 from twolink_pin.cli.output import emit, progress_bar
 
 if TYPE_CHECKING:
@@ -32,16 +27,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     robot = _robot(args)
     trajectory = _trajectory(args, robot)
     config = SweepConfig(
-        controller=args.controller,
+        run=run_spec(args, args.controller, fixed_gains=False),
         samples=args.samples,
         seed=args.seed,
         q0_spread=args.q0_spread,
         param_error=args.param_error,
         gains=tuple(args.gain),
-        simulation=_config(args),
-        lam=args.lam,
-        saturate=args.saturate,
-        friction_smoothing=_smoothing(args),
         chunk=args.chunk,
         threads=args.threads,
     )
