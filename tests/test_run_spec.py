@@ -147,3 +147,57 @@ def test_simulate_echoes_the_gains_it_used(capsys: pytest.CaptureFixture[str]) -
     payload = json.loads(capsys.readouterr().out)
     assert payload["gains"] == {"kp": [350.0, 300.0], "kd": [40.0, 50.0]}
     assert payload["q0_offset"] == [0.1, -0.1] and payload["plant"] == "no friction"
+
+
+BLOWUP = """
+from dataclasses import dataclass
+
+from twolink_pin.controllers import Controller, Gains, LawInput, LawOutput
+
+
+@dataclass(frozen=True, eq=False)
+class BlowupGains(Gains):
+    pass
+
+
+class Blowup(Controller[BlowupGains]):
+    name = "blowup"
+    title = "blows up"
+    Gains = BlowupGains
+
+    def compute(self, x: LawInput, terms: object) -> LawOutput:
+        return LawOutput(1e9 * (x.q - x.q_des))
+"""
+
+
+def test_compare_keeps_the_laws_that_finished(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A law that diverges is a row saying when; the others' rows are written; exit status 1."""
+    (tmp_path / "blowup.py").write_text(BLOWUP)
+    out = tmp_path / "cmp"
+    argv = ["compare", "pd", "computed-torque", f"{tmp_path}/blowup.py:Blowup", "--duration", "0.2"]
+    assert main([*argv, "--no-plot", "--out", str(out), "--json"]) == 1
+    payload = json.loads(capsys.readouterr().out)
+    assert sorted(payload["controllers"]) == ["computed-torque", "pd"]
+    assert "diverged at t = " in payload["failed"]["blowup"]
+    table = (out / "comparison.csv").read_text()
+    assert "pd,rms," in table and "blowup,failed," in table
+    # the finished laws' numbers are those of a comparison without the failing law
+    assert (
+        main(
+            [
+                "compare",
+                "pd",
+                "computed-torque",
+                "--duration",
+                "0.2",
+                "--no-plot",
+                "--out",
+                str(tmp_path / "b"),
+                "--json",
+            ]
+        )
+        == 0
+    )
+    alone = json.loads(capsys.readouterr().out)
+    assert alone["controllers"] == payload["controllers"]
+    assert set(payload["plants"].values()) == {"no friction"} and len(payload["plants"]) == 3

@@ -6,6 +6,7 @@ import argparse
 import shlex
 import sys
 import threading
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -148,19 +149,29 @@ def cmd_compare(args: argparse.Namespace) -> int:
             else:
                 bar.set_postfix_str(name)
 
+        plants: dict[str, str] = {}
+        gains: dict[str, dict[str, Any]] = {}
+
+        def run(name: str) -> SimulationResult:
+            from twolink_pin.run_spec import gains_used, plant_description
+            from twolink_pin.simulation import simulate
+
+            spec = shared.for_law(by_name[name])
+            scenario = spec.build(robot, identified)
+            plants[name], gains[name] = plant_description(scenario), gains_used(scenario.controller)
+            return simulate(*scenario, reference, spec.simulation)
+
         try:
-            table = run_comparison(
-                lambda n: _run_one(shared.for_law(by_name[n]), robot, reference, identified),
-                names,
-                progress,
-                on_result,
-            )
+            table = run_comparison(run, names, progress, on_result)
         finally:
             bar.close()
+        table = replace(table, plants=plants, gains=gains)
         files = [Path(args.out) / p.name for p in table.write(stage)]
     payload = table.as_dict() | {"files": [str(f) for f in files]}
     emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
-    return 0
+    for name, what in table.failed.items():
+        print(f"twolink-pin: {name} did not finish: {what}", file=sys.stderr)
+    return 1 if table.failed else 0
 
 
 RUN_OPTIONS = frozenset(
