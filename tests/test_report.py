@@ -11,7 +11,6 @@ import pytest
 from browser import network_requests, require_chromium, start_chromium
 
 from twolink_pin import OutputError, SimulationConfig
-from twolink_pin.errors import SimulationDivergedError
 from twolink_pin.report import MARKER, ReportOptions, build_report
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
@@ -196,14 +195,20 @@ def test_failure_midway_leaves_the_previous_report_whole(
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging directory left behind
 
 
-def test_a_diverging_run_in_a_worker_arrives_whole_and_nothing_is_written(tmp_path: Path) -> None:
-    """λ = 1e6 makes the Slotine–Li laws diverge in the worker processes: the parent gets the
-    SimulationDivergedError with its controller and time (the exception pickles), and the
-    output folder is not created."""
+def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp_path: Path) -> None:
+    """λ = 1e6 makes the Slotine–Li laws diverge in the worker processes: each is an entry saying
+    when (the exception pickles), the laws without λ (pd) are in the tables, the page is written."""
     options = ReportOptions(
-        run=RunSpec(simulation=SimulationConfig(duration=0.5), lam=1e6), workers=2, animation=False
+        run=RunSpec(simulation=SimulationConfig(duration=0.5), lam=1e6),
+        workers=2,
+        animation=False,
+        identification=False,
     )
-    with pytest.raises(SimulationDivergedError) as info:
-        build_report(tmp_path / "out", options)
-    assert info.value.controller in REPORT_CONTROLLERS and info.value.time > 0
-    assert list(tmp_path.iterdir()) == []
+    results = build_report(tmp_path / "out", options)
+    assert results["failed"] and set(results["failed"]) <= set(REPORT_CONTROLLERS)
+    assert all("diverged at t = " in what for what in results["failed"].values())
+    assert "pd" in results["controllers"] and "pd" not in results["failed"]
+    html = (tmp_path / "out" / "index.html").read_text()
+    for name in results["failed"]:
+        assert f'id="ctrl-{name}"' in html
+    assert "did not finish" in html

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import ControllerError, InvalidParameterError, SimulationDivergedError
 from twolink_pin.feasibility import check_torques
 from twolink_pin.files import output_directory
 from twolink_pin.metrics import Metrics, compute_metrics
@@ -323,6 +323,7 @@ def _build(
     order = [animated, *(n for n in names if n != animated)]
     by_name = dict(zip(names, specs))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
+    failed: dict[str, str] = {}
     animation = None
     workers = min(options.workers, len(order) + 1)
     with _pool(workers) as pool:
@@ -345,9 +346,17 @@ def _build(
             }
         tick("model and trajectory")
         for name in order:
-            runs[name] = futures[name].result()
+            try:
+                runs[name] = futures[name].result()
+            except (SimulationDivergedError, ControllerError) as exc:  # the others' results are kept
+                failed[name] = str(exc)
             tick(f"controller {name}")
-            if name == animated and options.animation:
+            if (
+                options.animation
+                and animation is None
+                and name in runs
+                and (name == animated or animated in failed)
+            ):
                 from twolink_pin.visualization import write_html
 
                 res = runs[name][0]
@@ -357,13 +366,15 @@ def _build(
                 write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points)
                 animation = "animation.html"
                 tick("animation")
+        if options.animation and animation is None:
+            tick("animation")  # every law failed: nothing to animate
         traj_figs = traj_future.result()
         tick("trajectory figures")
         identification = None
         if ident_futures is not None:
             runs_future, fit_future = ident_futures
             excitation_runs = {key: f.result() for key, f in runs_future.items()}
-            if reused:  # the report's own adaptive run is the one along its trajectory
+            if reused and "adaptive" in runs:  # the report's own adaptive run is the one along its trajectory
                 result = runs["adaptive"][0]
                 assert result.p_hat is not None
                 own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
@@ -375,9 +386,12 @@ def _build(
                 None if fit_future is None else fit_future.result(),
             )
             tick("identification")
-    runs = {n: runs[n] for n in names}  # the order asked for
+    runs = {n: runs[n] for n in names if n in runs}  # the order asked for
     table = ComparisonTable(
-        {n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()}, options.config.duration
+        {n: r[1] for n, r in runs.items()},
+        {n: r[3] for n, r in runs.items()},
+        options.config.duration,
+        {n: failed[n] for n in names if n in failed},
     )
     cfg = options.config
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
@@ -385,7 +399,7 @@ def _build(
     lams: dict[str, float] = {}
     for name, (result, metrics, figures, seconds) in runs.items():
         cls = law_class(by_name[name])
-        controller = make_scenario(cls, robot, lam=options.lam if cls.takes("lam") else None).controller
+        controller = options.run.for_law(by_name[name]).build(robot).controller  # the gains it ran with
         if cls.takes("lam"):
             lams[name] = float(np.max(controller.gains.lam))
         controllers[name] = {
@@ -427,6 +441,7 @@ def _build(
         },
         "run": options.run.as_dict(),
         "controllers": controllers,
+        "failed": table.failed,
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),
         "comparison_csv": table.csv(),

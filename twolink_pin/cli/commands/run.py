@@ -286,12 +286,15 @@ def cmd_report(args: argparse.Namespace) -> int:
     finally:
         bar.close()
     index = Path(args.out) / "index.html"
+    failed = results.get("failed") or {}
     emit(
         args,
-        {"index": str(index), "total_seconds": results["total_seconds"]},
+        {"index": str(index), "total_seconds": results["total_seconds"], "failed": failed},
         f"report written to {index} in {results['total_seconds']:.1f} s",
     )
-    return 0
+    for name, what in failed.items():
+        print(f"twolink-pin: {name} did not finish: {what}", file=sys.stderr)
+    return 1 if failed else 0
 
 
 def _record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
