@@ -367,3 +367,22 @@ def test_sweep_command_refuses_bad_options(bad: list[str], capsys: pytest.Captur
         _parser().parse_args(["sweep", "pd", "--samples", "3", *bad])
     assert info.value.code == 2
     assert "error" in capsys.readouterr().err
+
+
+def test_a_sweep_whose_runs_all_diverge_writes_its_table_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Kd from 2000 to 3000 with dt = 5 ms: RK4 is unstable for every case (above Kd ≈ 300).
+    The table and summary are written (every row flagged), the summary says why there is no
+    figure, and the command says so too."""
+    from twolink_pin.cli import main
+
+    argv = ["sweep", "pd", "--samples", "4", "--duration", "0.5", "--dt", "5e-3", "--gain", "kd=2000:3000"]
+    assert main([*argv, "--out", str(tmp_path / "s")]) == 0
+    out = capsys.readouterr()
+    assert "every one of the 4 runs diverged" in out.out + out.err
+    rows = _rows(tmp_path / "s" / "runs.csv")
+    assert len(rows) == 4 and all(r["diverged"] == "1" for r in rows)
+    summary = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert summary["diverged"] == 4 and "every one" in summary["note"]
+    assert not (tmp_path / "s" / "distributions.png").exists()

@@ -271,7 +271,12 @@ def run_sweep(
             write_json(stage / "summary.json", summary)
             files = [stage / "runs.csv", stage / "runs.json", stage / RUNS_FOLDER, stage / "summary.json"]
             files += sink.kept
-            if plot:
+            if summary["diverged"] == summary["runs"]:  # nothing to draw: the table and summary say so
+                summary["note"] = f"every one of the {summary['runs']} runs diverged: no distributions.png"
+                write_json(stage / "summary.json", summary)
+                if notify is not None:
+                    notify(f"sweep: {summary['note']}")
+            elif plot:
                 files.append(_figure(stage, config.samples, robot.nv, cls.name))
         description = "in-process" if engine is None else engine.description
     out = Path(out_dir)

@@ -80,6 +80,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     for name, stat in summary["metrics"].items():
         cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
         lines.append(f"  {name:28s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
+    if "note" in summary:
+        lines.append(f"  {summary['note']}")
     lines += [f"  wrote {f}" for f in output.files]
     emit(args, {}, "\n".join(lines))
     return 0
