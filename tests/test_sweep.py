@@ -386,3 +386,25 @@ def test_a_sweep_whose_runs_all_diverge_writes_its_table_and_says_so(
     summary = json.loads((tmp_path / "s" / "summary.json").read_text())
     assert summary["diverged"] == 4 and "every one" in summary["note"]
     assert not (tmp_path / "s" / "distributions.png").exists()
+
+
+def test_an_output_folder_that_is_a_mount_point_is_refused_before_any_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A mount point cannot be swapped for the finished folder: refused at the start (one line,
+    exit 2), not after the runs. (The mount is simulated: os.path.ismount says so for it.)"""
+    import os
+
+    from twolink_pin.cli import main
+
+    mounted = tmp_path / "mnt"
+    mounted.mkdir()
+    real = os.path.ismount
+    monkeypatch.setattr(os.path, "ismount", lambda p: Path(p) == mounted or real(p))
+    progress: list[int] = []
+    with pytest.raises(OutputError, match="mount point"):
+        run_sweep(_study(), ROBOT, TRAJECTORY, mounted, progress=lambda done, total: progress.append(done))
+    assert progress == [] and list(mounted.iterdir()) == []
+    assert main(["sweep", "pd", "--samples", "2", "--duration", "0.05", "--out", str(mounted)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "mount point" in err
