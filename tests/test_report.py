@@ -212,3 +212,23 @@ def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp
     for name in results["failed"]:
         assert f'id="ctrl-{name}"' in html
     assert "did not finish" in html
+
+
+def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> None:
+    """A URDF whose mesh file is missing: the report is written, with a note naming the mesh
+    where the animation would be, and the warning in results.json (the CLI prints it)."""
+    import shutil
+
+    urdf = tmp_path / "missing_mesh.urdf"
+    shutil.copy(Path(__file__).parent / "corpus" / "urdf" / "missing_mesh.urdf", urdf)
+    options = ReportOptions(
+        robot=str(urdf),
+        run=RunSpec(simulation=SimulationConfig(duration=0.5)),
+        workers=1,
+        controllers=("pd",),
+    )
+    results = build_report(tmp_path / "r", options)
+    assert results["animation"] is None and "pd" in results["controllers"]
+    assert len(results["warnings"]) == 1 and "nothere.stl" in results["warnings"][0]
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "nothere.stl" in html and not (tmp_path / "r" / "animation.html").exists()

@@ -27,7 +27,12 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import ControllerError, InvalidParameterError, SimulationDivergedError
+from twolink_pin.errors import (
+    ControllerError,
+    InvalidParameterError,
+    InvalidURDFError,
+    SimulationDivergedError,
+)
 from twolink_pin.feasibility import check_torques
 from twolink_pin.files import output_directory
 from twolink_pin.metrics import Metrics, compute_metrics
@@ -324,6 +329,8 @@ def _build(
     by_name = dict(zip(names, specs))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
     failed: dict[str, str] = {}
+    warnings: list[str] = []
+    tried, shown = False, animated
     animation = None
     workers = min(options.workers, len(order) + 1)
     with _pool(workers) as pool:
@@ -351,22 +358,23 @@ def _build(
             except (SimulationDivergedError, ControllerError) as exc:  # the others' results are kept
                 failed[name] = str(exc)
             tick(f"controller {name}")
-            if (
-                options.animation
-                and animation is None
-                and name in runs
-                and (name == animated or animated in failed)
-            ):
+            if options.animation and not tried and name in runs and (name == animated or animated in failed):
                 from twolink_pin.visualization import write_html
 
+                tried, shown = True, name
                 res = runs[name][0]
                 from twolink_pin.kinematics import joint_positions
 
                 points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
-                write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points)
-                animation = "animation.html"
+                try:
+                    write_html(
+                        robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points
+                    )
+                    animation = "animation.html"
+                except InvalidURDFError as exc:  # a missing mesh: the report without its animation
+                    warnings.append(f"no animation: {exc}")
                 tick("animation")
-        if options.animation and animation is None:
+        if options.animation and not tried:
             tick("animation")  # every law failed: nothing to animate
         traj_figs = traj_future.result()
         tick("trajectory figures")
@@ -446,7 +454,8 @@ def _build(
         "comparison_markdown": table.markdown(),
         "comparison_csv": table.csv(),
         "animation": animation,
-        "animated": animated,
+        "warnings": warnings,
+        "animated": shown,
         "errata": errata,
         "identification": identification,
         "versions": facts.versions(),

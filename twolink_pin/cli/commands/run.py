@@ -292,6 +292,8 @@ def cmd_report(args: argparse.Namespace) -> int:
         {"index": str(index), "total_seconds": results["total_seconds"], "failed": failed},
         f"report written to {index} in {results['total_seconds']:.1f} s",
     )
+    for warning in results.get("warnings") or []:
+        print(f"twolink-pin: warning: {warning}", file=sys.stderr)
     for name, what in failed.items():
         print(f"twolink-pin: {name} did not finish: {what}", file=sys.stderr)
     return 1 if failed else 0
