@@ -201,3 +201,72 @@ def test_compare_keeps_the_laws_that_finished(tmp_path: Path, capsys: pytest.Cap
     alone = json.loads(capsys.readouterr().out)
     assert alone["controllers"] == payload["controllers"]
     assert set(payload["plants"].values()) == {"no friction"} and len(payload["plants"]) == 3
+
+
+RAISER = """
+from dataclasses import dataclass
+
+from twolink_pin.controllers import Controller, Gains, LawInput, LawOutput
+
+
+@dataclass(frozen=True, eq=False)
+class RaiserGains(Gains):
+    pass
+
+
+class Raiser(Controller[RaiserGains]):
+    name = "raiser"
+    title = "raises"
+    Gains = RaiserGains
+
+    def compute(self, x: LawInput, terms: object) -> LawOutput:
+        if x.t > 0.01:
+            raise ZeroDivisionError("my bug")
+        return LawOutput(0 * x.q)
+"""
+
+NOT_A_DATACLASS = """
+from typing import Any
+
+from twolink_pin.controllers import Controller, Gains, LawInput, LawOutput
+from twolink_pin.controllers.gains import gain
+
+
+class PlainGains(Gains):
+    kp: Any = gain(1.0, per="joint", unit="N·m/rad", doc="kp")
+
+
+class Plain(Controller[PlainGains]):
+    name = "plain-gains"
+    title = "gains without @dataclass"
+    Gains = PlainGains
+
+    def compute(self, x: LawInput, terms: object) -> LawOutput:
+        return LawOutput(-self.gains.kp * (x.q - x.q_des))
+"""
+
+
+def test_a_law_that_raises_is_named_with_its_file_and_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """One line with the law's file and the line that raised; --debug adds its traceback."""
+    monkeypatch.delenv("TWOLINK_PIN_DEBUG", raising=False)
+    law = tmp_path / "raiser.py"
+    law.write_text(RAISER)
+    line = RAISER.splitlines().index('            raise ZeroDivisionError("my bug")') + 1
+    assert main(["simulate", f"{law}:Raiser", "--duration", "0.05"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"raised at {law}:{line} in compute" in err
+    assert main(["--debug", "simulate", f"{law}:Raiser", "--duration", "0.05"]) == 1
+    err = capsys.readouterr().err
+    assert "Traceback (most recent call last)" in err and f'File "{law}", line {line}' in err
+
+
+def test_a_gains_class_that_is_not_a_dataclass_is_refused_by_name(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    law = tmp_path / "plain.py"
+    law.write_text(NOT_A_DATACLASS)
+    assert main(["simulate", f"{law}:Plain", "--duration", "0.05"]) == 2
+    err = capsys.readouterr().err
+    assert "PlainGains" in err and "must be a dataclass" in err and "Traceback" not in err

@@ -187,6 +187,11 @@ def build_parser() -> argparse.ArgumentParser:
         prog="twolink-pin",
         description="Kinematics, dynamics and tracking control of robot arms on Pinocchio.",
     )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="print the traceback of a law that raised or of an internal error (as TWOLINK_PIN_DEBUG=1)",
+    )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("info", help="model summary: sizes, link lengths, torque limits, parameters")
