@@ -19,13 +19,8 @@ from typing import Any
 
 from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
-from twolink_pin.metrics import Metrics, compute_metrics
+from twolink_pin.metrics import NORMS, SIGNALS, Metrics, compute_metrics
 from twolink_pin.simulation import SimulationResult
-
-SIGNALS = (("e", "e", "rad"), ("edot", "ė", "rad/s"), ("tau", "τ", "N·m"))
-"""(field, symbol, unit) of each signal of the table."""
-NORMS = {"rms": ("RMS = sqrt((1/T)∫x² dt)", ""), "l2": ("L2 = sqrt(∫x² dt)", "·√s"), "max": ("max |x|", "")}
-"""Title and unit suffix of each norm."""
 
 
 def columns(nv: int) -> list[str]:

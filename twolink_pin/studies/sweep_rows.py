@@ -13,6 +13,7 @@ import numpy as np
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
@@ -33,27 +34,16 @@ def _joint_columns(prefix: str, nv: int) -> list[str]:
     return [f"{prefix}{j + 1}" for j in range(nv)]
 
 
-METRIC_UNITS = {
-    "rms_e": "rad",
-    "rms_edot": "rad/s",
-    "rms_tau": "N·m",
-    "max_e": "rad",
-    "max_edot": "rad/s",
-    "max_tau": "N·m",
-    "final_period_max_abs_e": "rad",
-    "peak_command": "N·m",
-}
-"""SI unit of each per-joint metric (the column names add the joint's 1-based index)."""
+METRIC_UNITS = metric_units()
+"""SI unit of each per-joint metric (the column names add the joint's 1-based index):
+:func:`twolink_pin.metrics.metric_units`, the one definition."""
 
 
 def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
     """Names of the metric columns of a row, in order."""
     columns: list[str] = []
-    for kind in ("rms", "max"):
-        for signal in ("e", "edot", "tau"):
-            columns += _joint_columns(f"{kind}_{signal}", nv)
-    columns += _joint_columns("final_period_max_abs_e", nv)
-    columns += _joint_columns("peak_command", nv)
+    for stem in METRIC_UNITS:
+        columns += _joint_columns(stem, nv)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
     return columns
 
@@ -80,16 +70,7 @@ def _chunk_rows(
     inputs += [cases.gains[g.name][:, None] for g in config.gains]
     exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & ~result.diverged
     flags = np.column_stack([exceeded, result.diverged, result.diverged_at]).astype(float)
-    parts = [
-        m.rms.e,
-        m.rms.edot,
-        m.rms.tau,
-        m.max.e,
-        m.max.edot,
-        m.max.tau,
-        m.final_period_max_abs_e,
-        m.peak_command,
-    ]
+    parts = [metric_array(m, stem) for stem in METRIC_UNITS]
     if result.p_hat_final is not None:
         parts.append(result.p_hat_final)
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
