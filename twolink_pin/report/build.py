@@ -39,7 +39,7 @@ from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
 from twolink_pin.run_spec import RunSpec
-from twolink_pin.scenario import law_class, make_scenario
+from twolink_pin.scenario import builtin_laws, law_class, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.comparison import ComparisonTable
@@ -256,11 +256,7 @@ def laws_to_run(options: ReportOptions, is_twolink: bool) -> tuple[str, ...]:
         from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
         return REPORT_CONTROLLERS
-    from twolink_pin.controllers import CONTROLLERS
-
-    return tuple(
-        name for name, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
-    )
+    return builtin_laws()
 
 
 def build_report(

@@ -115,15 +115,12 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    from twolink_pin.controllers import CONTROLLERS
     from twolink_pin.files import output_directory
-    from twolink_pin.scenario import law_class
+    from twolink_pin.scenario import builtin_laws, law_class
     from twolink_pin.studies.comparison import run_comparison
 
     robot = _robot(args)
-    specs = args.controllers or [
-        n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
-    ]
+    specs = args.controllers or list(builtin_laws())
     names = [law_class(s).name for s in specs]
     if len(set(names)) != len(names):
         raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
