@@ -176,7 +176,11 @@ def test_compare_keeps_the_laws_that_finished(tmp_path: Path, capsys: pytest.Cap
     out = tmp_path / "cmp"
     argv = ["compare", "pd", "computed-torque", f"{tmp_path}/blowup.py:Blowup", "--duration", "0.2"]
     assert main([*argv, "--no-plot", "--out", str(out), "--json"]) == 1
-    payload = json.loads(capsys.readouterr().out)
+    captured = capsys.readouterr()
+    said = [line for line in captured.err.split("\n") if "twolink-pin:" in line]
+    assert captured.out == "" and len(said) == 1  # a failed run: one line (besides the progress bar)
+    assert "blowup: simulation with controller 'blowup' diverged at t = " in captured.err
+    payload = json.loads((out / "comparison.json").read_text())
     assert sorted(payload["controllers"]) == ["computed-torque", "pd"]
     assert "diverged at t = " in payload["failed"]["blowup"]
     table = (out / "comparison.csv").read_text()

@@ -401,8 +401,8 @@ TRACEBACK = [
     C("traceback-simulate-stderr-closed-argparse", "simulate pd --dt 0", 2, run="stderr-closed"),
     C("traceback-simulate-stderr-closed-diverged", f"simulate computed-torque {SIM} --lambda 1e6", 1, run="stderr-closed"),
     # -- runs that fail: exit 1 naming the law and the time
-    C("traceback-report-lambda-1e6", "report --duration 1 --workers 1 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("r/index.html",), note="the laws without λ finish: their results are written"),
-    C("traceback-report-lambda-1e6-workers-2", "report --duration 1 --workers 2 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), run="proc", exists=("r/index.html",)),
+    C("traceback-report-lambda-1e6", "report --duration 1 --workers 1 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("r/index.html",), note="the laws without λ finish: their results are written", timeout=240),
+    C("traceback-report-lambda-1e6-workers-2", "report --duration 1 --workers 2 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), run="proc", exists=("r/index.html",), timeout=240),
     C("traceback-compare-lambda-1e6", f"compare {SIM} --no-plot --lambda 1e6 --out c", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("c/comparison.csv",), note="pd finishes: its row is written"),
     C("traceback-sweep-lambda-1e6", f"sweep computed-torque --samples 3 {SIM} --lambda 1e6 --no-plot --out s", (0, 1), err=("t =", "computed-torque"), note="a sweep may count diverged runs (exit 0, '3 diverged') or fail; both are sound"),
     C("traceback-simulate-lambda-1e6", f"simulate computed-torque {SIM} --lambda 1e6", 1, err=("computed-torque", "t =")),
@@ -420,7 +420,7 @@ TRACEBACK = [
     C("traceback-simulate-law-no-such-module", f"simulate nosuchmodule_xyz:Law {SIM}", 2, err=("nosuchmodule_xyz",)),
     C("traceback-compare-law-raises", f"compare {LAW}/raiser.py:Raiser pd {SIM} --no-plot --out c", 1, err=("corpus-raiser", "t ="), exists=("c/comparison.csv",), note="pd's row is written"),
     C("traceback-sweep-law-raises", f"sweep {LAW}/raiser.py:Raiser --samples 2 {SIM} --no-plot --out s", 1, err=("corpus-raiser", "t ="), absent=("s",)),
-    C("traceback-report-law-raises", f"report --duration 1 --workers 1 --no-animation --controller {LAW}/raiser.py:Raiser --out r", 1, err=("corpus-raiser", "t ="), exists=("r/index.html",), note="the page says the law did not finish"),
+    C("traceback-report-law-raises", f"report --duration 1 --workers 1 --no-animation --controller {LAW}/raiser.py:Raiser --out r", 1, err=("corpus-raiser", "t ="), exists=("r/index.html",), note="the page says the law did not finish", timeout=240),
     C("traceback-animate-law-raises", f"animate {LAW}/raiser.py:Raiser {SIM} --html a.html", 1, err=("corpus-raiser", "t ="), absent=("a.html",)),
     # -- saved results that are not
     *(C(f"traceback-animate-from-{name}", "animate --from bad.npz --html a.html", 2, err=("bad.npz",), setup=(step,), absent=("a.html",)) for name, step in NPZ_BAD.items()),

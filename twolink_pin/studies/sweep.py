@@ -274,8 +274,6 @@ def run_sweep(
             if summary["diverged"] == summary["runs"]:  # nothing to draw: the table and summary say so
                 summary["note"] = f"every one of the {summary['runs']} runs diverged: no distributions.png"
                 write_json(stage / "summary.json", summary)
-                if notify is not None:
-                    notify(f"sweep: {summary['note']}")
             elif plot:
                 files.append(_figure(stage, config.samples, robot.nv, cls.name))
         description = "in-process" if engine is None else engine.description

@@ -164,11 +164,18 @@ def cmd_compare(args: argparse.Namespace) -> int:
             bar.close()
         table = replace(table, plants=plants, gains=gains)
         files = [Path(args.out) / p.name for p in table.write(stage)]
+    if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
+        _say_failed(table.failed, f"the other laws' results are in {args.out}")
+        return 1
     payload = table.as_dict() | {"files": [str(f) for f in files]}
     emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
-    for name, what in table.failed.items():
-        print(f"twolink-pin: {name} did not finish: {what}", file=sys.stderr)
-    return 1 if table.failed else 0
+    return 0
+
+
+def _say_failed(failed: dict[str, str], where: str) -> None:
+    """One line on stderr for the laws that did not finish (each with what happened and when)."""
+    what = "; ".join(f"{name}: {text}" for name, text in failed.items())
+    print(f"twolink-pin: {len(failed)} law(s) did not finish ({what}); {where}", file=sys.stderr)
 
 
 RUN_OPTIONS = frozenset(
@@ -284,16 +291,17 @@ def cmd_report(args: argparse.Namespace) -> int:
         bar.close()
     index = Path(args.out) / "index.html"
     failed = results.get("failed") or {}
-    emit(
-        args,
-        {"index": str(index), "total_seconds": results["total_seconds"], "failed": failed},
-        f"report written to {index} in {results['total_seconds']:.1f} s",
-    )
     for warning in results.get("warnings") or []:
         print(f"twolink-pin: warning: {warning}", file=sys.stderr)
-    for name, what in failed.items():
-        print(f"twolink-pin: {name} did not finish: {what}", file=sys.stderr)
-    return 1 if failed else 0
+    if failed:  # a failed run: one line on stderr, nothing on stdout; the page holds the rest
+        _say_failed(failed, f"the report with the others is {index}")
+        return 1
+    emit(
+        args,
+        {"index": str(index), "total_seconds": results["total_seconds"]},
+        f"report written to {index} in {results['total_seconds']:.1f} s",
+    )
+    return 0
 
 
 def _record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
