@@ -2,7 +2,8 @@
 from URDF, on Pinocchio.
 
 Data flows one way: model → kinematics / trajectory → dynamics → controllers → plant →
-simulation → metrics → studies, identification → plotting / visualization / report / cli.
+simulation → identification → run_spec (one description of a run, built in one place) →
+metrics → studies → plotting / visualization / report / cli.
 Quick use::
 
     from twolink_pin import load_robot, default_trajectory, make_scenario, simulate, compute_metrics
