@@ -190,6 +190,7 @@ _SWEEP_CHILD = """
 import sys, tracemalloc
 from twolink_pin import default_trajectory, load_robot
 from twolink_pin.simulation import SimulationConfig
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.studies.sweep import SweepConfig, GainRange, run_sweep
 
 def high_water_mib():  # VmHWM: this process's peak RSS (ru_maxrss would carry the parent's over exec)
@@ -198,8 +199,8 @@ def high_water_mib():  # VmHWM: this process's peak RSS (ru_maxrss would carry t
 
 robot = load_robot(); trajectory = default_trajectory(robot)
 samples, duration, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
-config = SweepConfig("pd", samples, seed=1, q0_spread=0.1, param_error=0.2,
-                     gains=(GainRange("kp", 100.0, 400.0),), simulation=SimulationConfig(duration=duration))
+config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1,
+                     q0_spread=0.1, param_error=0.2, gains=(GainRange("kp", 100.0, 400.0),))
 before = high_water_mib()
 tracemalloc.start()
 output = run_sweep(config, robot, trajectory, out, plot=False)
@@ -234,15 +235,19 @@ TARGET_SPEEDUP = 1.6
 
 
 def _throughput_study(samples: int, duration: float) -> Any:
+    from twolink_pin.run_spec import RunSpec
     from twolink_pin.studies.sweep import SweepConfig
 
-    return SweepConfig("pd", samples, seed=1, q0_spread=0.05, simulation=SimulationConfig(duration=duration))
+    return SweepConfig(
+        RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1, q0_spread=0.05
+    )
 
 
 _CLIENT_CHILD = """
 import sys, tracemalloc
 from twolink_pin import default_trajectory, load_robot
 from twolink_pin.simulation import SimulationConfig
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.studies.sweep import SweepConfig, run_sweep
 
 def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask workers are other processes)
@@ -252,7 +257,7 @@ def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask work
 if __name__ == "__main__":
     samples, duration, out, workers = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
     robot = load_robot(); trajectory = default_trajectory(robot)
-    config = SweepConfig("pd", samples, seed=1, q0_spread=0.05, simulation=SimulationConfig(duration=duration))
+    config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1, q0_spread=0.05)
     before = high_water_mib()
     tracemalloc.start()
     output = run_sweep(config, robot, trajectory, out, plot=True, workers=workers or None)

@@ -36,6 +36,7 @@ from distributed import Client
 from twolink_pin.cli import build_parser, main
 from twolink_pin.cli.commands import cmd_sweep
 from twolink_pin.model import load_robot
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig
 from twolink_pin.studies import cluster as cluster_module
 from twolink_pin.studies import sweep as sweep_module
@@ -50,13 +51,12 @@ TWOLINK_PIN = str(BIN / "twolink-pin")
 ROBOT = load_robot()
 TRAJECTORY = default_trajectory(ROBOT)
 STUDY = SweepConfig(
-    "pd",
+    RunSpec(law="pd", simulation=SimulationConfig(duration=0.5, dt=2e-3)),  # 42 of 300 runs diverge: nulls
     samples=300,
     seed=11,
     q0_spread=0.2,
     param_error=0.3,
     gains=(GainRange("kp", 100.0, 400.0), GainRange("kd", 40.0, 600.0)),
-    simulation=SimulationConfig(duration=0.5, dt=2e-3),  # 42 of the 300 runs diverge: nulls in the table
 )
 STARTUP = 120.0
 """Generous bound on starting a scheduler or workers [s]: a guard against a hang, not an assertion."""
@@ -228,8 +228,8 @@ def test_a_law_and_a_urdf_from_files_reach_workers_that_do_not_have_them(
     monkeypatch.chdir(tmp_path)
     robot = load_robot("my_arm.urdf", payload=0.3)
     assert robot.name == "my_arm"
-    study = SweepConfig("my_law.py:SlidingMode", samples=24, seed=2, q0_spread=0.1, chunk=5)
-    study = replace(study, simulation=SimulationConfig(duration=0.2), gains=(GainRange("ks", 1.0, 5.0),))
+    run = RunSpec(law="my_law.py:SlidingMode", simulation=SimulationConfig(duration=0.2))
+    study = SweepConfig(run, samples=24, seed=2, q0_spread=0.1, chunk=5, gains=(GainRange("ks", 1.0, 5.0),))
     trajectory = default_trajectory(robot)
     run_sweep(study, robot, trajectory, "here", plot=False)
     for there in ("there", "again"):  # the same law in a second sweep on the same workers
@@ -261,7 +261,9 @@ def test_killing_a_worker_in_the_middle_of_its_task_still_gives_the_identical_ta
     """Two workers without nanny (nothing restarts them); once the first runs are reported,
     the worker that is running a chunk is killed with SIGKILL. Dask reschedules its chunks on
     the other; the table equals the in-process one."""
-    study = replace(STUDY, samples=240, chunk=30, simulation=SimulationConfig(duration=1.0))
+    study = replace(
+        STUDY, samples=240, chunk=30, run=replace(STUDY.run, simulation=SimulationConfig(duration=1.0))
+    )
     run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "reference", plot=False)
     processes = DaskProcesses(tmp_path, workers=2, nanny=False)
     try:
@@ -521,7 +523,8 @@ def test_a_chunk_that_keeps_killing_its_workers_fails_the_sweep_naming_it(
     the nannies restart the workers; nothing is written."""
     (tmp_path / "crash.py").write_text(CRASHING_LAW)
     study = SweepConfig(
-        f"{tmp_path}/crash.py:CrashOnWorker", samples=4, simulation=SimulationConfig(duration=0.1)
+        RunSpec(law=f"{tmp_path}/crash.py:CrashOnWorker", simulation=SimulationConfig(duration=0.1)),
+        samples=4,
     )
     with scheduler.client() as client:
         client.run_on_scheduler(lambda dask_scheduler: setattr(dask_scheduler, "allowed_failures", 0))

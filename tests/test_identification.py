@@ -630,9 +630,13 @@ def test_the_html_report_answers_figure_27(tmp_path: Path) -> None:
     references, the adaptation excitation within 5 % in the run, an identification with its true
     values within ±3σ, and its figures on disk."""
     from twolink_pin.report import ReportOptions, build_report
+    from twolink_pin.run_spec import RunSpec
 
     options = ReportOptions(
-        config=SimulationConfig(duration=10.0), workers=1, animation=False, controllers=("adaptive",)
+        run=RunSpec(simulation=SimulationConfig(duration=10.0)),
+        workers=1,
+        animation=False,
+        controllers=("adaptive",),
     )
     results = build_report(tmp_path / "r", options)
     section = results["identification"]

@@ -11,11 +11,11 @@ import pytest
 from browser import network_requests, require_chromium, start_chromium
 
 from twolink_pin import OutputError, SimulationConfig
-from twolink_pin.errors import SimulationDivergedError
 from twolink_pin.report import MARKER, ReportOptions, build_report
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
-SHORT = ReportOptions(config=SimulationConfig(duration=4.0), workers=1)
+SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1)
 
 
 @pytest.fixture(scope="module")
@@ -104,8 +104,7 @@ def test_a_sixth_law_gets_its_own_section_and_the_errata_use_the_runs_lambda(tmp
     """--controller adds the tutorial's law beside pd and adaptive; λ = 3 appears in the errata
     text (the page may not contradict the run's settings)."""
     options = ReportOptions(
-        config=SimulationConfig(duration=1.0),
-        lam=3.0,
+        run=RunSpec(simulation=SimulationConfig(duration=1.0), lam=3.0),
         workers=1,
         animation=False,
         controllers=("pd", "adaptive", "examples/sliding_mode.py:SlidingMode"),
@@ -125,7 +124,11 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
 
     urdf = str(example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf"))
     options = ReportOptions(
-        robot=urdf, config=SimulationConfig(duration=1.0), workers=1, animation=False, controllers=("pd",)
+        robot=urdf,
+        run=RunSpec(simulation=SimulationConfig(duration=1.0)),
+        workers=1,
+        animation=False,
+        controllers=("pd",),
     )
     results = build_report(tmp_path / "r", options)
     assert results["twolink"] is None and results["errata"] == []
@@ -142,7 +145,7 @@ def test_the_identification_section_can_be_left_out(tmp_path: Path) -> None:
     """--no-identification (ReportOptions.identification=False): no section, no link in the
     navigation, no entry in results.json; left in, a 1-s report still has its table."""
     short = {
-        "config": SimulationConfig(duration=1.0),
+        "run": RunSpec(simulation=SimulationConfig(duration=1.0)),
         "workers": 1,
         "animation": False,
         "controllers": ("pd",),
@@ -184,17 +187,48 @@ def test_failure_midway_leaves_the_previous_report_whole(
 
     monkeypatch.setattr(pages, "write_pages", boom)
     with pytest.raises(RuntimeError, match="disk full"):
-        build_report(out, ReportOptions(config=SimulationConfig(duration=0.5), workers=1, animation=False))
+        build_report(
+            out,
+            ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=0.5)), workers=1, animation=False),
+        )
     assert (out / "index.html").read_text() == "previous report"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging directory left behind
 
 
-def test_a_diverging_run_in_a_worker_arrives_whole_and_nothing_is_written(tmp_path: Path) -> None:
-    """λ = 1e6 makes the Slotine–Li laws diverge in the worker processes: the parent gets the
-    SimulationDivergedError with its controller and time (the exception pickles), and the
-    output folder is not created."""
-    options = ReportOptions(config=SimulationConfig(duration=0.5), lam=1e6, workers=2, animation=False)
-    with pytest.raises(SimulationDivergedError) as info:
-        build_report(tmp_path / "out", options)
-    assert info.value.controller in REPORT_CONTROLLERS and info.value.time > 0
-    assert list(tmp_path.iterdir()) == []
+def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp_path: Path) -> None:
+    """λ = 1e6 makes the Slotine–Li laws diverge in the worker processes: each is an entry saying
+    when (the exception pickles), the laws without λ (pd) are in the tables, the page is written."""
+    options = ReportOptions(
+        run=RunSpec(simulation=SimulationConfig(duration=0.5), lam=1e6),
+        workers=2,
+        animation=False,
+        identification=False,
+    )
+    results = build_report(tmp_path / "out", options)
+    assert results["failed"] and set(results["failed"]) <= set(REPORT_CONTROLLERS)
+    assert all("diverged at t = " in what for what in results["failed"].values())
+    assert "pd" in results["controllers"] and "pd" not in results["failed"]
+    html = (tmp_path / "out" / "index.html").read_text()
+    for name in results["failed"]:
+        assert f'id="ctrl-{name}"' in html
+    assert "did not finish" in html
+
+
+def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> None:
+    """A URDF whose mesh file is missing: the report is written, with a note naming the mesh
+    where the animation would be, and the warning in results.json (the CLI prints it)."""
+    import shutil
+
+    urdf = tmp_path / "missing_mesh.urdf"
+    shutil.copy(Path(__file__).parent / "corpus" / "urdf" / "missing_mesh.urdf", urdf)
+    options = ReportOptions(
+        robot=str(urdf),
+        run=RunSpec(simulation=SimulationConfig(duration=0.5)),
+        workers=1,
+        controllers=("pd",),
+    )
+    results = build_report(tmp_path / "r", options)
+    assert results["animation"] is None and "pd" in results["controllers"]
+    assert len(results["warnings"]) == 1 and "nothere.stl" in results["warnings"][0]
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert "nothere.stl" in html and not (tmp_path / "r" / "animation.html").exists()

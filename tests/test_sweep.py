@@ -29,6 +29,7 @@ from twolink_pin.errors import ControllerSpecError, InvalidParameterError, Outpu
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.parquet import METADATA_KEY, read_columns, read_metadata
@@ -55,17 +56,20 @@ def _rows(path: Path) -> list[dict[str, str]]:
 
 
 def _study(**changes) -> SweepConfig:  # type: ignore[no-untyped-def]
-    base = SweepConfig(
-        "pd",
-        samples=12,
-        seed=7,
-        q0_spread=0.1,
-        param_error=0.2,
-        gains=(GainRange("kp", 100.0, 400.0), GainRange("kd2", 20.0, 80.0)),
-        simulation=SHORT,
-        chunk=5,
+    run = RunSpec(
+        law=changes.pop("controller", "pd"),
+        simulation=changes.pop("simulation", SHORT),
+        lam=changes.pop("lam", None),
     )
-    return replace(base, **changes)
+    base = {
+        "samples": 12,
+        "seed": 7,
+        "q0_spread": 0.1,
+        "param_error": 0.2,
+        "gains": (GainRange("kp", 100.0, 400.0), GainRange("kd2", 20.0, 80.0)),
+        "chunk": 5,
+    }
+    return SweepConfig(run, **(base | changes))
 
 
 def _table(out: Path) -> pa.Table:
@@ -263,7 +267,9 @@ def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None
     )
     np.testing.assert_array_equal(law.gains.kd[:, 0], 40.0)
     np.testing.assert_array_equal(law.gains.kd[:, 1], cases.gains["kd2"])
-    robust = replace(study, controller="robust", gains=(GainRange("model_scale", 0.2, 0.3),))
+    robust = replace(
+        study, run=RunSpec(law="robust", simulation=SHORT), gains=(GainRange("model_scale", 0.2, 0.3),)
+    )
     built = _chunk_law(robust, ROBOT, Cases(robust, ROBOT, 0, 12), make_scenario("robust", ROBOT).controller)
     assert isinstance(built, WrongModel) and np.all(
         (built.gains.model_scale >= 0.2) & (built.gains.model_scale <= 0.3)
@@ -278,7 +284,11 @@ def test_a_users_law_from_a_file_sweeps_like_a_built_in_one(tmp_path: Path) -> N
         gains=(GainRange("ks", 1.0, 5.0), GainRange("phi", 0.02, 0.1)),
     )
     output = run_sweep(
-        replace(study, simulation=SimulationConfig(duration=0.3)), ROBOT, TRAJECTORY, tmp_path, plot=False
+        replace(study, run=replace(study.run, simulation=SimulationConfig(duration=0.3))),
+        ROBOT,
+        TRAJECTORY,
+        tmp_path,
+        plot=False,
     )
     assert output.summary["controller"] == "sliding-mode" and output.summary["diverged"] == 0
     rows = _rows(tmp_path / "runs.csv")
@@ -379,3 +389,44 @@ def test_sweep_command_refuses_bad_options(bad: list[str], capsys: pytest.Captur
         _parser().parse_args(["sweep", "pd", "--samples", "3", *bad])
     assert info.value.code == 2
     assert "error" in capsys.readouterr().err
+
+
+def test_a_sweep_whose_runs_all_diverge_writes_its_table_and_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Kd from 2000 to 3000 with dt = 5 ms: RK4 is unstable for every case (above Kd ≈ 300).
+    The table and summary are written (every row flagged), the summary says why there is no
+    figure, and the command says so too."""
+    from twolink_pin.cli import main
+
+    argv = ["sweep", "pd", "--samples", "4", "--duration", "0.5", "--dt", "5e-3", "--gain", "kd=2000:3000"]
+    assert main([*argv, "--out", str(tmp_path / "s")]) == 0
+    out = capsys.readouterr()
+    assert "every one of the 4 runs diverged" in out.out + out.err
+    rows = _rows(tmp_path / "s" / "runs.csv")
+    assert len(rows) == 4 and all(r["diverged"] == "1" for r in rows)
+    summary = json.loads((tmp_path / "s" / "summary.json").read_text())
+    assert summary["diverged"] == 4 and "every one" in summary["note"]
+    assert not (tmp_path / "s" / "distributions.png").exists()
+
+
+def test_an_output_folder_that_is_a_mount_point_is_refused_before_any_run(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A mount point cannot be swapped for the finished folder: refused at the start (one line,
+    exit 2), not after the runs. (The mount is simulated: os.path.ismount says so for it.)"""
+    import os
+
+    from twolink_pin.cli import main
+
+    mounted = tmp_path / "mnt"
+    mounted.mkdir()
+    real = os.path.ismount
+    monkeypatch.setattr(os.path, "ismount", lambda p: Path(p) == mounted or real(p))
+    progress: list[int] = []
+    with pytest.raises(OutputError, match="mount point"):
+        run_sweep(_study(), ROBOT, TRAJECTORY, mounted, progress=lambda done, total: progress.append(done))
+    assert progress == [] and list(mounted.iterdir()) == []
+    assert main(["sweep", "pd", "--samples", "2", "--duration", "0.05", "--out", str(mounted)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "mount point" in err

@@ -2,7 +2,8 @@
 from URDF, on Pinocchio.
 
 Data flows one way: model → kinematics / trajectory → dynamics → controllers → plant →
-simulation → metrics → studies, identification → plotting / visualization / report / cli.
+simulation → identification → run_spec (one description of a run, built in one place) →
+metrics → studies → plotting / visualization / report / cli.
 Quick use::
 
     from twolink_pin import load_robot, default_trajectory, make_scenario, simulate, compute_metrics
@@ -70,6 +71,7 @@ from twolink_pin.identification import (
 from twolink_pin.metrics import BatchMetrics, Metrics, RunningMetrics, compute_metrics
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
 from twolink_pin.plant import Plant
+from twolink_pin.run_spec import PlantOptions, RunSpec
 from twolink_pin.scenario import Scenario, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import BatchResult, simulate_batch
@@ -116,8 +118,10 @@ __all__ = [
     "PDFeedforward",
     "PDGains",
     "Plant",
+    "PlantOptions",
     "RobotModel",
     "RunLog",
+    "RunSpec",
     "RunningMetrics",
     "Scenario",
     "SimulationConfig",

@@ -187,3 +187,24 @@ class OutputError(TwolinkPinError):
         self.path = path
         self.reason = reason
         super().__init__(f"{path}: {reason}")
+
+
+def raised_at(exc: BaseException, law: object = None) -> str:
+    """`` (raised at FILE:LINE in FUNCTION)`` for ``exc``: the innermost frame of the file that
+    defines ``law``'s class (a user's law: the line to look at), else the innermost frame; ``""``
+    without a traceback."""
+    import inspect
+    import traceback
+
+    frames = traceback.extract_tb(exc.__traceback__)
+    if not frames:
+        return ""
+    frame = frames[-1]
+    if law is not None:
+        try:
+            source = inspect.getfile(type(law))
+        except (TypeError, OSError):
+            source = ""
+        mine = [f for f in frames if source and f.filename == source]
+        frame = mine[-1] if mine else frame
+    return f" (raised at {frame.filename}:{frame.lineno} in {frame.name})"

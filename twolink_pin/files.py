@@ -166,6 +166,22 @@ def _is_ours(folder: Path, marker: str) -> bool:
     return True
 
 
+def _is_mount_point(folder: Path) -> bool:
+    """Whether ``folder`` is a mount point (bind mounts too, from /proc/self/mountinfo on
+    Linux): a folder that cannot be renamed, found before the work rather than after it."""
+    if os.path.ismount(folder):
+        return True
+    try:
+        resolved = str(folder.resolve())
+        with open("/proc/self/mountinfo", encoding="utf-8", errors="replace") as f:
+            points = {
+                line.split()[4].encode().decode("unicode_escape") for line in f if len(line.split()) > 4
+            }
+    except OSError:
+        return False
+    return resolved in points
+
+
 def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
     """``path`` if an output folder may be written there: absent, empty, or one the same
     command wrote (holding ``marker``, which lists what it wrote: a folder that also holds
@@ -178,6 +194,12 @@ def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
     if out.exists() and not os.access(out, os.W_OK | os.X_OK):
         raise OutputError(
             str(out), "is not writable (its permissions); refusing to replace it with a writable folder"
+        )
+    if out.exists() and _is_mount_point(out):
+        raise OutputError(
+            str(out),
+            "is a mount point: the finished folder could not replace it (it is swapped in whole); give a "
+            "folder inside it",
         )
     if out.exists() and not _is_ours(out, marker):
         raise OutputError(

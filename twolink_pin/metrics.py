@@ -28,6 +28,31 @@ if TYPE_CHECKING:
     from twolink_pin.simulation import Samples, SimulationResult
 
 
+SIGNALS = (("e", "e", "rad"), ("edot", "ė", "rad/s"), ("tau", "τ", "N·m"))
+"""``(field of Norms, symbol, SI unit)`` of each signal: the one list every table reads."""
+NORMS = {"rms": ("RMS = sqrt((1/T)∫x² dt)", ""), "l2": ("L2 = sqrt(∫x² dt)", "·√s"), "max": ("max |x|", "")}
+"""Title and unit suffix of each norm (a field of :class:`Metrics` / :class:`BatchMetrics`)."""
+RUN_METRICS = {"final_period_max_abs_e": "rad", "peak_command": "N·m"}
+"""Per-joint metrics beyond the norms, and their SI units (fields of :class:`BatchMetrics`)."""
+TABLE_NORMS = ("rms", "max")
+"""The norms a one-row-per-run table (the sweep's) carries (L2 is RMS·√T there)."""
+
+
+def metric_units(norms: tuple[str, ...] = TABLE_NORMS) -> dict[str, str]:
+    """``{"rms_e": "rad", ..., "peak_command": "N·m"}``: every per-joint metric of a run's row,
+    in column order, with its SI unit (a column name adds the joint's 1-based index)."""
+    units = {f"{kind}_{field}": unit + NORMS[kind][1] for kind in norms for field, _, unit in SIGNALS}
+    return units | RUN_METRICS
+
+
+def metric_array(metrics: BatchMetrics, stem: str) -> np.ndarray:
+    """The array of metric ``stem`` (a key of :func:`metric_units`), shape (N, nv)."""
+    kind, _, field = stem.partition("_")
+    if kind in NORMS and field in Norms._fields:
+        return np.asarray(getattr(getattr(metrics, kind), field))
+    return np.asarray(getattr(metrics, stem))
+
+
 class Norms(NamedTuple):
     """One norm of each signal, per joint: shape (nv,) for a run, (N, nv) for a batch."""
 

@@ -40,6 +40,14 @@ def law_class(law: str | type[Controller]) -> type[Controller]:
     )
 
 
+def builtin_laws() -> tuple[str, ...]:
+    """Names of the laws twolink-pin defines (not a user's nor a package's), in registry order:
+    what ``compare`` and ``report`` run when no law is named."""
+    from twolink_pin.controllers import CONTROLLERS
+
+    return tuple(n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers."))
+
+
 def make_scenario(
     law: str | type[Controller],
     robot: RobotModel,

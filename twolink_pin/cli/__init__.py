@@ -3,14 +3,15 @@
 ==============  ===================================================================
 ``parser.py``   commands and options
 ``arguments.py`` the argument types that check numbers against their bounds
-``commands.py`` one function per command, each a thin shell over the library
+``commands/``   one module per family of commands, each command a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr
 ==============  ===================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
 simulation, a law that raised) exit status 1; Ctrl-C exit status 130, SIGTERM 143. An
 unexpected exception (a bug) is one line with exit status 1, or its traceback with
-``TWOLINK_PIN_DEBUG=1``.
+``TWOLINK_PIN_DEBUG=1`` or ``twolink-pin --debug``; ``--debug`` also prints the traceback
+of a law that raised.
 """
 
 from __future__ import annotations
@@ -90,6 +91,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args))
     except (SimulationDivergedError, ControllerError) as exc:
+        if isinstance(exc, ControllerError) and _debug(args):  # the law's own traceback
+            import traceback
+
+            traceback.print_exception(exc.__cause__ or exc, file=sys.stderr)
         _say(f"twolink-pin: {exc}")
         return 1
     except TwolinkPinError as exc:
@@ -109,9 +114,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _say(f"twolink-pin: error: cannot write the output ({exc.strerror or exc})")
         return 1
     except Exception as exc:  # a bug of ours: one line that says so (TWOLINK_PIN_DEBUG=1 for the traceback)
-        import os
-
-        if os.environ.get("TWOLINK_PIN_DEBUG"):
+        if _debug(args):
             raise
         _say(
             f"twolink-pin: internal error: {type(exc).__name__}: {str(exc)[:500]} — please report it with the "
@@ -121,6 +124,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
+
+
+def _debug(args: argparse.Namespace) -> bool:
+    """``--debug`` or ``TWOLINK_PIN_DEBUG=1``: tracebacks wanted."""
+    import os
+
+    return bool(getattr(args, "debug", False) or os.environ.get("TWOLINK_PIN_DEBUG"))
 
 
 def _say(line: str) -> None:

@@ -2,22 +2,19 @@
 ``--sensor-noise``, ``--noise-seed``, ``--delay`` (:mod:`twolink_pin.disturbances`).
 
 Each value type raises :class:`argparse.ArgumentTypeError` naming the value and the expected
-form (one line on stderr, exit 2); :func:`plant_with_disturbances` puts them on the plant a
-command built.
+form (one line on stderr, exit 2); :func:`plant_events` gives them to the run's
+:class:`~twolink_pin.run_spec.PlantOptions`.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from twolink_pin.cli.arguments import MAX_TEXT, finite, whole
 from twolink_pin.disturbances import PayloadStep, Wrench
 from twolink_pin.errors import TwolinkPinError
-
-if TYPE_CHECKING:  # the parser imports this module: Pinocchio only when a plant is built
-    from twolink_pin.plant import Plant
 
 MAX_FORCE = 1e6
 """Largest force [N] or moment [N·m] accepted on the command line."""
@@ -123,25 +120,17 @@ def add_disturbance_options(p: argparse.ArgumentParser) -> None:
     )
 
 
-def plant_with_disturbances(plant: Plant, args: Any) -> Plant:
-    """``plant`` with the events ``args`` asks for (the same plant when none)."""
+def plant_events(args: Any) -> dict[str, Any]:
+    """The plant's events the arguments ask for, as :class:`~twolink_pin.run_spec.PlantOptions`
+    fields (none for a command without these options)."""
     from twolink_pin.disturbances import SensorNoise
-    from twolink_pin.plant import Plant
 
-    wrench_value = getattr(args, "wrench", None)
-    payload = getattr(args, "payload_step", None)
     noise = getattr(args, "sensor_noise", None)
-    delay = getattr(args, "delay", 0) or 0
-    if wrench_value is None and payload is None and noise is None and not delay:
-        return plant
-    return Plant(
-        plant.robot,
-        plant.friction,
-        plant.saturate,
-        wrench=wrench_value,
-        payload_step=payload,
-        sensor_noise=None
+    return {
+        "wrench": getattr(args, "wrench", None),
+        "payload_step": getattr(args, "payload_step", None),
+        "sensor_noise": None
         if noise is None
         else SensorNoise(noise[0], noise[1], seed=getattr(args, "noise_seed", 0)),
-        delay=delay,
-    )
+        "delay": getattr(args, "delay", 0) or 0,
+    }

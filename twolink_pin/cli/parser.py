@@ -107,6 +107,13 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         metavar="EPS",
         help="ε [rad/s] of tanh(v/ε) for Coulomb friction (default: exact sgn with rk4, 1e-3 with adaptive)",
     )
+    p.add_argument(
+        "--plant-friction",
+        choices=("law", "on", "off"),
+        default="law",
+        help="the robot's friction in the plant: of the laws that estimate friction (law, default), of every "
+        "law (on), of none (off)",
+    )
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
@@ -116,6 +123,18 @@ def add_gain_option(p: argparse.ArgumentParser) -> None:
         default=[],
         metavar="NAME=VALUE",
         help="set a gain of the law: one value for all joints or comma-separated per joint, e.g. kp=200 or kd=30,40 (repeatable)",
+    )
+
+
+def add_law_gain_option(p: argparse.ArgumentParser) -> None:
+    """``--gain LAW.NAME=VALUE`` of the commands that run several laws."""
+    p.add_argument(
+        "--gain",
+        action="append",
+        default=[],
+        metavar="LAW.NAME=VALUE",
+        help="set a gain of one law: one value for all joints or comma-separated per joint, e.g. pd.kp=200 or "
+        "computed-torque.kd=30,40 (repeatable)",
     )
 
 
@@ -168,6 +187,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser = Parser(
         prog="twolink-pin",
         description="Kinematics, dynamics and tracking control of robot arms on Pinocchio.",
+    )
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="print the traceback of a law that raised or of an internal error (as TWOLINK_PIN_DEBUG=1)",
     )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
@@ -250,6 +274,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     add_sim_options(p)
     add_identified_options(p, several=True)
+    add_law_gain_option(p)
     p.add_argument(
         "--out", default="out/compare", metavar="DIR", help="output directory (default out/compare)"
     )
@@ -281,6 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
     add_sim_options(p)
+    add_law_gain_option(p)
     add_identified_options(p, several=True)
     p.add_argument(
         "--controller",
@@ -300,6 +326,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="skip the twolink's identification section (beside Fig. 27; ~6 s of the report's time)",
     )
     add_robot_options(p)
+    add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)
 
     p = sub.add_parser(
@@ -342,6 +369,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
     )
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
+    add_disturbance_options(p)
     p.add_argument(
         "--threads",
         type=whole(1, 256),

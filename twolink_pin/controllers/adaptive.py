@@ -101,7 +101,7 @@ class Adaptive(Controller[AdaptiveGains]):
     def scaled_gains(self) -> dict[str, Any]:
         """``K = κ diag M(q₀)`` and ``γ_i = G_ii / α``: ``G = Σ Yᵀ K⁻¹ Y`` over unit joint
         accelerations and gravity at 8 seeded configurations within the joint limits, so
-        that each parameter alone adapts at about α = 1 1/s under unit excitation."""
+        that each parameter alone adapts at about α (:data:`ADAPTATION_RATE`) under unit excitation."""
         k = SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)
         return {"k": k, "gamma": _gram_diagonal(self, k) / ADAPTATION_RATE}
 

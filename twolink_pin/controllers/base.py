@@ -181,6 +181,14 @@ def _register(cls: type[Controller[Any]]) -> None:
         and dataclasses.is_dataclass(cls.Gains)
     ):
         raise ControllerSpecError(name, f"{cls.__qualname__}.Gains must be a dataclass subclassing Gains")
+    if cls.Gains is not GainsBase and "__dataclass_fields__" not in cls.Gains.__dict__:
+        # a subclass of a dataclass without @dataclass of its own: its gain(...) fields would stay
+        # class attributes (dataclasses.Field objects) and fail at t = 0
+        raise ControllerSpecError(
+            name,
+            f"{cls.__qualname__}.Gains ({cls.Gains.__qualname__}) must be a dataclass: decorate it with "
+            "@dataclass(frozen=True, eq=False)",
+        )
     unknown = [e for e in cls.estimates if e not in ESTIMATES]
     if unknown or len(set(cls.estimates)) != len(cls.estimates):
         raise ControllerSpecError(

@@ -56,7 +56,8 @@ class RobotProfile:
             robot without explicit gains (e.g. the course report's gains on the twolink).
         friction: ``(viscous [N·m·s/rad], coulomb [N·m])`` per joint of the plant that
             friction-estimating laws run on; ``None``: no friction.
-        q0_offset: Default ``q(0) − q_d(0)`` [rad], one per joint; ``None``: zeros.
+        q0_offset: Default ``q(0) − q_d(0)`` [rad], one per joint; ``None``: ±
+            :data:`DEFAULT_Q0_OFFSET`, alternating in sign (:func:`default_q0_offset`).
         trajectory: The default reference; ``None``: built from the joint limits.
         ee_frame: End-effector frame name; ``None``: ``ee_link`` if present, else the last
             frame on the last joint.
@@ -83,6 +84,16 @@ class RobotProfile:
     locked_joints: tuple[str, ...] = ()
     locked_positions: tuple[float, ...] | None = None
     home: tuple[float, ...] | None = None
+
+
+DEFAULT_Q0_OFFSET = 0.05
+"""The initial error ``|q(0) − q_d(0)|`` [rad] of a robot whose profile sets none (a URDF of
+yours): a run that starts on its reference would show every law as perfect."""
+
+
+def default_q0_offset(nv: int) -> tuple[float, ...]:
+    """``(+0.05, −0.05, +0.05, ...)`` [rad]: :data:`DEFAULT_Q0_OFFSET`, alternating in sign."""
+    return tuple(DEFAULT_Q0_OFFSET * (-1) ** j for j in range(nv))
 
 
 def generic_profile(path: Path) -> RobotProfile:

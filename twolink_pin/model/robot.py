@@ -10,6 +10,7 @@ along (its gain presets, default trajectory, plant friction).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -26,7 +27,7 @@ from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.catalog import example_robot_urdf, resolve
 from twolink_pin.model.parameters import ParameterMap
-from twolink_pin.model.profile import RobotProfile
+from twolink_pin.model.profile import RobotProfile, default_q0_offset
 from twolink_pin.model.urdf_validation import validate_urdf_file
 
 DEFAULT_EE_FRAME = "ee_link"
@@ -325,6 +326,8 @@ def load_robot(
     model = _build_model(path, profile)
     _check_home(model, profile, path)
     ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
+    if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
+        profile = dataclasses.replace(profile, q0_offset=default_q0_offset(model.nv))
     if payload > 0:
         frame = model.frames[ee_id]
         point = pin.Inertia(float(payload), np.zeros(3), np.zeros((3, 3)))

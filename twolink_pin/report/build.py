@@ -21,19 +21,25 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import (
+    ControllerError,
+    InvalidParameterError,
+    InvalidURDFError,
+    SimulationDivergedError,
+)
 from twolink_pin.feasibility import check_torques
 from twolink_pin.files import output_directory
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
-from twolink_pin.scenario import law_class, make_scenario
+from twolink_pin.run_spec import RunSpec
+from twolink_pin.scenario import builtin_laws, law_class, make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.comparison import ComparisonTable
@@ -54,12 +60,13 @@ class ReportOptions:
     """What the report runs.
 
     Attributes:
+        run: The runs' common description (:class:`~twolink_pin.run_spec.RunSpec`, shared by
+            the laws: each law's own with :meth:`~twolink_pin.run_spec.RunSpec.for_law`):
+            simulation settings, λ of the laws that have one, per-law gains, the plant, an
+            identified-parameter file (``p0``: the estimates of the laws that estimate start
+            there; ``model``: every law's model believes it).
         robot: A catalog name or a URDF path; None for the twolink.
         payload: End-effector payload [kg].
-        config: Simulation settings of every run.
-        lam: λ [1/s] of the laws that have one (None: their default).
-        saturate: Clip torques at the URDF limits in every plant.
-        friction_smoothing: ε [rad/s] of the friction sign (0: exact sgn).
         controllers: The laws to run (names, ``file.py:Class``, ``module:Class``); None for
             the course report's five on the twolink, every built-in law elsewhere.
         workers: Processes for the runs and figures (1: in this process), 1 to 64.
@@ -71,24 +78,46 @@ class ReportOptions:
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
             the report's.
-        p0: A parameter file (``twolink-pin identify --save``) the estimates of the laws that
-            estimate start at (:func:`~twolink_pin.identification.seeded_scenario`, mode "p0").
-        model: A parameter file every law's model believes (mode "model").
     """
 
+    run: RunSpec = field(default_factory=lambda: RunSpec(shared=True))
     robot: str | None = None
     payload: float = 0.0
-    config: SimulationConfig = field(default_factory=SimulationConfig)
-    lam: float | None = None
-    saturate: bool = False
-    friction_smoothing: float = 0.0
     controllers: tuple[str, ...] | None = None
     workers: int = 2
     animation: bool = True
     identification: bool = True
     trajectory: str | None = None
-    p0: str | None = None
-    model: str | None = None
+
+    @property
+    def config(self) -> SimulationConfig:
+        """The simulation settings of every run."""
+        return self.run.simulation
+
+    @property
+    def lam(self) -> float | None:
+        """λ [1/s] of the laws that have one (None: their default)."""
+        return self.run.lam
+
+    @property
+    def saturate(self) -> bool:
+        """Whether every plant clips torques at the URDF limits."""
+        return self.run.plant.saturate
+
+    @property
+    def friction_smoothing(self) -> float:
+        """ε [rad/s] of the friction sign."""
+        return self.run.friction_smoothing
+
+    @property
+    def p0(self) -> str | None:
+        """The parameter file the estimates start at, if any."""
+        return self.run.parameters if self.run.parameters_use == "p0" else None
+
+    @property
+    def model(self) -> str | None:
+        """The parameter file every law's model believes, if any."""
+        return self.run.parameters if self.run.parameters_use == "model" else None
 
     def __post_init__(self) -> None:
         if not (
@@ -97,6 +126,10 @@ class ReportOptions:
             and 1 <= self.workers <= MAX_WORKERS
         ):
             raise InvalidParameterError("workers", self.workers, f"a whole number from 1 to {MAX_WORKERS}")
+        if not isinstance(self.run, RunSpec):
+            raise InvalidParameterError("run", type(self.run).__name__, "a RunSpec")
+        if not self.run.shared:  # one description for several laws: λ and p0 go where they apply
+            object.__setattr__(self, "run", replace(self.run, shared=True))
 
 
 def _reference(robot: Any, options: ReportOptions) -> Any:
@@ -128,27 +161,7 @@ def _run(
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
     cls = law_class(spec)
-    seed_file, mode = (options.p0, "p0") if options.p0 else (options.model, "model")
-    if seed_file and (mode == "model" or cls.estimates):
-        from twolink_pin.identification import read_parameter_file, seeded_scenario
-
-        controller, plant = seeded_scenario(
-            cls,
-            robot,
-            read_parameter_file(seed_file, robot),
-            mode,
-            lam=options.lam if cls.takes("lam") else None,
-            saturate=options.saturate,
-            friction_smoothing=options.friction_smoothing,
-        )
-    else:
-        controller, plant = make_scenario(
-            cls,
-            robot,
-            lam=options.lam if cls.takes("lam") else None,
-            saturate=options.saturate,
-            friction_smoothing=options.friction_smoothing,
-        )
+    controller, plant = options.run.for_law(spec).build(robot)
     result = simulate(controller, plant, _reference(robot, options), options.config)
     metrics = compute_metrics(result)
     paths = save_simulation_figures(
@@ -243,11 +256,7 @@ def laws_to_run(options: ReportOptions, is_twolink: bool) -> tuple[str, ...]:
         from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
         return REPORT_CONTROLLERS
-    from twolink_pin.controllers import CONTROLLERS
-
-    return tuple(
-        name for name, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")
-    )
+    return builtin_laws()
 
 
 def build_report(
@@ -269,6 +278,7 @@ def build_report(
     robot = load_robot(options.robot, payload=options.payload)
     is_twolink = robot.name == "twolink"
     specs = laws_to_run(options, is_twolink)
+    options.run.check_law_gains(specs)
     steps = (
         4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink and options.identification else 0)
     )
@@ -314,6 +324,9 @@ def _build(
     order = [animated, *(n for n in names if n != animated)]
     by_name = dict(zip(names, specs))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
+    failed: dict[str, str] = {}
+    warnings: list[str] = []
+    tried, shown = False, animated
     animation = None
     workers = min(options.workers, len(order) + 1)
     with _pool(workers) as pool:
@@ -336,25 +349,36 @@ def _build(
             }
         tick("model and trajectory")
         for name in order:
-            runs[name] = futures[name].result()
+            try:
+                runs[name] = futures[name].result()
+            except (SimulationDivergedError, ControllerError) as exc:  # the others' results are kept
+                failed[name] = str(exc)
             tick(f"controller {name}")
-            if name == animated and options.animation:
+            if options.animation and not tried and name in runs and (name == animated or animated in failed):
                 from twolink_pin.visualization import write_html
 
+                tried, shown = True, name
                 res = runs[name][0]
                 from twolink_pin.kinematics import joint_positions
 
                 points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
-                write_html(robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points)
-                animation = "animation.html"
+                try:
+                    write_html(
+                        robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points
+                    )
+                    animation = "animation.html"
+                except InvalidURDFError as exc:  # a missing mesh: the report without its animation
+                    warnings.append(f"no animation: {exc}")
                 tick("animation")
+        if options.animation and not tried:
+            tick("animation")  # every law failed: nothing to animate
         traj_figs = traj_future.result()
         tick("trajectory figures")
         identification = None
         if ident_futures is not None:
             runs_future, fit_future = ident_futures
             excitation_runs = {key: f.result() for key, f in runs_future.items()}
-            if reused:  # the report's own adaptive run is the one along its trajectory
+            if reused and "adaptive" in runs:  # the report's own adaptive run is the one along its trajectory
                 result = runs["adaptive"][0]
                 assert result.p_hat is not None
                 own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
@@ -366,9 +390,12 @@ def _build(
                 None if fit_future is None else fit_future.result(),
             )
             tick("identification")
-    runs = {n: runs[n] for n in names}  # the order asked for
+    runs = {n: runs[n] for n in names if n in runs}  # the order asked for
     table = ComparisonTable(
-        {n: r[1] for n, r in runs.items()}, {n: r[3] for n, r in runs.items()}, options.config.duration
+        {n: r[1] for n, r in runs.items()},
+        {n: r[3] for n, r in runs.items()},
+        options.config.duration,
+        {n: failed[n] for n in names if n in failed},
     )
     cfg = options.config
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
@@ -376,7 +403,7 @@ def _build(
     lams: dict[str, float] = {}
     for name, (result, metrics, figures, seconds) in runs.items():
         cls = law_class(by_name[name])
-        controller = make_scenario(cls, robot, lam=options.lam if cls.takes("lam") else None).controller
+        controller = options.run.for_law(by_name[name]).build(robot).controller  # the gains it ran with
         if cls.takes("lam"):
             lams[name] = float(np.max(controller.gains.lam))
         controllers[name] = {
@@ -416,12 +443,15 @@ def _build(
             "saturate": options.saturate,
             "friction_smoothing": options.friction_smoothing,
         },
+        "run": options.run.as_dict(),
         "controllers": controllers,
+        "failed": table.failed,
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),
         "comparison_csv": table.csv(),
         "animation": animation,
-        "animated": animated,
+        "warnings": warnings,
+        "animated": shown,
         "errata": errata,
         "identification": identification,
         "versions": facts.versions(),

@@ -19,7 +19,8 @@ import numpy as np
 
 from twolink_pin.files import atomic_write, write_json
 from twolink_pin.mathml import docstring_html
-from twolink_pin.studies.comparison import NORMS, SIGNALS, headers
+from twolink_pin.metrics import NORMS, SIGNALS
+from twolink_pin.studies.comparison import headers
 
 DIGITS = 4
 """Significant digits of the numbers on the page (tables of coefficients: 6)."""

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from twolink_pin.controllers import Controller, LawInput
-from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
 from twolink_pin.simulation.engine import Samples, _validate
@@ -64,7 +64,9 @@ def integrate_adaptive(
         except TwolinkPinError as exc:
             raise ControllerError(name, time, str(exc)) from exc
         except Exception as exc:
-            raise ControllerError(name, time, f"{type(exc).__name__}: {exc}") from exc
+            raise ControllerError(
+                name, time, f"{type(exc).__name__}: {exc}{raised_at(exc, controller)}"
+            ) from exc
         if calls <= 1:
             _validate(controller, out, 1, nv, nz, time)
         return out.tau, (out.dz if out.dz is not None else np.zeros((1, 0)))

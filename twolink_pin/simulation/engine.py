@@ -34,7 +34,7 @@ from typing import Any, NamedTuple, Protocol
 import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
-from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.simulation.forward import dynamics_for
@@ -268,7 +268,7 @@ def integrate(
                 if isinstance(exc, ControllerError):
                     raise
                 what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
-                raise ControllerError(name, now, what) from exc
+                raise ControllerError(name, now, what + raised_at(exc, controller)) from exc
             rows = slice(k0 - off, k1 - off)
             RQ[rows], RV[rows], RA[rows] = (x[: 2 * (k1 - k0) : 2] for x in (rq, rv, ra))
             newly = _flag_block(

@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import io
+import json
 import os
 import zipfile
+from collections.abc import Mapping
 from dataclasses import fields
 from pathlib import Path
 from typing import Any
@@ -19,9 +21,19 @@ MAX_RESULT_BYTES = 2**31
 """Largest result file :func:`load_result` reads (2 GiB)."""
 
 
-def save_result(result: SimulationResult, path: str | os.PathLike[str]) -> Path:
-    """Save a :class:`SimulationResult` as a compressed ``.npz``, atomically."""
+RECORD = "run_record"
+"""Entry of a saved result that holds what produced it (JSON text: the robot as given, its
+payload, the trajectory file, the run's :class:`~twolink_pin.run_spec.RunSpec`)."""
+
+
+def save_result(
+    result: SimulationResult, path: str | os.PathLike[str], record: Mapping[str, Any] | None = None
+) -> Path:
+    """Save a :class:`SimulationResult` as a compressed ``.npz``, atomically; ``record``
+    (JSON-ready data: what produced the run) is saved beside it (:func:`load_record`)."""
     arrays: dict[str, Any] = {}
+    if record is not None:
+        arrays[RECORD] = np.asarray(json.dumps(dict(record)))
     for entry in fields(result):
         value = getattr(result, entry.name)
         if value is None:
@@ -137,3 +149,19 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
         return SimulationResult(**kwargs)
     except TypeError as exc:
         raise InputFileError(name, f"not a complete twolink-pin result ({exc})") from exc
+
+
+def load_record(path: str | os.PathLike[str]) -> dict[str, Any] | None:
+    """What produced the result saved in ``path`` (:func:`save_result`'s ``record``), or None
+    for a file that records nothing (an older one). Call after :func:`load_result` (which
+    checks the file)."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            if RECORD not in data.files:
+                return None
+            value = json.loads(str(data[RECORD]))
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
+        raise InputFileError(os.fspath(path), f"its run record cannot be read ({str(exc)[:200]})") from exc
+    if not isinstance(value, dict):
+        raise InputFileError(os.fspath(path), "its run record is not a JSON object")
+    return value

@@ -2,8 +2,12 @@
 
 ==================  ===================================================================
 ``batch.py``        :func:`simulate_batch`: N runs together, each run's metrics streamed
-``sweep.py``        Monte Carlo sweeps (``twolink-pin sweep``): drawn cases, chunks, rows
-                    streamed to Parquet / CSV / JSON, summary from the dataset
+``sweep.py``        Monte Carlo sweeps (``twolink-pin sweep``): :func:`run_sweep`, which
+                    streams the rows to Parquet / CSV / JSON and summarises the dataset
+``sweep_cases.py``  the study (``SweepConfig``: a ``RunSpec`` plus the draws), the cases
+``sweep_rows.py``   the columns, a chunk's runs as rows, the summary statistics
+``sweep_writers.py`` Parquet parts, runs.csv / runs.json, metadata, distributions.png
+``sweep_transport.py`` what a Dask worker gets (robot, law file) and the chunk task
 ``cluster.py``      Dask for sweeps: a LocalCluster on 127.0.0.1 or a scheduler, tasks as
                     completed, cancelled on exit (optional: ``twolink-pin[cluster]``)
 ``comparison.py``   every law side by side: our Table 2

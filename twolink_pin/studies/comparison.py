@@ -13,18 +13,14 @@ import csv
 import io
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
-from twolink_pin.metrics import Metrics, compute_metrics
+from twolink_pin.metrics import NORMS, SIGNALS, Metrics, compute_metrics
 from twolink_pin.simulation import SimulationResult
-
-SIGNALS = (("e", "e", "rad"), ("edot", "ė", "rad/s"), ("tau", "τ", "N·m"))
-"""(field, symbol, unit) of each signal of the table."""
-NORMS = {"rms": ("RMS = sqrt((1/T)∫x² dt)", ""), "l2": ("L2 = sqrt(∫x² dt)", "·√s"), "max": ("max |x|", "")}
-"""Title and unit suffix of each norm."""
 
 
 def columns(nv: int) -> list[str]:
@@ -54,12 +50,18 @@ class ComparisonTable:
     """Wall-clock time of each run [s]."""
     duration: float
     """Simulated time of each run [s]."""
+    failed: dict[str, str] = field(default_factory=dict)
+    """What happened to each law that did not finish (diverged, raised), by law name."""
+    plants: dict[str, str] = field(default_factory=dict)
+    """The plant each law ran on, in a few words, by law name."""
+    gains: dict[str, dict[str, Any]] = field(default_factory=dict)
+    """The gains each law ran with, by law name."""
 
     @property
     def nv(self) -> int:
         """Joints of the robot."""
-        first = next(iter(self.metrics.values()))
-        return int(first.rms.e.shape[0])
+        first = next(iter(self.metrics.values()), None)
+        return 0 if first is None else int(first.rms.e.shape[0])
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -68,6 +70,9 @@ class ComparisonTable:
             "columns": columns(self.nv),
             "duration_s": self.duration,
             "seconds": self.seconds,
+            "failed": dict(self.failed),
+            "plants": dict(self.plants),
+            "gains": dict(self.gains),
         }
 
     def csv(self) -> str:
@@ -81,6 +86,8 @@ class ComparisonTable:
                 writer.writerow([name, kind, *(f"{x:.6g}" for x in row(m, kind))])
             e_last = [f"{x:.6g}" for x in m.final_period_max_abs_e]
             writer.writerow([name, "last_period_max_abs_e", *e_last, *([""] * (len(cols) - len(e_last)))])
+        for name, what in self.failed.items():
+            writer.writerow([name, "failed", what, *([""] * (len(cols) - 1))])
         return buffer.getvalue()
 
     def markdown(self) -> str:
@@ -99,6 +106,13 @@ class ComparisonTable:
         out.append("|---|" + "---:|" * self.nv)
         for name, m in self.metrics.items():
             out.append(f"| {name} | " + " | ".join(f"{x:.3g}" for x in m.final_period_max_abs_e) + " |")
+        if self.plants or self.failed:
+            out.append("\n### the runs\n")
+            out.append("| controller | plant | outcome |")
+            out.append("|---|---|---|")
+            for name in [*self.metrics, *(n for n in self.failed if n not in self.metrics)]:
+                outcome = f"FAILED: {self.failed[name]}" if name in self.failed else "finished"
+                out.append(f"| {name} | {self.plants.get(name, '')} | {outcome} |")
         return "\n".join(out) + "\n"
 
     def write(self, out_dir: Path) -> list[Path]:
@@ -126,15 +140,27 @@ def run_comparison(
         progress: Called as ``progress(name, None)`` before and ``progress(name, result)``
             after each run.
         on_result: Called with each result (e.g. to write its figures).
+
+    A law that diverges or raises (:class:`~twolink_pin.errors.SimulationDivergedError`,
+    :class:`~twolink_pin.errors.ControllerError`) is a row of ``failed`` saying what
+    happened and when; the other laws run on. Bad input still raises.
     """
     metrics: dict[str, Metrics] = {}
     seconds: dict[str, float] = {}
+    failed: dict[str, str] = {}
     duration = 0.0
     for name in names:
         if progress:
             progress(name, None)
         start = time.perf_counter()
-        result = runner(name)
+        try:
+            result = runner(name)
+        except (SimulationDivergedError, ControllerError) as exc:  # the others' results are kept
+            failed[name] = str(exc)
+            seconds[name] = time.perf_counter() - start
+            if progress:
+                progress(name, None)
+            continue
         metrics[name] = compute_metrics(result)
         duration = result.duration
         if on_result is not None:
@@ -142,4 +168,4 @@ def run_comparison(
         seconds[name] = time.perf_counter() - start
         if progress:
             progress(name, result)
-    return ComparisonTable(metrics, seconds, duration)
+    return ComparisonTable(metrics, seconds, duration, failed)

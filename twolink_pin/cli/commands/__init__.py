@@ -1,0 +1,44 @@
+"""The commands of ``twolink-pin``: each a thin shell over the library, one module per family.
+
+================  =====================================================================
+``common.py``     what they share: the robot, the reference, the settings, one run
+``model.py``      ``info``, ``robots``, ``controllers``, ``fk``, ``ik``, ``trajectory``
+``identify.py``   ``identify``, ``excite``
+``run.py``        ``simulate``, ``compare``, ``animate``, ``report``
+``sweep.py``      ``sweep``
+================  =====================================================================
+
+Every command prints a readable summary, or JSON with ``--json``. The library is imported
+inside each command, so ``--help`` stays fast.
+"""
+
+from __future__ import annotations
+
+from twolink_pin.cli.commands.identify import cmd_excite, cmd_identify
+from twolink_pin.cli.commands.model import (
+    cmd_controllers,
+    cmd_fk,
+    cmd_ik,
+    cmd_info,
+    cmd_robots,
+    cmd_trajectory,
+)
+from twolink_pin.cli.commands.run import RUN_OPTIONS, cmd_animate, cmd_compare, cmd_report, cmd_simulate
+from twolink_pin.cli.commands.sweep import cmd_sweep
+
+__all__ = [
+    "RUN_OPTIONS",
+    "cmd_animate",
+    "cmd_compare",
+    "cmd_controllers",
+    "cmd_excite",
+    "cmd_fk",
+    "cmd_identify",
+    "cmd_ik",
+    "cmd_info",
+    "cmd_report",
+    "cmd_robots",
+    "cmd_simulate",
+    "cmd_sweep",
+    "cmd_trajectory",
+]

@@ -1,0 +1,125 @@
+"""What the commands share: the robot, the reference, the simulation settings and one run
+from the arguments."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING, Any
+
+from twolink_pin.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from twolink_pin.identification import IdentifiedParameters
+    from twolink_pin.model import RobotModel
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.simulation import SimulationConfig, SimulationResult
+    from twolink_pin.trajectory import Trajectory
+
+
+def _robot(args: argparse.Namespace) -> RobotModel:
+    from twolink_pin.model import load_robot
+
+    return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
+
+
+def _trajectory(args: argparse.Namespace, robot: RobotModel) -> Trajectory:
+    """The reference of ``--trajectory FILE``, else the robot's default."""
+    from twolink_pin.trajectory import default_trajectory, read_trajectory_file
+
+    path = getattr(args, "trajectory", None)
+    return read_trajectory_file(path, robot) if path else default_trajectory(robot)
+
+
+def _config(args: argparse.Namespace) -> SimulationConfig:
+    from twolink_pin.simulation import SimulationConfig
+
+    offset = args.q0_offset
+    return SimulationConfig(
+        duration=args.duration,
+        dt=args.dt,
+        method=args.method,
+        q0_offset=None if offset is None else (offset[0] if len(offset) == 1 else tuple(offset)),
+        control_period=args.control_period,
+    )
+
+
+def _gain_values(texts: list[str]) -> dict[str, Any]:
+    """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}``."""
+    from twolink_pin.cli.arguments import finite
+
+    gains: dict[str, Any] = {}
+    for text in texts:
+        name, sep, value = text.partition("=")
+        if not sep or not name.strip() or not value.strip():
+            raise InvalidParameterError("--gain", text, "NAME=VALUE, e.g. kp=200 or kd=30,40")
+        try:
+            numbers = tuple(finite(x) for x in value.split(","))
+        except argparse.ArgumentTypeError as exc:
+            raise InvalidParameterError(
+                f"--gain {name.strip()}", value, str(exc).removeprefix("expected ")
+            ) from None
+        gains[name.strip()] = numbers[0] if len(numbers) == 1 else numbers
+    return gains
+
+
+def _law_gains(texts: list[str]) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
+    """compare/report ``--gain LAW.NAME=VALUE`` → per-law gains; a text without ``LAW.`` is refused."""
+    per_law: dict[str, dict[str, Any]] = {}
+    for text in texts:
+        name, sep, _ = text.partition("=")
+        law, dot, gain = name.strip().rpartition(".")
+        if not (sep and dot and law and gain):
+            raise InvalidParameterError("--gain", text, "LAW.NAME=VALUE with several laws, e.g. pd.kp=200")
+        per_law.setdefault(law, {}).update(_gain_values([f"{gain}={text.partition('=')[2]}"]))
+    return tuple((law, tuple(g.items())) for law, g in per_law.items())
+
+
+def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool = True) -> RunSpec:
+    """The run the arguments describe, built once per command (``law`` None: the common part
+    of several laws' runs, as ``compare`` and ``report`` give them; ``fixed_gains`` False: the
+    command's ``--gain`` is not a fixed gain, as the sweep's ranges)."""
+    from twolink_pin.cli.disturbance_options import plant_events
+    from twolink_pin.run_spec import PlantOptions, RunSpec
+
+    several = law is None
+    texts = (getattr(args, "gain", []) or []) if fixed_gains else []
+    mode = "p0" if getattr(args, "p0", None) else "model" if getattr(args, "model", None) else ""
+    return RunSpec(
+        law=law,
+        gains=() if several else tuple(_gain_values(texts).items()),
+        law_gains=_law_gains(texts) if several else (),
+        lam=args.lam,
+        plant=PlantOptions(
+            friction=getattr(args, "plant_friction", None) or "law",
+            saturate=args.saturate,
+            friction_smoothing=args.friction_smoothing,
+            **plant_events(args),
+        ),
+        parameters=getattr(args, mode) if mode else None,
+        parameters_use=mode,
+        simulation=_config(args),
+        shared=several,
+    )
+
+
+def _identified(spec: RunSpec, robot: RobotModel) -> IdentifiedParameters | None:
+    """The parameter file of ``--p0`` or ``--model``, read once per command (its notes on stderr)."""
+    identified = spec.read_parameters(robot)
+    if identified is not None:
+        for note in identified.notes:
+            print(f"twolink-pin: note: {identified.source}: {note}", file=sys.stderr)
+    return identified
+
+
+def _run_one(
+    spec: RunSpec,
+    robot: RobotModel,
+    reference: Trajectory,
+    identified: IdentifiedParameters | None = None,
+) -> SimulationResult:
+    """One law's run (``spec`` of one law: :meth:`RunSpec.for_law` of a shared one)."""
+    from twolink_pin.simulation import simulate
+
+    controller, plant = spec.build(robot, identified)
+    return simulate(controller, plant, reference, spec.simulation)

@@ -1,0 +1,304 @@
+"""``info``, ``robots``, ``controllers``, ``fk``, ``ik``, ``trajectory``: the robot, its laws and
+its reference, without a simulation."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from twolink_pin.cli.commands.common import _robot, _trajectory
+from twolink_pin.cli.output import emit, fmt
+from twolink_pin.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from twolink_pin.model import RobotModel
+
+
+def cmd_info(args: argparse.Namespace) -> int:
+    from twolink_pin.model.base_parameters import BaseParameterMap
+
+    robot = _robot(args)
+    base = (
+        robot.parameter_map
+        if isinstance(robot.parameter_map, BaseParameterMap)
+        else BaseParameterMap(robot.model)
+    )
+    payload: dict[str, Any] = {
+        "robot": robot.name,
+        "urdf": str(robot.urdf_path),
+        "nq": robot.nq,
+        "nv": robot.nv,
+        "gravity": robot.model.gravity.linear.tolist(),
+        "link_lengths": robot.link_lengths.tolist(),
+        "torque_limits": robot.torque_limits.tolist(),
+        "parameter_names": list(robot.parameter_map.names),
+        "p": robot.p.tolist(),
+        "base_parameters": {
+            "count": base.size,
+            "names": list(base.names),
+            "units": list(base.units),
+            "values": base.values(robot.model).tolist(),
+        },
+    }
+    if args.friction:
+        payload["friction_parameters"] = {
+            "names": [f"V{j + 1}" for j in range(robot.nv)] + [f"C{j + 1}" for j in range(robot.nv)],
+            "units": ["N·m·s/rad"] * robot.nv + ["N·m"] * robot.nv,
+        }
+    names = robot.parameter_map.names
+    p_text = (
+        ", ".join(f"{n} = {v:.6g}" for n, v in zip(names, robot.p))
+        if len(names) <= 6
+        else f"{len(names)} values"
+    )
+    limits = ", ".join("no limit" if not np.isfinite(x) else f"{x:g}" for x in robot.torque_limits)
+    text = "\n".join(
+        [
+            f"robot      {robot.name}: {robot.model.name} ({robot.urdf_path})",
+            f"joints     nq = {robot.nq}, nv = {robot.nv}; end effector '{robot.ee_frame}'",
+            f"gravity    {fmt(robot.model.gravity.linear, 3)} m/s²",
+            f"links      {fmt(robot.link_lengths, 3)} m",
+            f"limits     ({limits}) N·m",
+            f"payload    {robot.payload:g} kg",
+            f"parameters {p_text}",
+            f"base       {base.size} identifiable base parameters (twolink-pin info --json lists them)"
+            + (f", plus {2 * robot.nv} friction (viscous V, Coulomb C per joint)" if args.friction else ""),
+        ]
+    )
+    if args.write_urdf:
+        from twolink_pin.model.payload import write_payload_urdf
+
+        if robot.payload <= 0:
+            raise InvalidParameterError(
+                "--payload", robot.payload, "a mass > 0 kg to write a payload variant"
+            )
+        target = Path(args.write_urdf)
+        if target.exists() and target.resolve() == Path(robot.urdf_path).resolve():
+            raise InvalidParameterError(
+                "--write-urdf",
+                args.write_urdf,
+                "a file other than the robot's own URDF (it would be replaced)",
+            )
+        written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
+        payload["urdf_written"] = str(written)
+        text += f"\nwrote      {written}"
+    emit(args, payload, text)
+    return 0
+
+
+def cmd_robots(args: argparse.Namespace) -> int:
+    from twolink_pin.model import catalog, load_robot
+
+    rows = []
+    for name in catalog.names():
+        robot = load_robot(name)
+        model = robot.model
+        rows.append(
+            {
+                "name": name,
+                "nq": robot.nq,
+                "nv": robot.nv,
+                "gravity": model.gravity.linear.tolist(),
+                "torque_limits": robot.torque_limits.tolist(),
+                "end_effector": robot.ee_frame,
+                "unlimited_joints": [
+                    str(model.names[int(j) + 1]) for j in np.flatnonzero(np.isinf(model.lowerPositionLimit))
+                ],
+                "locked_joints": list(robot.profile.locked_joints),
+                "home": robot.home.tolist(),
+                "base_parameters": robot.parameter_map.size if name != "twolink" else 4,
+                "description": robot.profile.description,
+                "source": robot.profile.source,
+            }
+        )
+    lines = []
+    for row in rows:
+        limits = ", ".join("none" if not np.isfinite(x) else f"{x:g}" for x in row["torque_limits"])
+        notes = []
+        if row["unlimited_joints"]:
+            notes.append(f"no position limit on {', '.join(row['unlimited_joints'])}")
+        if row["locked_joints"]:
+            notes.append(f"locked {', '.join(row['locked_joints'])}")
+        lines.append(
+            f"{row['name']:16s} nq = {row['nq']}, nv = {row['nv']}, gravity {fmt(row['gravity'], 2)} m/s², "
+            f"effort limits ({limits}) N·m — {row['description']}"
+            + (f"\n{'':16s} {'; '.join(notes)}" if notes else "")
+        )
+    lines.append(
+        "effort limit 'none': the URDF gives none (or 0); no torque check or saturation on that joint"
+    )
+    emit(args, {"robots": rows}, "\n".join(lines))
+    return 0
+
+
+def cmd_controllers(args: argparse.Namespace) -> int:
+    from dataclasses import fields
+
+    from twolink_pin.controllers import available_controllers
+    from twolink_pin.controllers.gains import _spec
+
+    rows: list[dict[str, Any]] = []
+    for name, cls in available_controllers().items():
+        gains: list[dict[str, Any]] = [
+            {
+                "name": f.name,
+                "per": _spec(f).per,
+                "unit": _spec(f).unit,
+                "default": f.default,
+                "doc": _spec(f).doc,
+            }
+            for f in fields(cls.Gains)
+        ]
+        rows.append(
+            {
+                "name": name,
+                "title": cls.title,
+                "class": f"{cls.__module__}:{cls.__qualname__}",
+                "estimates": list(cls.estimates),
+                "gains": gains,
+            }
+        )
+    lines = []
+    for row in rows:
+        listed = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
+        lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {listed}")
+    emit(args, {"controllers": rows}, "\n".join(lines))
+    return 0
+
+
+def cmd_fk(args: argparse.Namespace) -> int:
+    from twolink_pin.kinematics import joint_positions
+
+    robot = _robot(args)
+    q = np.array(args.q, dtype=float)
+    if q.shape != (robot.nq,):
+        raise InvalidParameterError(
+            "Q", args.q, f"{robot.nq} joint angles [rad] for {robot.name} (nq = {robot.nq})"
+        )
+    position = joint_positions(robot, q)[-1]
+    emit(
+        args,
+        {"position": position.tolist(), "xy": position[:2].tolist()},
+        f"end effector at {fmt(position)} m for q = {fmt(q)} rad",
+    )
+    return 0
+
+
+def cmd_ik(args: argparse.Namespace) -> int:
+    from twolink_pin.kinematics import inverse_kinematics, is_planar_2r, solve_position
+    from twolink_pin.trajectory import home_configuration
+
+    robot = _robot(args)
+    if args.z is None and args.seed is None and is_planar_2r(robot):
+        sols = inverse_kinematics(robot, (args.x, args.y))
+        text = "\n".join(
+            f"{label}: q = {fmt(s)} rad" for label, s in zip(("elbow q2 >= 0", "elbow q2 <= 0"), sols)
+        )
+        emit(args, {"solutions": sols.tolist()}, text)
+        return 0
+    target = (args.x, args.y) if args.z is None else (args.x, args.y, args.z)
+    seed = home_configuration(robot) if args.seed is None else np.array(args.seed, dtype=float)
+    if seed.shape != (robot.nv,):
+        raise InvalidParameterError("--seed", args.seed, f"{robot.nv} joint angles [rad] for {robot.name}")
+    q = solve_position(robot, target, seed)
+    emit(
+        args,
+        {"solutions": [q.tolist()], "seed": seed.tolist()},
+        f"q = {fmt(q)} rad (damped least squares from {'home' if args.seed is None else 'the seed'})",
+    )
+    return 0
+
+
+def cmd_trajectory(args: argparse.Namespace) -> int:
+    from twolink_pin.feasibility import check_torques
+    from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, default_via_points
+
+    robot = _robot(args)
+    traj = _trajectory(args, robot)
+    via = default_via_points(robot) if not args.trajectory else None
+    check = check_torques(robot, traj)
+    if args.save:
+        from twolink_pin.trajectory.file import write_trajectory_file
+
+        if Path(args.save).suffix.lower() not in (".json", ".toml"):
+            raise InvalidParameterError(
+                "--save", args.save, "a trajectory file name ending in .json or .toml"
+            )
+        write_trajectory_file(args.save, traj)  # type: ignore[arg-type]
+        print(f"reference saved to {args.save} (read by --trajectory and --reference)", file=sys.stderr)
+    if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
+        return _fourier_trajectory(args, robot, traj, check)
+    assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting import save_trajectory_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_trajectory_figures(robot, traj, check, folder)]
+    payload = {
+        "times": traj.times.tolist(),
+        "via_xy": None if via is None else [list(p) for p in via.xy],
+        "via_q": traj.via_q.tolist(),
+        "coefficients": traj.coefficients.tolist(),
+        "peak_torque": check.peak.tolist(),
+        "peak_time": check.peak_time.tolist(),
+        "torque_limits": check.limits.tolist(),
+        "margin": check.margin.tolist(),
+        "within_limits": check.within_limits,
+        "figures": figures,
+    }
+    lines = ["via points (t [s], q [rad]" + (", end effector (x, y) [m])" if via is not None else ")") + ":"]
+    for k, (t, q) in enumerate(zip(traj.times, traj.via_q)):
+        lines.append(f"  {t:5.2f}  {fmt(q)}" + (f"  {fmt(via.xy[k], 3)}" if via is not None else ""))
+    for j, c in enumerate(traj.coefficients):
+        terms = " ".join(f"{x:+.5g}" for x in c)
+        lines.append(f"q{j + 1}(t) coefficients, ascending powers of t: {terms}")
+    lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
+    lines.append(check.verdict())
+    lines += [f"figure {f}" for f in figures]
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:
+    """``trajectory`` for a Fourier-series file: its coefficients, bounds and torque check."""
+    from twolink_pin.identification.measures import excitation_measures
+
+    measures = excitation_measures(robot, traj)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_excitation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_excitation_figures(robot, traj, folder, check=check)]
+    q_bound, v_bound, a_bound = traj.bounds
+    payload = {
+        "fourier": traj.as_dict(),
+        "bandwidth_hz": traj.bandwidth,
+        "bounds": {"q_minus_offset": q_bound.tolist(), "v": v_bound.tolist(), "a": a_bound.tolist()},
+        "condition_number": measures.condition_number,
+        "gram_min_eigenvalue_per_s": measures.gram_min_eigenvalue_per_s,
+        "peak_torque": check.peak.tolist(),
+        "peak_time": check.peak_time.tolist(),
+        "torque_limits": check.limits.tolist(),
+        "margin": check.margin.tolist(),
+        "within_limits": check.within_limits,
+        "figures": figures,
+    }
+    lines = [
+        f"Fourier series: period {traj.period:g} s, {traj.harmonics} harmonics (up to {traj.bandwidth:.3g} Hz)",
+        f"offsets q0 {fmt(traj.offset)} rad; bounds |q − q0| <= {fmt(q_bound, 3)} rad, |q̇| <= {fmt(v_bound, 3)} rad/s, "
+        f"|q̈| <= {fmt(a_bound, 3)} rad/s²",
+        f"cond(W) of the base parameters and friction over a period: {measures.condition_number:.4g}",
+        f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s",
+        check.verdict(),
+    ]
+    lines += [f"figure {f}" for f in figures]
+    emit(args, payload, "\n".join(lines))
+    return 0

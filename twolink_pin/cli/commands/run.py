@@ -1,0 +1,349 @@
+"""``simulate``, ``compare``, ``animate``, ``report``: one law or several, run and shown."""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import threading
+from dataclasses import replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from twolink_pin.cli.commands.common import _identified, _robot, _run_one, _trajectory, run_spec
+from twolink_pin.cli.output import emit, fmt, progress_bar
+from twolink_pin.errors import InvalidParameterError
+
+if TYPE_CHECKING:
+    from twolink_pin.metrics import Metrics
+    from twolink_pin.model import RobotModel
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.simulation import SimulationResult
+    from twolink_pin.trajectory import Trajectory
+
+
+def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any]:
+    return {
+        "controller": result.controller,
+        "robot": result.robot,
+        "duration": result.duration,
+        "dt": result.dt,
+        "metrics": metrics.as_dict(),
+        "peak_torque": np.abs(result.tau).max(axis=0).tolist(),
+        "peak_command": np.abs(result.tau_command).max(axis=0).tolist(),
+        "torque_limits": result.torque_limits.tolist(),
+        "limit_exceeded": result.limit_exceeded.tolist(),
+        "limit_exceeded_at": result.first_exceeded_at,
+        "parameter_names": list(result.parameter_names),
+        "p_true": None if result.p_true is None else result.p_true.tolist(),
+        "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
+    }
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from twolink_pin.metrics import compute_metrics
+    from twolink_pin.run_spec import gains_used, plant_description
+    from twolink_pin.simulation import simulate
+    from twolink_pin.simulation.config import joint_offsets
+
+    robot = _robot(args)
+    spec = run_spec(args, args.controller)
+    scenario = spec.build(robot, _identified(spec, robot))
+    result = simulate(*scenario, _trajectory(args, robot), spec.simulation)
+    metrics = compute_metrics(result)
+    payload = _result_payload(result, metrics)
+    q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
+    payload |= {
+        "gains": gains_used(scenario.controller),
+        "plant": plant_description(scenario),
+        "q0_offset": q0_offset.tolist(),
+        "run": spec.as_dict(),
+    }
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting import save_simulation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_simulation_figures(result, folder)]
+    if args.save:
+        from twolink_pin.simulation.storage import save_result
+
+        save_result(result, args.save, record=_record(args, spec))
+    payload["figures"] = figures
+    lines = [
+        f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
+        f"  gains {scenario.controller.gains.describe()}",
+        f"  plant {payload['plant']}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
+        f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
+        f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
+        f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
+        + (
+            f" (the run is shorter than one {result.reference_period:g}-s period: over the whole run)"
+            if result.duration < result.reference_period
+            else ""
+        ),
+    ]
+    for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
+        if over:
+            lines.append(
+                f"  joint {j + 1}: commanded torque exceeded its {result.torque_limits[j]:g} N·m limit "
+                f"(first at t = {at:.3f} s, by up to {result.limit_excess[j]:.3g} N·m"
+                + (
+                    ", clipped by the plant)"
+                    if result.saturate
+                    else "; not saturated: add --saturate to clip)"
+                )
+            )
+    if not np.isfinite(result.torque_limits).any():
+        lines.append("  no effort limits in the model: torques are not checked against limits")
+    if result.p_hat is not None and result.p_true is not None:
+        if len(result.parameter_names) <= 8:
+            lines.append(f"  p_hat(end) {fmt(result.p_hat[-1])}  true {fmt(result.p_true)}")
+        else:
+            err = np.abs(result.p_hat[-1] - result.p_true)
+            lines.append(
+                f"  {len(result.parameter_names)} estimates; max |p_hat − p| at the end {err.max():.4g}"
+            )
+    lines += [f"  figure {f}" for f in figures]
+    if args.save:
+        lines.append(f"  saved {args.save}")
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def cmd_compare(args: argparse.Namespace) -> int:
+    from twolink_pin.files import output_directory
+    from twolink_pin.scenario import builtin_laws, law_class
+    from twolink_pin.studies.comparison import run_comparison
+
+    robot = _robot(args)
+    specs = args.controllers or list(builtin_laws())
+    names = [law_class(s).name for s in specs]
+    if len(set(names)) != len(names):
+        raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
+    by_name = dict(zip(names, specs))
+    shared = run_spec(args)
+    shared.check_law_gains(specs)
+    identified = _identified(shared, robot)
+    reference = _trajectory(args, robot)
+    with output_directory(args.out, ".twolink-pin-compare") as stage:
+        bar = progress_bar(len(names), "run", "compare")
+
+        def on_result(name: str, result: SimulationResult) -> None:
+            if not args.no_plot:
+                from twolink_pin.plotting import save_simulation_figures
+
+                save_simulation_figures(
+                    result, stage / "figures", prefix=name, title=law_class(by_name[name]).title
+                )
+
+        def progress(name: str, result: SimulationResult | None) -> None:
+            if result is not None:
+                bar.update(1)
+            else:
+                bar.set_postfix_str(name)
+
+        plants: dict[str, str] = {}
+        gains: dict[str, dict[str, Any]] = {}
+
+        def run(name: str) -> SimulationResult:
+            from twolink_pin.run_spec import gains_used, plant_description
+            from twolink_pin.simulation import simulate
+
+            spec = shared.for_law(by_name[name])
+            scenario = spec.build(robot, identified)
+            plants[name], gains[name] = plant_description(scenario), gains_used(scenario.controller)
+            return simulate(*scenario, reference, spec.simulation)
+
+        try:
+            table = run_comparison(run, names, progress, on_result)
+        finally:
+            bar.close()
+        table = replace(table, plants=plants, gains=gains)
+        files = [Path(args.out) / p.name for p in table.write(stage)]
+    if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
+        _say_failed(table.failed, f"the other laws' results are in {args.out}")
+        return 1
+    payload = table.as_dict() | {"files": [str(f) for f in files]}
+    emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
+    return 0
+
+
+def _say_failed(failed: dict[str, str], where: str) -> None:
+    """One line on stderr for the laws that did not finish (each with what happened and when)."""
+    what = "; ".join(f"{name}: {text}" for name, text in failed.items())
+    print(f"twolink-pin: {len(failed)} law(s) did not finish ({what}); {where}", file=sys.stderr)
+
+
+RUN_OPTIONS = frozenset(
+    {
+        "--duration",
+        "--dt",
+        "--lambda",
+        "--q0-offset",
+        "--saturate",
+        "--method",
+        "--control-period",
+        "--friction-smoothing",
+        "--plant-friction",
+        "--gain",
+        "--p0",
+        "--model",
+    }
+)
+"""Options that shape a run: meaningless with ``animate --from`` (a saved run)."""
+
+
+def cmd_animate(args: argparse.Namespace) -> int:
+    import signal
+
+    if args.from_file:
+        typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
+        ignored = sorted(typed & RUN_OPTIONS)
+        if args.controller is not None or ignored:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
+                + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
+            )
+    if args.from_file:
+        robot, reference, result = _saved_run(args)
+    elif args.controller is None:
+        raise InvalidParameterError(
+            "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
+        )
+    else:
+        robot = _robot(args)
+        reference = _trajectory(args, robot)
+        spec = run_spec(args, args.controller)
+        result = _run_one(spec, robot, reference, _identified(spec, robot))
+    from twolink_pin.kinematics import joint_positions
+
+    via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
+    points = None if via_q is None else joint_positions(robot, via_q)[:, -1, :]  # the end effector's
+    if args.html:
+        from twolink_pin.visualization import write_html
+
+        path = write_html(
+            robot, result.t, result.q, result.q_des, path=args.html, via_points=points, loop=args.loop
+        )
+        emit(args, {"html": str(path), "controller": result.controller}, f"animation written to {path}")
+        return 0
+    from twolink_pin.visualization import serve
+
+    def _stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    signal.signal(signal.SIGTERM, _stop)  # a service manager's stop shuts down as cleanly as Ctrl-C
+    with serve(
+        robot,
+        result.t,
+        result.q,
+        result.q_des,
+        via_points=points,
+        host=args.host,
+        port=args.port,
+        loop=args.loop,
+        open_browser=not args.no_browser,
+        quiet=True,
+    ) as viewer:
+        emit(
+            args,
+            {"url": viewer.url, "host": viewer.host, "port": viewer.port},
+            f"meshcat viewer at {viewer.url}",
+        )
+        print("press Ctrl-C to stop", file=sys.stderr, flush=True)
+        try:
+            threading.Event().wait()
+        except KeyboardInterrupt:
+            print("stopping the viewer", file=sys.stderr)
+    return 0
+
+
+def cmd_report(args: argparse.Namespace) -> int:
+    from twolink_pin.report import ReportOptions, build_report
+
+    options = ReportOptions(
+        run=run_spec(args),
+        robot=args.robot,
+        payload=args.payload,
+        controllers=None if args.controllers is None else tuple(args.controllers),
+        workers=args.workers,
+        animation=not args.no_animation,
+        identification=not args.no_identification,
+        trajectory=args.trajectory,
+    )
+    command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
+    bar = progress_bar(1, "step", "report")
+
+    def progress(what: str, done: int, total: int) -> None:
+        bar.total = total
+        bar.set_postfix_str(what)
+        bar.update(done - bar.n)
+
+    try:
+        results = build_report(args.out, options, progress=progress, command_line=command)
+    finally:
+        bar.close()
+    index = Path(args.out) / "index.html"
+    failed = results.get("failed") or {}
+    for warning in results.get("warnings") or []:
+        print(f"twolink-pin: warning: {warning}", file=sys.stderr)
+    if failed:  # a failed run: one line on stderr, nothing on stdout; the page holds the rest
+        _say_failed(failed, f"the report with the others is {index}")
+        return 1
+    emit(
+        args,
+        {"index": str(index), "total_seconds": results["total_seconds"]},
+        f"report written to {index} in {results['total_seconds']:.1f} s",
+    )
+    return 0
+
+
+def _record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
+    """What a saved result records beside its arrays: the robot (as given: a catalog name or a
+    URDF path), its payload, the trajectory file and the run's spec."""
+    from pathlib import Path as _Path
+
+    robot = args.robot
+    if robot is not None and (robot.endswith(".urdf") or "/" in robot):
+        robot = str(_Path(robot).resolve())
+    trajectory = getattr(args, "trajectory", None)
+    return {
+        "robot": robot,
+        "payload": args.payload,
+        "trajectory": None if trajectory is None else str(_Path(trajectory).resolve()),
+        "run": spec.as_dict(),
+    }
+
+
+def _saved_run(args: argparse.Namespace) -> tuple[RobotModel, Trajectory, SimulationResult]:
+    """``animate --from FILE``: the result, on the robot and reference it records (``--robot``,
+    ``--payload``, ``--trajectory`` given: those); a file that records no robot: the catalog
+    robot of its name, else ``--robot``."""
+    from twolink_pin.model import catalog, load_robot
+    from twolink_pin.simulation.storage import load_record, load_result
+    from twolink_pin.trajectory import default_trajectory, read_trajectory_file
+
+    result = load_result(args.from_file)
+    record = load_record(args.from_file) or {}
+    source = args.robot
+    payload = args.payload
+    if source is None:
+        source = record.get("robot") or (result.robot if result.robot in catalog.CATALOG else None)
+        if "payload" in record and payload == 0.0:
+            payload = float(record["payload"])
+    robot = load_robot(source, payload=payload)
+    if result.q.shape[1] != robot.nq:
+        raise InvalidParameterError(
+            "--from",
+            args.from_file,
+            f"a result for {robot.name} (nq = {robot.nq}); it has {result.q.shape[1]} joints",
+        )
+    path = args.trajectory or record.get("trajectory")
+    reference = read_trajectory_file(path, robot) if path else default_trajectory(robot)
+    return robot, reference, result

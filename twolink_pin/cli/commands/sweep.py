@@ -1,0 +1,87 @@
+"""``sweep``: a Monte Carlo study of one law, in-process or on Dask."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING, Any
+
+from twolink_pin.cli.commands.common import _robot, _trajectory, run_spec
+from twolink_pin.cli.output import emit, progress_bar
+
+if TYPE_CHECKING:
+    pass
+
+
+def cmd_sweep(args: argparse.Namespace) -> int:
+    from twolink_pin.studies import cluster
+    from twolink_pin.studies.sweep import SweepConfig, run_sweep
+
+    if (args.workers is not None or args.scheduler is not None) and not cluster.available():
+        option = "--workers" if args.workers is not None else "--scheduler"
+        print(
+            f"twolink-pin: error: {option} needs Dask, which is not installed: {cluster.INSTALL_HINT}",
+            file=sys.stderr,
+        )
+        return 1
+    robot = _robot(args)
+    trajectory = _trajectory(args, robot)
+    config = SweepConfig(
+        run=run_spec(args, args.controller, fixed_gains=False),
+        samples=args.samples,
+        seed=args.seed,
+        q0_spread=args.q0_spread,
+        param_error=args.param_error,
+        gains=tuple(args.gain),
+        chunk=args.chunk,
+        threads=args.threads,
+    )
+    bars: list[Any] = []  # shown from the first runs on: its rate and ETA leave out a cluster's start
+
+    def progress(done: int, total: int) -> None:
+        if not bars:
+            bars.append(progress_bar(config.samples, "run", f"sweep {config.controller}"))
+        bars[0].update(done - bars[0].n)
+
+    def notify(line: str) -> None:
+        if bars:
+            bars[0].write(line, file=sys.stderr)
+        else:
+            print(line, file=sys.stderr, flush=True)
+
+    try:
+        output = run_sweep(
+            config,
+            robot,
+            trajectory,
+            args.out,
+            progress=progress,
+            keep_trajectories=args.keep_trajectories,
+            plot=not args.no_plot,
+            scheduler=args.scheduler,
+            workers=args.workers,
+            timeout=args.connect_timeout,
+            notify=notify,
+        )
+    finally:
+        if bars:
+            bars[0].close()
+    summary = output.summary
+    if args.json:
+        payload = {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}
+        emit(args, {**payload, "engine": output.engine, "chunk": output.chunk}, "")
+        return 0
+    lines = [
+        f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
+        f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
+        f"  ran {'' if output.engine == 'in-process' else 'on '}{output.engine}, in chunks of {output.chunk} runs",
+        f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
+    ]
+    for name, stat in summary["metrics"].items():
+        cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
+        lines.append(f"  {name:28s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
+    if "note" in summary:
+        lines.append(f"  {summary['note']}")
+    lines += [f"  wrote {f}" for f in output.files]
+    emit(args, {}, "\n".join(lines))
+    return 0

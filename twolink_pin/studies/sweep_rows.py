@@ -1,0 +1,226 @@
+"""A sweep's rows: the columns, one chunk's runs as rows (:class:`ChunkRows`, wherever it runs)
+and the summary statistics over them."""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.controllers import Controller
+from twolink_pin.controllers.gains import spec_of
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.metrics import metric_array, metric_units
+from twolink_pin.model import RobotModel
+from twolink_pin.scenario import Scenario
+from twolink_pin.studies.batch import BatchResult, simulate_batch
+from twolink_pin.studies.sweep_cases import Cases, SweepConfig, _chunk_law, gain_target
+from twolink_pin.trajectory import Trajectory
+
+PERCENTILES = (5.0, 50.0, 95.0)
+"""Percentiles in the summary (the 50th is the median)."""
+MAX_KEPT_VALUES = 1_000_000_000
+"""Largest number of floats ``--keep-trajectories`` writes over the whole sweep (8 GB):
+samples × (steps + 1) × 3 nv (q, q̇, τ_command)."""
+
+
+# -- rows -----------------------------------------------------------------------------------------
+
+
+def _joint_columns(prefix: str, nv: int) -> list[str]:
+    return [f"{prefix}{j + 1}" for j in range(nv)]
+
+
+METRIC_UNITS = metric_units()
+"""SI unit of each per-joint metric (the column names add the joint's 1-based index):
+:func:`twolink_pin.metrics.metric_units`, the one definition."""
+
+
+def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
+    """Names of the metric columns of a row, in order."""
+    columns: list[str] = []
+    for stem in METRIC_UNITS:
+        columns += _joint_columns(stem, nv)
+    columns += [f"p_hat_final_{name}" for name in parameter_names]
+    return columns
+
+
+def input_columns(config: SweepConfig, nv: int, parameter_names: Sequence[str]) -> list[str]:
+    """Names of the input columns of a row, in order."""
+    columns = ["run", *_joint_columns("q0_offset", nv)]
+    columns += [f"param_factor_{name}" for name in parameter_names]
+    columns += [f"gain_{g.name}" for g in config.gains]
+    return columns
+
+
+FLAG_COLUMNS = ("limit_exceeded", "diverged", "diverged_at")
+"""Per-run outcome columns after the inputs."""
+
+
+def _chunk_rows(
+    result: BatchResult, cases: Cases, config: SweepConfig, start: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(inputs, flags, metrics) of one chunk as float arrays, plus the limit-exceeded mask."""
+    m = result.metrics
+    stop = start + result.n_runs
+    inputs = [np.arange(start, stop, dtype=float)[:, None], cases.q0_offset, cases.param_factor]
+    inputs += [cases.gains[g.name][:, None] for g in config.gains]
+    exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & ~result.diverged
+    flags = np.column_stack([exceeded, result.diverged, result.diverged_at]).astype(float)
+    parts = [metric_array(m, stem) for stem in METRIC_UNITS]
+    if result.p_hat_final is not None:
+        parts.append(result.p_hat_final)
+    return np.hstack(inputs), flags, np.hstack(parts), exceeded
+
+
+def _stats(column: np.ndarray) -> dict[str, float | None]:
+    if column.size == 0:
+        return {"median": None, "p5": None, "p95": None}
+    p5, p50, p95 = np.percentile(column, PERCENTILES)
+    return {"median": float(p50), "p5": float(p5), "p95": float(p95)}
+
+
+def summarize(
+    metrics: np.ndarray, names: Sequence[str], diverged: np.ndarray, exceeded: np.ndarray
+) -> dict[str, Any]:
+    """Summary statistics of the metric table ``metrics`` (N, len(names)).
+
+    Percentiles are ``numpy.percentile`` (linear interpolation) over the runs that did not
+    diverge; a metric with no such run gets None.
+    """
+    keep = ~diverged
+    return {
+        "runs": int(diverged.size),
+        "diverged": int(diverged.sum()),
+        "limit_exceeded": int((exceeded & keep).sum()),
+        "metrics": {name: _stats(metrics[keep, j]) for j, name in enumerate(names)},
+    }
+
+
+# -- one chunk, wherever it runs ------------------------------------------------------------------
+
+
+def environment() -> tuple[tuple[str, str], ...]:
+    """The versions a run's numbers depend on: twolink-pin, numpy, Pinocchio."""
+    import pinocchio
+
+    from twolink_pin.version import __version__
+
+    return (
+        ("twolink-pin", __version__),
+        ("numpy", str(np.__version__)),
+        ("pinocchio", str(pinocchio.__version__)),
+    )
+
+
+@dataclass(frozen=True)
+class ChunkRows:
+    """The rows of runs ``start .. start + n − 1`` as computed by a worker (or in-process)."""
+
+    start: int
+    """Index of the first run."""
+    inputs: np.ndarray
+    """Input columns (the run index as a float first), shape (n, inputs)."""
+    flags: np.ndarray
+    """``limit_exceeded``, ``diverged`` (0/1) and ``diverged_at`` [s], shape (n, 3)."""
+    metrics: np.ndarray
+    """Metric columns, shape (n, metrics)."""
+    environment: tuple[tuple[str, str], ...]
+    """:func:`environment` where the chunk ran."""
+    trajectories: dict[str, np.ndarray] | None = None
+    """``t``, ``q``, ``v``, ``tau_command`` when trajectories are kept."""
+
+    @property
+    def stop(self) -> int:
+        """One past the last run."""
+        return self.start + int(self.inputs.shape[0])
+
+
+class _Prepared:
+    """What every chunk of a study shares: the law's class and base scenario, the columns."""
+
+    def __init__(
+        self,
+        config: SweepConfig,
+        cls: type[Controller],
+        robot: RobotModel,
+        trajectory: Trajectory,
+        record: bool,
+    ) -> None:
+        self.config, self.cls, self.robot, self.trajectory, self.record = (
+            config,
+            cls,
+            robot,
+            trajectory,
+            record,
+        )
+        self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
+        nv = robot.nv
+        if record:
+            kept = config.samples * (config.simulation.steps + 1) * 3 * nv
+            if kept > MAX_KEPT_VALUES:
+                raise InvalidParameterError(
+                    "keep_trajectories",
+                    True,
+                    f"at most {MAX_KEPT_VALUES:.3g} recorded values over the whole sweep (8 GB: samples × "
+                    f"(steps + 1) × 3 nv); {config.samples} runs of {config.simulation.steps} steps need "
+                    f"{kept:.3g} ({8 * kept / 1e9:.3g} GB): fewer samples, a larger dt or a shorter duration",
+                )
+        self.parameter_names = tuple(robot.parameter_map.names)
+        law = self.base.controller
+        estimated = law.parameter_names if law.estimates else ()
+        self.input_columns = input_columns(config, nv, self.parameter_names)
+        self.metric_columns = metric_columns(nv, estimated)
+        self.header = [*self.input_columns, *FLAG_COLUMNS, *self.metric_columns]
+        units = {"run": "", **{c: "rad" for c in _joint_columns("q0_offset", nv)}}
+        units.update({f"param_factor_{n}": "" for n in self.parameter_names})
+        for g in config.gains:
+            key, _ = gain_target(cls, g.name)
+            units[f"gain_{g.name}"] = spec_of(cls.Gains, key).unit
+        units.update(limit_exceeded="", diverged="", diverged_at="s")
+        for stem, unit in METRIC_UNITS.items():
+            units.update({c: unit for c in _joint_columns(stem, nv)})
+        if law.estimates:
+            units.update(
+                {f"p_hat_final_{n}": u for n, u in zip(law.parameter_names, law.parameter_units, strict=True)}
+            )
+        self.units = units
+
+    def run(
+        self, start: int, stop: int, threads: int | None, progress: Callable[[int], None] | None = None
+    ) -> ChunkRows:
+        """Draw and simulate runs ``start .. stop − 1``; ``progress(runs done)`` meanwhile."""
+        config = self.config
+        cases = Cases(config, self.robot, start, stop)
+        law = _chunk_law(config, self.robot, cases, self.base.controller)
+        size = stop - start
+
+        def steps(done: int, total: int) -> None:
+            if progress is not None:
+                progress(int(size * done / total))
+
+        plant, noise = self.base.plant, self.base.plant.sensor_noise
+        if noise is not None:  # run i of the sweep draws stream i, whatever the chunking
+            plant = copy.copy(plant)
+            plant.sensor_noise = dataclasses.replace(noise, stream=noise.stream + start)
+        result = simulate_batch(
+            law,
+            plant,
+            self.trajectory,
+            config.simulation,
+            runs=size,
+            q0_offsets=cases.q0_offset,
+            threads=threads,
+            record=self.record,
+            progress=steps,
+        )
+        inputs, flags, metrics, _ = _chunk_rows(result, cases, config, start)
+        kept = None
+        if self.record:
+            assert result.q is not None and result.v is not None and result.tau_command is not None
+            kept = {"t": result.t, "q": result.q, "v": result.v, "tau_command": result.tau_command}
+        return ChunkRows(start, inputs, flags, metrics, environment(), kept)
