@@ -23,6 +23,7 @@ from collections.abc import Sequence
 
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.readiness import ready
 
 
 class Terminated(KeyboardInterrupt):
@@ -83,11 +84,13 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     _check_texts(parser, args)
+    ready("parsed")
     args.argv = list(sys.argv[1:] if argv is None else argv)
     previous = None
     if threading.current_thread() is threading.main_thread():
         previous = signal.signal(signal.SIGTERM, _terminate)
     try:
+        ready("running")
         return int(args.func(args))
     except (SimulationDivergedError, ControllerError) as exc:
         _say(f"twolink-pin: {exc}")
