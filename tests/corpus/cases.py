@@ -756,6 +756,39 @@ INTERRUPT = [
 ]
 
 
+# == 8. User code ====================================================================================
+# A law or plug-in that misbehaves as user code can (laws/misbehaving.py): an error naming the
+# law (exit 1, or 2 for a file that cannot be imported), nothing written, never a silent exit,
+# a changed simulation, a corrupted --json or a hang. os._exit cannot be caught in-process
+# (docs/reliability.md): no case for it.
+MIS = f"{LAW}/misbehaving.py"
+PLUGIN = (
+    text("site/corpus_broken_plugin-1.0.dist-info/METADATA", "Metadata-Version: 2.1\nName: corpus-broken-plugin\nVersion: 1.0\n"),
+    text("site/corpus_broken_plugin-1.0.dist-info/entry_points.txt", "[twolink_pin.controllers]\ncorpus-broken = corpus_broken_plugin:Law\n"),
+    text("site/corpus_broken_plugin.py", 'raise ImportError("corpus: this plug-in needs a package that is not installed")\n'),
+)
+"""An installed plug-in (a dist-info on PYTHONPATH) whose module fails to import."""
+USERCODE = [
+    C("usercode-simulate-law-exit-0", f"simulate {MIS}:ExitZero {SIM} --save run.npz", 1, err=("corpus-exit-zero", "sys.exit(0)", "t ="), absent=("run.npz",), note="sys.exit(0) in a law must not look like success"),
+    C("usercode-simulate-law-exit-3", f"simulate {MIS}:ExitThree {SIM} --json", 1, err=("corpus-exit-three", "sys.exit(3)")),
+    C("usercode-simulate-law-exit-0-proc", f"simulate {MIS}:ExitZero {SIM} --save run.npz", 1, err=("corpus-exit-zero", "sys.exit(0)"), run="proc", absent=("run.npz",)),
+    C("usercode-simulate-law-exit-adaptive", f"simulate {MIS}:ExitZero {SIM} --method adaptive", 1, err=("corpus-exit-zero", "sys.exit(0)")),
+    C("usercode-simulate-law-file-exits-on-import", f"simulate {LAW}/exit_on_import.py:Law {SIM}", 2, err=("exit_on_import.py", "sys.exit(0)")),
+    C("usercode-sweep-law-exit-0", f"sweep {MIS}:ExitZero --samples 4 {SIM} --no-plot --out s", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("s",), note="a sweep leaves no partial folder"),
+    C("usercode-compare-law-exit-0", f"compare {MIS}:ExitZero pd {SIM} --no-plot --out c", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("c",)),
+    C("usercode-simulate-law-writes-state", f"simulate {MIS}:WritesState {SIM} --save run.npz", 1, err=("corpus-writes-state", "read-only"), absent=("run.npz",)),
+    C("usercode-simulate-law-writes-reference", f"simulate {MIS}:WritesReference {SIM}", 1, err=("corpus-writes-reference", "read-only", "reference")),
+    C("usercode-simulate-law-writes-state-adaptive", f"simulate {MIS}:WritesState {SIM} --method adaptive", 1, err=("corpus-writes-state", "read-only")),
+    C("usercode-simulate-law-memory", f"simulate {MIS}:Hog {SIM}", 1, err=("corpus-hog", "memory"), not_err=("please report",)),
+    C("usercode-simulate-law-prints-json", f"simulate {MIS}:Printer {SIM} --json", 0, warns=("corpus-printer says hello",), checks=(strict_json(), json_at("stdout", "controller", "==", "corpus-printer")), note="a law's print goes to stderr with --json: stdout holds the JSON alone"),
+    C("usercode-simulate-law-sleeps-timeout", f"simulate {MIS}:Sleeper {SIM} --timeout 2 --save run.npz", 1, err=("--timeout 2 s", "Sleeper"), run="proc", absent=("run.npz",), timeout=30),
+    C("usercode-simulate-law-spins-timeout", f"simulate {MIS}:Spinner {SIM} --timeout 2 --method adaptive", 1, err=("--timeout 2 s", "Spinner"), run="proc", timeout=30),
+    C("usercode-compare-law-sleeps-timeout", f"compare {MIS}:Sleeper pd {SIM} --timeout 2 --no-plot --out c", 1, err=("--timeout 2 s",), run="proc", absent=("c",), timeout=30),
+    C("usercode-simulate-timeout-negative", f"simulate pd {SIM} --timeout -1", 2, err=("--timeout", "-1")),
+    C("usercode-controllers-broken-plugin-warns", "controllers --json", 0, warns=("warning", "corpus-broken", "ImportError"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc", checks=(strict_json(),), note="the built-in laws are still listed; the broken plug-in is a warning, not silently missing"),
+    C("usercode-simulate-broken-plugin-by-name", f"simulate corpus-broken {SIM}", 2, err=("corpus-broken", "plug-in", "ImportError", "not installed"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc"),
+]
+
 # == 6b. Library-level arguments =====================================================================
 # The public functions raise InvalidParameterError naming the argument (expected vs received),
 # not a numpy / Pinocchio / Python error, and never return NaN for NaN input.
@@ -836,7 +869,7 @@ LIBRARY = [
 # fmt: on
 
 
-CASES: list[Case] = [*DATALOSS, *WRONG, *HANG, *TRACEBACK, *NONFINITE, *UNCLEAR, *INTERRUPT]
+CASES: list[Case] = [*DATALOSS, *WRONG, *HANG, *TRACEBACK, *NONFINITE, *UNCLEAR, *INTERRUPT, *USERCODE]
 """Every command-line case."""
 
 

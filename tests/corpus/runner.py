@@ -626,8 +626,11 @@ def verify(case: Case, ctx: Context, before: dict[str, tuple[str, str]], outcome
         if missing:
             problems.append(f"stderr lacks {missing}: {last_line(err)[:300]!r}")
     if code == 0 and case.run != "signal":
-        if messages:
+        if messages and not case.warns:
             problems.append(f"success printed on stderr: {' / '.join(m[:160] for m in messages[:3])}")
+        missing_warnings = [w for w in case.warns if not _has(err, w)]
+        if missing_warnings:
+            problems.append(f"stderr of the success lacks {missing_warnings}: {last_line(err)[:200]!r}")
         missing = [w for w in case.out if not _has(out, w)]
         if missing:
             problems.append(f"stdout lacks {missing}: {out.strip()[:200]!r}")
@@ -879,8 +882,13 @@ def _check_whole_or_absent(ctx: Context, outcome: Outcome, path: str, kind: str)
         except Exception as exc:
             return f"{path} is not whole after exit 0: {type(exc).__name__}: {exc}"
         return None
-    if outcome.code in (130, 143) and os.path.lexists(target) and kind == "npz":
-        return f"interrupted (exit {outcome.code}) but {path} was written"
+    if os.path.lexists(target) and kind == "npz":  # interrupted after it was committed: whole
+        try:
+            from twolink_pin.simulation.storage import load_result
+
+            load_result(target)
+        except Exception as exc:
+            return f"{path} is partial after exit {outcome.code}: {type(exc).__name__}: {exc}"
     return None
 
 

@@ -36,6 +36,7 @@ CLASSES = {
     "unclear": "6. unclear messages: what works must work, what fails must say why",
     "interrupt": "7. interrupts: SIGINT and SIGTERM on running commands",
     "library": "6b. library-level arguments: wrong sizes, NaN, wrong types",
+    "usercode": "8. user code contained: laws and plug-ins that exit, print, write their inputs, exhaust memory, never return",
 }
 """Case classes, by the first word of a case id."""
 
@@ -94,6 +95,8 @@ class Case:
             goes out as soon as the program reports ``stage`` (``started``, ``parsed``,
             ``running``, ``writing``: :mod:`twolink_pin.readiness`), never after a delay.
         nonfinite_ok: A successful run may print ``nan`` / ``inf``.
+        warns: Words a successful run's stderr must hold (a warning, a law's own prints); a
+            success may then print on stderr.
         silent_ok: A failed run may print nothing on stderr (stdout unwritable, killed).
         timeout: Seconds before the case counts as a hang (the default is generous: every case
             that works takes a few seconds at most).
@@ -119,6 +122,7 @@ class Case:
     run: str = "inproc"
     signal: tuple[int, str, str] | None = None
     nonfinite_ok: bool = False
+    warns: tuple[str, ...] = ()
     silent_ok: bool = False
     timeout: float = 20.0
     env: tuple[tuple[str, str], ...] = ()
@@ -224,7 +228,8 @@ def finite_file(path: str) -> Check:
 
 def whole_or_absent(path: str, kind: str = "npz") -> Check:
     """After an interrupt that may have come too late to stop the command: ``path`` is absent
-    (interrupted) or a whole file that loads (it finished first); never a partial file."""
+    or a whole file that loads (the signal came after it was committed; exit 0 requires it);
+    never a partial file."""
     return Check("whole_or_absent", (path, kind))
 
 

@@ -20,7 +20,9 @@ import signal
 import sys
 import threading
 from collections.abc import Sequence
+from typing import Any
 
+from twolink_pin.cli import guard
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
 from twolink_pin.readiness import ready
@@ -31,8 +33,35 @@ class Terminated(KeyboardInterrupt):
     folders removed, worker processes stopped) as for Ctrl-C."""
 
 
+_signalled: list[int] = []
+"""The signals received while the command ran: whatever exception then reaches :func:`main`
+(an import that turned the ``KeyboardInterrupt`` into an ``ImportError``, a library that
+caught it), the outcome is the interrupt."""
+
+
 def _terminate(signum: int, frame: object) -> None:
+    _signalled.append(signum)
     raise Terminated
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    _signalled.append(signum)
+    raise KeyboardInterrupt
+
+
+def _run(args: argparse.Namespace) -> int:
+    """The command under its guards; any exception after a signal is the interrupt."""
+    try:
+        with guard.wall_clock_bound(getattr(args, "timeout", None)):
+            with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
+                code = int(args.func(args))
+    except BaseException:
+        if _signalled:
+            raise (Terminated if _signalled[-1] == signal.SIGTERM else KeyboardInterrupt)() from None
+        raise
+    if _signalled:  # a library swallowed the interrupt: it still ends the command
+        raise Terminated if _signalled[-1] == signal.SIGTERM else KeyboardInterrupt
+    return code
 
 
 MAX_LINE = 1000
@@ -86,12 +115,27 @@ def main(argv: Sequence[str] | None = None) -> int:
     _check_texts(parser, args)
     ready("parsed")
     args.argv = list(sys.argv[1:] if argv is None else argv)
-    previous = None
+    previous: dict[int, Any] = {}
+    del _signalled[:]
     if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _terminate)
+        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _terminate)}
+        if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job ignores Ctrl-C
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, _interrupt)
     try:
         ready("running")
-        return int(args.func(args))
+        return _run(args)
+    except guard.RunTimeout as exc:
+        law = getattr(args, "controller", None) or getattr(args, "controllers", None)
+        named = (
+            f" (the law {law if isinstance(law, str) else ', '.join(map(str, law))} may never return)"
+            if law
+            else ""
+        )
+        _say(
+            f"twolink-pin: stopped after --timeout {exc.seconds:g} s of wall-clock time{named}; "
+            "give a larger --timeout for a longer run"
+        )
+        return 1
     except (SimulationDivergedError, ControllerError) as exc:
         _say(f"twolink-pin: {exc}")
         return 1
@@ -122,8 +166,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return 1
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _say(line: str) -> None:

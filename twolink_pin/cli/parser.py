@@ -6,6 +6,7 @@ import argparse
 from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
+from twolink_pin.cli.guard import DEFAULT_TIMEOUT
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -98,6 +99,13 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="T",
         help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
+    )
+    p.add_argument(
+        "--timeout",
+        type=bounded(0.0, 1e7, unit="s"),
+        default=DEFAULT_TIMEOUT,
+        metavar="S",
+        help=f"stop the command after S s of wall-clock time: a law that never returns (0: no bound; default {DEFAULT_TIMEOUT:g} = one day)",
     )
     p.add_argument(
         "--friction-smoothing",

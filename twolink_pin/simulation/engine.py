@@ -37,6 +37,7 @@ from twolink_pin.controllers import Controller, LawInput, LawOutput
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
+from twolink_pin.simulation.containment import contained
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
@@ -148,7 +149,7 @@ def integrate(
     name = controller.name
     terms = terms_for(controller, runs, threads)
     accel = dynamics_for(plant, runs, threads)
-    compute = controller.compute
+    compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
     n = config.steps
     dt = config.duration / n
     hold = config.hold_steps
