@@ -3,9 +3,10 @@
 :func:`contained` wraps ``controller.compute`` so that what a law does wrong is an error
 naming the law, never a changed simulation or a silent exit:
 
-* its input arrays (``q``, ``v``, ``z`` and the reference ``q_des``, ``v_des``, ``a_des``,
-  which later steps share) reach it as **read-only views**: a write raises, and the
-  resulting :class:`~twolink_pin.errors.ControllerError` says that the inputs are read-only;
+* its input arrays reach it as **read-only views**: ``q``, ``v``, ``z`` here, the reference
+  ``q_des``, ``v_des``, ``a_des`` (which later steps share) where the engine samples it
+  (:func:`read_only`); a write raises, and the resulting
+  :class:`~twolink_pin.errors.ControllerError` says that the inputs are read-only;
 * ``sys.exit()`` inside ``compute`` (``SystemExit``) is an error naming the law, not an exit
   of the program with a status the law chose;
 * ``MemoryError`` inside ``compute`` names the law (it is the law's allocation, not a bug of
@@ -32,12 +33,11 @@ READ_ONLY_HINT = (
 )
 
 
-def _frozen(a: Any) -> Any:
-    if isinstance(a, np.ndarray) and a.flags.writeable:
-        view = a.view()
-        view.flags.writeable = False
-        return view
-    return a
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (views taken from it are read-only too)."""
+    view = a.view()
+    view.setflags(write=False)
+    return view
 
 
 def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
@@ -51,9 +51,8 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
 
     def call(x: LawInput, terms: Any) -> LawOutput:
         t, q, v, z, q_des, v_des, a_des = x
-        frozen = new(
-            LawInput, (t, _frozen(q), _frozen(v), _frozen(z), _frozen(q_des), _frozen(v_des), _frozen(a_des))
-        )
+        # The reference is made read-only where the engine samples it (once per block).
+        frozen = new(LawInput, (t, read_only(q), read_only(v), read_only(z), q_des, v_des, a_des))
         try:
             return compute(frozen, terms)
         except SystemExit as exc:
@@ -74,4 +73,4 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
     return call
 
 
-__all__ = ["contained"]
+__all__ = ["contained", "read_only"]
