@@ -762,6 +762,14 @@ INTERRUPT = [
 # a changed simulation, a corrupted --json or a hang. os._exit cannot be caught in-process
 # (docs/reliability.md): no case for it.
 MIS = f"{LAW}/misbehaving.py"
+
+
+def json_text(obj: object) -> str:
+    import json
+
+    return json.dumps(obj)
+
+
 PLUGIN = (
     text("site/corpus_broken_plugin-1.0.dist-info/METADATA", "Metadata-Version: 2.1\nName: corpus-broken-plugin\nVersion: 1.0\n"),
     text("site/corpus_broken_plugin-1.0.dist-info/entry_points.txt", "[twolink_pin.controllers]\ncorpus-broken = corpus_broken_plugin:Law\n"),
@@ -787,6 +795,33 @@ USERCODE = [
     C("usercode-simulate-timeout-negative", f"simulate pd {SIM} --timeout -1", 2, err=("--timeout", "-1")),
     C("usercode-controllers-broken-plugin-warns", "controllers --json", 0, warns=("warning", "corpus-broken", "ImportError"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc", checks=(strict_json(),), note="the built-in laws are still listed; the broken plug-in is a warning, not silently missing"),
     C("usercode-simulate-broken-plugin-by-name", f"simulate corpus-broken {SIM}", 2, err=("corpus-broken", "plug-in", "ImportError", "not installed"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc"),
+]
+
+# == Bounded readers and outputs that would replace an input (issue 23) ================================
+PFORMAT = "twolink-pin identified parameters"
+DEEP_JSON = '{"times": ' + "[" * 5000 + "]" * 5000 + "}"
+DEEP_TOML = "times = " + "[" * 5000 + "]" * 5000 + "\n"
+PLAIN_TOML = "times = [0.0, 1.0, 2.0]\njoints = [[0.0, 0.0], [0.2, 0.1], [0.0, 0.0]]\n"
+FOURIER = "[fourier]\nperiod = {}\nharmonics = 1\na = [[0.1], [0.1]]\nb = [[0.0], [0.0]]\noffset = [0.0, 0.0]\n"
+READERS = [
+    C("traceback-simulate-trajectory-json-deep", f"simulate pd {SIM} --trajectory deep.json", 2, err=("deep.json", "32 deep"), setup=(text("deep.json", DEEP_JSON),)),
+    C("traceback-simulate-trajectory-toml-deep", f"simulate pd {SIM} --trajectory deep.toml", 2, err=("deep.toml", "32 deep"), setup=(text("deep.toml", DEEP_TOML),)),
+    C("traceback-simulate-p0-json-deep", f"simulate adaptive {SIM} --p0 deep.json", 2, err=("deep.json", "32 deep"), setup=(text("deep.json", '{"format": ' + "[" * 100000 + "]" * 100000 + "}"),)),
+    C("traceback-simulate-trajectory-json-deep-in-string", f"simulate pd {SIM} --trajectory t.json", 2, err=("t.json", "only the keys"), setup=(text("t.json", '{"times": [0, 1, 2], "joints": [[0, 0], [0.2, 0.1], [0, 0]], "comment": "' + "[" * 5000 + '"}'),), note="brackets inside a string are not nesting: the file is refused for its key, not its depth"),
+    C("nonfinite-simulate-trajectory-times-overflow", f"simulate pd {SIM} --trajectory t.toml", 2, err=("times[1]", "1e+300", "1e+06"), setup=(text("t.toml", "times = [0, 1e300, 2e300]\njoints = [[0, 0], [0.2, 0.1], [0, 0]]\n"),)),
+    C("nonfinite-simulate-trajectory-times-crowded", f"simulate pd {SIM} --trajectory t.toml", 2, err=("times[1]", "0.001 s"), setup=(text("t.toml", "times = [0, 1e-12, 2]\njoints = [[0, 0], [0.2, 0.1], [0, 0]]\n"),)),
+    C("wrong-simulate-fourier-period-1e-300", f"simulate pd {SIM} --trajectory f.toml", 2, err=("fourier.period", "1e-300", "0.001"), setup=(text("f.toml", FOURIER.format("1e-300")),)),
+    C("wrong-simulate-fourier-period-1e300", f"simulate pd {SIM} --trajectory f.toml", 2, err=("fourier.period", "1e+300|1e300", "1e+06"), setup=(text("f.toml", FOURIER.format("1e300")),)),
+    C("wrong-simulate-p0-duplicate-parameter", f"simulate adaptive {SIM} --p0 p.json", 2, err=("p.json", "repeats", "'m1'"), setup=(text("p.json", json_text({"format": PFORMAT, "nv": 2, "robot": "twolink", "parameters": [{"name": "m1", "estimate": 1.0}, {"name": "m1", "estimate": 2.0}]})),)),
+    C("wrong-simulate-p0-duplicate-key", f"simulate adaptive {SIM} --p0 p.json", 2, err=("p.json", "'nv'", "twice"), setup=(text("p.json", '{"format": "' + PFORMAT + '", "nv": 6, "nv": 2, "parameters": []}'),)),
+    C("unclear-simulate-p0-other-robot", f"simulate adaptive {SIM} --p0 p.json", 2, err=("nv = 6", "expected nv = 2", "twolink"), not_err=("twolink has 2",), setup=(text("p.json", json_text({"format": PFORMAT, "nv": 6, "robot": "ur5", "parameters": []})),)),
+    C("hang-identify-data-npz-bomb", "identify --data bomb.npz", 2, err=("bomb.npz", "claims"), setup=(blob("bomb.npz", npz_bomb),), run="proc", memory=2 * GiB, timeout=60, note="4 MB that inflate to 4 GiB: refused from the headers, before anything is inflated"),
+    C("dataloss-simulate-save-over-trajectory", f"simulate pd {SIM} --trajectory t.toml --save t.toml", 2, err=("--save", "t.toml", "--trajectory"), setup=(text("t.toml", PLAIN_TOML),)),
+    C("dataloss-simulate-save-over-trajectory-symlink", f"simulate pd {SIM} --trajectory t.toml --save link.npz", 2, err=("--save", "link.npz", "t.toml"), setup=(text("t.toml", PLAIN_TOML), symlink("link.npz", "t.toml"))),
+    C("dataloss-identify-save-over-trajectory", "identify --trajectory t.toml --duration 2 --save t.toml", 2, err=("--save", "t.toml"), setup=(text("t.toml", PLAIN_TOML),)),
+    C("dataloss-animate-html-over-from", "animate --from run.npz --html run.npz", 2, err=("--html", "run.npz"), setup=(SAVED,)),
+    C("unclear-ik-just-outside-annulus", "ik 0.62000000001 0", 2, err=("r = 0.62000000001", "<= 0.62 m")),
+    C("unclear-ik-just-inside-hole", "ik 0.13999999999 0", 2, err=("r = 0.13999999999", "0.14 <=")),
 ]
 
 # == 6b. Library-level arguments =====================================================================
@@ -869,7 +904,7 @@ LIBRARY = [
 # fmt: on
 
 
-CASES: list[Case] = [*DATALOSS, *WRONG, *HANG, *TRACEBACK, *NONFINITE, *UNCLEAR, *INTERRUPT, *USERCODE]
+CASES: list[Case] = [*DATALOSS, *WRONG, *HANG, *TRACEBACK, *NONFINITE, *UNCLEAR, *INTERRUPT, *USERCODE, *READERS]
 """Every command-line case."""
 
 

@@ -112,6 +112,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     _check_texts(parser, args)
+    try:
+        guard.check_outputs_are_not_inputs(args, _option_names(parser, args.command))
+    except TwolinkPinError as exc:
+        parser.error(str(exc))
     ready("parsed")
     args.argv = list(sys.argv[1:] if argv is None else argv)
     previous: dict[int, Any] = {}

@@ -85,3 +85,56 @@ def results_only_on_stdout(active: bool) -> Iterator[None]:
 
 
 __all__ = ["DEFAULT_TIMEOUT", "RunTimeout", "results_only_on_stdout", "wall_clock_bound"]
+
+
+OUTPUT_OPTIONS = ("save", "save_data", "out", "html", "write_urdf", "plot")
+"""Destinations of the options that name something the command writes."""
+
+
+def _named_paths(value: object) -> list[str]:
+    values = value if isinstance(value, list) else [value]
+    paths = []
+    for text in values:
+        if isinstance(text, str) and text:
+            paths.append(text)
+            location, sep, _ = text.rpartition(":")  # a law given as path/to/file.py:Class
+            if sep and location.endswith(".py"):
+                paths.append(location)
+    return paths
+
+
+def check_outputs_are_not_inputs(args: object, names: dict[str, str]) -> None:
+    """Refuse, before any work, an output option naming a file the same command reads
+    (``--save F`` where F is the log or the trajectory): the output would replace the input.
+    Every other text argument that names an existing file counts as read.
+
+    Raises:
+        InvalidParameterError: an output and an input are the same file (links followed).
+    """
+    import os
+
+    from twolink_pin.errors import InvalidParameterError
+
+    given = vars(args)
+    inputs = [
+        (dest, path)
+        for dest, value in given.items()
+        if dest not in OUTPUT_OPTIONS and dest not in ("command", "argv", "func")
+        for path in _named_paths(value)
+    ]
+    for dest in OUTPUT_OPTIONS:
+        for out in _named_paths(given.get(dest)):
+            if not os.path.exists(out):
+                continue
+            for source, path in inputs:
+                try:
+                    same = os.path.exists(path) and os.path.samefile(out, path)
+                except OSError:
+                    same = False
+                if same:
+                    raise InvalidParameterError(
+                        names.get(dest, dest),
+                        out,
+                        f"a path other than the {names.get(source, source)} {path!r} it would replace "
+                        "(the command reads that file)",
+                    )
