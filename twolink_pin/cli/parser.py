@@ -498,7 +498,7 @@ def add_identification_commands(sub: Any, c: Any) -> None:
     p.add_argument("--harmonics", type=whole(1, 20), default=5, help="harmonics per joint (default 5)")
     p.add_argument(
         "--period",
-        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
+        type=bounded(1e-3, 3600.0, unit="s"),  # the Fourier trajectory's shortest period
         default=10.0,
         help="period [s]: the base frequency is 1/period (default 10)",
     )
