@@ -392,13 +392,16 @@ def _command(case: Case, argv: list[Any], ctx: Context) -> list[Any]:
 
 
 def _limit(memory: int | None) -> Any:
-    if memory is None:
-        return None
+    """In the child before it starts: Ctrl-C's default disposition (the suite itself may run
+    as a background job, whose children inherit an ignored SIGINT and would, by the Unix
+    convention the program follows, keep ignoring it), and the memory limit if any."""
 
     def apply() -> None:
-        import resource
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        if memory is not None:
+            import resource
 
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
     return apply
 
