@@ -176,7 +176,13 @@ def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
     out = Path(path)
     if not str(path):
         raise OutputError("''", "is an empty path; expected a folder name")
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
+    if out.is_symlink():  # the swap would replace the link, not the folder it points to
+        raise OutputError(
+            str(out),
+            f"is a symbolic link (to {os.readlink(out)!r}); an output folder is replaced as a whole, which "
+            "would replace the link: give the folder's own path or a new name",
+        )
+    if out.exists() and not out.is_dir():
         raise OutputError(str(out), "exists and is not a directory")
     if out.exists() and not os.access(out, os.W_OK | os.X_OK):
         raise OutputError(

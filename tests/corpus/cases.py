@@ -823,6 +823,7 @@ READERS = [
     C("wrong-excite-infeasible", "excite --out e.toml --velocity-fraction 1e-12 --starts 1 --max-iterations 5 --samples 20", 1, err=("excite failed", "infeasible|not move", "e.toml"), absent=("e.toml",), note="an excitation beyond its limits is a failed run: exit 1, nothing written"),
     C("wrong-excite-period-1e-300", "excite --out e.toml --period 1e-300", 2, err=("--period", "1e-300", "0.001"), absent=("e.toml",)),
     C("hang-excite-months-of-work", "excite --out e.toml --starts 50 --max-iterations 100000 --samples 100000", 2, err=("1.1e+13", "2e+08"), absent=("e.toml",), note="each maximum is accepted alone; together they would run for months: refused before any work"),
+    C("unclear-compare-out-symlink-to-empty-folder", f"compare pd {SIM} --no-plot --out link", 2, err=("link", "symbolic link", "empty"), setup=(folder("empty"), symlink("link", "empty")), checks=(still_symlink("link"),), note="refused (the swap would replace the link), saying so rather than 'not a directory'"),
     C("unclear-ik-just-outside-annulus", "ik 0.62000000001 0", 2, err=("r = 0.62000000001", "<= 0.62 m")),
     C("unclear-ik-just-inside-hole", "ik 0.13999999999 0", 2, err=("r = 0.13999999999", "0.14 <=")),
 ]
