@@ -5,6 +5,7 @@
 ``arguments.py`` the argument types that check numbers against their bounds
 ``commands.py`` one function per command, each a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr
+``guard.py``    around a command: ``--timeout``, ``--json`` stdout kept for the JSON, outputs ≠ inputs
 ==============  ===================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
