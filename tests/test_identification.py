@@ -523,7 +523,9 @@ def test_identify_then_control_with_what_was_identified(tmp_path: Path, twolink,
 def test_a_parameter_file_of_another_robot_is_refused(tmp_path: Path, twolink) -> None:
     path = tmp_path / "p.json"
     path.write_text(json.dumps({"format": "twolink-pin identified parameters", "nv": 6, "robot": "ur5"}))
-    with pytest.raises(InputFileError, match="is for an arm of 6 joints \\(ur5\\); twolink has 2"):
+    with pytest.raises(
+        InputFileError, match="says nv = 6 \\(robot 'ur5'\\); expected nv = 2, the joint count of twolink"
+    ):
         read_parameter_file(path, twolink)
 
 

@@ -78,9 +78,13 @@ class UnreachableTargetError(TwolinkPinError, ValueError):
         self.r_min = r_min
         self.r_max = r_max
         x, y = target
+        r = float((x * x + y * y) ** 0.5)
+        digits = 4  # enough digits that r and the radius it crosses print differently
+        while digits < 17 and any(f"{r:.{digits}g}" == f"{bound:.{digits}g}" for bound in (r_min, r_max)):
+            digits += 1
         super().__init__(
-            f"target ({x:.4g}, {y:.4g}) m is outside the reachable annulus "
-            f"{r_min:.4g} <= r <= {r_max:.4g} m (r = {float((x * x + y * y) ** 0.5):.4g} m)"
+            f"target ({x:.{digits}g}, {y:.{digits}g}) m is outside the reachable annulus "
+            f"{r_min:.{digits}g} <= r <= {r_max:.{digits}g} m (r = {r:.{digits}g} m)"
         )
 
 

@@ -21,6 +21,7 @@ import errno
 import json
 import os
 import shutil
+import signal
 import stat
 import tempfile
 from collections.abc import Iterator
@@ -28,6 +29,7 @@ from pathlib import Path
 from typing import IO, Any
 
 from twolink_pin.errors import InputFileError, OutputError
+from twolink_pin.readiness import ready
 
 
 def _reason(exc: OSError) -> str:
@@ -93,6 +95,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
     try:
         try:
             with os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8") as f:
+                ready("writing")
                 yield f
                 f.flush()
                 os.fsync(f.fileno())
@@ -189,7 +192,13 @@ def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
     out = Path(path)
     if not str(path):
         raise OutputError("''", "is an empty path; expected a folder name")
-    if out.is_symlink() or (out.exists() and not out.is_dir()):
+    if out.is_symlink():  # the swap would replace the link, not the folder it points to
+        raise OutputError(
+            str(out),
+            f"is a symbolic link (to {os.readlink(out)!r}); an output folder is replaced as a whole, which "
+            "would replace the link: give the folder's own path or a new name",
+        )
+    if out.exists() and not out.is_dir():
         raise OutputError(str(out), "exists and is not a directory")
     if out.exists() and not os.access(out, os.W_OK | os.X_OK):
         raise OutputError(
@@ -208,6 +217,22 @@ def check_output_directory(path: str | os.PathLike[str], marker: str) -> Path:
             "— give a new or empty directory",
         )
     return out
+
+
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held back (delivered when the block ends): for the few system
+    calls that must happen together or not at all."""
+    held = {signal.SIGINT, signal.SIGTERM}
+    try:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    except (AttributeError, OSError, ValueError):  # no POSIX signal masks here
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 @contextlib.contextmanager
@@ -231,6 +256,7 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
         raise OutputError(str(out.parent), f"cannot create a folder there ({_reason(exc)})") from exc
     try:
         os.chmod(stage, 0o777 & ~_umask())
+        ready("writing")
         yield stage
         written = sorted(p.name for p in stage.iterdir() if p.name != marker)
         manifest = "".join(f"{MANIFEST_PREFIX}{name}\n" for name in written)
@@ -239,10 +265,11 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
         )
         check_output_directory(out, marker)  # still ours after the work
         old = None
-        if out.exists():
-            old = out.parent / f".{out.name}.old-{os.getpid()}"
-            os.replace(out, old)
-        os.replace(stage, out)
+        with _signals_deferred():  # Ctrl-C between the two renames would lose the old folder
+            if out.exists():
+                old = out.parent / f".{out.name}.old-{os.getpid()}"
+                os.replace(out, old)
+            os.replace(stage, out)
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
     except OSError as exc:

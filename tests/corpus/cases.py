@@ -61,6 +61,7 @@ from corpus.spec import (
     urdf_roundtrip,
     utf8_bom,
     utf16,
+    whole_or_absent,
 )
 from corpus.spec import _zip as zip_of
 
@@ -719,26 +720,113 @@ def twolink_text_latin1() -> bytes:
 # SIGINT (Ctrl-C: to the whole process group) and SIGTERM (kill: to the parent only) on a
 # running command: it ends within 5 s with 130 (SIGTERM: 130, 143 or death by the signal,
 # as long as it cleans up), leaves no staging folder, no partial file, no worker process.
-TERM_EXITS = (130, 143, -15)
+TERM_EXITS = 143
 INTERRUPT = [
-    C("interrupt-report-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), absent=("r",), silent_ok=True),
-    C("interrupt-report-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("r",)),
-    C("interrupt-report-sigint-parent-only", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "parent"), absent=("r",)),
-    C("interrupt-report-workers-1-sigterm", "report --workers 1 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), absent=("r",), silent_ok=True),
-    C("interrupt-report-workers-1-sigint", "report --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("r",)),
-    C("interrupt-report-own-folder-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the previous report stays whole"),
-    C("interrupt-report-own-folder-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), silent_ok=True),
-    C("interrupt-sweep-sigint", "sweep pd --samples 20000 --duration 30 --out s", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("s",)),
-    C("interrupt-sweep-sigterm", "sweep pd --samples 20000 --duration 30 --out s", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), absent=("s",), silent_ok=True),
-    C("interrupt-simulate-sigint", "simulate adaptive --duration 1000 --save run.npz", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("run.npz",)),
-    C("interrupt-simulate-sigterm", "simulate adaptive --duration 1000 --save run.npz", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), absent=("run.npz",), silent_ok=True),
-    C("interrupt-compare-sigint", "compare --duration 300 --out c", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("c",)),
-    C("interrupt-compare-sigterm", "compare --duration 300 --out c", TERM_EXITS, run="signal", signal=(SIGTERM, 1.5, "parent"), absent=("c",), silent_ok=True),
-    C("interrupt-animate-simulating-sigint", "animate adaptive --duration 1000 --html a.html", 130, err=("interrupted",), run="signal", signal=(SIGINT, 1.5, "group"), absent=("a.html",)),
-    C("interrupt-animate-serve-sigint", f"animate pd {SIM} --no-browser", (0, 130), run="signal", signal=(SIGINT, 3.0, "group"), note="Ctrl-C is how the live viewer is meant to stop: 0 (or 130) and nothing left listening"),
-    C("interrupt-animate-serve-sigterm", f"animate pd {SIM} --no-browser", (0, 130, 143), run="signal", signal=(SIGTERM, 3.0, "parent"))
+    C("interrupt-report-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
+    C("interrupt-report-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
+    C("interrupt-report-sigint-parent-only", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "parent"), absent=("r",)),
+    C("interrupt-report-workers-1-sigterm", "report --workers 1 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
+    C("interrupt-report-workers-1-sigint", "report --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
+    C("interrupt-report-own-folder-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the previous report stays whole"),
+    C("interrupt-report-own-folder-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), err=("terminated",)),
+    C("interrupt-sweep-sigint", "sweep pd --samples 20000 --duration 30 --out s", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("s",)),
+    C("interrupt-sweep-sigterm", "sweep pd --samples 20000 --duration 30 --out s", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("s",), err=("terminated",)),
+    C("interrupt-simulate-sigint", "simulate adaptive --duration 1000 --save run.npz", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("run.npz",)),
+    C("interrupt-simulate-sigterm", "simulate adaptive --duration 1000 --save run.npz", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("run.npz",), err=("terminated",)),
+    C("interrupt-compare-sigint", "compare --duration 300 --out c", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("c",)),
+    C("interrupt-compare-sigterm", "compare --duration 300 --out c", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("c",), err=("terminated",)),
+    C("interrupt-animate-simulating-sigint", "animate adaptive --duration 1000 --html a.html", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("a.html",)),
+    C("interrupt-animate-serve-sigint", f"animate pd {SIM} --no-browser", (0, 130), run="signal", signal=(SIGINT, "running", "group"), note="Ctrl-C is how the live viewer is meant to stop: 0 (or 130) and nothing left listening"),
+    C("interrupt-animate-serve-sigterm", f"animate pd {SIM} --no-browser", (0, 130, 143), run="signal", signal=(SIGTERM, "running", "parent")),
+
+    # while importing the package and parsing the arguments (the signal goes out at the entry's first statement)
+    C("interrupt-simulate-importing-sigint", "simulate adaptive --duration 1000 --save run.npz", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), absent=("run.npz",)),
+    C("interrupt-simulate-importing-sigterm", "simulate adaptive --duration 1000 --save run.npz", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "started", "parent"), absent=("run.npz",)),
+    C("interrupt-fk-importing-sigint", "fk 0 0 --json", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), note="a command that takes no time still says 'interrupted' if Ctrl-C comes while it loads"),
+    C("interrupt-report-importing-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), absent=("r",)),
+    C("interrupt-sweep-importing-sigterm", "sweep pd --samples 20000 --duration 30 --out s", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "started", "parent"), absent=("s",)),
+    C("interrupt-compare-parsed-sigint", "compare --duration 300 --out c", 130, err=("interrupted",), run="signal", signal=(SIGINT, "parsed", "group"), absent=("c",)),
+    C("interrupt-sweep-parsed-sigint", "sweep pd --samples 20000 --duration 30 --out s", 130, err=("interrupted",), run="signal", signal=(SIGINT, "parsed", "group"), absent=("s",)),
+    C("interrupt-report-parsed-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "parsed", "parent"), absent=("r",)),
+    C("interrupt-ik-parsed-sigterm", "ik 0.3 0.2 --json", (0, 143), run="signal", signal=(SIGTERM, "parsed", "parent"), note="ik may finish before the signal lands: its answer (exit 0) or 143, never a traceback"),
+    # while writing: the signal comes when the output is being staged; the command may finish first
+    C("interrupt-simulate-writing-sigint", "simulate pd --duration 20 --save run.npz", (0, 130), run="signal", signal=(SIGINT, "writing", "group"), checks=(whole_or_absent("run.npz"),)),
+    C("interrupt-simulate-writing-sigterm", "simulate pd --duration 20 --save run.npz", (0, 143), run="signal", signal=(SIGTERM, "writing", "parent"), checks=(whole_or_absent("run.npz"),)),
+    C("interrupt-report-own-folder-writing-sigint", "report --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "writing", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the report stages its folder before its runs: the previous report stays whole"),
 ]
 
+
+# == 8. User code ====================================================================================
+# A law or plug-in that misbehaves as user code can (laws/misbehaving.py): an error naming the
+# law (exit 1, or 2 for a file that cannot be imported), nothing written, never a silent exit,
+# a changed simulation, a corrupted --json or a hang. os._exit cannot be caught in-process
+# (docs/reliability.md): no case for it.
+MIS = f"{LAW}/misbehaving.py"
+
+
+def json_text(obj: object) -> str:
+    import json
+
+    return json.dumps(obj)
+
+
+PLUGIN = (
+    text("site/corpus_broken_plugin-1.0.dist-info/METADATA", "Metadata-Version: 2.1\nName: corpus-broken-plugin\nVersion: 1.0\n"),
+    text("site/corpus_broken_plugin-1.0.dist-info/entry_points.txt", "[twolink_pin.controllers]\ncorpus-broken = corpus_broken_plugin:Law\n"),
+    text("site/corpus_broken_plugin.py", 'raise ImportError("corpus: this plug-in needs a package that is not installed")\n'),
+)
+"""An installed plug-in (a dist-info on PYTHONPATH) whose module fails to import."""
+USERCODE = [
+    C("usercode-simulate-law-exit-0", f"simulate {MIS}:ExitZero {SIM} --save run.npz", 1, err=("corpus-exit-zero", "sys.exit(0)", "t ="), absent=("run.npz",), note="sys.exit(0) in a law must not look like success"),
+    C("usercode-simulate-law-exit-3", f"simulate {MIS}:ExitThree {SIM} --json", 1, err=("corpus-exit-three", "sys.exit(3)")),
+    C("usercode-simulate-law-exit-0-proc", f"simulate {MIS}:ExitZero {SIM} --save run.npz", 1, err=("corpus-exit-zero", "sys.exit(0)"), run="proc", absent=("run.npz",)),
+    C("usercode-simulate-law-exit-adaptive", f"simulate {MIS}:ExitZero {SIM} --method adaptive", 1, err=("corpus-exit-zero", "sys.exit(0)")),
+    C("usercode-simulate-law-file-exits-on-import", f"simulate {LAW}/exit_on_import.py:Law {SIM}", 2, err=("exit_on_import.py", "sys.exit(0)")),
+    C("usercode-sweep-law-exit-0", f"sweep {MIS}:ExitZero --samples 4 {SIM} --no-plot --out s", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("s",), note="a sweep leaves no partial folder"),
+    C("usercode-compare-law-exit-0", f"compare {MIS}:ExitZero pd {SIM} --no-plot --out c", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("c",)),
+    C("usercode-simulate-law-writes-state", f"simulate {MIS}:WritesState {SIM} --save run.npz", 1, err=("corpus-writes-state", "read-only"), absent=("run.npz",)),
+    C("usercode-simulate-law-writes-reference", f"simulate {MIS}:WritesReference {SIM}", 1, err=("corpus-writes-reference", "read-only", "reference")),
+    C("usercode-simulate-law-writes-state-adaptive", f"simulate {MIS}:WritesState {SIM} --method adaptive", 1, err=("corpus-writes-state", "read-only")),
+    C("usercode-simulate-law-memory", f"simulate {MIS}:Hog {SIM}", 1, err=("corpus-hog", "memory"), not_err=("please report",)),
+    C("usercode-simulate-law-prints-json", f"simulate {MIS}:Printer {SIM} --json", 0, warns=("corpus-printer says hello",), checks=(strict_json(), json_at("stdout", "controller", "==", "corpus-printer")), note="a law's print goes to stderr with --json: stdout holds the JSON alone"),
+    C("usercode-simulate-law-sleeps-timeout", f"simulate {MIS}:Sleeper {SIM} --timeout 2 --save run.npz", 1, err=("--timeout 2 s", "Sleeper"), run="proc", absent=("run.npz",), timeout=30),
+    C("usercode-simulate-law-spins-timeout", f"simulate {MIS}:Spinner {SIM} --timeout 2 --method adaptive", 1, err=("--timeout 2 s", "Spinner"), run="proc", timeout=30),
+    C("usercode-compare-law-sleeps-timeout", f"compare {MIS}:Sleeper pd {SIM} --timeout 2 --no-plot --out c", 1, err=("--timeout 2 s",), run="proc", absent=("c",), timeout=30),
+    C("usercode-simulate-timeout-negative", f"simulate pd {SIM} --timeout -1", 2, err=("--timeout", "-1")),
+    C("usercode-controllers-broken-plugin-warns", "controllers --json", 0, warns=("warning", "corpus-broken", "ImportError"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc", checks=(strict_json(),), note="the built-in laws are still listed; the broken plug-in is a warning, not silently missing"),
+    C("usercode-simulate-broken-plugin-by-name", f"simulate corpus-broken {SIM}", 2, err=("corpus-broken", "plug-in", "ImportError", "not installed"), setup=PLUGIN, env=(("PYTHONPATH", "{dir}/site"),), run="proc"),
+]
+
+# == Bounded readers and outputs that would replace an input (issue 23) ================================
+PFORMAT = "twolink-pin identified parameters"
+DEEP_JSON = '{"times": ' + "[" * 5000 + "]" * 5000 + "}"
+DEEP_TOML = "times = " + "[" * 5000 + "]" * 5000 + "\n"
+PLAIN_TOML = "times = [0.0, 1.0, 2.0]\njoints = [[0.0, 0.0], [0.2, 0.1], [0.0, 0.0]]\n"
+FOURIER = "[fourier]\nperiod = {}\nharmonics = 1\na = [[0.1], [0.1]]\nb = [[0.0], [0.0]]\noffset = [0.0, 0.0]\n"
+READERS = [
+    C("traceback-simulate-trajectory-json-deep", f"simulate pd {SIM} --trajectory deep.json", 2, err=("deep.json", "32 deep"), setup=(text("deep.json", DEEP_JSON),)),
+    C("traceback-simulate-trajectory-toml-deep", f"simulate pd {SIM} --trajectory deep.toml", 2, err=("deep.toml", "32 deep"), setup=(text("deep.toml", DEEP_TOML),)),
+    C("traceback-simulate-p0-json-deep", f"simulate adaptive {SIM} --p0 deep.json", 2, err=("deep.json", "32 deep"), setup=(text("deep.json", '{"format": ' + "[" * 100000 + "]" * 100000 + "}"),)),
+    C("traceback-simulate-trajectory-json-deep-in-string", f"simulate pd {SIM} --trajectory t.json", 2, err=("t.json", "only the keys"), setup=(text("t.json", '{"times": [0, 1, 2], "joints": [[0, 0], [0.2, 0.1], [0, 0]], "comment": "' + "[" * 5000 + '"}'),), note="brackets inside a string are not nesting: the file is refused for its key, not its depth"),
+    C("nonfinite-simulate-trajectory-times-overflow", f"simulate pd {SIM} --trajectory t.toml", 2, err=("times[1]", "1e+300", "1e+06"), setup=(text("t.toml", "times = [0, 1e300, 2e300]\njoints = [[0, 0], [0.2, 0.1], [0, 0]]\n"),)),
+    C("nonfinite-simulate-trajectory-times-crowded", f"simulate pd {SIM} --trajectory t.toml", 2, err=("times[1]", "0.001 s"), setup=(text("t.toml", "times = [0, 1e-12, 2]\njoints = [[0, 0], [0.2, 0.1], [0, 0]]\n"),)),
+    C("wrong-simulate-fourier-period-1e-300", f"simulate pd {SIM} --trajectory f.toml", 2, err=("fourier.period", "1e-300", "0.001"), setup=(text("f.toml", FOURIER.format("1e-300")),)),
+    C("wrong-simulate-fourier-period-1e300", f"simulate pd {SIM} --trajectory f.toml", 2, err=("fourier.period", "1e+300|1e300", "1e+06"), setup=(text("f.toml", FOURIER.format("1e300")),)),
+    C("wrong-simulate-p0-duplicate-parameter", f"simulate adaptive {SIM} --p0 p.json", 2, err=("p.json", "repeats", "'m1'"), setup=(text("p.json", json_text({"format": PFORMAT, "nv": 2, "robot": "twolink", "parameters": [{"name": "m1", "estimate": 1.0}, {"name": "m1", "estimate": 2.0}]})),)),
+    C("wrong-simulate-p0-duplicate-key", f"simulate adaptive {SIM} --p0 p.json", 2, err=("p.json", "'nv'", "twice"), setup=(text("p.json", '{"format": "' + PFORMAT + '", "nv": 6, "nv": 2, "parameters": []}'),)),
+    C("unclear-simulate-p0-other-robot", f"simulate adaptive {SIM} --p0 p.json", 2, err=("nv = 6", "expected nv = 2", "twolink"), not_err=("twolink has 2",), setup=(text("p.json", json_text({"format": PFORMAT, "nv": 6, "robot": "ur5", "parameters": []})),)),
+    C("hang-identify-data-npz-bomb", "identify --data bomb.npz", 2, err=("bomb.npz", "claims"), setup=(blob("bomb.npz", npz_bomb),), run="proc", memory=2 * GiB, timeout=60, note="4 MB that inflate to 4 GiB: refused from the headers, before anything is inflated"),
+    C("dataloss-simulate-save-over-trajectory", f"simulate pd {SIM} --trajectory t.toml --save t.toml", 2, err=("--save", "t.toml", "--trajectory"), setup=(text("t.toml", PLAIN_TOML),)),
+    C("dataloss-simulate-save-over-trajectory-symlink", f"simulate pd {SIM} --trajectory t.toml --save link.npz", 2, err=("--save", "link.npz", "t.toml"), setup=(text("t.toml", PLAIN_TOML), symlink("link.npz", "t.toml"))),
+    C("dataloss-identify-save-over-trajectory", "identify --trajectory t.toml --duration 2 --save t.toml", 2, err=("--save", "t.toml"), setup=(text("t.toml", PLAIN_TOML),)),
+    C("dataloss-animate-html-over-from", "animate --from run.npz --html run.npz", 2, err=("--html", "run.npz"), setup=(SAVED,)),
+    C("wrong-excite-infeasible", "excite --out e.toml --velocity-fraction 1e-12 --starts 1 --max-iterations 5 --samples 20", 1, err=("excite failed", "infeasible|not move", "e.toml"), absent=("e.toml",), note="an excitation beyond its limits is a failed run: exit 1, nothing written"),
+    C("wrong-excite-period-1e-300", "excite --out e.toml --period 1e-300", 2, err=("--period", "1e-300", "0.001"), absent=("e.toml",)),
+    C("hang-excite-months-of-work", "excite --out e.toml --starts 50 --max-iterations 100000 --samples 100000", 2, err=("1.1e+13", "2e+08"), absent=("e.toml",), note="each maximum is accepted alone; together they would run for months: refused before any work"),
+    C("unclear-compare-out-symlink-to-empty-folder", f"compare pd {SIM} --no-plot --out link", 2, err=("link", "symbolic link", "empty"), setup=(folder("empty"), symlink("link", "empty")), checks=(still_symlink("link"),), note="refused (the swap would replace the link), saying so rather than 'not a directory'"),
+    C("unclear-ik-just-outside-annulus", "ik 0.62000000001 0", 2, err=("r = 0.62000000001", "<= 0.62 m")),
+    C("unclear-ik-just-inside-hole", "ik 0.13999999999 0", 2, err=("r = 0.13999999999", "0.14 <=")),
+]
 
 # == 6b. Library-level arguments =====================================================================
 # The public functions raise InvalidParameterError naming the argument (expected vs received),
@@ -820,7 +908,17 @@ LIBRARY = [
 # fmt: on
 
 
-CASES: list[Case] = [*DATALOSS, *WRONG, *HANG, *TRACEBACK, *NONFINITE, *UNCLEAR, *INTERRUPT]
+CASES: list[Case] = [
+    *DATALOSS,
+    *WRONG,
+    *HANG,
+    *TRACEBACK,
+    *NONFINITE,
+    *UNCLEAR,
+    *INTERRUPT,
+    *USERCODE,
+    *READERS,
+]
 """Every command-line case."""
 
 

@@ -55,6 +55,17 @@ TRACEBACK = "Traceback (most recent call last)"
 MARK = "TWOLINK_CORPUS_MARK"
 """Environment variable carrying a per-case token into every process the case starts."""
 DROPPED_CAPS = "-dac_override,-dac_read_search,-fowner"
+HANG_SCALE = 3.0
+"""A case's ``timeout`` is what it needs on a quiet machine; the runner waits this many
+times longer before calling it a hang, so that a machine busy with other work (CI, two
+CPU-bound processes beside the suite) does not fail the suite. A hang is a hang either way."""
+SIGNAL_GRACE = 30.0
+"""How long a signalled process (and its workers) may take to clean up and end [s]: a bound
+against a hang, not a speed requirement."""
+REAP_GRACE = 15.0
+"""How long after a command ended the processes it started may take to be gone [s]."""
+READY = "TWOLINK_PIN_READY_FILE"
+"""Environment variable naming the file where the program writes the stages it reaches."""
 
 FULLFS_SCRIPT = r"""
 mount -t tmpfs -o size=32k,mode=0777 tmpfs "$1" || exit 97
@@ -353,7 +364,7 @@ def _env(token: str, case: Case, ctx: Context) -> dict[str, str]:
 
 
 def _command(case: Case, argv: list[Any], ctx: Context) -> list[Any]:
-    base = [sys.executable, "-m", "twolink_pin.cli", *argv]
+    base = [sys.executable, "-m", "twolink_pin_entry", *argv]  # what the console script runs
     if case.run == "setpriv":
         return ["setpriv", f"--bounding-set={DROPPED_CAPS}", "--", *base] if os.geteuid() == 0 else base
     if case.run in ("fullfs", "fullfs-filled"):
@@ -381,13 +392,16 @@ def _command(case: Case, argv: list[Any], ctx: Context) -> list[Any]:
 
 
 def _limit(memory: int | None) -> Any:
-    if memory is None:
-        return None
+    """In the child before it starts: Ctrl-C's default disposition (the suite itself may run
+    as a background job, whose children inherit an ignored SIGINT and would, by the Unix
+    convention the program follows, keep ignoring it), and the memory limit if any."""
 
     def apply() -> None:
-        import resource
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
+        if memory is not None:
+            import resource
 
-        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
+            resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
 
     return apply
 
@@ -411,7 +425,7 @@ def _marked(token: str) -> list[int]:
     return found
 
 
-def _reap(token: str, outcome: Outcome, grace: float = 3.0) -> None:
+def _reap(token: str, outcome: Outcome, grace: float = REAP_GRACE) -> None:
     """Note and kill (by pid) the processes the case left behind."""
     deadline = time.monotonic() + grace
     left = _marked(token)
@@ -435,7 +449,7 @@ def run(case: Case, ctx: Context, capfd: Any) -> Outcome:
     cwd = ctx.folder / case.cwd
     start = time.monotonic()
     if case.run == "inproc":
-        code, out, err = _inproc_main(argv, cwd, case.timeout, capfd)
+        code, out, err = _inproc_main(argv, cwd, case.timeout * HANG_SCALE, capfd)
         return Outcome(code, out, err, time.monotonic() - start, timed_out=code is None)
     token = uuid.uuid4().hex
     cmd = _command(case, argv, ctx)
@@ -446,10 +460,13 @@ def run(case: Case, ctx: Context, capfd: Any) -> Outcome:
             full = open("/dev/full", "wb")  # closed below
             stdout = full
         stdin: Any = subprocess.PIPE if case.run == "stdin-pipe" else subprocess.DEVNULL
+        ready = ctx.harness / "ready"
+        env = _env(token, case, ctx)
+        env[READY] = str(ready)
         proc = subprocess.Popen(
             cmd,
             cwd=cwd,
-            env=_env(token, case, ctx),
+            env=env,
             stdin=stdin,
             stdout=stdout,
             stderr=err_f,
@@ -458,10 +475,10 @@ def run(case: Case, ctx: Context, capfd: Any) -> Outcome:
         )
         outcome = Outcome(None, "", "", 0.0)
         if case.run == "signal":
-            _signal(case, proc, outcome)
+            _signal(case, proc, ready, outcome)
         else:
             try:
-                proc.wait(timeout=case.timeout)
+                proc.wait(timeout=case.timeout * HANG_SCALE)
             except subprocess.TimeoutExpired:
                 outcome.timed_out = True
                 with contextlib.suppress(OSError):
@@ -483,18 +500,38 @@ def run(case: Case, ctx: Context, capfd: Any) -> Outcome:
     return outcome
 
 
-def _signal(case: Case, proc: subprocess.Popen[bytes], outcome: Outcome) -> None:
-    """Send ``case.signal`` after its delay; the process must end within 5 s and its children with it."""
+def _wait_for_stage(proc: subprocess.Popen[bytes], ready: Path, stage: str, bound: float) -> bool:
+    """Wait until the process has written ``stage`` to its readiness file (True) or has ended
+    (False). ``bound`` [s] only guards against a program that never gets there (a hang)."""
+    end = time.monotonic() + bound
+    while time.monotonic() < end:
+        with contextlib.suppress(OSError):
+            if stage in ready.read_text().split():
+                return True
+        if proc.poll() is not None:
+            return False
+        time.sleep(0.01)  # polling a file, not a delay before the signal
+    return False
+
+
+def _signal(case: Case, proc: subprocess.Popen[bytes], ready: Path, outcome: Outcome) -> None:
+    """Send ``case.signal`` as soon as the program says it reached the case's stage (its
+    readiness file, :mod:`twolink_pin.readiness`); it must end, and its children with it."""
     import psutil
 
     assert case.signal is not None
-    signum, after, target = case.signal
-    try:
-        proc.wait(timeout=after)
-        outcome.notes.append(f"ended by itself (exit {proc.returncode}) before the signal at {after:g} s")
+    signum, stage, target = case.signal
+    if not _wait_for_stage(proc, ready, stage, case.timeout * HANG_SCALE):
+        if proc.poll() is None:
+            outcome.notes.append(f"never reached the stage {stage!r} within {case.timeout * HANG_SCALE:g} s")
+            with contextlib.suppress(OSError):
+                os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+        else:
+            outcome.notes.append(
+                f"ended by itself (exit {proc.returncode}) before reaching the stage {stage!r}"
+            )
         return
-    except subprocess.TimeoutExpired:
-        pass
     try:
         children = psutil.Process(proc.pid).children(recursive=True)
     except psutil.Error:
@@ -505,20 +542,20 @@ def _signal(case: Case, proc: subprocess.Popen[bytes], outcome: Outcome) -> None
         proc.send_signal(signum)
     sent = time.monotonic()
     try:
-        proc.wait(timeout=5.0)
+        proc.wait(timeout=SIGNAL_GRACE)
     except subprocess.TimeoutExpired:
-        outcome.notes.append(f"still running 5 s after {signal.Signals(signum).name}")
+        outcome.notes.append(f"still running {SIGNAL_GRACE:g} s after {signal.Signals(signum).name}")
         with contextlib.suppress(OSError):
             os.killpg(proc.pid, signal.SIGKILL)
         proc.wait()
-    deadline = sent + 5.0
+    deadline = sent + SIGNAL_GRACE
     alive = [c for c in children if _alive(c)]
     while alive and time.monotonic() < deadline:
         time.sleep(0.1)
         alive = [c for c in alive if _alive(c)]
     if alive:
         outcome.notes.append(
-            f"{len(alive)} worker process(es) of {len(children)} still running 5 s after "
+            f"{len(alive)} worker process(es) of {len(children)} still running {SIGNAL_GRACE:g} s after "
             f"{signal.Signals(signum).name}: pids {[c.pid for c in alive]}"
         )
         for c in alive:
@@ -562,7 +599,7 @@ def verify(case: Case, ctx: Context, before: dict[str, tuple[str, str]], outcome
     problems: list[str] = list(outcome.notes)
     code, out, err = outcome.code, outcome.stdout, outcome.stderr
     if outcome.timed_out:
-        problems.append(f"hang: still running after {case.timeout:g} s")
+        problems.append(f"hang: still running after {case.timeout * HANG_SCALE:g} s")
     if TRACEBACK in err:
         problems.append(f"traceback: {last_line(err)}")
     if not outcome.timed_out and code not in case.exits:
@@ -592,8 +629,11 @@ def verify(case: Case, ctx: Context, before: dict[str, tuple[str, str]], outcome
         if missing:
             problems.append(f"stderr lacks {missing}: {last_line(err)[:300]!r}")
     if code == 0 and case.run != "signal":
-        if messages:
+        if messages and not case.warns:
             problems.append(f"success printed on stderr: {' / '.join(m[:160] for m in messages[:3])}")
+        missing_warnings = [w for w in case.warns if not _has(err, w)]
+        if missing_warnings:
+            problems.append(f"stderr of the success lacks {missing_warnings}: {last_line(err)[:200]!r}")
         missing = [w for w in case.out if not _has(out, w)]
         if missing:
             problems.append(f"stdout lacks {missing}: {out.strip()[:200]!r}")
@@ -830,7 +870,33 @@ def _check_finite_file(ctx: Context, outcome: Outcome, path: str) -> str | None:
     )
 
 
+def _check_whole_or_absent(ctx: Context, outcome: Outcome, path: str, kind: str) -> str | None:
+    target = ctx.folder / path
+    if outcome.code == 0:
+        if not target.exists():
+            return f"exit 0 but {path} is missing"
+        try:
+            if kind == "npz":
+                from twolink_pin.simulation.storage import load_result
+
+                load_result(target)
+            else:
+                (target / "index.html").read_text(encoding="utf-8")
+        except Exception as exc:
+            return f"{path} is not whole after exit 0: {type(exc).__name__}: {exc}"
+        return None
+    if os.path.lexists(target) and kind == "npz":  # interrupted after it was committed: whole
+        try:
+            from twolink_pin.simulation.storage import load_result
+
+            load_result(target)
+        except Exception as exc:
+            return f"{path} is partial after exit {outcome.code}: {type(exc).__name__}: {exc}"
+    return None
+
+
 CHECKS = {
+    "whole_or_absent": _check_whole_or_absent,
     "json": _check_json,
     "ik_reaches": _check_ik,
     "fk_closed_form": _check_fk,

@@ -36,6 +36,7 @@ CLASSES = {
     "unclear": "6. unclear messages: what works must work, what fails must say why",
     "interrupt": "7. interrupts: SIGINT and SIGTERM on running commands",
     "library": "6b. library-level arguments: wrong sizes, NaN, wrong types",
+    "usercode": "8. user code contained: laws and plug-ins that exit, print, write their inputs, exhaust memory, never return",
 }
 """Case classes, by the first word of a case id."""
 
@@ -50,7 +51,7 @@ RUNNERS = (
     "stdout-full",  # stdout is /dev/full
     "stderr-closed",  # sh -c '... 2>&-'
     "stdin-pipe",  # stdin is a pipe nobody writes to or closes
-    "signal",  # a real process that gets Case.signal after a delay
+    "signal",  # a real process that gets Case.signal when it reports a stage
 )
 
 
@@ -90,8 +91,12 @@ class Case:
         chardev: Paths that must still be character devices afterwards.
         checks: Extra checks.
         run: How to run it (:data:`RUNNERS`).
-        signal: ``(signum, after [s], "group" | "parent")`` for the ``signal`` runner.
+        signal: ``(signum, stage, "group" | "parent")`` for the ``signal`` runner: the signal
+            goes out as soon as the program reports ``stage`` (``started``, ``parsed``,
+            ``running``, ``writing``: :mod:`twolink_pin.readiness`), never after a delay.
         nonfinite_ok: A successful run may print ``nan`` / ``inf``.
+        warns: Words a successful run's stderr must hold (a warning, a law's own prints); a
+            success may then print on stderr.
         silent_ok: A failed run may print nothing on stderr (stdout unwritable, killed).
         timeout: Seconds before the case counts as a hang (the default is generous: every case
             that works takes a few seconds at most).
@@ -115,8 +120,9 @@ class Case:
     chardev: tuple[str, ...] = ()
     checks: tuple[Check, ...] = ()
     run: str = "inproc"
-    signal: tuple[int, float, str] | None = None
+    signal: tuple[int, str, str] | None = None
     nonfinite_ok: bool = False
+    warns: tuple[str, ...] = ()
     silent_ok: bool = False
     timeout: float = 20.0
     env: tuple[tuple[str, str], ...] = ()
@@ -131,6 +137,8 @@ class Case:
             raise ValueError(f"case {self.id!r}: unknown runner {self.run!r}")
         if (self.run == "signal") != (self.signal is not None):
             raise ValueError(f"case {self.id!r}: the signal runner and Case.signal go together")
+        if self.signal is not None and self.signal[1] not in STAGES:
+            raise ValueError(f"case {self.id!r}: stage {self.signal[1]!r} is not one of {STAGES}")
 
     @property
     def cls(self) -> str:
@@ -216,6 +224,13 @@ def contains(path: str, word: str) -> Check:
 def finite_file(path: str) -> Check:
     """The text file ``path`` holds no nan / inf (after a success)."""
     return Check("finite_file", (path,))
+
+
+def whole_or_absent(path: str, kind: str = "npz") -> Check:
+    """After an interrupt that may have come too late to stop the command: ``path`` is absent
+    or a whole file that loads (the signal came after it was committed; exit 0 requires it);
+    never a partial file."""
+    return Check("whole_or_absent", (path, kind))
 
 
 # -- setup steps -------------------------------------------------------------------------------
@@ -492,3 +507,5 @@ def json_file(obj: Any) -> str:
 
 
 SIGINT, SIGTERM = int(signal.SIGINT), int(signal.SIGTERM)
+STAGES = ("started", "parsed", "running", "writing")
+"""The stages the program reports (:mod:`twolink_pin.readiness`), in order."""

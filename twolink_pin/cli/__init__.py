@@ -5,6 +5,7 @@
 ``arguments.py`` the argument types that check numbers against their bounds
 ``commands/``   one module per family of commands, each command a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr
+``guard.py``    around a command: ``--timeout``, ``--json`` stdout kept for the JSON, outputs ≠ inputs
 ==============  ===================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
@@ -21,9 +22,12 @@ import signal
 import sys
 import threading
 from collections.abc import Sequence
+from typing import Any
 
+from twolink_pin.cli import guard
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.readiness import ready
 
 
 class Terminated(KeyboardInterrupt):
@@ -31,8 +35,34 @@ class Terminated(KeyboardInterrupt):
     folders removed, worker processes stopped) as for Ctrl-C."""
 
 
+_signalled: list[int] = []
+"""The signals received while the command ran: whatever exception then reaches :func:`main`
+(an import that turned the ``KeyboardInterrupt`` into an ``ImportError``, a library that
+caught it), the outcome is the interrupt."""
+
+
 def _terminate(signum: int, frame: object) -> None:
+    _signalled.append(signum)
     raise Terminated
+
+
+def _interrupt(signum: int, frame: object) -> None:
+    _signalled.append(signum)
+    raise KeyboardInterrupt
+
+
+def _run(args: argparse.Namespace) -> int:
+    """The command under its guards; an exception after a signal is the interrupt, whatever
+    it turned into on its way (an ``ImportError`` from an interrupted import)."""
+    try:
+        with guard.wall_clock_bound(getattr(args, "timeout", None)):
+            with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
+                code = int(args.func(args))
+    except BaseException:
+        if _signalled:
+            raise (Terminated if _signalled[-1] == signal.SIGTERM else KeyboardInterrupt)() from None
+        raise
+    return code  # a command may end on Ctrl-C by design (the live viewer): its status stands
 
 
 MAX_LINE = 1000
@@ -84,12 +114,33 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     _check_texts(parser, args)
-    args.argv = list(sys.argv[1:] if argv is None else argv)
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        return int(args.func(args))
+        guard.check_outputs_are_not_inputs(args, _option_names(parser, args.command))
+    except TwolinkPinError as exc:
+        parser.error(str(exc))
+    ready("parsed")
+    args.argv = list(sys.argv[1:] if argv is None else argv)
+    previous: dict[int, Any] = {}
+    del _signalled[:]
+    if threading.current_thread() is threading.main_thread():
+        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _terminate)}
+        if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job ignores Ctrl-C
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, _interrupt)
+    try:
+        ready("running")
+        return _run(args)
+    except guard.RunTimeout as exc:
+        law = getattr(args, "controller", None) or getattr(args, "controllers", None)
+        named = (
+            f" (the law {law if isinstance(law, str) else ', '.join(map(str, law))} may never return)"
+            if law
+            else ""
+        )
+        _say(
+            f"twolink-pin: stopped after --timeout {exc.seconds:g} s of wall-clock time{named}; "
+            "give a larger --timeout for a longer run"
+        )
+        return 1
     except (SimulationDivergedError, ControllerError) as exc:
         if isinstance(exc, ControllerError) and _debug(args):  # the law's own traceback
             import traceback
@@ -122,8 +173,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return 1
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 def _debug(args: argparse.Namespace) -> bool:

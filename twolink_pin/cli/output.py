@@ -29,23 +29,29 @@ def jsonable(obj: Any) -> Any:
     return obj
 
 
+RESULT_STREAM: Any = None
+"""Where :func:`emit` writes when set (the real stdout while ``--json`` sends everything
+else written to ``sys.stdout`` to stderr: :mod:`twolink_pin.cli.guard`)."""
+
+
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
     """Print ``payload`` as one JSON line with ``--json``, else ``text``.
 
     Raises:
         OutputError: stdout is closed (nothing can be printed).
     """
-    if sys.stdout is None:
+    stream = RESULT_STREAM if RESULT_STREAM is not None else sys.stdout
+    if stream is None:
         from twolink_pin.errors import OutputError
 
         raise OutputError(
             "<stdout>", "is closed; nothing can be printed (reopen it or redirect it to a file)"
         )
     if getattr(args, "json", False):
-        sys.stdout.write(json.dumps(jsonable(payload), allow_nan=False) + "\n")
+        stream.write(json.dumps(jsonable(payload), allow_nan=False) + "\n")
     else:
-        sys.stdout.write(text + "\n")
-    sys.stdout.flush()
+        stream.write(text + "\n")
+    stream.flush()
 
 
 def fmt(values: Sequence[float] | np.ndarray, digits: int = 4) -> str:

@@ -7,6 +7,7 @@ from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
 from twolink_pin.cli.disturbance_options import add_disturbance_options
+from twolink_pin.cli.guard import DEFAULT_TIMEOUT
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -99,6 +100,13 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         default=None,
         metavar="T",
         help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
+    )
+    p.add_argument(
+        "--timeout",
+        type=bounded(0.0, 1e7, unit="s"),
+        default=DEFAULT_TIMEOUT,
+        metavar="S",
+        help=f"stop the command after S s of wall-clock time: a law that never returns (0: no bound; default {DEFAULT_TIMEOUT:g} = one day)",
     )
     p.add_argument(
         "--friction-smoothing",
@@ -552,7 +560,7 @@ def add_identification_commands(sub: Any, c: Any) -> None:
     p.add_argument("--harmonics", type=whole(1, 20), default=5, help="harmonics per joint (default 5)")
     p.add_argument(
         "--period",
-        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
+        type=bounded(1e-3, 3600.0, unit="s"),  # the Fourier trajectory's shortest period
         default=10.0,
         help="period [s]: the base frequency is 1/period (default 10)",
     )

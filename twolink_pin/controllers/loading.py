@@ -28,25 +28,45 @@ ENTRY_POINT_GROUP = "twolink_pin.controllers"
 """Entry-point group through which installed packages add control laws."""
 
 _entry_points_loaded = False
+_broken_plugins: dict[str, str] = {}
+"""Plug-in name → why it could not be loaded (kept so that asking for it by name says why)."""
+
+
+def _raised(exc: BaseException) -> str:
+    """What user code raised, in words (``sys.exit`` spelled as such)."""
+    if isinstance(exc, SystemExit):
+        return f"called sys.exit({exc.code!r})"
+    return f"raised {type(exc).__name__}: {exc}"
 
 
 def load_entry_points() -> list[str]:
     """Import every law registered through :data:`ENTRY_POINT_GROUP` (once); returns the
-    problems met, one line each (a broken plug-in must not break the built-in laws)."""
+    problems met, one line each (a broken plug-in must not break the built-in laws; it is
+    listed by :func:`broken_plugins` and named when asked for)."""
     global _entry_points_loaded
-    problems: list[str] = []
     if _entry_points_loaded:
-        return problems
+        return list(_broken_plugins.values())
     _entry_points_loaded = True
     for entry in importlib.metadata.entry_points(group=ENTRY_POINT_GROUP):
         try:
             cls = entry.load()
-        except Exception as exc:  # a plug-in's own failure: reported, not fatal
-            problems.append(f"entry point {entry.name} = {entry.value}: {type(exc).__name__}: {exc}")
+        except KeyboardInterrupt:
+            raise
+        except BaseException as exc:  # a plug-in's own failure (even sys.exit): reported, not fatal
+            _broken_plugins[entry.name] = (
+                f"plug-in {entry.name!r} ({entry.value}): importing it {_raised(exc)}"
+            )
             continue
         if not (inspect.isclass(cls) and issubclass(cls, Controller)):
-            problems.append(f"entry point {entry.name} = {entry.value}: not a Controller subclass")
-    return problems
+            _broken_plugins[entry.name] = f"plug-in {entry.name!r} ({entry.value}): not a Controller subclass"
+    return list(_broken_plugins.values())
+
+
+def broken_plugins() -> dict[str, str]:
+    """Plug-ins registered under :data:`ENTRY_POINT_GROUP` that could not be loaded: name →
+    the reason (one line)."""
+    load_entry_points()
+    return dict(_broken_plugins)
 
 
 def available_controllers() -> dict[str, type[Controller]]:
@@ -81,9 +101,9 @@ def _from_file(spec: str, file_part: str, class_name: str) -> type:
             raise
         except BaseException as exc:
             sys.modules.pop(module_name, None)
-            if isinstance(exc, (KeyboardInterrupt, SystemExit)):
+            if isinstance(exc, KeyboardInterrupt):
                 raise
-            raise ControllerSpecError(spec, f"importing {path} raised {type(exc).__name__}: {exc}") from exc
+            raise ControllerSpecError(spec, f"importing {path} {_raised(exc)}") from None
     if not hasattr(module, class_name):
         found = sorted(
             n
@@ -101,10 +121,10 @@ def _from_module(spec: str, module_name: str, class_name: str) -> type:
         module = importlib.import_module(module_name)
     except ImportError as exc:
         raise ControllerSpecError(spec, f"cannot import module {module_name!r} ({exc})") from exc
-    except Exception as exc:
-        raise ControllerSpecError(
-            spec, f"importing {module_name!r} raised {type(exc).__name__}: {exc}"
-        ) from exc
+    except KeyboardInterrupt:
+        raise
+    except BaseException as exc:  # the module's own failure, sys.exit and MemoryError included
+        raise ControllerSpecError(spec, f"importing {module_name!r} {_raised(exc)}") from None
     if not hasattr(module, class_name):
         raise ControllerSpecError(spec, f"module {module_name!r} has no class {class_name!r}")
     return getattr(module, class_name)
@@ -121,6 +141,8 @@ def load_controller(spec: str) -> type[Controller]:
     known = available_controllers()
     if spec in known:
         return known[spec]
+    if spec in _broken_plugins:
+        raise ControllerSpecError(spec, _broken_plugins[spec])
     location, sep, class_name = spec.rpartition(":")
     if not sep or not location or not class_name.isidentifier():
         raise ControllerSpecError(

@@ -21,6 +21,7 @@ and the command line use it, never the reverse.
 ``measures.py``          how a trajectory excites: ``cond(W)``, the Gram matrix, and the
                          averaged adaptation rates of an adaptive law
 ``excitation.py``        :func:`optimise_excitation`: Swevers' Fourier excitation, optimised
+``excitation_check.py``  whether an excitation may be saved (within limits, moving); excite's work bound
 ``simulated.py``         :func:`simulate_log`: a closed-loop identification run, logged
 ``parameters_file.py``   the identified-parameter file; mapping onto a law's parameters;
                          :func:`seeded_scenario` for ``--p0`` / ``--model``

@@ -38,6 +38,9 @@ from twolink_pin.files import atomic_write, read_input_file
 
 MAX_LOG_BYTES = 512 << 20
 """Largest log file read (512 MiB)."""
+MAX_LOG_VALUES = MAX_LOG_BYTES // 8
+"""Most numbers a log's arrays may hold once inflated (as many float64 as the file bound
+allows bytes): a compressed archive that expands past that is refused before it is read."""
 MIN_SAMPLES = 10
 """Fewest samples a log may have whatever the number of parameters."""
 TIME_NAMES = ("t", "time")
@@ -226,6 +229,20 @@ def _read_csv(path: Path, nv: int) -> RunLog:
 
 def _read_npz(path: Path, nv: int) -> RunLog:
     raw = read_input_file(path, MAX_LOG_BYTES, "a run log (.csv or .npz)")
+    from twolink_pin.simulation.storage import _claimed_values  # the one header reader
+
+    try:  # the sizes the arrays claim, from their headers, before anything is inflated
+        claimed = _claimed_values(io.BytesIO(raw))  # type: ignore[arg-type]
+    except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
+        raise InputFileError(
+            str(path), f"is not a readable .npz archive ({type(exc).__name__}: {exc})"
+        ) from None
+    if claimed > MAX_LOG_VALUES:
+        raise InputFileError(
+            str(path),
+            f"claims {claimed:.3g} numbers in its arrays; expected at most {MAX_LOG_VALUES:.3g} "
+            f"({MAX_LOG_VALUES * 8 >> 20} MiB of float64) for a run log",
+        )
     try:
         with np.load(io.BytesIO(raw), allow_pickle=False) as archive:
             arrays = {k: np.asarray(archive[k]) for k in archive.files}

@@ -304,7 +304,10 @@ class _Problem:
 
 
 def optimise_excitation(
-    robot: RobotModel, design: ExcitationDesign | None = None, controller: Controller[Any] | None = None
+    robot: RobotModel,
+    design: ExcitationDesign | None = None,
+    controller: Controller[Any] | None = None,
+    progress: Any = None,
 ) -> Excitation:
     """The Fourier excitation of ``robot`` that best meets ``design`` (module docstring).
 
@@ -313,6 +316,8 @@ def optimise_excitation(
         design: Harmonics, period, criterion, limits, starts, seed.
         controller: For the ``"adaptation"`` criterion, the adaptive law whose averaged
             adaptation is made fastest (default: ``adaptive`` with the robot's gains).
+        progress: Called as ``progress(iterations_done, iterations_at_most)`` after each
+            optimiser iteration.
 
     Raises:
         InvalidParameterError: the controller estimates nothing or lacks ``k``/``gamma``.
@@ -332,15 +337,26 @@ def optimise_excitation(
     started = time.perf_counter()
     best: Any = None
     iterations = 0
-    for _ in range(design.starts):
+    at_most = design.starts * design.max_iterations
+    for start in range(design.starts):
         x0 = problem.start(rng)
+        done = [start * design.max_iterations]
+
+        def step(_: Any, done: list[int] = done) -> None:
+            done[0] += 1
+            if progress is not None:
+                progress(done[0], at_most)
+
         result = minimize(
             lambda x: problem.evaluate(x)[0],
             x0,
             method="SLSQP",
             constraints=[{"type": "ineq", "fun": problem.constraints}],
             options={"maxiter": design.max_iterations, "ftol": 1e-9},
+            callback=step,
         )
+        if progress is not None:
+            progress((start + 1) * design.max_iterations, at_most)
         iterations += int(result.nit)
         feasible = float(problem.constraints(result.x).min()) >= -FEASIBILITY_TOLERANCE
         key = (not feasible, float(result.fun))

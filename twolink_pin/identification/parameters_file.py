@@ -23,7 +23,6 @@ makes the identified values what the law *believes* (model-based laws' model; ad
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Mapping
@@ -32,6 +31,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.documents import load_json
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InputFileError, InvalidParameterError
 from twolink_pin.files import read_input_file
@@ -122,9 +122,10 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
     file = str(path)
     raw = read_input_file(path, MAX_PARAMETER_BYTES, "an identified-parameter file (.json)")
     try:
-        document = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
         raise InputFileError(file, f"is not valid JSON: {err}") from None
+    document = load_json(text, file)  # nesting bounded, repeated keys refused
     if not isinstance(document, dict) or document.get("format") != FORMAT:
         raise InputFileError(
             file,
@@ -134,7 +135,8 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
     if document.get("nv") != robot.nv:
         raise InputFileError(
             file,
-            f"is for an arm of {document.get('nv')} joints ({document.get('robot')}); {robot.name} has {robot.nv}",
+            f"says nv = {document.get('nv')!r} (robot {document.get('robot')!r}); expected nv = {robot.nv}, the "
+            f"joint count of {robot.name}",
         )
     rows = document.get("parameters")
     if not isinstance(rows, list):
@@ -144,6 +146,10 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
         if not isinstance(row, dict) or not isinstance(row.get("name"), str):
             raise InputFileError(file, f'parameters[{k}]: expected an object with a "name"')
         name = row["name"]
+        if name in values:
+            raise InputFileError(
+                file, f"parameters[{k}] repeats the name {name!r}; expected each parameter once"
+            )
         estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), "a finite number")
         std = row.get("std")
         sigma = 0.0 if std is None else _number(file, f"parameters[{k}] ({name}).std", std, "a finite number")

@@ -6,6 +6,7 @@
 ``forward.py``        the plant's accelerations (ABA) for one run or N
 ``engine.py``         :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks
 ``adaptive_step.py``  DOP853 with error control, one run
+``containment.py``    the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
 ``result.py``         :class:`SimulationResult`
 ``run.py``            :func:`simulate` (N = 1, recorded)
 ``storage.py``        results as ``.npz``

@@ -19,6 +19,7 @@ from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
+from twolink_pin.simulation.containment import contained
 from twolink_pin.simulation.engine import Samples, _validate
 from twolink_pin.simulation.forward import SingleRunDynamics
 from twolink_pin.simulation.terms import SingleRunTerms
@@ -57,10 +58,14 @@ def integrate_adaptive(
     calls = 0
     checkpoint = [0.0]  # simulated time at the last progress check
 
+    compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
+
     def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ref = trajectory.sample(time)
         try:
-            out = controller.compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
+            out = compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
+        except ControllerError:
+            raise
         except TwolinkPinError as exc:
             raise ControllerError(name, time, str(exc)) from exc
         except Exception as exc:

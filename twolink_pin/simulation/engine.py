@@ -37,6 +37,7 @@ from twolink_pin.controllers import Controller, LawInput, LawOutput
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
+from twolink_pin.simulation.containment import contained, read_only
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
@@ -165,7 +166,7 @@ def integrate(
     name = controller.name
     terms = terms_for(controller, runs, threads)
     accel = dynamics_for(plant, runs, threads)
-    compute = controller.compute
+    compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
     n = config.steps
     dt = config.duration / n
     hold = config.hold_steps
@@ -202,7 +203,9 @@ def integrate(
             k1 = min(k0 + BLOCK, total)
             last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
             half = trajectory.sample(np.arange(2 * k0, last_half + 1) * (dt / 2))
-            rq, rv, ra = half.q[:, None, :], half.v[:, None, :], half.a[:, None, :]
+            rq, rv, ra = (
+                read_only(x[:, None, :]) for x in (half.q, half.v, half.a)
+            )  # shared: law can't write
             off = 0 if record else k0
             filled = k0 - off
             try:

@@ -27,9 +27,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput
-from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import SimulationConfig
+from twolink_pin.simulation.containment import contained, read_only
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.rigid_terms import RigidBodyTerms
 from twolink_pin.simulation.terms import terms_for
@@ -111,11 +112,13 @@ def integrate_events(
     first = True
     now = 0.0
 
+    compute = contained(controller)  # the engine's one door: read-only inputs, sys.exit named
+
     def law(t: float, q: np.ndarray, v: np.ndarray, z: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         nonlocal first, now
         now = t
         x = LawInput(t, q + noise_q, v + noise_v, z, rq[i], rv[i], ra[i])
-        out = controller.compute(x, terms)
+        out = compute(x, terms)
         if first:
             _validate(controller, out, runs, nv, nz, t)
             first = False
@@ -136,7 +139,7 @@ def integrate_events(
             k1 = min(k0 + BLOCK, total)
             last_half = min(2 * k1, 2 * n)
             half = trajectory.sample(np.arange(2 * k0, last_half + 1) * (dt / 2))
-            rq, rv, ra = half.q[:, None, :], half.v[:, None, :], half.a[:, None, :]
+            rq, rv, ra = (read_only(x[:, None, :]) for x in (half.q, half.v, half.a))  # shared: read-only
             if noise is not None:
                 draws = np.stack([g.standard_normal((k1 - k0, 2 * nv)) for g in generators], axis=1)
                 block_q, block_v = noise.sigma_q * draws[..., :nv], noise.sigma_v * draws[..., nv:]
@@ -200,7 +203,7 @@ def integrate_events(
             except Exception as exc:
                 _flag_block(Q, V, Z, T, k0 - off, filled, times, off, alive, diverged_at, detail, name, True)
                 what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
-                raise ControllerError(name, now, what) from exc
+                raise ControllerError(name, now, what + raised_at(exc, controller)) from exc
             rows = slice(k0 - off, k1 - off)
             RQ[rows], RV[rows], RA[rows] = (x[: 2 * (k1 - k0) : 2] for x in (rq, rv, ra))
             newly = _flag_block(

@@ -172,6 +172,12 @@ def _handshake(address: str, timeout: float) -> None:
         raise ClusterError(
             address, f"cannot connect within {timeout:g} s: it does not answer as a Dask scheduler"
         )
+    if failure and not isinstance(failure[0], OSError):  # it answered, with no Dask message
+        # (Dask reads the first bytes as a frame length: an SSH or HTTP greeting asks for exabytes)
+        raise ClusterError(
+            address,
+            "answers, but not as a Dask scheduler (what it sent is no Dask message); check the host and port",
+        )
     if failure:
         raise ClusterError(address, f"cannot connect ({type(failure[0]).__name__}: {failure[0]})")
 

@@ -35,25 +35,20 @@ from __future__ import annotations
 import json
 import math
 import os
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from twolink_pin.documents import load_json, load_toml
 from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError
 from twolink_pin.files import read_input_file
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
-from twolink_pin.trajectory.fourier import MAX_HARMONICS, FourierTrajectory
+from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 MAX_TRAJECTORY_BYTES = 1 << 20
 """Largest trajectory file read (1 MiB)."""
@@ -62,6 +57,11 @@ MAX_VIA_POINTS = 24
 beyond about two dozen points its normal equations lose the digits the fit needs."""
 LIMIT_SAMPLES = 2001
 """Samples over one period at which the trajectory is checked against the joint limits."""
+
+MAX_TIME = 1e6
+"""Largest via-point time [s] (the longest simulation): larger times overflow the polynomial."""
+MIN_TIME_STEP = 1e-3
+"""Shortest interval between via points [s]."""
 
 CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
@@ -80,15 +80,12 @@ def _load(path: Path) -> dict[str, Any]:
             str(path), f"is not UTF-8 (byte {err.start}); expected a UTF-8 text file"
         ) from None
     suffix = path.suffix.lower()
-    try:
-        if suffix == ".json":
-            document = json.loads(text)
-        elif suffix == ".toml":
-            document = tomllib.loads(text)
-        else:
-            raise InputFileError(str(path), f"has the suffix {suffix!r}; expected .toml or .json")
-    except (json.JSONDecodeError, tomllib.TOMLDecodeError) as err:
-        raise InputFileError(str(path), f"is not valid {suffix[1:].upper()}: {err}") from None
+    if suffix == ".json":
+        document = load_json(text, str(path))  # nesting bounded, repeated keys refused
+    elif suffix == ".toml":
+        document = load_toml(text, str(path))
+    else:
+        raise InputFileError(str(path), f"has the suffix {suffix!r}; expected .toml or .json")
     if not isinstance(document, dict):
         raise InputFileError(str(path), "expected a table (TOML) or an object (JSON) at the top level")
     return document
@@ -170,7 +167,20 @@ def read_trajectory_file(
         raise InvalidParameterError(
             f"{file}: times", document["times"], f"a list of 2 to {MAX_VIA_POINTS} times [s]"
         )
+    if np.any(np.abs(times) > MAX_TIME):
+        k = int(np.flatnonzero(np.abs(times) > MAX_TIME)[0])
+        raise InvalidParameterError(
+            f"{file}: times[{k}]", float(times[k]), f"a time within ±{MAX_TIME:g} s (the longest simulation)"
+        )
     steps = np.diff(times)
+    if np.any(steps < MIN_TIME_STEP):
+        k = int(np.flatnonzero(steps < MIN_TIME_STEP)[0])
+        if steps[k] > 0:
+            raise InvalidParameterError(
+                f"{file}: times[{k + 1}]",
+                float(times[k + 1]),
+                f"at least {MIN_TIME_STEP:g} s after times[{k}] = {times[k]:.17g} s",
+            )
     if np.any(steps <= 0):
         k = int(np.flatnonzero(steps <= 0)[0])
         raise InvalidParameterError(
@@ -267,9 +277,11 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
             )
     period = table["period"]
     if isinstance(period, bool) or not (
-        isinstance(period, (int, float)) and math.isfinite(period) and period > 0
+        isinstance(period, (int, float)) and MIN_PERIOD <= period <= MAX_PERIOD
     ):
-        raise InvalidParameterError(f"{file}: fourier.period", period, "a finite period > 0 s")
+        raise InvalidParameterError(
+            f"{file}: fourier.period", period, f"a period from {MIN_PERIOD:g} to {MAX_PERIOD:g} s"
+        )
     a = _numbers(file, "fourier.a", table["a"], f"{robot.nv} rows of N sine coefficients [rad/s]")
     if a.ndim != 2 or a.shape[0] != robot.nv or not 1 <= a.shape[1] <= MAX_HARMONICS:
         raise InvalidParameterError(

@@ -31,6 +31,11 @@ from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.trajectory.base import Trajectory, TrajectorySample
 
+MIN_PERIOD = 1e-3
+"""Shortest period [s]: its harmonics' accelerations (∝ 1/T²) and jerks (∝ 1/T³) stay
+finite and meaningful (a period of 1e-300 s would overflow them to inf)."""
+MAX_PERIOD = 1e6
+"""Longest period [s] (the longest simulation)."""
 MAX_HARMONICS = 100
 """Most harmonics per joint a Fourier trajectory may have."""
 
@@ -66,9 +71,9 @@ class FourierTrajectory(Trajectory):
 
     def __init__(self, period: float, a: Any, b: Any, offset: Any, t0: float = 0.0) -> None:
         if isinstance(period, bool) or not (
-            isinstance(period, (int, float)) and math.isfinite(period) and period > 0
+            isinstance(period, (int, float)) and MIN_PERIOD <= period <= MAX_PERIOD
         ):
-            raise InvalidParameterError("period", period, "a finite period > 0 s")
+            raise InvalidParameterError("period", period, f"a period from {MIN_PERIOD:g} to {MAX_PERIOD:g} s")
         if isinstance(t0, bool) or not (isinstance(t0, (int, float)) and math.isfinite(t0)):
             raise InvalidParameterError("t0", t0, "a finite start time [s]")
         a_arr = np.array(a, dtype=float) if np.ndim(a) == 2 else None

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from twolink_pin.cli.commands.common import _robot
-from twolink_pin.cli.output import emit, fmt
+from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -222,7 +222,16 @@ def cmd_excite(args: argparse.Namespace) -> int:
         seed=args.seed,
         limits=limits,
     )
-    excitation = optimise_excitation(robot, design)
+    from twolink_pin.identification.excitation_check import check_excitation_work, excitation_problem
+
+    check_excitation_work(robot.nv, args.harmonics, args.samples, args.starts, args.max_iterations)
+    bar = progress_bar(args.starts * args.max_iterations, "it", f"excite {robot.name}")
+    with bar:
+        excitation = optimise_excitation(robot, design, progress=lambda done, total: bar.update(done - bar.n))
+    problem = excitation_problem(excitation.peaks, excitation.limits)
+    if problem:  # an infeasible or motionless excitation is a failed run, never a saved success
+        print(f"twolink-pin: excite failed: {problem}; nothing written to {args.out}", file=sys.stderr)
+        return 1
     written = write_trajectory_file(args.out, excitation.trajectory)
     default = excitation_measures(robot, default_trajectory(robot))
     payload: dict[str, Any] = {

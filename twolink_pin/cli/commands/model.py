@@ -140,6 +140,7 @@ def cmd_controllers(args: argparse.Namespace) -> int:
 
     from twolink_pin.controllers import available_controllers
     from twolink_pin.controllers.gains import _spec
+    from twolink_pin.controllers.loading import broken_plugins
 
     rows: list[dict[str, Any]] = []
     for name, cls in available_controllers().items():
@@ -166,7 +167,10 @@ def cmd_controllers(args: argparse.Namespace) -> int:
     for row in rows:
         listed = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
         lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {listed}")
-    emit(args, {"controllers": rows}, "\n".join(lines))
+    broken = broken_plugins()
+    for problem in broken.values():  # a plug-in that failed to load is not silently missing
+        print(f"twolink-pin: warning: {problem}", file=sys.stderr, flush=True)
+    emit(args, {"controllers": rows, "broken_plugins": broken}, "\n".join(lines))
     return 0
 
 

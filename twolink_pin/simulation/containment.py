@@ -1,0 +1,76 @@
+"""The one door through which the engine calls a law's ``compute``: user code contained.
+
+:func:`contained` wraps ``controller.compute`` so that what a law does wrong is an error
+naming the law, never a changed simulation or a silent exit:
+
+* its input arrays reach it as **read-only views**: ``q``, ``v``, ``z`` here, the reference
+  ``q_des``, ``v_des``, ``a_des`` (which later steps share) where the engine samples it
+  (:func:`read_only`); a write raises, and the resulting
+  :class:`~twolink_pin.errors.ControllerError` says that the inputs are read-only;
+* ``sys.exit()`` inside ``compute`` (``SystemExit``) is an error naming the law, not an exit
+  of the program with a status the law chose;
+* ``MemoryError`` inside ``compute`` names the law (it is the law's allocation, not a bug of
+  twolink-pin).
+
+What cannot be contained in-process: ``os._exit()``, a crash in C code, a law that blocks
+signals. The CLI bounds a law that never returns with ``--timeout`` (``cli``), and
+``docs/reliability.md`` says what it does about ``os._exit``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.controllers import Controller, LawInput, LawOutput
+from twolink_pin.errors import ControllerError
+
+READ_ONLY_HINT = (
+    "wrote into its input arrays, which are read-only (the engine's state and the reference "
+    "shared with later steps); copy first, e.g. q = x.q.copy()"
+)
+
+
+def read_only(a: np.ndarray) -> np.ndarray:
+    """A read-only view of ``a`` (views taken from it are read-only too)."""
+    view = a.view()
+    view.setflags(write=False)
+    return view
+
+
+def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
+    """``controller.compute`` behind read-only inputs, with ``SystemExit`` and
+    ``MemoryError`` turned into :class:`ControllerError` naming the law (see module doc).
+
+    The returned function has the law's signature ``(x, terms) -> LawOutput``."""
+    compute = controller.compute
+    name = controller.name
+    new = tuple.__new__
+
+    def call(x: LawInput, terms: Any) -> LawOutput:
+        t, q, v, z, q_des, v_des, a_des = x
+        # The reference is made read-only where the engine samples it (once per block).
+        frozen = new(LawInput, (t, read_only(q), read_only(v), read_only(z), q_des, v_des, a_des))
+        try:
+            return compute(frozen, terms)
+        except SystemExit as exc:
+            raise ControllerError(
+                name, float(t), f"compute called sys.exit({exc.code!r}); a law must return or raise"
+            ) from None
+        except MemoryError as exc:
+            raise ControllerError(
+                name,
+                float(t),
+                f"compute ran out of memory (MemoryError{': ' + str(exc) if str(exc) else ''})",
+            ) from None
+        except ValueError as exc:
+            if "read-only" in str(exc):
+                raise ControllerError(name, float(t), f"{READ_ONLY_HINT} ({exc})") from exc
+            raise
+
+    return call
+
+
+__all__ = ["contained", "read_only"]
