@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from twolink_pin.controllers import adaptive, computed_torque, pd
+from twolink_pin.controllers import adaptive, computed_torque, impedance, osc, pd
 
 PAGE = (Path(__file__).resolve().parents[1] / "docs" / "controllers.md").read_text(encoding="utf-8")
 
@@ -17,6 +17,10 @@ PAGE = (Path(__file__).resolve().parents[1] / "docs" / "controllers.md").read_te
     ("symbol", "unit", "value"),
     [
         ("ω", "rad/s", pd.NATURAL_FREQUENCY),
+        ("ω", "rad/s", impedance.STIFFNESS_FREQUENCY),
+        ("ω", "rad/s", osc.TASK_FREQUENCY),
+        ("ω_n", "rad/s", osc.POSTURE_FREQUENCY),
+        ("ω_n", "rad/s", impedance.POSTURE_FREQUENCY),
         ("κ", "1/s", computed_torque.SLIDING_RATE),
         ("α", "1/s", adaptive.ADAPTATION_RATE),
         ("λ", "1/s", computed_torque.DEFAULT_LAMBDA),

@@ -470,10 +470,15 @@ def test_a_short_optimisation_meets_its_limits_and_improves(twolink) -> None:
 
 @pytest.mark.slow
 def test_the_stored_twolink_excitation_is_what_the_default_design_gives(twolink) -> None:
-    """Re-optimising with the defaults (3 seeded starts, SLSQP) gives the stored condition number."""
+    """Re-optimising with the defaults (3 seeded starts, SLSQP) finds an excitation at least as
+    well conditioned as the stored one, to 1 %. Not to 1e-6: SLSQP's local optimum moves with
+    the machine's floating-point rounding (one 2-core VM gives 2.3742 against the stored
+    2.3859, another the stored value exactly) — both sit on the floor that friction puts under
+    the condition number (test below), within 3 %."""
     fresh = optimise_excitation(twolink)
     stored = excitation_measures(twolink, twolink_excitation.identification_excitation())
-    assert fresh.measures.condition_number == pytest.approx(stored.condition_number, rel=1e-6)
+    assert fresh.measures.condition_number <= stored.condition_number * 1.01
+    assert stored.condition_number <= fresh.measures.condition_number * 1.03
 
 
 # ------------------------------------------------------------------ closing the loop

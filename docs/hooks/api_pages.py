@@ -40,8 +40,8 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, a law with its plant, and the engine.",
-        ("plant", "disturbances", "scenario", "simulation"),
+        "The simulated arm, what pushes back on it, a law with its plant, the run description, and the engine.",
+        ("plant", "disturbances", "scenario", "run_spec", "simulation"),
     ),
     ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),
@@ -63,9 +63,10 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("twolink", "The twolink", "Everything specific to the course report's arm.", ("twolink",)),
     (
         "files",
-        "Files, errors, arrays, math, version",
-        "The one writer, the exceptions, read-only arrays, LaTeX → MathML, the version.",
-        ("files", "errors", "arrays", "mathml", "version"),
+        "Files, errors, arrays, math, threads, version",
+        "The one writer, bounded input documents, the stages a command reports, the exceptions, "
+        "read-only arrays, LaTeX → MathML, OpenMP threads, the version.",
+        ("files", "documents", "readiness", "errors", "arrays", "mathml", "openmp", "version"),
     ),
 )
 """``(page, title, one line, modules under twolink_pin)`` in the navigation's order."""

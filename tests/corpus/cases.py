@@ -783,7 +783,7 @@ USERCODE = [
     C("usercode-simulate-law-exit-adaptive", f"simulate {MIS}:ExitZero {SIM} --method adaptive", 1, err=("corpus-exit-zero", "sys.exit(0)")),
     C("usercode-simulate-law-file-exits-on-import", f"simulate {LAW}/exit_on_import.py:Law {SIM}", 2, err=("exit_on_import.py", "sys.exit(0)")),
     C("usercode-sweep-law-exit-0", f"sweep {MIS}:ExitZero --samples 4 {SIM} --no-plot --out s", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("s",), note="a sweep leaves no partial folder"),
-    C("usercode-compare-law-exit-0", f"compare {MIS}:ExitZero pd {SIM} --no-plot --out c", 1, err=("corpus-exit-zero", "sys.exit(0)"), absent=("c",)),
+    C("usercode-compare-law-exit-0", f"compare {MIS}:ExitZero pd {SIM} --no-plot --out c", 1, err=("corpus-exit-zero", "sys.exit(0)"), exists=("c/comparison.csv",), note="the law that exits is a failed row; pd's row is written"),
     C("usercode-simulate-law-writes-state", f"simulate {MIS}:WritesState {SIM} --save run.npz", 1, err=("corpus-writes-state", "read-only"), absent=("run.npz",)),
     C("usercode-simulate-law-writes-reference", f"simulate {MIS}:WritesReference {SIM}", 1, err=("corpus-writes-reference", "read-only", "reference")),
     C("usercode-simulate-law-writes-state-adaptive", f"simulate {MIS}:WritesState {SIM} --method adaptive", 1, err=("corpus-writes-state", "read-only")),
