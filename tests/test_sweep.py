@@ -38,11 +38,11 @@ from twolink_pin.studies.sweep import (
     Cases,
     GainRange,
     SweepConfig,
-    _chunk_law,
     auto_chunk,
     run_sweep,
     sweep_metadata,
 )
+from twolink_pin.studies.sweep_cases import _chunk_law
 from twolink_pin.trajectory import build_trajectory
 
 ROBOT = load_robot()

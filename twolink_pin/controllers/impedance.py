@@ -63,8 +63,8 @@ class Impedance(Controller[ImpedanceGains]):
     near singularities as in ``osc``). The frame behaves as a spring $K$ and damper $D$
     to its desired pose, with the arm's own task inertia (no inertia shaping, no model
     feedforward: it is a regulator, exact at rest). Under a constant external wrench $F$ on
-    the frame, at rest $J^\top (F - K e) + N^\top \tau_n = 0$, and since $J \hat M^{-1}
-    N^\top = 0$ with $J$ of full row rank, $K e = F$: the frame settles at $e = K^{-1} F$.
+    the frame, at rest $J^\top (F - K e) + N^\top \tau_n = 0$, and since $J \hat M^{-1} N^\top = 0$
+    with $J$ of full row rank, $K e = F$: the frame settles at $e = K^{-1} F$.
     With the exact gravity, $V = \tfrac12 \dot q^\top M \dot q + \tfrac12 e^\top K e$ decreases
     for a constant desired pose (Hogan, "Impedance control: an approach to manipulation",
     *J. Dyn. Sys., Meas., Control* 107(1), 1985; Ott, *Cartesian Impedance Control of

@@ -59,8 +59,8 @@ class OperationalSpace(Controller[OSCGains]):
     N^\top = I - J^\top \Lambda J \hat M^{-1}$$
 
     with the frame's pose error $e = (p - p_d,\ \log(R R_d^\top))$, $\dot e = J \dot q - \dot x_d$,
-    and the joint error $e_q = q - q_d$. With the exact model, $\ddot x = J \ddot q + \dot J
-    \dot q$ gives the decoupled task dynamics $\ddot e_p + D_p \dot e_p + K_p e_p = 0$ for the
+    and the joint error $e_q = q - q_d$. With the exact model, $\ddot x = J \ddot q + \dot J \dot q$
+    gives the decoupled task dynamics $\ddot e_p + D_p \dot e_p + K_p e_p = 0$ for the
     position (exactly) and $\dot{\tilde\omega} + D_o \tilde\omega + K_o e_o = 0$ for the
     orientation ($\tilde\omega = \omega - \omega_d$; $\dot e_o = \tilde\omega$ to first order);
     the posture torque produces no task acceleration, $J \hat M^{-1} N^\top = 0$. The desired

@@ -29,8 +29,8 @@ class PDGravity(Controller[PDGravityGains]):
 
     $$\tau = \hat g(q) - K_p e - K_d \dot e, \qquad e = q - q_d$$
 
-    For a constant reference ($\dot q_d = 0$) and the exact gravity, $V = \tfrac12 \dot q^\top
-    M \dot q + \tfrac12 e^\top K_p e$ gives $\dot V = -\dot q^\top K_d \dot q$ and LaSalle
+    For a constant reference ($\dot q_d = 0$) and the exact gravity,
+    $V = \tfrac12 \dot q^\top M \dot q + \tfrac12 e^\top K_p e$ gives $\dot V = -\dot q^\top K_d \dot q$ and LaSalle
     gives $e \to 0$ (Takegaki and Arimoto, "A new feedback method for dynamic control of
     manipulators", *J. Dyn. Sys., Meas., Control* 103(2), 1981). On a moving reference it
     lags (no feedforward of $M \ddot q_d + C \dot q_d$): compare ``pd``. Gains: each joint

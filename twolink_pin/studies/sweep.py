@@ -81,7 +81,6 @@ from twolink_pin.studies.sweep_cases import (
     Cases,
     GainRange,
     SweepConfig,
-    _chunk_law,
     auto_chunk,
     gain_target,
 )
@@ -302,7 +301,6 @@ __all__ = [
     "SweepConfig",
     "SweepJob",
     "SweepOutput",
-    "_chunk_law",
     "auto_chunk",
     "environment",
     "gain_target",
