@@ -4,7 +4,8 @@
 ``config.py``         :class:`SimulationConfig`, the divergence limit and step bounds
 ``terms.py``          the Pinocchio terms a law asks for, for one run or N (``terms_for``)
 ``forward.py``        the plant's accelerations (ABA) for one run or N
-``engine.py``         :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks
+``engine.py``         :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks, plant events
+``events.py``         what a plant that pushes back does to a step: wrench, payload step, noise, delay
 ``adaptive_step.py``  DOP853 with error control, one run
 ``containment.py``    the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
 ``result.py``         :class:`SimulationResult`

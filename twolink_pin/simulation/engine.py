@@ -10,6 +10,12 @@ State ``x = (q, q̇, z)`` per run (``z``: the law's internal state), arrays ``(N
   step. This is what a digital controller does; it differs from the per-stage law by
   O(control_period).
 
+A plant that pushes back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
+sensor noise, a delay) runs in the same loop: :class:`~twolink_pin.simulation.events.PlantEvents`
+gives each step's dynamics and the noise on what the law measures, and with a delay the law is
+sampled every step (or control period) and a :class:`~twolink_pin.simulation.events.DelayLine`
+applies its torque ``delay`` steps late (details in :mod:`twolink_pin.simulation.events`).
+
 The law gets its Pinocchio terms from :func:`~twolink_pin.simulation.terms.terms_for`
 and the plant's accelerations come from :func:`~twolink_pin.simulation.forward.dynamics_for`
 (one ABA per run and stage). Output samples are written block by block (:data:`BLOCK`
@@ -38,6 +44,7 @@ from twolink_pin.errors import ControllerError, SimulationDivergedError, Twolink
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.simulation.containment import contained, read_only
+from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
@@ -144,32 +151,29 @@ def integrate(
             run instead of parking it.
         progress: Called as ``progress(steps_done, steps_total)`` after each block.
     """
-    if plant.has_events:  # a plant that pushes back: its own loop, this one stays as it was
-        from twolink_pin.simulation.events import integrate_events
-
-        return integrate_events(
-            controller,
-            plant,
-            trajectory,
-            config,
-            q0,
-            v0,
-            z0,
-            record=record,
-            observer=observer,
-            threads=threads,
-            stop_on_divergence=stop_on_divergence,
-            progress=progress,
-        )
     runs, nv = q0.shape
     nz = z0.shape[1]
     name = controller.name
-    terms = terms_for(controller, runs, threads)
-    accel = dynamics_for(plant, runs, threads)
-    compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
     n = config.steps
     dt = config.duration / n
     hold = config.hold_steps
+    new = tuple.__new__  # LawInput(...) through tuple.__new__ (see below)
+    terms = terms_for(controller, runs, threads)
+    # A plant that pushes back (wrench, payload step, sensor noise, delay): its events
+    # choose the dynamics of each step, offset what the law measures, delay its torque.
+    events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
+    line = DelayLine(plant.delay) if plant.delay > 0 else None
+    accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
+    compute = law = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
+    noise: list[np.ndarray] = []
+    if events is not None and events.noise is not None:
+
+        def compute(x: LawInput, terms: Any) -> LawOutput:  # the law measures the state + noise
+            t, q, v, z, q_des, v_des, a_des = x
+            return law(new(LawInput, (t, q + noise[0], v + noise[1], z, q_des, v_des, a_des)), terms)
+
+    sampled = hold is not None or line is not None  # the law evaluated once per step or period
+    every = hold if hold is not None else 1
     total = n + 1
     size = total if record else min(total, BLOCK)
     Q, V, T = (np.empty((size, runs, nv)) for _ in range(3))
@@ -187,9 +191,8 @@ def integrate(
     hz, h2z, h6z, twoz = (np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0))
     no_state = np.zeros((runs, 0))
 
-    # LawInput(...) through tuple.__new__: the NamedTuple's own __new__ is a Python function
-    # that costs twice as much, four times a step.
-    new = tuple.__new__
+    # LawInput(...) through tuple.__new__ (``new`` above): the NamedTuple's own __new__ is a
+    # Python function that costs twice as much, four times a step.
     # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
     tau1: Any = None
     dz1: Any = None
@@ -206,28 +209,37 @@ def integrate(
             rq, rv, ra = (
                 read_only(x[:, None, :]) for x in (half.q, half.v, half.a)
             )  # shared: law can't write
+            if events is not None:
+                events.draw(k0, k1)
             off = 0 if record else k0
             filled = k0 - off
             try:
                 for k in range(k0, k1):
                     i = 2 * (k - k0)
                     t = k * dt
-                    if hold is None or k % hold == 0:
+                    if events is not None:
+                        accel = events.accel_at(t)
+                        if events.noise is not None:
+                            noise[:] = events.noise_at(k)
+                    if not sampled or k % every == 0:
                         now = t
                         out = compute(new(LawInput, (t, q, v, z, rq[i], rv[i], ra[i])), terms)
                         if first:
                             _validate(controller, out, runs, nv, nz, t)
                             first = False
                         tau1, dz1 = out.tau, (out.dz if nz else no_state)
+                        if line is not None:
+                            line.push(k, tau1, dz1)
+                    tau_k, dz_k = (tau1, dz1) if line is None else line.at(k)  # the torque applied
                     b = k - off
-                    Q[b], V[b], T[b] = q, v, tau1
+                    Q[b], V[b], T[b] = q, v, tau_k
                     if nz:
                         Z[b] = z
                     filled = b + 1
                     if k == n:
                         break
-                    a1 = accel(q, v, tau1)
-                    if hold is None:
+                    a1 = accel(q, v, tau_k)
+                    if not sampled:
                         now = t + dt / 2
                         q2, v2 = q + h2 * v, v + h2 * a1
                         z2 = z + h2z * dz1 if nz else z
@@ -250,15 +262,15 @@ def integrate(
                         a4 = accel(q4, v4, tau4)
                         if nz:
                             z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)
-                    else:  # zero-order hold: τ and ż fixed over the step
+                    else:  # zero-order hold (or delay): τ and ż fixed over the step
                         q2, v2 = q + h2 * v, v + h2 * a1
-                        a2 = accel(q2, v2, tau1)
+                        a2 = accel(q2, v2, tau_k)
                         q3, v3 = q + h2 * v2, v + h2 * a2
-                        a3 = accel(q3, v3, tau1)
+                        a3 = accel(q3, v3, tau_k)
                         q4, v4 = q + h * v3, v + h * a3
-                        a4 = accel(q4, v4, tau1)
+                        a4 = accel(q4, v4, tau_k)
                         if nz:
-                            z = z + hz * dz1
+                            z = z + hz * dz_k
                     q = q + h6 * (v + two * (v2 + v3) + v4)
                     v = v + h6 * (a1 + two * (a2 + a3) + a4)
             except (KeyboardInterrupt, SystemExit, MemoryError):

@@ -1,0 +1,159 @@
+"""Per-stage profile of a single run (N = 1): microseconds per RK4 stage in the law, in
+Pinocchio (the ``Terms`` the law asks for and the plant's ABA) and in the engine.
+
+An instrumented run: the engine's three doors (``contained`` — the law behind its
+containment —, ``terms_for`` and ``dynamics_for``) are wrapped with
+``time.perf_counter_ns`` accumulators, then one timed single run per law is made with the
+wrappers and one without (the plain wall time). Split per stage (4 stages per step):
+
+* **law** — inside the law's ``compute`` less the ``Terms`` calls it makes, plus the
+  containment around it;
+* **Pinocchio** — the ``Terms`` calls (``pin.rnea``, the regressor, CRBA, ...) and the
+  plant's ``pin.aba``, with their small numpy glue;
+* **engine** — the rest of the plain wall time: RK4 arithmetic, LawInput, recording,
+  block checks (the plain time less law and Pinocchio as measured instrumented, so the
+  timers' own cost — about 0.1 µs a pair — is not charged to the engine).
+
+Usage::
+
+    .venv/bin/python scripts/profile_stages.py [--duration 2] [--robot twolink|ur5|panda] [--laws pd,...]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from typing import Any
+
+from twolink_pin import SimulationConfig, default_trajectory, load_robot, make_scenario, simulate
+from twolink_pin.simulation import engine
+
+DEFAULT_LAWS = {
+    "twolink": ("pd", "computed-torque", "adaptive", "adaptive-friction"),
+    "ur5": ("pd", "computed-torque", "adaptive"),
+    "panda": ("osc",),
+}
+
+
+class _Clock:
+    def __init__(self) -> None:
+        self.ns = {"law": 0, "terms": 0, "aba": 0}
+        self.calls = 0
+
+
+def _instrument(clock: _Clock) -> tuple[Any, Any, Any]:
+    originals = (engine.contained, engine.terms_for, engine.dynamics_for)
+    contained, terms_for, dynamics_for = originals
+    ns = clock.ns
+    now = time.perf_counter_ns
+
+    def timed_contained(controller: Any) -> Any:
+        call = contained(controller)
+
+        def law(x: Any, terms: Any) -> Any:
+            start = now()
+            try:
+                return call(x, terms)
+            finally:
+                ns["law"] += now() - start
+                clock.calls += 1
+
+        return law
+
+    class TimedTerms:
+        def __init__(self, inner: Any) -> None:
+            self._inner = inner
+
+        def __getattr__(self, name: str) -> Any:
+            method = getattr(self._inner, name)
+            if not callable(method):
+                return method
+
+            def timed(*args: Any, **kwargs: Any) -> Any:
+                start = now()
+                try:
+                    return method(*args, **kwargs)
+                finally:
+                    ns["terms"] += now() - start
+
+            return timed
+
+    def timed_terms_for(*args: Any, **kwargs: Any) -> Any:
+        return TimedTerms(terms_for(*args, **kwargs))
+
+    def timed_dynamics_for(*args: Any, **kwargs: Any) -> Any:
+        accel = dynamics_for(*args, **kwargs)
+
+        def timed(*a: Any) -> Any:
+            start = now()
+            try:
+                return accel(*a)
+            finally:
+                ns["aba"] += now() - start
+
+        return timed
+
+    engine.contained, engine.terms_for, engine.dynamics_for = (  # type: ignore[assignment]
+        timed_contained,
+        timed_terms_for,
+        timed_dynamics_for,
+    )
+    return originals
+
+
+def profile(robot_name: str, spec: str, duration: float, repeats: int) -> dict[str, float]:
+    """µs per RK4 stage: law, Pinocchio, engine, total (plain run, min of ``repeats``)."""
+    robot = load_robot(robot_name)
+    reference = default_trajectory(robot)
+    config = SimulationConfig(duration=duration, dt=1e-3, q0_offset=0.05 if robot_name != "twolink" else None)
+    stages = 4 * config.steps
+    plain = []
+    for _ in range(repeats):
+        controller, plant = make_scenario(spec, robot)
+        start = time.perf_counter_ns()
+        simulate(controller, plant, reference, config)
+        plain.append(time.perf_counter_ns() - start)
+    best: dict[str, float] | None = None
+    for _ in range(repeats):
+        clock = _Clock()
+        originals = _instrument(clock)
+        try:
+            controller, plant = make_scenario(spec, robot)
+            simulate(controller, plant, reference, config)
+        finally:
+            engine.contained, engine.terms_for, engine.dynamics_for = originals  # type: ignore[assignment]
+        law = (clock.ns["law"] - clock.ns["terms"]) / stages / 1e3
+        pinocchio = (clock.ns["terms"] + clock.ns["aba"]) / stages / 1e3
+        if best is None or law + pinocchio < best["law"] + best["pinocchio"]:
+            best = {"law": law, "pinocchio": pinocchio}
+    assert best is not None
+    total = min(plain) / stages / 1e3
+    best["engine"] = total - best["law"] - best["pinocchio"]
+    best["total"] = total
+    return best
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--duration", type=float, default=2.0, help="simulated seconds per run (default 2)")
+    parser.add_argument("--robot", default="twolink", help="twolink, ur5 or panda (default twolink)")
+    parser.add_argument("--laws", default=None, help="comma-separated laws (default: the robot's set)")
+    parser.add_argument("--repeats", type=int, default=3, help="runs per law, the least disturbed kept")
+    args = parser.parse_args()
+    laws = args.laws.split(",") if args.laws else DEFAULT_LAWS[args.robot]
+    print(
+        f"{args.robot}, {args.duration:g} s simulated, dt = 1 ms, min of {args.repeats}; "
+        f"load average {[round(x, 2) for x in os.getloadavg()]}"
+    )
+    print(f"  {'law':20s} {'law µs':>8s} {'Pinocchio µs':>13s} {'engine µs':>10s} {'total µs/stage':>15s}")
+    for spec in laws:
+        row = profile(args.robot, spec, args.duration, args.repeats)
+        print(
+            f"  {spec:20s} {row['law']:8.2f} {row['pinocchio']:13.2f} {row['engine']:10.2f} {row['total']:15.2f}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
