@@ -54,8 +54,10 @@ def _interrupt(signum: int, frame: object) -> None:
 def _run(args: argparse.Namespace) -> int:
     """The command under its guards; an exception after a signal is the interrupt, whatever
     it turned into on its way (an ``ImportError`` from an interrupted import)."""
-    try:
-        with guard.wall_clock_bound(getattr(args, "timeout", None)):
+    from twolink_pin.simulation.deadline import per_run_limit
+
+    try:  # --timeout bounds each simulation (a law that never returns), not the whole command
+        with per_run_limit(getattr(args, "timeout", None)):
             with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
                 code = int(args.func(args))
     except BaseException:
@@ -129,18 +131,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         ready("running")
         return _run(args)
-    except guard.RunTimeout as exc:
-        law = getattr(args, "controller", None) or getattr(args, "controllers", None)
-        named = (
-            f" (the law {law if isinstance(law, str) else ', '.join(map(str, law))} may never return)"
-            if law
-            else ""
-        )
-        _say(
-            f"twolink-pin: stopped after --timeout {exc.seconds:g} s of wall-clock time{named}; "
-            "give a larger --timeout for a longer run"
-        )
-        return 1
     except (SimulationDivergedError, ControllerError) as exc:
         if isinstance(exc, ControllerError) and _debug(args):  # the law's own traceback
             import traceback

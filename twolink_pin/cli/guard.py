@@ -1,11 +1,8 @@
 """What the CLI puts around a command so that user code cannot take it over.
 
-* :func:`wall_clock_bound` — ``--timeout``: a law that never returns (sleeps, spins, waits
-  on a lock) is stopped after the bound; the command ends with exit 1 naming the bound. A
-  watchdog thread sends SIGUSR1 to the main thread, whose handler raises
-  :class:`RunTimeout` where the program is (so ``with`` blocks clean up as for Ctrl-C; a
-  blocking ``time.sleep`` is interrupted too). Code that blocks signals or loops inside C
-  without returning to Python cannot be stopped this way.
+* ``--timeout`` — :data:`DEFAULT_TIMEOUT`; the bound applies to each simulation
+  (:mod:`twolink_pin.simulation.deadline`): a law that never returns stops its run with an
+  error naming the law and the bound, and ``compare`` keeps the other laws' results.
 * :func:`results_only_on_stdout` — with ``--json``, what the command's code (a law's
   ``print``) writes to ``sys.stdout`` goes to stderr, so stdout holds the JSON alone;
   :func:`twolink_pin.cli.output.emit` writes to the real stdout.
@@ -14,56 +11,14 @@
 from __future__ import annotations
 
 import contextlib
-import signal
 import sys
-import threading
 from collections.abc import Iterator
 
 from twolink_pin.cli import output
 
 DEFAULT_TIMEOUT = 86_400.0
-"""Default ``--timeout`` [s]: one day, far beyond any run the bounds allow on one machine
-(the longest single simulation, 10^7 steps, takes minutes), short of "forever"."""
-
-
-class RunTimeout(BaseException):
-    """The command ran past ``--timeout`` (a ``BaseException``, like ``KeyboardInterrupt``,
-    so that a law's ``except Exception`` cannot swallow it)."""
-
-    def __init__(self, seconds: float) -> None:
-        super().__init__(seconds)
-        self.seconds = seconds
-
-
-@contextlib.contextmanager
-def wall_clock_bound(seconds: float | None) -> Iterator[None]:
-    """Raise :class:`RunTimeout` in the main thread once the block has run ``seconds`` of
-    wall-clock time (None or 0: no bound; outside the main thread: no bound)."""
-    if not seconds or threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def expire(signum: int, frame: object) -> None:
-        raise RunTimeout(seconds)
-
-    previous = signal.signal(signal.SIGUSR1, expire)
-    done = threading.Event()
-    main_id = threading.main_thread().ident
-    assert main_id is not None
-
-    def watch() -> None:
-        if not done.wait(seconds):
-            with contextlib.suppress(OSError, ValueError):
-                signal.pthread_kill(main_id, signal.SIGUSR1)
-
-    watchdog = threading.Thread(target=watch, name="twolink-pin-timeout", daemon=True)
-    watchdog.start()
-    try:
-        yield
-    finally:
-        done.set()
-        watchdog.join()
-        signal.signal(signal.SIGUSR1, previous)
+"""Default ``--timeout`` [s] per simulation: one day, far beyond any run the bounds allow on
+one machine (the longest single simulation, 10^7 steps, takes minutes), short of "forever"."""
 
 
 @contextlib.contextmanager
@@ -84,7 +39,7 @@ def results_only_on_stdout(active: bool) -> Iterator[None]:
         output.RESULT_STREAM = None
 
 
-__all__ = ["DEFAULT_TIMEOUT", "RunTimeout", "results_only_on_stdout", "wall_clock_bound"]
+__all__ = ["DEFAULT_TIMEOUT", "results_only_on_stdout"]
 
 
 OUTPUT_OPTIONS = ("save", "save_data", "out", "html", "write_urdf", "plot")

@@ -106,7 +106,7 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         type=bounded(0.0, 1e7, unit="s"),
         default=DEFAULT_TIMEOUT,
         metavar="S",
-        help=f"stop the command after S s of wall-clock time: a law that never returns (0: no bound; default {DEFAULT_TIMEOUT:g} = one day)",
+        help=f"stop each simulation after S s of wall-clock time: a law that never returns (0: no bound; default {DEFAULT_TIMEOUT:g} = one day)",
     )
     p.add_argument(
         "--friction-smoothing",

@@ -20,6 +20,7 @@ from twolink_pin.errors import ControllerError, SimulationDivergedError, Twolink
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
 from twolink_pin.simulation.containment import contained
+from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.engine import Samples, _validate
 from twolink_pin.simulation.forward import SingleRunDynamics
 from twolink_pin.simulation.terms import SingleRunTerms
@@ -60,7 +61,10 @@ def integrate_adaptive(
 
     compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
 
+    last = [0.0]  # simulated time of the latest law evaluation
+
     def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        last[0] = time
         ref = trajectory.sample(time)
         try:
             out = compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
@@ -109,7 +113,8 @@ def integrate_adaptive(
             )
         return np.concatenate([v[0], accel(q, v, tau)[0], dz[0]])
 
-    with np.errstate(all="ignore"):
+    # bounded in wall-clock time (--timeout, simulation.deadline): past it, an error naming the law
+    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, last[0], seconds)):
         sol = solve_ivp(
             rhs,
             (t[0], t[-1]),

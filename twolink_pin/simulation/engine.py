@@ -44,6 +44,7 @@ from twolink_pin.errors import ControllerError, SimulationDivergedError, Twolink
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.simulation.containment import contained, read_only
+from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.terms import terms_for
@@ -201,7 +202,9 @@ def integrate(
     dz4: Any
     first = True
     now = 0.0  # time of the law evaluation under way (for error messages)
-    with np.errstate(all="ignore"):  # a diverging run overflows before its block is checked
+    # A diverging run overflows before its block is checked. The run is bounded in wall-clock
+    # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
+    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, now, seconds)):
         for k0 in range(0, total, BLOCK):
             k1 = min(k0 + BLOCK, total)
             last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1

@@ -1,0 +1,91 @@
+"""``--timeout`` bounds each simulation (twolink_pin.simulation.deadline), not the command.
+
+The laws here loop forever (no finite sleep): the bound itself is the only signal, so the
+tests do not depend on the machine's speed.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest_sim import ROBOT, TRAJECTORY
+
+from twolink_pin.cli import main
+from twolink_pin.controllers import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.gains import Gains
+from twolink_pin.errors import ControllerError
+from twolink_pin.plant import Plant
+from twolink_pin.scenario import make_scenario
+from twolink_pin.simulation import SimulationConfig, simulate
+from twolink_pin.simulation.deadline import per_run_limit
+
+SPINNER = Path(__file__).parent / "corpus" / "laws" / "misbehaving.py"
+
+
+class SpinsAtStep(Controller, register=False):
+    """PD until the simulated time passes ``t_stop``, then a busy loop that never ends (and
+    swallows ``Exception``, as careless user code does)."""
+
+    name = "test-spins-later"
+    title = "spins later"
+    Gains = Gains
+    t_stop = 0.02
+
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        while x.t >= self.t_stop:
+            try:
+                pass
+            except Exception:  # the point: it cannot swallow the bound
+                pass
+        return LawOutput(-100.0 * (x.q - x.q_des) - 20.0 * (x.v - x.v_des))
+
+
+@pytest.mark.parametrize("method", ["rk4", "adaptive"])
+def test_a_law_that_never_returns_is_stopped_naming_the_law_and_the_bound(method: str) -> None:
+    law = SpinsAtStep(ROBOT)
+    config = SimulationConfig(duration=0.1, method=method)
+    previous = signal.getsignal(signal.SIGALRM)
+    with per_run_limit(1.0), pytest.raises(ControllerError) as caught:
+        simulate(law, Plant(ROBOT), TRAJECTORY, config)
+    message = str(caught.value)
+    assert "test-spins-later" in message and "SpinsAtStep" in message and "--timeout 1 s" in message
+    assert caught.value.time >= SpinsAtStep.t_stop  # stopped where it spins, not before
+    # the timer is disarmed and the handler restored: the next run is not cut short
+    assert signal.getitimer(signal.ITIMER_REAL)[0] == 0
+    assert signal.getsignal(signal.SIGALRM) is previous
+    with per_run_limit(1.0):
+        plain = simulate(make_scenario("pd", ROBOT).controller, Plant(ROBOT), TRAJECTORY, config)
+    assert plain.t[-1] == pytest.approx(0.1)
+
+
+def test_without_a_bound_nothing_is_armed() -> None:
+    with per_run_limit(None):
+        simulate(
+            make_scenario("pd", ROBOT).controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.01)
+        )
+    assert signal.getitimer(signal.ITIMER_REAL)[0] == 0
+
+
+def test_compare_stops_the_run_that_never_returns_and_keeps_the_others(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "c"
+    argv = ["compare", "pd", f"{SPINNER}:Spinner", "computed-torque", "--duration", "0.05"]
+    code = main([*argv, "--timeout", "1", "--no-plot", "--out", str(out)])
+    assert code == 1
+    err = [x for x in capsys.readouterr().err.splitlines() if x.strip() and not x.startswith("compare:")]
+    assert len(err) == 1 and "--timeout 1 s" in err[0] and "Spinner" in err[0] and "Traceback" not in err[0]
+    table = json.loads((out / "comparison.json").read_text())
+    assert set(table["failed"]) == {"corpus-spinner"} and "--timeout 1 s" in table["failed"]["corpus-spinner"]
+    # the two laws around it ran to the end: their rows equal the runs made alone
+    assert set(table["controllers"]) == {"pd", "computed-torque"}
+    for name in ("pd", "computed-torque"):
+        alone = simulate(
+            make_scenario(name, ROBOT).controller, Plant(ROBOT), TRAJECTORY, SimulationConfig(duration=0.05)
+        )
+        e = np.asarray(alone.q) - np.asarray(alone.q_des)
+        np.testing.assert_allclose(table["controllers"][name]["max"]["e"], np.abs(e).max(axis=0), rtol=1e-12)

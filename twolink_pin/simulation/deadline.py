@@ -1,0 +1,104 @@
+"""A wall-clock bound per simulation: a law that never returns stops its run, not the program.
+
+:func:`per_run_limit` sets the bound (the CLI's ``--timeout``) for the simulations started
+inside it; the engine (:func:`~twolink_pin.simulation.engine.integrate`, and the adaptive-step
+integrator) runs each simulation inside :func:`bounded`, which arms ``SIGALRM``
+(``signal.setitimer``) for the bound and, when it fires, raises :class:`RunTimeout` where
+the program is — in the law's busy loop, in its ``time.sleep`` — which the engine turns into
+a :class:`~twolink_pin.errors.ControllerError` naming the law and the bound. So ``compare``
+records that law's run as failed and keeps the others' results, as for a law that raises.
+
+:class:`RunTimeout` is a ``BaseException`` (like ``KeyboardInterrupt``): a law's
+``except Exception`` cannot swallow it.
+
+Where it does not apply: outside the main thread (Python delivers signals to the main
+thread only) — a Dask worker runs its tasks in worker threads, so a sweep on Dask workers
+is not bounded per run (an in-process sweep is, per chunk of runs: one chunk is one
+simulation of N runs); on a platform without ``setitimer`` (Windows); and code that blocks
+signals or loops inside C without returning to Python.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import contextvars
+import signal
+import threading
+from collections.abc import Callable, Iterator
+from typing import TYPE_CHECKING
+
+from twolink_pin.errors import ControllerError
+
+if TYPE_CHECKING:
+    from twolink_pin.controllers import Controller
+
+_LIMIT: contextvars.ContextVar[float | None] = contextvars.ContextVar("twolink_pin_run_limit", default=None)
+
+
+class RunTimeout(BaseException):
+    """A simulation ran past its wall-clock bound (see module doc)."""
+
+    def __init__(self, seconds: float) -> None:
+        super().__init__(seconds)
+        self.seconds = seconds
+
+
+@contextlib.contextmanager
+def per_run_limit(seconds: float | None) -> Iterator[None]:
+    """Bound every simulation started inside the block to ``seconds`` of wall-clock time
+    (None or 0: no bound)."""
+    token = _LIMIT.set(float(seconds) if seconds else None)
+    try:
+        yield
+    finally:
+        _LIMIT.reset(token)
+
+
+def run_limit() -> float | None:
+    """The bound [s] in force (None: none)."""
+    return _LIMIT.get()
+
+
+@contextlib.contextmanager
+def bounded(error: Callable[[float], BaseException] | None = None) -> Iterator[float | None]:
+    """Raise :class:`RunTimeout` inside the block once it has run for the bound in force
+    (:func:`per_run_limit`) — or ``error(seconds)`` in its place, e.g. :func:`timed_out`
+    naming the law; yields the bound. No bound outside the main thread, without
+    ``setitimer``, or when a bound is already armed (an enclosing simulation)."""
+    seconds = _LIMIT.get()
+    if (
+        not seconds
+        or threading.current_thread() is not threading.main_thread()
+        or not hasattr(signal, "setitimer")
+        or signal.getitimer(signal.ITIMER_REAL)[0] > 0
+    ):
+        yield None
+        return
+
+    def expire(signum: int, frame: object) -> None:
+        raise RunTimeout(seconds)
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield seconds
+    except RunTimeout as exc:
+        if error is None:
+            raise
+        raise error(exc.seconds) from None
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def timed_out(controller: Controller, t: float, seconds: float) -> ControllerError:
+    """The error of a run stopped by its bound: names the law (its name and class) and the bound."""
+    return ControllerError(
+        controller.name,
+        t,
+        f"the run did not finish within --timeout {seconds:g} s of wall-clock time (the law "
+        f"{type(controller).__qualname__} may never return); give a larger --timeout for a longer run",
+    )
+
+
+__all__ = ["RunTimeout", "bounded", "per_run_limit", "run_limit", "timed_out"]
