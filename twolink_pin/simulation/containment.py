@@ -28,8 +28,9 @@ from twolink_pin.controllers import Controller, LawInput, LawOutput
 from twolink_pin.errors import ControllerError
 
 READ_ONLY_HINT = (
-    "wrote into its input arrays, which are read-only (the engine's state and the reference "
-    "shared with later steps); copy first, e.g. q = x.q.copy()"
+    "wrote into an array it was given, which is read-only: its inputs (the engine's state and the "
+    "reference shared with later steps) and what Terms returns (mass, gravity, bias, model term, "
+    "regressor, frame quantities); copy first, e.g. q = x.q.copy() or M = terms.mass(q).copy()"
 )
 
 

@@ -17,7 +17,7 @@ parameters, built the first time a law asks):
                 ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model)
 ==============  ================================================================
 
-A batch computes every run with the same calls as a single run, so a batch equals N
+Every array returned is read-only (:func:`frozen`). A batch computes every run with the same calls as a single run, so a batch equals N
 single runs bit for bit. The runs are looped over in Python: these terms cost about
 N × (one Pinocchio call + 2 µs) per evaluation.
 
@@ -38,6 +38,13 @@ from twolink_pin.model.parameters import model_with_parameters
 
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 """The one convention of :meth:`RigidBodyTerms.frame`."""
+
+
+def frozen(a: np.ndarray) -> np.ndarray:
+    """``a`` made read-only in place and returned: every array a law gets from ``Terms``
+    (a law that writes into one raises; the engine's containment names the law)."""
+    a.setflags(write=False)
+    return a
 
 
 class RigidBodyTerms:
@@ -120,7 +127,7 @@ class RigidBodyTerms:
         out = np.empty((n, self._nv))
         for i in range(n):
             out[i] = pin.computeGeneralizedGravity(models[i % len(models)], data, Q[i])
-        return out
+        return frozen(out)
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         q, v = np.atleast_2d(q), np.atleast_2d(v)
@@ -129,7 +136,7 @@ class RigidBodyTerms:
         out = np.empty((n, self._nv))
         for i in range(n):
             out[i] = pin.nonLinearEffects(models[i % len(models)], data, Q[i], V[i])
-        return out
+        return frozen(out)
 
     def solve_mass(self, q: np.ndarray, b: np.ndarray) -> np.ndarray:
         b = np.asarray(b, dtype=float)
@@ -143,8 +150,8 @@ class RigidBodyTerms:
         n = max(M.shape[0], b.shape[0])
         M = np.broadcast_to(M, (n, self._nv, self._nv))
         if b.ndim == 2:
-            return np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0]
-        return np.linalg.solve(M, np.broadcast_to(b, (n, *b.shape[1:])))
+            return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
+        return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, *b.shape[1:]))))
 
     def frame_id(self, frame: str | None) -> int:
         """Index of ``frame`` in the model (None: the end effector)."""
@@ -176,7 +183,7 @@ class RigidBodyTerms:
             rotation[i] = placement.rotation
             jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
             drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
-        return FrameTerms(position, rotation, jacobian, drift)
+        return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
 
 
 class RigidBodyTermsMixin:

@@ -23,6 +23,9 @@
 ``mass``, ``gravity``, ``bias``, ``solve_mass`` and ``frame`` are one Pinocchio algorithm per
 run on the believed model (:mod:`twolink_pin.simulation.rigid_terms`).
 
+Every array a law gets from these terms is read-only (:func:`~twolink_pin.simulation.rigid_terms.frozen`):
+a law that writes into one raises, and the engine's containment names the law.
+
 Every run's numbers are computed by the same code whatever N and whichever runs share its
 batch (element-wise numpy, one Pinocchio evaluation per column), so a batch equals N
 single runs to rounding and a run's result does not depend on how a sweep is chunked.
@@ -46,7 +49,7 @@ from twolink_pin.model.parameters import (
     model_with_parameters,
     with_inertial_parameters,
 )
-from twolink_pin.simulation.rigid_terms import RigidBodyTerms, RigidBodyTermsMixin
+from twolink_pin.simulation.rigid_terms import RigidBodyTerms, RigidBodyTermsMixin, frozen
 
 if TYPE_CHECKING:
     from twolink_pin.controllers import Controller
@@ -148,15 +151,15 @@ class SingleRunTerms(RigidBodyTermsMixin):
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         nv = self._nv
         tau = pin.rnea(self._pair, self._data, *self._inputs.fill(q, v, w, a))
-        return tau[None, :nv] - tau[None, nv:]
+        return frozen(tau[None, :nv] - tau[None, nv:])
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         nv, n_pi = self._nv, self._n_pi
         R = pin.computeJointTorqueRegressor(self._pair, self._data, *self._inputs.fill(q, v, w, a))
-        return ((R[:nv, :n_pi] - R[nv:, n_pi:]) @ self._P)[None]
+        return frozen(((R[:nv, :n_pi] - R[nv:, n_pi:]) @ self._P)[None])
 
     def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
-        return friction_regressor(np.reshape(v, (1, self._nv)), smoothing)
+        return frozen(friction_regressor(np.reshape(v, (1, self._nv)), smoothing))
 
 
 # -- N runs ----------------------------------------------------------------------------------
@@ -367,21 +370,21 @@ class BatchTerms(RigidBodyTermsMixin):
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
         if self._shared is not None:
-            return self._shared(q, v, w, a)[0]
+            return frozen(self._shared(q, v, w, a)[0])
         assert self._p_rows is not None
         columns = self._columns()(q, v, w, a)
         p = self._p_rows
         tau = columns[0] * p[:, 0:1]
         for j in range(1, len(columns)):
             tau = tau + columns[j] * p[:, j : j + 1]
-        return tau
+        return frozen(tau)
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
-        return np.stack(self._columns()(q, v, w, a), axis=2)
+        return frozen(np.stack(self._columns()(q, v, w, a), axis=2))
 
     def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
-        return friction_regressor(np.broadcast_to(v, (self._runs, self._nv)), smoothing)
+        return frozen(friction_regressor(np.broadcast_to(v, (self._runs, self._nv)), smoothing))
 
 
 def terms_for(
