@@ -3,7 +3,8 @@
 :func:`contained` wraps ``controller.compute`` so that what a law does wrong is an error
 naming the law, never a changed simulation or a silent exit:
 
-* its input arrays reach it as **read-only views**: ``q``, ``v``, ``z`` here, the reference
+* its input arrays reach it **read-only**: ``q``, ``v``, ``z`` here (flagged in place: the
+  caller passes arrays it will not write into), the reference
   ``q_des``, ``v_des``, ``a_des`` (which later steps share) where the engine samples it
   (:func:`read_only`); a write raises, and the resulting
   :class:`~twolink_pin.errors.ControllerError` says that the inputs are read-only;
@@ -48,14 +49,18 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
     The returned function has the law's signature ``(x, terms) -> LawOutput``."""
     compute = controller.compute
     name = controller.name
-    new = tuple.__new__
 
     def call(x: LawInput, terms: Any) -> LawOutput:
-        t, q, v, z, q_des, v_des, a_des = x
-        # The reference is made read-only where the engine samples it (once per block).
-        frozen = new(LawInput, (t, read_only(q), read_only(v), read_only(z), q_des, v_des, a_des))
+        # Frozen in place (one flag each, no view: four times per RK4 step): the engine's
+        # stage states are its own temporaries (it copies before it writes into one), the
+        # adaptive-step method passes views. The reference is made read-only where the
+        # engine samples it (once per block).
+        t = x[0]
+        x[1].setflags(write=False)
+        x[2].setflags(write=False)
+        x[3].setflags(write=False)
         try:
-            return compute(frozen, terms)
+            return compute(x, terms)
         except SystemExit as exc:
             raise ControllerError(
                 name, float(t), f"compute called sys.exit({exc.code!r}); a law must return or raise"

@@ -317,6 +317,7 @@ def integrate(
                     newly |= late
                 if newly.any():  # park them on the reference, keep the batch going
                     j = 2 * (k1 - k0)
+                    q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
                     q[newly], v[newly], z[newly] = rq[j][0], rv[j][0], z_start[newly]
             if observer is not None:
                 observer.add(
