@@ -14,7 +14,9 @@ parameters, built the first time a law asks):
                 LU with pivoting: no inverse is formed)
 ``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
                 then ``getFrameJacobian`` and ``getFrameClassicalAcceleration`` in
-                ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model)
+                ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model); the
+                last few results kept by value (the reference's frame is asked
+                again at the next RK4 stage)
 ==============  ================================================================
 
 Every array returned is read-only (:func:`frozen`). A batch computes every run with the same calls as a single run, so a batch equals N
@@ -38,6 +40,11 @@ from twolink_pin.model.parameters import model_with_parameters
 
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 """The one convention of :meth:`RigidBodyTerms.frame`."""
+
+
+FRAME_CACHE = 4
+"""Frame results kept by value (:meth:`RigidBodyTerms.frame`): the law's state and the
+reference's, for a frame or two."""
 
 
 def frozen(a: np.ndarray) -> np.ndarray:
@@ -71,6 +78,7 @@ class RigidBodyTerms:
         self._zero = np.zeros(robot.nv)
         self._lower = np.tril_indices(robot.nv, -1)
         self._last_mass: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._frame_cache: dict[tuple[object, ...], FrameTerms] = {}
 
     # -- models ------------------------------------------------------------------------
 
@@ -97,6 +105,8 @@ class RigidBodyTerms:
         return n, models, data
 
     def _states(self, q: np.ndarray, n: int) -> np.ndarray:
+        if type(q) is np.ndarray and q.shape == (n, self._nv) and q.dtype == np.float64:
+            return q  # the engine's (N, nv) state as it is: no conversion, no broadcast
         q = np.asarray(q, dtype=float)
         if q.ndim == 1:
             q = q[None]
@@ -168,6 +178,21 @@ class RigidBodyTerms:
     def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
         fid = self.frame_id(frame)
         q, v = np.atleast_2d(q), np.atleast_2d(v)
+        # The same (q, q̇) is asked again within a step (the reference's frame at RK4 stages 2
+        # and 3, and at stage 4 and the next step's stage 1): the last FRAME_CACHE results by
+        # value (read-only, so sharing them is safe).
+        key = (fid, q.shape, v.shape, q.tobytes(), v.tobytes())
+        cache = self._frame_cache
+        hit = cache.get(key)
+        if hit is not None:
+            return hit
+        result = self._frame(fid, q, v)
+        if len(cache) >= FRAME_CACHE:
+            del cache[next(iter(cache))]
+        cache[key] = result
+        return result
+
+    def _frame(self, fid: int, q: np.ndarray, v: np.ndarray) -> FrameTerms:
         n = max(q.shape[0], v.shape[0])
         Q, V = self._states(q, n), self._states(v, n)
         model, data, zero = self._kinematics, self._kinematics_data, self._zero
