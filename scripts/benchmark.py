@@ -31,6 +31,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --json     # also a JSON line at the end
     .venv/bin/python scripts/benchmark.py --sweep-only [--quick]   # Dask throughput, client memory
     .venv/bin/python scripts/benchmark.py --ur5-only [--quick]     # the UR5 against the baseline
+    .venv/bin/python scripts/benchmark.py --single-only [--quick]  # every law's single run, back to back; osc on the Panda
     .venv/bin/python scripts/benchmark.py --shared-only [--quick]  # two batches at once; 200-run sweep, 2 workers
 
 A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
@@ -553,6 +554,124 @@ def ur5_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats:
     return {"ur5": {"baseline_seconds": base, "batch_n": batch_n, "seconds": rows}}
 
 
+SINGLE_RUN_LAWS = {
+    "twolink": ("pd", "computed-torque", "robust", "adaptive", "adaptive-friction"),
+    "ur5": ("pd", "computed-torque", "adaptive"),
+}
+"""The single-run rows: every built-in joint-space law on the twolink, and the UR5's set."""
+MUJOCO_RATIO = 12.8
+"""Issue 22 item 4: MuJoCo 4.0 with a Python law at every RK4 stage, × the baseline of the same run."""
+
+
+def single_runs_section(
+    baseline: Callable[[], Any], scale: float, quick: bool, repeats: int
+) -> dict[str, Any]:
+    """Every built-in law's single run (N = 1, law at every RK4 stage) against the pure-Python
+    baseline, timed **back to back** (baseline, law; baseline, law; ...) so that each pair sees
+    the same load: per law the ratio of minima and the median of the pairs' ratios, against
+    MuJoCo's 12.8x (:data:`MUJOCO_RATIO`); the load average before and after."""
+    duration = 0.2 if quick else 2.0
+    load_before = [round(x, 2) for x in os.getloadavg()]
+    rows: dict[str, dict[str, Any]] = {}
+    for robot_name, laws in SINGLE_RUN_LAWS.items():
+        robot = load_robot(robot_name)
+        reference = default_trajectory(robot)
+        config = SimulationConfig(
+            duration=duration, dt=DT, q0_offset=None if robot_name == "twolink" else 0.05
+        )
+        for spec in laws:
+            law, plant = make_scenario(spec, robot)
+            simulate(law, plant, reference, SimulationConfig(duration=0.01, dt=DT))  # warm: imports, caches
+            base, run, pairs = [], [], []
+            for _ in range(repeats):
+                b = _timed(baseline) * scale
+                r = (
+                    _timed(lambda c=law, p=plant, t=reference, f=config: simulate(c, p, t, f))
+                    * FULL
+                    / duration
+                )
+                base.append(b)
+                run.append(r)
+                pairs.append(r / b)
+            rows[f"{robot_name} {spec}"] = {
+                "seconds": min(run),
+                "baseline_seconds": min(base),
+                "ratio_of_minima": min(run) / min(base),
+                "median_pair_ratio": statistics.median(pairs),
+            }
+    load_after = [round(x, 2) for x in os.getloadavg()]
+    print(
+        f"\nsingle runs (N = 1, law at every RK4 stage, {duration:g} s simulated), each timed back to back with "
+        f"the baseline {repeats} times; load average {load_before} -> {load_after}"
+    )
+    print(
+        f"  {'law':28s} {'s per 30 s':>10s} {'min/min':>9s} {'median pair':>12s}  target <= {MUJOCO_RATIO:g}x"
+    )
+    for name, row in rows.items():
+        verdict = "met" if row["median_pair_ratio"] <= MUJOCO_RATIO else "NOT met"
+        print(
+            f"  {name:28s} {row['seconds']:10.3f} {row['ratio_of_minima']:8.2f}x {row['median_pair_ratio']:11.2f}x  "
+            f"{verdict}"
+        )
+    return {
+        "single_runs": {
+            "duration": duration,
+            "repeats": repeats,
+            "load_average": [load_before, load_after],
+            "target": MUJOCO_RATIO,
+            "rows": rows,
+        }
+    }
+
+
+def osc_panda_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats: int) -> dict[str, Any]:
+    """``osc`` on the Panda (7 joints, a redundant arm: the posture task in the null space):
+    seconds per 30-s simulation of a single run and of the batch at N = 1000 per simulation,
+    beside the pure-Python baseline timed in the same run (issue 20)."""
+    panda = load_robot("panda")
+    reference = default_trajectory(panda)
+    law, plant = make_scenario("osc", panda)
+    single_duration = 0.05 if quick else 0.5
+    batch_n = 100 if quick else 1000
+    batch_duration = 0.01 if quick else 0.02
+    offsets = np.random.default_rng(0).uniform(-0.05, 0.05, (batch_n, panda.nv))
+    single_config = SimulationConfig(duration=single_duration, dt=DT, q0_offset=0.05)
+    batch_config = SimulationConfig(duration=batch_duration, dt=DT)
+    base: list[float] = []
+    single: list[float] = []
+    batch: list[float] = []
+    for _ in range(repeats):
+        base.append(_timed(baseline) * scale)
+        single.append(_timed(lambda: simulate(law, plant, reference, single_config)) * FULL / single_duration)
+    for _ in range(1 if quick else 2):
+        base.append(_timed(baseline) * scale)
+        elapsed = _timed(
+            lambda: simulate_batch(
+                law, plant, reference, batch_config, q0_offsets=offsets, threads=None, progress=False
+            )
+        )
+        batch.append(elapsed * FULL / batch_duration / batch_n)
+    b = min(base)
+    print(
+        f"\nosc on the Panda (7 joints): seconds per 30-s simulation and ratio to the baseline ({b:.3f} s, min of "
+        f"{len(base)} interleaved; single: {single_duration:g} s simulated, min of {repeats}; batch: N = {batch_n}, "
+        f"{batch_duration:g} s simulated, default threads, per simulation); load average "
+        f"{[round(x, 2) for x in os.getloadavg()]}"
+    )
+    print(f"  {'single':10s} {min(single):10.3f} s {min(single) / b:7.2f}x")
+    print(f"  {'batch':10s} {min(batch):10.3f} s {min(batch) / b:7.2f}x")
+    return {
+        "osc_panda": {
+            "baseline_seconds": b,
+            "single_seconds": min(single),
+            "batch_per_sim_seconds": min(batch),
+            "batch_n": batch_n,
+            "single_duration": single_duration,
+            "batch_duration": batch_duration,
+        }
+    }
+
+
 def _verdict(ratio: float, target: float | None) -> str:
     if target is None:
         return ""
@@ -612,6 +731,11 @@ def main(argv: list[str] | None = None) -> int:
         "--identify-only", action="store_true", help="only identify on the UR5 and its --physical fit"
     )
     parser.add_argument(
+        "--single-only",
+        action="store_true",
+        help="only every law's single run (twolink, UR5) back to back with the baseline, and osc on the Panda",
+    )
+    parser.add_argument(
         "--shared-only",
         action="store_true",
         help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
@@ -655,6 +779,12 @@ def main(argv: list[str] | None = None) -> int:
         results.update(contention_section(baseline, scale, repeats))
         if not quick:
             results.update(sweep_200_section())
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.single_only:
+        results.update(single_runs_section(baseline, scale, quick, repeats))
+        results.update(osc_panda_section(baseline, scale, quick, repeats))
         if args.json:
             print(json.dumps(results))
         return 0
@@ -751,6 +881,8 @@ def main(argv: list[str] | None = None) -> int:
         "seconds": {_label(k): v for k, v in batch.items()},
     }
     results.update(ur5_section(baseline, scale, quick, repeats))
+    results.update(single_runs_section(baseline, scale, quick, repeats))
+    results.update(osc_panda_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))
 
     # -- batch scaling ------------------------------------------------------------------------------
