@@ -8,6 +8,7 @@
 ``events.py``         what a plant that pushes back does to a step: wrench, payload step, noise, delay
 ``adaptive_step.py``  DOP853 with error control, one run
 ``containment.py``    the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
+``deadline.py``       the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law
 ``result.py``         :class:`SimulationResult`
 ``run.py``            :func:`simulate` (N = 1, recorded)
 ``storage.py``        results as ``.npz``
