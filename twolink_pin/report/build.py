@@ -18,7 +18,7 @@ import inspect
 import os
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
@@ -35,42 +35,33 @@ from twolink_pin.files import output_directory
 from twolink_pin.metrics import Metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
-from twolink_pin.report.identification import (
-    _identification_section,
-    _reuses_adaptive_run,
-    _submit_identification,
-)
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import _pool
 from twolink_pin.report.runs import _reference, _run, _trajectory_figures
-from twolink_pin.scenario import builtin_laws, law_class, make_scenario
+from twolink_pin.run_spec import plant_description
+from twolink_pin.scenario import builtin_laws, law_class
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.comparison import ComparisonTable
-from twolink_pin.trajectory import default_trajectory, default_via_points
+from twolink_pin.trajectory import default_via_points
 
 MARKER = ".twolink-pin-report"
 """File that marks a directory as written by this command (safe to replace)."""
-ANIMATED = "adaptive"
-"""The law whose run the report animates (the first law if it is not run)."""
-
 Progress = Callable[[str, int, int], None]
 
 __all__ = ["MARKER", "MAX_WORKERS", "ReportOptions", "build_report", "laws_to_run"]
 
 
-def laws_to_run(options: ReportOptions, is_twolink: bool) -> tuple[str, ...]:
-    """The laws the report runs (see :class:`ReportOptions`)."""
+def laws_to_run(options: ReportOptions, robot: Any) -> tuple[str, ...]:
+    """The laws the report runs (see :class:`ReportOptions`): those asked for, else the
+    robot profile's report laws, else every built-in law."""
     if options.controllers is not None:
         names = tuple(law_class(spec).name for spec in options.controllers)
         if len(set(names)) != len(names):
             raise InvalidParameterError("controllers", list(options.controllers), "each law at most once")
         return tuple(options.controllers)
-    if is_twolink:
-        from twolink_pin.twolink.reference import REPORT_CONTROLLERS
-
-        return REPORT_CONTROLLERS
-    return builtin_laws()
+    laws = robot.profile.report.laws
+    return tuple(laws) if laws is not None else builtin_laws()
 
 
 def build_report(
@@ -90,12 +81,10 @@ def build_report(
     options = options if options is not None else ReportOptions()
     started = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
-    is_twolink = robot.name == "twolink"
-    specs = laws_to_run(options, is_twolink)
+    sections = robot.profile.report.sections  # the robot's own sections (the twolink's course report)
+    specs = laws_to_run(options, robot)
     options.run.check_law_gains(specs)
-    steps = (
-        4 + len(specs) + (1 if options.animation else 0) + (1 if is_twolink and options.identification else 0)
-    )
+    steps = 4 + len(specs) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
     done = 0
 
     def tick(what: str) -> None:
@@ -105,7 +94,7 @@ def build_report(
             progress(what, done, steps)
 
     with output_directory(out_dir, MARKER, "written by twolink-pin report\n") as stage:
-        results = _build(stage, robot, is_twolink, specs, options, tick)
+        results = _build(stage, robot, specs, options, tick)
         results["total_seconds"] = time.perf_counter() - started
         results["command_line"] = command_line
         from twolink_pin.report.pages import write_pages
@@ -118,7 +107,6 @@ def build_report(
 def _build(
     stage: Path,
     robot: Any,
-    is_twolink: bool,
     specs: Sequence[str],
     options: ReportOptions,
     tick: Callable[[str], None],
@@ -128,13 +116,11 @@ def _build(
     trajectory = _reference(robot, options)
     via = default_via_points(robot) if not options.trajectory else None
     check = check_torques(robot, trajectory)
-    numbers: dict[str, dict[str, int]] = {}
-    if is_twolink:
-        from twolink_pin.twolink.reference import REPORT_FIGURES
-
-        numbers = REPORT_FIGURES
+    declared = robot.profile.report
+    sections = declared.sections
+    numbers = {k: dict(v) for k, v in declared.figure_numbers.items()}
     names = [law_class(spec).name for spec in specs]
-    animated = ANIMATED if ANIMATED in names else names[0]
+    animated = declared.animated_law if declared.animated_law in names else names[0]
     order = [animated, *(n for n in names if n != animated)]
     by_name = dict(zip(names, specs))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
@@ -144,23 +130,13 @@ def _build(
     animation = None
     workers = min(options.workers, len(order) + 1)
     with _pool(workers) as pool:
-        # The identification's runs first: they are the longest tasks (3 adaptive runs and a
-        # logged run of 30 s), so the laws' runs fill the other worker meanwhile.
-        reused = "adaptive" in names and _reuses_adaptive_run(options)
-        ident_futures = (
-            _submit_identification(pool, options, str(fig_dir), reused)
-            if is_twolink and options.identification
-            else None
-        )
+        # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
+        # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
+        pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
         futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
         traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
         model = facts.model_facts(robot)
-        twolink: dict[str, Any] | None = None
-        if is_twolink:
-            twolink = {
-                "closed_form_check": facts.twolink_closed_form_check(robot),
-                "table1": None if via is None else facts.table1(robot, via),  # None: another trajectory
-            }
+        own_facts = sections.facts(robot, via) if sections else None
         tick("model and trajectory")
         for name in order:
             try:
@@ -189,35 +165,26 @@ def _build(
         traj_figs = traj_future.result()
         tick("trajectory figures")
         identification = None
-        if ident_futures is not None:
-            runs_future, fit_future = ident_futures
-            excitation_runs = {key: f.result() for key, f in runs_future.items()}
-            if reused and "adaptive" in runs:  # the report's own adaptive run is the one along its trajectory
-                result = runs["adaptive"][0]
-                assert result.p_hat is not None
-                own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
-                excitation_runs = {"report": own, **excitation_runs}
-            identification = _identification_section(
-                options,
-                str(fig_dir),
-                excitation_runs,
-                None if fit_future is None else fit_future.result(),
-            )
+        if sections and pending is not None:
+            done_runs = {n: r[0] for n, r in runs.items()}
+            identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
             tick("identification")
     runs = {n: runs[n] for n in names if n in runs}  # the order asked for
     table = ComparisonTable(
         {n: r[1] for n, r in runs.items()},
         {n: r[3] for n, r in runs.items()},
-        options.config.duration,
+        options.run.simulation.duration,
         {n: failed[n] for n in names if n in failed},
     )
-    cfg = options.config
+    cfg = options.run.simulation
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
     controllers = {}
     lams: dict[str, float] = {}
+    scenarios = {n: options.run.for_law(by_name[n]).build(robot) for n in names}  # what each ran with
+    table = replace(table, plants={n: plant_description(scenarios[n]) for n in names})
     for name, (result, metrics, figures, seconds) in runs.items():
         cls = law_class(by_name[name])
-        controller = options.run.for_law(by_name[name]).build(robot).controller  # the gains it ran with
+        controller = scenarios[name].controller  # the gains it ran with
         if cls.takes("lam"):
             lams[name] = float(np.max(controller.gains.lam))
         controllers[name] = {
@@ -234,13 +201,13 @@ def _build(
             "limit_exceeded_at": result.first_exceeded_at,
         }
     errata: list[dict[str, Any]] = []
-    if is_twolink:
-        lam = next(iter(lams.values()), 5.0)
-        errata = _twolink_errata(robot, trajectory, runs, by_name, options, q0_offset, lam)
+    if sections:
+        done_runs = {n: r[0] for n, r in runs.items()}
+        errata = sections.errata(robot, trajectory, done_runs, by_name, options, q0_offset, lams)
     tick("errata")
     out: dict[str, Any] = {
         "robot": model,
-        "twolink": twolink,
+        "twolink": own_facts,
         "trajectory": {
             "times": trajectory.times.tolist(),
             "via_q": trajectory.via_q.tolist(),
@@ -254,8 +221,8 @@ def _build(
         | {
             "q0_offset": q0_offset.tolist(),
             "lambda": lams,
-            "saturate": options.saturate,
-            "friction_smoothing": options.friction_smoothing,
+            "saturate": options.run.plant.saturate,
+            "friction_smoothing": options.run.friction_smoothing,
         },
         "run": options.run.as_dict(),
         "controllers": controllers,
@@ -270,44 +237,4 @@ def _build(
         "identification": identification,
         "versions": facts.versions(),
     }
-    if is_twolink:
-        from twolink_pin.twolink.reference import (
-            REPORT_COEFFICIENTS,
-            REPORT_P,
-            REPORT_TABLE2,
-            REPORT_TABLE2_COLUMNS,
-        )
-
-        assert twolink is not None
-        twolink["report_p"] = REPORT_P
-        twolink["report_coefficients"] = [list(c) for c in REPORT_COEFFICIENTS]
-        twolink["report_table2"] = {n: list(v) for n, v in REPORT_TABLE2.items()}
-        twolink["report_table2_columns"] = list(REPORT_TABLE2_COLUMNS)
     return out
-
-
-def _twolink_errata(
-    robot: Any,
-    trajectory: Any,
-    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
-    by_name: dict[str, str],
-    options: ReportOptions,
-    q0_offset: np.ndarray,
-    lam: float,
-) -> list[dict[str, Any]]:
-    from twolink_pin.twolink import errata
-
-    report_trajectory = default_trajectory(robot)  # the errata are about the report's own trajectory
-    items = [
-        errata.third_via_point(robot),
-        errata.printed_coefficients(report_trajectory),
-        errata.y3_sign(robot),
-    ]
-    items.append(errata.unstated_settings(lam, tuple(q0_offset.tolist())))
-    if "robust" in runs:
-        items.append(errata.robust_naming(runs["robust"][0]))
-    if "adaptive" in runs:
-        cls = law_class(by_name["adaptive"])
-        controller = make_scenario(cls, robot, lam=options.lam).controller
-        items.append(errata.parameter_convergence(runs["adaptive"][0], controller, trajectory))  # type: ignore[arg-type]
-    return [e._asdict() for e in items]

@@ -7,7 +7,6 @@ from dataclasses import dataclass, field, replace
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.run_spec import RunSpec
-from twolink_pin.simulation import SimulationConfig
 
 MAX_WORKERS = 64
 """Largest number of worker processes (more than the runs is never used)."""
@@ -46,36 +45,6 @@ class ReportOptions:
     animation: bool = True
     identification: bool = True
     trajectory: str | None = None
-
-    @property
-    def config(self) -> SimulationConfig:
-        """The simulation settings of every run."""
-        return self.run.simulation
-
-    @property
-    def lam(self) -> float | None:
-        """λ [1/s] of the laws that have one (None: their default)."""
-        return self.run.lam
-
-    @property
-    def saturate(self) -> bool:
-        """Whether every plant clips torques at the URDF limits."""
-        return self.run.plant.saturate
-
-    @property
-    def friction_smoothing(self) -> float:
-        """ε [rad/s] of the friction sign."""
-        return self.run.friction_smoothing
-
-    @property
-    def p0(self) -> str | None:
-        """The parameter file the estimates start at, if any."""
-        return self.run.parameters if self.run.parameters_use == "p0" else None
-
-    @property
-    def model(self) -> str | None:
-        """The parameter file every law's model believes, if any."""
-        return self.run.parameters if self.run.parameters_use == "model" else None
 
     def __post_init__(self) -> None:
         if not (

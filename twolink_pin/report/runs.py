@@ -47,7 +47,7 @@ def _run(
     robot = load_robot(options.robot, payload=options.payload)
     cls = law_class(spec)
     controller, plant = options.run.for_law(spec).build(robot)
-    result = simulate(controller, plant, _reference(robot, options), options.config)
+    result = simulate(controller, plant, _reference(robot, options), options.run.simulation)
     metrics = compute_metrics(result)
     paths = save_simulation_figures(
         result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title

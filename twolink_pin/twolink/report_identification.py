@@ -1,15 +1,20 @@
 """The twolink report's identification section (beside Fig. 27): the adaptive law along
-the excitations, an identification from one logged run, their figures and numbers."""
+the excitations, an identification from one logged run, their figures and numbers.
+
+Called by :class:`twolink_pin.twolink.course_report.CourseReport` (the twolink profile's
+report hook); the tasks run in the report's worker processes (picklable arguments only)."""
 
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from twolink_pin.model import load_robot
-from twolink_pin.report.options import ReportOptions
+
+if TYPE_CHECKING:
+    from twolink_pin.report.options import ReportOptions
 
 IDENTIFICATION_NOISE = (1e-5, 0.05)
 """Noise of the report's identification example: σ_q [rad] (encoder level), σ_τ [N·m]."""
@@ -29,16 +34,12 @@ def _finite(x: Any) -> Any:
 def _reuses_adaptive_run(options: ReportOptions) -> bool:
     """Whether the report's ``adaptive`` run is exactly the identification section's run
     along the report's trajectory (same law, gains, p̂(0), reference and simulation)."""
+    from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationConfig
 
-    return (
-        options.trajectory is None
-        and options.p0 is None
-        and options.model is None
-        and options.lam is None
-        and not options.saturate
-        and options.friction_smoothing == 0.0
-        and options.config == SimulationConfig(duration=options.config.duration)
+    duration = options.run.simulation.duration  # the one setting the section follows
+    return options.trajectory is None and options.run == RunSpec(
+        shared=True, simulation=SimulationConfig(duration=duration)
     )
 
 
@@ -50,7 +51,7 @@ def _submit_identification(
     report's own adaptive run is that one) and the identification from a logged run."""
     from twolink_pin.twolink import excitation as twolink_excitation
 
-    if options.config.duration < twolink_excitation.PERIOD:
+    if options.run.simulation.duration < twolink_excitation.PERIOD:
         return {}, None
     keys = [key for key in twolink_excitation.TRAJECTORIES if not (reused and key == "report")]
     runs = {key: pool.submit(_excitation_run, options, key) for key in keys}
@@ -62,7 +63,9 @@ def _excitation_run(options: ReportOptions, key: str) -> tuple[np.ndarray, np.nd
     from twolink_pin.twolink import excitation as twolink_excitation
 
     robot = load_robot(options.robot, payload=options.payload)
-    result = twolink_excitation.adaptive_runs(robot, duration=options.config.duration, keys=(key,))[key]
+    result = twolink_excitation.adaptive_runs(robot, duration=options.run.simulation.duration, keys=(key,))[
+        key
+    ]
     assert result.p_hat is not None
     return np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size]
 
@@ -84,7 +87,7 @@ def _identification_fit(options: ReportOptions, fig_dir: str) -> tuple[list[str]
     robot = load_robot(options.robot, payload=options.payload)
     p = np.asarray(robot.p, dtype=float)
     log = simulate_log(
-        robot, twolink_excitation.identification_excitation(), duration=options.config.duration
+        robot, twolink_excitation.identification_excitation(), duration=options.run.simulation.duration
     )
     noisy = add_noise(log, *IDENTIFICATION_NOISE, seed=0)
     found = identify(noisy, robot)
@@ -134,7 +137,7 @@ def _identification_section(
     from twolink_pin.twolink import excitation as twolink_excitation
 
     robot = load_robot(options.robot, payload=options.payload)
-    duration = options.config.duration
+    duration = options.run.simulation.duration
     section: dict[str, Any] = {
         "table": twolink_excitation.excitation_table(robot),
         "duration_s": duration,
