@@ -73,9 +73,11 @@ class CourseReport:
             assert result.p_hat is not None
             own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
             excitation_runs = {"report": own, **excitation_runs}
-        return ident._identification_section(
+        section = ident._identification_section(
             options, fig_dir, excitation_runs, None if fit_future is None else fit_future.result()
         )
+        section["beside_law"] = REUSED_LAW  # the page shows it after this law's section (Fig. 27's)
+        return section
 
     def errata(
         self,
