@@ -40,6 +40,13 @@ def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> 
     assert len(csv_rows) == 1 + 4 * len(REPORT_CONTROLLERS)  # header, 3 norms + last-period row each
     errata = [e["topic"] for e in results["errata"]]
     assert len(errata) == 6 and "Unstated λ, initial state and norm" in errata
+    # which plant each law ran on, as compare says it: the report's plant has friction only
+    # under the laws that estimate it (the default --plant-friction law)
+    plants = results["comparison"]["plants"]
+    assert plants == {
+        n: "friction" if n == "adaptive-friction" else "no friction" for n in REPORT_CONTROLLERS
+    }
+    assert "| adaptive-friction | friction | finished |" in (report_dir / "report.md").read_text()
 
 
 def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:
@@ -141,6 +148,41 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
     assert nav is not None and re.findall(r'">(\d+) ', nav[1]) == [str(n) for n in numbers]
 
 
+def test_what_the_report_shows_of_a_robot_is_its_profiles_declaration(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A catalog robot whose profile declares two report laws and the animated one: the
+    report runs those (not every built-in law), animates the declared one, and with
+    ``--plant-friction on`` every law's row says it ran on a plant with friction."""
+    from dataclasses import replace
+
+    from twolink_pin.model import catalog, example_robot_urdf
+    from twolink_pin.model.profile import ReportProfile, generic_profile
+    from twolink_pin.run_spec import PlantOptions
+
+    urdf = example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf")
+    profile = replace(
+        generic_profile(urdf),
+        name="declared",
+        friction=((0.1, 0.1), (0.05, 0.05)),
+        report=ReportProfile(laws=("pd", "computed-torque"), animated_law="computed-torque"),
+    )
+    monkeypatch.setitem(catalog.CATALOG, "declared", lambda: (urdf, profile))
+    options = ReportOptions(
+        robot="declared",
+        run=RunSpec(simulation=SimulationConfig(duration=0.5), plant=PlantOptions(friction="on")),
+        workers=1,
+        animation=False,
+    )
+    results = build_report(tmp_path / "r", options)
+    assert list(results["controllers"]) == ["pd", "computed-torque"]
+    assert results["animated"] == "computed-torque"
+    assert results["comparison"]["plants"] == {"pd": "friction", "computed-torque": "friction"}
+    assert results["twolink"] is None and results["errata"] == [] and results["identification"] is None
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert re.search(r"<tr><td>pd</td><td>friction</td>", html)
+
+
 def test_the_identification_section_can_be_left_out(tmp_path: Path) -> None:
     """--no-identification (ReportOptions.identification=False): no section, no link in the
     navigation, no entry in results.json; left in, a 1-s report still has its table."""
@@ -186,11 +228,15 @@ def test_failure_midway_leaves_the_previous_report_whole(
         raise RuntimeError("disk full")
 
     monkeypatch.setattr(pages, "write_pages", boom)
+    small = ReportOptions(  # the smallest report that still goes through every stage before the pages
+        run=RunSpec(simulation=SimulationConfig(duration=0.5)),
+        workers=1,
+        animation=False,
+        identification=False,
+        controllers=("pd",),
+    )
     with pytest.raises(RuntimeError, match="disk full"):
-        build_report(
-            out,
-            ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=0.5)), workers=1, animation=False),
-        )
+        build_report(out, small)
     assert (out / "index.html").read_text() == "previous report"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging directory left behind
 

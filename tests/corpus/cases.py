@@ -78,7 +78,7 @@ def _bound(module: str, name: str, default: float) -> float:
 MAX_SAMPLES = int(_bound("twolink_pin.studies.sweep", "MAX_SAMPLES", 10_000_000))
 MAX_CHUNK = int(_bound("twolink_pin.studies.sweep", "MAX_CHUNK", 100_000))
 MAX_STEPS = int(_bound("twolink_pin.simulation.config", "MAX_STEPS", 10_000_000))
-MAX_WORKERS = int(_bound("twolink_pin.report.build", "MAX_WORKERS", 64))
+MAX_WORKERS = int(_bound("twolink_pin.report.options", "MAX_WORKERS", 64))
 MAX_OFFSET = _bound("twolink_pin.cli.parser", "MAX_OFFSET", 100.0)
 MAX_PAYLOAD = _bound("twolink_pin.cli.parser", "MAX_PAYLOAD", 1e4)
 MAX_DURATION = _bound("twolink_pin.cli.parser", "MAX_DURATION", 1e6)

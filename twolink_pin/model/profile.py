@@ -3,17 +3,19 @@
 A :class:`RobotProfile` is attached to every :class:`~twolink_pin.model.RobotModel`. For a
 robot of the catalog (:mod:`twolink_pin.model.catalog`) it names the URDF, the parameter
 map, the gains its maintainers recommend per law, the friction of its simulated plant, the
-initial tracking error and the default trajectory; for any other URDF it is
+initial tracking error, the default trajectory and what its report shows
+(:class:`ReportProfile`: the laws, the animated one, figure numbers, the robot's own
+sections through a :class:`ReportSections` hook); for any other URDF it is
 :func:`generic_profile` (nothing preset: laws derive their gains from the robot).
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     import pinocchio as pin
@@ -43,6 +45,70 @@ class TrajectorySpec:
     period: float | None = None
 
 
+class ReportSections(Protocol):
+    """Sections a robot adds to its ``twolink-pin report`` (the twolink's: the course
+    report's Table 1, Table 2, errata and identification section,
+    :class:`twolink_pin.twolink.course_report.CourseReport`). The report calls them in this
+    order; arguments are the report's own objects (typed loosely: this module sits below
+    the report).
+    """
+
+    def steps(self, options: Any) -> int:
+        """Progress steps :meth:`collect` adds for the report's ``options``."""
+        ...
+
+    def submit(self, pool: Any, options: Any, fig_dir: str, laws: Sequence[str]) -> Any:
+        """Submit the sections' long tasks to the report's worker ``pool`` (before the
+        laws' runs); returns what :meth:`collect` takes (None: nothing submitted)."""
+        ...
+
+    def facts(self, robot: Any, via: Any) -> dict[str, Any]:
+        """The robot's document's facts (``results.json``'s ``twolink`` entry); ``via``:
+        the via points of the robot's default trajectory, None for another trajectory."""
+        ...
+
+    def collect(
+        self, pending: Any, robot: Any, options: Any, fig_dir: str, runs: Mapping[str, Any]
+    ) -> dict[str, Any] | None:
+        """The section built from :meth:`submit`'s tasks and the laws' ``runs`` (law name →
+        simulation result); ``results.json``'s ``identification`` entry."""
+        ...
+
+    def errata(
+        self,
+        robot: Any,
+        trajectory: Any,
+        runs: Mapping[str, Any],
+        specs: Mapping[str, str],
+        options: Any,
+        q0_offset: Any,
+        lams: Mapping[str, float],
+    ) -> list[dict[str, Any]]:
+        """Where the robot's document is wrong or silent (law name → result ``runs``, law
+        name → spec ``specs``, law name → λ [1/s] ``lams``)."""
+        ...
+
+
+@dataclass(frozen=True)
+class ReportProfile:
+    """What ``twolink-pin report`` shows of a robot beyond what every robot gets.
+
+    Attributes:
+        laws: The laws the report runs when none are asked for (law specs); ``None``:
+            every built-in law.
+        animated_law: The law whose run the report animates; ``None`` (or that law not
+            run): the first law.
+        figure_numbers: Law name (and ``"trajectory"``) → figure kind → the number the
+            robot's own document gives that figure (shown in the figures' titles).
+        sections: The robot's own sections (:class:`ReportSections`); ``None``: none.
+    """
+
+    laws: tuple[str, ...] | None = None
+    animated_law: str | None = None
+    figure_numbers: Mapping[str, Mapping[str, int]] = field(default_factory=lambda: MappingProxyType({}))
+    sections: ReportSections | None = None
+
+
 @dataclass(frozen=True)
 class RobotProfile:
     """A robot's name and the defaults the toolkit uses with it.
@@ -69,6 +135,7 @@ class RobotProfile:
         locked_positions: Position of each locked joint [rad or m]; ``None``: 0 clipped to its limits.
         home: A configuration the default trajectory and the viewer start from [rad], one
             per joint of the (reduced) model; ``None``: the middle of each joint's range.
+        report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
     """
 
     name: str
@@ -84,6 +151,7 @@ class RobotProfile:
     locked_joints: tuple[str, ...] = ()
     locked_positions: tuple[float, ...] | None = None
     home: tuple[float, ...] | None = None
+    report: ReportProfile = field(default_factory=ReportProfile)
 
 
 DEFAULT_Q0_OFFSET = 0.05

@@ -1,5 +1,6 @@
-"""The numbers the report shows that are not simulations: the model, the torque check,
-the twolink's closed-form check and Table 1, the software versions."""
+"""The numbers every robot's report shows that are not simulations: the model, the torque
+check, the software versions (the twolink's closed-form check and Table 1 are its profile's
+sections: :mod:`twolink_pin.twolink.course_report`)."""
 
 from __future__ import annotations
 
@@ -10,11 +11,8 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.dynamics import coriolis_matrix, mass_matrix
 from twolink_pin.feasibility import TorqueCheck
-from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
-from twolink_pin.trajectory import ViaPoints
 
 
 def _finite_or_none(values: Any) -> list[float | None]:
@@ -48,35 +46,6 @@ def model_facts(robot: RobotModel) -> dict[str, Any]:
         "parameters": dict(zip(robot.parameter_map.names, robot.p.tolist())),
         "parameter_units": dict(zip(robot.parameter_map.names, robot.parameter_map.units)),
     }
-
-
-def twolink_closed_form_check(robot: RobotModel, samples: int = 1000) -> dict[str, Any]:
-    """Largest difference between Pinocchio's M, C and the report's closed form (twolink)."""
-    from twolink_pin.twolink.closed_form import coriolis_matrix as cf_coriolis
-    from twolink_pin.twolink.closed_form import mass_matrix as cf_mass
-
-    rng = np.random.default_rng(0)
-    data = robot.create_data()
-    dev_m, dev_c = 0.0, 0.0
-    for _ in range(samples):
-        q = rng.uniform(-np.pi, np.pi, robot.nv)
-        v = rng.uniform(-5, 5, robot.nv)
-        dev_m = max(dev_m, float(np.abs(mass_matrix(robot.model, data, q) - cf_mass(q, robot.p)).max()))
-        dev_c = max(
-            dev_c, float(np.abs(coriolis_matrix(robot.model, data, q, v) - cf_coriolis(q, v, robot.p)).max())
-        )
-    return {"states": samples, "max_abs_dM": dev_m, "max_abs_dC": dev_c}
-
-
-def table1(robot: RobotModel, via: ViaPoints) -> list[dict[str, Any]]:
-    """Our inverse kinematics of the report's via points beside its Table 1 (twolink)."""
-    from twolink_pin.twolink.reference import REPORT_TABLE1
-
-    rows = []
-    for xy, report in zip(via.xy[:4], REPORT_TABLE1.values()):
-        ours = inverse_kinematics(robot, xy)
-        rows.append({"xy": list(xy), "ours": ours.tolist(), "report": [list(r) for r in report]})
-    return rows
 
 
 def torque_facts(check: TorqueCheck) -> dict[str, Any]:

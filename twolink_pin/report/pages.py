@@ -75,10 +75,12 @@ def _environment() -> jinja2.Environment:
 
 
 def _comparison_rows(r: dict[str, Any], kind: str) -> list[list[str]]:
+    """One row per law: its name, the plant it ran on (as compare's table says it), its norms."""
+    plants = r["comparison"].get("plants", {})
     rows = []
     for name, entry in r["controllers"].items():
         m = entry["metrics"][kind]
-        rows.append([name, *(fmt(x) for part, _, _ in SIGNALS for x in m[part])])
+        rows.append([name, plants.get(name, ""), *(fmt(x) for part, _, _ in SIGNALS for x in m[part])])
     return rows
 
 
@@ -100,7 +102,7 @@ def html(r: dict[str, Any]) -> str:
     tables = {
         kind: {
             "title": NORMS[kind][0],
-            "headers": ["controller", *headers(nv, kind)],
+            "headers": ["controller", "plant", *headers(nv, kind)],
             "rows": _comparison_rows(r, kind),
         }
         for kind in NORMS

@@ -11,8 +11,9 @@ from pathlib import Path
 from types import MappingProxyType
 
 from twolink_pin.model import catalog
-from twolink_pin.model.profile import RobotProfile, TrajectorySpec
+from twolink_pin.model.profile import ReportProfile, RobotProfile, TrajectorySpec
 from twolink_pin.twolink import reference
+from twolink_pin.twolink.course_report import ANIMATED_LAW, CourseReport
 from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
 
@@ -33,7 +34,16 @@ TWOLINK = RobotProfile(
     ),
     ee_frame="ee_link",
     source="robots/twolink.urdf (this package)",
+    report=ReportProfile(
+        laws=reference.REPORT_CONTROLLERS,
+        animated_law=ANIMATED_LAW,
+        figure_numbers=MappingProxyType(
+            {k: MappingProxyType(v) for k, v in reference.REPORT_FIGURES.items()}
+        ),
+        sections=CourseReport(),
+    ),
 )
-"""The twolink's profile: the report's gains, friction, initial offset and via points."""
+"""The twolink's profile: the report's gains, friction, initial offset, via points and what
+its report shows (the report's five laws, its figure numbers, its sections)."""
 
 catalog.register("twolink", lambda: (twolink_urdf_path(), TWOLINK))

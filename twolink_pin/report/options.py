@@ -1,0 +1,59 @@
+"""What the report runs: :class:`ReportOptions` (a :class:`~twolink_pin.run_spec.RunSpec`
+and the report's own options beside it)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.run_spec import RunSpec
+
+MAX_WORKERS = 64
+"""Largest number of worker processes (more than the runs is never used)."""
+
+
+@dataclass(frozen=True)
+class ReportOptions:
+    """What the report runs.
+
+    Attributes:
+        run: The runs' common description (:class:`~twolink_pin.run_spec.RunSpec`, shared by
+            the laws: each law's own with :meth:`~twolink_pin.run_spec.RunSpec.for_law`):
+            simulation settings, λ of the laws that have one, per-law gains, the plant, an
+            identified-parameter file (``p0``: the estimates of the laws that estimate start
+            there; ``model``: every law's model believes it).
+        robot: A catalog name or a URDF path; None for the twolink.
+        payload: End-effector payload [kg].
+        controllers: The laws to run (names, ``file.py:Class``, ``module:Class``); None for
+            the course report's five on the twolink, every built-in law elsewhere.
+        workers: Processes for the runs and figures (1: in this process), 1 to 64.
+        animation: Whether to write the self-contained animation.
+        identification: Whether the twolink's report has its identification section (beside
+            Fig. 27: the adaptive law along two excitations and an identification; about
+            14 s of CPU: without it the report takes 11–13 s on 2 cores instead of 17–19 s).
+        trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
+            to track instead of the robot's default; the twolink's sections about the
+            report's own trajectory (Table 1, the printed coefficients) then still describe
+            the report's.
+    """
+
+    run: RunSpec = field(default_factory=lambda: RunSpec(shared=True))
+    robot: str | None = None
+    payload: float = 0.0
+    controllers: tuple[str, ...] | None = None
+    workers: int = 2
+    animation: bool = True
+    identification: bool = True
+    trajectory: str | None = None
+
+    def __post_init__(self) -> None:
+        if not (
+            isinstance(self.workers, int)
+            and not isinstance(self.workers, bool)
+            and 1 <= self.workers <= MAX_WORKERS
+        ):
+            raise InvalidParameterError("workers", self.workers, f"a whole number from 1 to {MAX_WORKERS}")
+        if not isinstance(self.run, RunSpec):
+            raise InvalidParameterError("run", type(self.run).__name__, "a RunSpec")
+        if not self.run.shared:  # one description for several laws: λ and p0 go where they apply
+            object.__setattr__(self, "run", replace(self.run, shared=True))

@@ -1,0 +1,68 @@
+"""The report's worker tasks for the laws: the reference, one law's run with its figures,
+the desired trajectory's figures (picklable arguments only)."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.feasibility import check_torques
+from twolink_pin.metrics import Metrics, compute_metrics
+from twolink_pin.model import load_robot
+from twolink_pin.report.options import ReportOptions
+from twolink_pin.scenario import law_class
+from twolink_pin.simulation import SimulationResult, simulate
+from twolink_pin.trajectory import default_trajectory
+
+
+def _reference(robot: Any, options: ReportOptions) -> Any:
+    """The trajectory the runs track: the options' file, else the robot's default."""
+    from twolink_pin.trajectory import read_trajectory_file
+
+    reference = (
+        read_trajectory_file(options.trajectory, robot) if options.trajectory else default_trajectory(robot)
+    )
+    if not hasattr(reference, "via_q"):
+        raise InvalidParameterError(
+            "trajectory",
+            options.trajectory,
+            "a via-point trajectory file (the report shows its via points and coefficients); a Fourier "
+            "excitation is for identify --trajectory, simulate, compare and animate",
+        )
+    return reference
+
+
+def _run(
+    spec: str,
+    options: ReportOptions,
+    fig_dir: str,
+    figure_numbers: dict[str, int] | None,
+) -> tuple[SimulationResult, Metrics, list[str], float]:
+    """Worker: one law's run, metrics and figures (picklable arguments only)."""
+    from twolink_pin.plotting import save_simulation_figures
+
+    start = time.perf_counter()
+    robot = load_robot(options.robot, payload=options.payload)
+    cls = law_class(spec)
+    controller, plant = options.run.for_law(spec).build(robot)
+    result = simulate(controller, plant, _reference(robot, options), options.run.simulation)
+    metrics = compute_metrics(result)
+    paths = save_simulation_figures(
+        result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title
+    )
+    return result, metrics, [Path(p).name for p in paths], time.perf_counter() - start
+
+
+def _trajectory_figures(
+    options: ReportOptions, fig_dir: str, figure_numbers: dict[str, int] | None
+) -> list[str]:
+    """Worker: the desired trajectory's figures (picklable arguments only)."""
+    from twolink_pin.plotting import save_trajectory_figures
+
+    robot = load_robot(options.robot, payload=options.payload)
+    trajectory = _reference(robot, options)
+    check = check_torques(robot, trajectory)
+    paths = save_trajectory_figures(robot, trajectory, check, Path(fig_dir), figure_numbers=figure_numbers)
+    return [p.name for p in paths]
