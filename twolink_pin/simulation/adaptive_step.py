@@ -22,6 +22,7 @@ from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_
 from twolink_pin.simulation.containment import contained
 from twolink_pin.simulation.engine import Samples, _validate
 from twolink_pin.simulation.forward import SingleRunDynamics
+from twolink_pin.simulation.task_reference import task_reference
 from twolink_pin.simulation.terms import SingleRunTerms
 from twolink_pin.trajectory import Trajectory
 
@@ -62,8 +63,11 @@ def integrate_adaptive(
 
     def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         ref = trajectory.sample(time)
+        task = task_reference(controller, trajectory, np.array([time]), ref)
         try:
-            out = compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
+            out = compute(
+                LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None], *(x[0] for x in task)), terms
+            )
         except ControllerError:
             raise
         except TwolinkPinError as exc:

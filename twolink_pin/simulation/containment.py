@@ -50,9 +50,9 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
     new = tuple.__new__
 
     def call(x: LawInput, terms: Any) -> LawOutput:
-        t, q, v, z, q_des, v_des, a_des = x
+        t, q, v, z, *reference = x
         # The reference is made read-only where the engine samples it (once per block).
-        frozen = new(LawInput, (t, read_only(q), read_only(v), read_only(z), q_des, v_des, a_des))
+        frozen = new(LawInput, (t, read_only(q), read_only(v), read_only(z), *reference))
         try:
             return compute(frozen, terms)
         except SystemExit as exc:

@@ -33,6 +33,7 @@ from twolink_pin.simulation.config import SimulationConfig
 from twolink_pin.simulation.containment import contained, read_only
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.rigid_terms import RigidBodyTerms
+from twolink_pin.simulation.task_reference import task_reference
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
 
@@ -117,7 +118,7 @@ def integrate_events(
     def law(t: float, q: np.ndarray, v: np.ndarray, z: np.ndarray, i: int) -> tuple[np.ndarray, np.ndarray]:
         nonlocal first, now
         now = t
-        x = LawInput(t, q + noise_q, v + noise_v, z, rq[i], rv[i], ra[i])
+        x = LawInput(t, q + noise_q, v + noise_v, z, rq[i], rv[i], ra[i], px[i], pr[i], pw[i], pa[i])
         out = compute(x, terms)
         if first:
             _validate(controller, out, runs, nv, nz, t)
@@ -138,8 +139,10 @@ def integrate_events(
         for k0 in range(0, total, BLOCK):
             k1 = min(k0 + BLOCK, total)
             last_half = min(2 * k1, 2 * n)
-            half = trajectory.sample(np.arange(2 * k0, last_half + 1) * (dt / 2))
+            half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
+            half = trajectory.sample(half_t)
             rq, rv, ra = (read_only(x[:, None, :]) for x in (half.q, half.v, half.a))  # shared: read-only
+            px, pr, pw, pa = task_reference(controller, trajectory, half_t, half)  # None unless task-space
             if noise is not None:
                 draws = np.stack([g.standard_normal((k1 - k0, 2 * nv)) for g in generators], axis=1)
                 block_q, block_v = noise.sigma_q * draws[..., :nv], noise.sigma_v * draws[..., nv:]
