@@ -26,14 +26,14 @@ from twolink_pin.task_metrics import TaskMetrics
 TASK_COLUMNS = TaskMetrics._fields
 """Columns of the task-space rows (CSV), in :class:`~twolink_pin.task_metrics.TaskMetrics` order."""
 TASK_HEADERS = (
-    "RMS |Δp| [mm]",
-    "max |Δp| [mm]",
-    "last period max |Δp| [mm]",
+    "RMS ‖Δp‖ [mm]",
+    "max ‖Δp‖ [mm]",
+    "last period max ‖Δp‖ [mm]",
     "RMS angle [deg]",
     "max angle [deg]",
     "last period max angle [deg]",
 )
-"""Markdown headers of the task-space table."""
+"""Markdown headers of the task-space table (no "|" inside a cell: ‖·‖ for the norm)."""
 
 
 def columns(nv: int) -> list[str]:
