@@ -87,7 +87,7 @@ def integrate_events(
     after = dynamics_for(_payload_plant(plant), runs, threads) if plant.payload_step is not None else None
     wrench = plant.wrench
     kinematics = RigidBodyTerms(plant.robot, None) if wrench is not None else None
-    force = None if wrench is None else np.array(wrench.force)
+    force = None if wrench is None else wrench.forces(runs)
     noise = plant.sensor_noise
     generators = noise.generators(runs) if noise is not None else []
     delay = plant.delay
