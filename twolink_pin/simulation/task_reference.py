@@ -66,17 +66,17 @@ def forward_pose(controller: Controller, joint: TrajectorySample) -> PoseSample:
 
 
 def desired_pose(
-    controller: Controller, trajectory: Trajectory, t: np.ndarray, joint: TrajectorySample
+    controller: Controller, trajectory: Trajectory | None, t: np.ndarray, joint: TrajectorySample
 ) -> PoseSample:
-    """The desired frame at times ``t`` [s] (K,): the SE(3) reference's, else the forward
-    kinematics of the joint samples ``joint`` at those times."""
+    """The desired frame at times ``t`` [s] (K,): the SE(3) reference's, else (any other
+    trajectory, or None) the forward kinematics of the joint samples ``joint`` at those times."""
     if isinstance(trajectory, PoseTrajectory) and controller.robot.nv == trajectory.nv:
         return trajectory.pose(t)
     return forward_pose(controller, joint)
 
 
 def task_reference(
-    controller: Controller, trajectory: Trajectory, t: np.ndarray, joint: TrajectorySample
+    controller: Controller, trajectory: Trajectory | None, t: np.ndarray, joint: TrajectorySample
 ) -> tuple[Sequence[Any], Sequence[Any], Sequence[Any], Sequence[Any]]:
     """``x_des``, ``R_des``, ``twist_des``, ``accel_des`` per sample time ``t`` [s], each
     indexable by the sample (an item of shape (1, …), read-only); four :data:`NONES` for a
@@ -103,24 +103,8 @@ def law_input(
     ``a_des`` of shape (1, nv) and, for a task-space law, the desired frame from
     ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics."""
     joint = TrajectorySample(q_des, v_des, a_des, np.zeros_like(a_des))
-    if trajectory is None or not isinstance(trajectory, PoseTrajectory):
-        trajectory = _NoPose()
     task = task_reference(controller, trajectory, np.array([t]), joint)
     return LawInput(t, q, v, z, q_des, v_des, a_des, *(x[0] for x in task))
-
-
-class _NoPose(Trajectory):
-    """A stand-in trajectory without an SE(3) reference (for :func:`law_input`)."""
-
-    t0 = 0.0
-    period = 1.0
-
-    @property
-    def nv(self) -> int:  # pragma: no cover - never sampled
-        return 0
-
-    def sample(self, t: float | np.ndarray) -> TrajectorySample:  # pragma: no cover - never sampled
-        raise NotImplementedError
 
 
 def reference_rows(
