@@ -49,6 +49,7 @@ def test_the_page_runs_simulate_compare_and_sweep() -> None:
     assert all("--robot ur5" in c and "examples/ur5_square_pose.toml" in c for c, _ in COMMANDS)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("command", "quoted"), COMMANDS, ids=[shlex.split(c)[1] for c, _ in COMMANDS])
 def test_every_command_prints_what_the_page_says(
     command: str,
