@@ -218,3 +218,22 @@ def test_a_joint_reference_still_gives_the_same_osc_torque_as_before() -> None:
     np.testing.assert_allclose(x.twist_des, np.matvec(d.jacobian, ref.v), atol=1e-13)
     tau = law.compute(x, terms).tau
     assert np.all(np.isfinite(tau)) and tau.shape == (1, 2)
+
+
+def test_the_trajectory_command_shows_the_via_poses_and_their_configurations(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    import json
+
+    from twolink_pin.cli import main
+
+    path = str(ROOT / "examples" / "ur5_square_pose.toml")
+    assert main(["trajectory", "--robot", "ur5", "--trajectory", path, "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    model, data, fid = UR5.model, UR5.model.createData(), UR5.ee_frame_id
+    for q, p, rpy in zip(payload["via_q"], payload["positions"], payload["rpy"], strict=True):
+        pin.framesForwardKinematics(model, data, np.array(q))
+        np.testing.assert_allclose(data.oMf[fid].translation, p, atol=1e-9)  # the IK'd configuration's FK
+        angle = np.linalg.norm(pin.log3(data.oMf[fid].rotation.T @ pin.rpy.rpyToMatrix(*rpy)))
+        assert angle < 1e-9
+    assert payload["ik_error"]["position_m"] < 1e-9 and payload["within_limits"]

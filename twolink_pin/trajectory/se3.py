@@ -119,6 +119,8 @@ class PoseTrajectory(Trajectory):
         """The joint configurations at the via poses [rad], shape (n + 1, nv)."""
         self.period = float(period)
         self.t0 = float(times[0])
+        self.span = float(times[-1] - times[0])
+        """Time from the first via pose to the last [s] (the rest of the period is a rest)."""
         self.ik_error = ik_error
         """Largest distance [m] and rotation angle [rad] between the joint path's forward
         kinematics and the pose path, measured midway between the IK samples."""
