@@ -52,7 +52,7 @@ class SlidingMode(Controller):
     Gains = SlidingModeGains
 
     def scaled_gains(self) -> dict[str, Any]:
-        inertia = joint_inertia(self.robot.model)
+        inertia = joint_inertia(self.robot.model, self.robot.home)  # diag M(home) [kg·m²]
         return {"k": 10.0 * inertia, "ks": 2.0 * inertia}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:

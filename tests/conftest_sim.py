@@ -19,7 +19,7 @@ from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import mass_matrix
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
 from twolink_pin.scenario import make_scenario
-from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
+from twolink_pin.simulation import SimulationConfig, SimulationResult, law_input, simulate, terms_for
 from twolink_pin.trajectory import JointTrajectory, default_trajectory
 
 ROBOT: RobotModel = load_robot()
@@ -63,7 +63,9 @@ def evaluate(
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """The law at one state (single-run terms): ``(τ, ż)`` of shapes (nv,), (nz,) or None."""
     z = np.atleast_1d(controller.initial_state()) if z is None else z
-    x = LawInput(t, q[None], v[None], np.reshape(z, (1, -1)), q_des[None], v_des[None], a_des[None])
+    x = law_input(
+        controller, t, q[None], v[None], np.reshape(z, (1, -1)), q_des[None], v_des[None], a_des[None]
+    )
     out = controller.compute(x, terms_for(controller))
     return out.tau[0], None if out.dz is None else out.dz[0]
 

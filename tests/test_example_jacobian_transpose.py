@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.controllers import LawInput, load_controller
+from twolink_pin.controllers import load_controller
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
-from twolink_pin.simulation import SimulationConfig, simulate, terms_for
+from twolink_pin.simulation import SimulationConfig, law_input, simulate, terms_for
 from twolink_pin.trajectory import Trajectory, TrajectorySample
 
 JacobianTranspose = load_controller("examples/jacobian_transpose.py:JacobianTranspose")
@@ -33,8 +33,12 @@ class Hold(Trajectory):
 
 
 def test_torque_is_the_jacobian_transpose_law() -> None:
+    """The law's torque against τ = Jᵀ(K e_x + D ė_x) + ĝ − D_q q̇ written with Pinocchio directly:
+    the desired pose from the forward kinematics of the joint reference (what ``law_input``,
+    like the engine, passes), the orientation error ``log(R_d Rᵀ)``."""
     law = JacobianTranspose(
-        UR5, JacobianTranspose.Gains(k=((900.0, 50.0, 0.0), (50.0, 700.0, 0.0), (0.0, 0.0, 800.0)))
+        UR5,
+        JacobianTranspose.Gains(k=((900.0, 50.0, 0.0), (50.0, 700.0, 0.0), (0.0, 0.0, 800.0)), k_rot=30.0),
     )
     terms = terms_for(law)
     model, data = UR5.model, UR5.model.createData()
@@ -42,13 +46,16 @@ def test_torque_is_the_jacobian_transpose_law() -> None:
     K = np.array([[900.0, 50.0, 0.0], [50.0, 700.0, 0.0], [0.0, 0.0, 800.0]])
     for _ in range(5):
         q, v, qd, vd, ad = rng.uniform(-1.5, 1.5, (5, 6))
-        J = pin.computeFrameJacobian(model, data, q, UR5.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3]
-        p = data.oMf[UR5.ee_frame_id].translation.copy()
-        Jd = pin.computeFrameJacobian(model, data, qd, UR5.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)[:3]
-        pd = data.oMf[UR5.ee_frame_id].translation.copy()
+        J = pin.computeFrameJacobian(model, data, q, UR5.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+        p, R = data.oMf[UR5.ee_frame_id].translation.copy(), data.oMf[UR5.ee_frame_id].rotation.copy()
+        Jd = pin.computeFrameJacobian(model, data, qd, UR5.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+        pd, Rd = data.oMf[UR5.ee_frame_id].translation.copy(), data.oMf[UR5.ee_frame_id].rotation.copy()
         g = pin.computeGeneralizedGravity(model, data, q)
-        expected = J.T @ (K @ (pd - p) + 100.0 * (Jd @ vd - J @ v)) + g - 1.0 * v
-        x = LawInput(0.0, q[None], v[None], np.zeros((1, 0)), qd[None], vd[None], ad[None])
+        twist_error = Jd @ vd - J @ v
+        force = K @ (pd - p) + 100.0 * twist_error[:3]
+        moment = 30.0 * pin.log3(Rd @ R.T) + 5.0 * twist_error[3:]
+        expected = J.T @ np.concatenate((force, moment)) + g - 1.0 * v
+        x = law_input(law, 0.0, q[None], v[None], np.zeros((1, 0)), qd[None], vd[None], ad[None])
         np.testing.assert_allclose(law.compute(x, terms).tau[0], expected, rtol=1e-10, atol=1e-9)
 
 

@@ -53,12 +53,15 @@ class Wrench:
         start: When it starts [s], >= 0.
         stop: When it stops [s], > start (``inf``: never).
         frame: The frame it acts on; None: the robot's end effector.
+        scale: One factor per run of a batch (a sweep's drawn wrench, ``--wrench-scale``):
+            run i feels ``scale[i] · force``; None: every run feels ``force``.
     """
 
     force: tuple[float, ...]
     start: float = 0.0
     stop: float = math.inf
     frame: str | None = None
+    scale: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -76,10 +79,26 @@ class Wrench:
         object.__setattr__(self, "stop", float(stop))
         if self.frame is not None and not (isinstance(self.frame, str) and self.frame):
             raise InvalidParameterError("wrench.frame", self.frame, "a frame name or None (the end effector)")
+        if self.scale is not None:
+            try:
+                scale = tuple(float(x) for x in self.scale)
+            except (TypeError, ValueError):
+                raise InvalidParameterError("wrench.scale", self.scale, "one finite factor per run") from None
+            if not scale or not all(math.isfinite(x) for x in scale):
+                raise InvalidParameterError("wrench.scale", self.scale, "one finite factor per run")
+            object.__setattr__(self, "scale", scale)
 
     def active(self, t: float) -> bool:
         """Whether the wrench acts during the step that starts at ``t`` [s]."""
         return self.start <= t < self.stop
+
+    def forces(self, runs: int) -> np.ndarray:
+        """The wrench [N, N·m] each of ``runs`` runs feels: (6,), or (runs, 6) with ``scale``."""
+        if self.scale is None:
+            return np.array(self.force)
+        if len(self.scale) != runs:
+            raise InvalidParameterError("wrench.scale", f"{len(self.scale)} factors", f"one per run ({runs})")
+        return np.outer(self.scale, self.force)
 
 
 @dataclass(frozen=True)

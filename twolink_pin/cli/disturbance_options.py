@@ -88,6 +88,21 @@ def sensor_noise(text: str) -> tuple[float, float]:
     return values[0], values[1] if len(values) == 2 else 0.0
 
 
+def scale_range(text: str) -> tuple[float, float]:
+    """``LO:HI``: the range a sweep draws each run's factor on ``--wrench`` from."""
+    expected = f"LO:HI: finite factors with LO <= HI (e.g. 0:2), got {_shown(text)}"
+    low, colon, high = text.partition(":")
+    if not colon:
+        raise argparse.ArgumentTypeError(f"expected {expected}")
+    try:
+        lo, hi = finite(low), finite(high)
+    except argparse.ArgumentTypeError:
+        raise argparse.ArgumentTypeError(f"expected {expected}") from None
+    if lo > hi or max(abs(lo), abs(hi)) > MAX_FORCE:
+        raise argparse.ArgumentTypeError(f"expected {expected}")
+    return lo, hi
+
+
 def add_disturbance_options(p: argparse.ArgumentParser) -> None:
     """The plant's events, on a command that simulates."""
     p.add_argument(

@@ -6,7 +6,7 @@ import argparse
 from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
-from twolink_pin.cli.disturbance_options import add_disturbance_options
+from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT
 
 CONTROLLER_HELP = (
@@ -375,6 +375,13 @@ def build_parser() -> argparse.ArgumentParser:
         default=[],
         metavar="NAME=LO:HI",
         help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
+    )
+    p.add_argument(
+        "--wrench-scale",
+        type=scale_range,
+        default=None,
+        metavar="LO:HI",
+        help="draw each run's factor on --wrench uniformly in [LO, HI], e.g. 0:2",
     )
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
     add_disturbance_options(p)

@@ -78,6 +78,17 @@ class LawInput(NamedTuple):
     """Reference velocity [rad/s], shape (1, nv)."""
     a_des: np.ndarray
     """Reference acceleration [rad/s²], shape (1, nv)."""
+    x_des: np.ndarray | None = None
+    """Desired end-effector position [m], shape (1, 3): the SE(3) reference's
+    (:class:`~twolink_pin.trajectory.se3.PoseTrajectory`), else the forward kinematics of
+    the joint reference. Filled for a law that declares ``task_space = True``, else None."""
+    R_des: np.ndarray | None = None
+    """Desired end-effector orientation (its axes in world coordinates), shape (1, 3, 3)."""
+    twist_des: np.ndarray | None = None
+    """Desired twist ``[ṗ; ω]`` [m/s; rad/s], world-aligned, linear rows first, shape (1, 6)."""
+    accel_des: np.ndarray | None = None
+    """Desired spatial (classical) acceleration ``[p̈; ω̇]`` [m/s²; rad/s²], world-aligned,
+    linear rows first, shape (1, 6)."""
 
 
 class LawOutput(NamedTuple):
@@ -227,6 +238,10 @@ class Controller(abc.ABC, Generic[G]):
     """The law's gains class (a :class:`~twolink_pin.controllers.gains.Gains` dataclass)."""
     estimates: ClassVar[tuple[str, ...]] = ()
     """Parameters held in ``z``: a subsequence of :data:`ESTIMATES`."""
+    task_space: ClassVar[bool] = False
+    """True for a law on the end effector's pose: the engine fills ``LawInput.x_des``,
+    ``R_des``, ``twist_des`` and ``accel_des`` for it, and the commands show its task-space
+    errors (mm, deg)."""
 
     def __init_subclass__(cls, register: bool = True, **kwargs: Any) -> None:
         """Register the class under its ``name`` (``class X(Controller, register=False)``

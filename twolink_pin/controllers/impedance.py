@@ -13,6 +13,7 @@ from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,
+    desired_frame,
     null_space_torque,
     pose_error,
     task_rows,
@@ -68,14 +69,16 @@ class Impedance(Controller[ImpedanceGains]):
     With the exact gravity, $V = \tfrac12 \dot q^\top M \dot q + \tfrac12 e^\top K e$ decreases
     for a constant desired pose (Hogan, "Impedance control: an approach to manipulation",
     *J. Dyn. Sys., Meas., Control* 107(1), 1985; Ott, *Cartesian Impedance Control of
-    Redundant and Flexible-Joint Robots*, Springer 2008, ch. 3). The desired pose is the
-    forward kinematics of the joint reference, the posture the joint reference itself;
+    Redundant and Flexible-Joint Robots*, Springer 2008, ch. 3). The desired pose and twist
+    are ``LawInput``'s ``x_des``, ``R_des``, ``twist_des`` (the SE(3) reference's, else the
+    forward kinematics of the joint reference), the posture the joint reference itself;
     the task's rows are chosen as in ``osc`` (the twolink: position x, y).
     """
 
     name = "impedance"
     title = "Cartesian impedance + gravity compensation"
     Gains = ImpedanceGains
+    task_space = True
 
     def __init__(self, robot: RobotModel, gains: ImpedanceGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
@@ -126,10 +129,10 @@ class Impedance(Controller[ImpedanceGains]):
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         rows = self.rows
         f = terms.frame(x.q, x.v)
-        d = terms.frame(x.q_des, x.v_des)
         J = f.jacobian[:, rows]
+        d = desired_frame(x)  # x_des, R_des, twist_des
         e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
-        e_dot = np.matvec(J, x.v) - np.matvec(d.jacobian, x.v_des)[:, rows]
+        e_dot = np.matvec(J, x.v) - d.twist[:, rows]
         force = -(np.matvec(self._K, e) + np.matvec(self._D, e_dot))
         tau = terms.gravity(x.q) + np.vecmat(force, J)
         if self._redundant:

@@ -12,6 +12,7 @@ from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,
+    desired_frame,
     null_space_torque,
     pose_error,
     task_rows,
@@ -64,9 +65,10 @@ class OperationalSpace(Controller[OSCGains]):
     position (exactly) and $\dot{\tilde\omega} + D_o \tilde\omega + K_o e_o = 0$ for the
     orientation ($\tilde\omega = \omega - \omega_d$; $\dot e_o = \tilde\omega$ to first order);
     the posture torque produces no task acceleration, $J \hat M^{-1} N^\top = 0$. The desired
-    pose, twist and acceleration are the forward kinematics of the joint reference
-    ($x_d = f(q_d)$, $\dot x_d = J(q_d) \dot q_d$, $\ddot x_d = J(q_d) \ddot q_d + \dot J \dot q_d$),
-    which also serves as the posture. Khatib, "A unified approach for motion and force
+    pose, twist and acceleration are ``LawInput``'s ``x_des``, ``R_des``, ``twist_des``,
+    ``accel_des``: the SE(3) reference's (via poses), else the forward kinematics of the joint
+    reference ($x_d = f(q_d)$, $\dot x_d = J(q_d) \dot q_d$,
+    $\ddot x_d = J(q_d) \ddot q_d + \dot J \dot q_d$); the joint reference is the posture. Khatib, "A unified approach for motion and force
     control of robot manipulators: the operational space formulation", *IEEE J. Robotics and
     Automation* 3(1), 1987; null space: Khatib, *Int. J. Robotics Research* 14(1), 1995.
 
@@ -80,6 +82,7 @@ class OperationalSpace(Controller[OSCGains]):
     name = "osc"
     title = "operational-space control (Khatib)"
     Gains = OSCGains
+    task_space = True
 
     def __init__(self, robot: RobotModel, gains: OSCGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
@@ -99,10 +102,10 @@ class OperationalSpace(Controller[OSCGains]):
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         rows = self.rows
         f = terms.frame(x.q, x.v)
-        d = terms.frame(x.q_des, x.v_des)
         J = f.jacobian[:, rows]
-        x_dot_des = np.matvec(d.jacobian, x.v_des)[:, rows]
-        x_ddot_des = (np.matvec(d.jacobian, x.a_des) + d.drift)[:, rows]
+        d = desired_frame(x)  # x_des, R_des, twist_des, accel_des
+        x_dot_des = d.twist[:, rows]
+        x_ddot_des = d.accel[:, rows]
         e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
         e_dot = np.matvec(J, x.v) - x_dot_des
         desired = x_ddot_des - np.matvec(self._D, e_dot) - np.matvec(self._K, e)

@@ -24,10 +24,13 @@ once (:class:`SingularityWarning`) and counts the damped evaluations.
 from __future__ import annotations
 
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.controllers.base import LawInput
+from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
 SINGULAR_RATIO = 1e-3
@@ -39,6 +42,33 @@ AXES = ("x", "y", "z", "rx", "ry", "rz")
 
 class SingularityWarning(UserWarning):
     """A task-space law damped its task inertia near a singularity."""
+
+
+class DesiredFrame(NamedTuple):
+    """The desired end-effector frame of a :class:`~twolink_pin.controllers.LawInput`
+    (world-aligned, linear rows first), each ``(1, …)``."""
+
+    position: np.ndarray
+    """``x_des`` [m], (1, 3)."""
+    rotation: np.ndarray
+    """``R_des``, (1, 3, 3)."""
+    twist: np.ndarray
+    """``twist_des`` [m/s; rad/s], (1, 6)."""
+    accel: np.ndarray
+    """``accel_des`` [m/s²; rad/s²], (1, 6)."""
+
+
+def desired_frame(x: LawInput) -> DesiredFrame:
+    """``x``'s desired frame; a clear error when the engine did not fill it (the law does not
+    declare ``task_space = True``)."""
+    if x.x_des is None or x.R_des is None or x.twist_des is None or x.accel_des is None:
+        raise InvalidParameterError(
+            "LawInput.x_des",
+            None,
+            "the desired frame, which the engine fills only for a law that declares task_space = True "
+            "(or build the input with twolink_pin.simulation.law_input)",
+        )
+    return DesiredFrame(x.x_des, x.R_des, x.twist_des, x.accel_des)
 
 
 def task_rows(robot: RobotModel) -> np.ndarray:

@@ -23,6 +23,8 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ``distribution.py``  :func:`save_distribution_figure`: histograms of metrics over a sweep
 ``cartesian.py``     :func:`save_end_effector_figure`: the end-effector path and its distance
                      to the desired one
+``task.py``          :func:`save_task_error_figure`: a task-space law's position [mm] and
+                     orientation [deg] errors over time
 ===================  =====================================================================
 
 Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,
@@ -34,11 +36,13 @@ tests can check what is drawn. Units: time [s], angles [rad], rates [rad/s], pos
 from twolink_pin.plotting.cartesian import save_end_effector_figure
 from twolink_pin.plotting.distribution import save_distribution_figure
 from twolink_pin.plotting.run import save_simulation_figures
+from twolink_pin.plotting.task import save_task_error_figure
 from twolink_pin.plotting.trajectory import save_trajectory_figures
 
 __all__ = [
     "save_distribution_figure",
     "save_end_effector_figure",
     "save_simulation_figures",
+    "save_task_error_figure",
     "save_trajectory_figures",
 ]

@@ -1,18 +1,6 @@
 """Closed-loop simulation: one engine for one run or thousands.
 
-====================  ==================================================================
-``config.py``         :class:`SimulationConfig`, the divergence limit and step bounds
-``terms.py``          the Pinocchio terms a law asks for, for one run or N (``terms_for``)
-``forward.py``        the plant's accelerations (ABA) for one run or N
-``engine.py``         :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks, plant events
-``events.py``         what a plant that pushes back does to a step: wrench, payload step, noise, delay
-``adaptive_step.py``  DOP853 with error control, one run
-``containment.py``    the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
-``deadline.py``       the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law
-``result.py``         :class:`SimulationResult`
-``run.py``            :func:`simulate` (N = 1, recorded)
-``storage.py``        results as ``.npz``
-====================  ==================================================================
+======================  ==================================================================
 
 N runs with streamed metrics (the batch) and studies over them are in
 :mod:`twolink_pin.studies`.
@@ -22,6 +10,7 @@ from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_STEPS, Simulatio
 from twolink_pin.simulation.engine import EngineRun, Samples, integrate
 from twolink_pin.simulation.result import SimulationResult
 from twolink_pin.simulation.run import estimated_truth, simulate
+from twolink_pin.simulation.task_reference import law_input
 from twolink_pin.simulation.terms import BatchUnavailableError, default_threads, terms_for
 
 __all__ = [
@@ -35,6 +24,7 @@ __all__ = [
     "default_threads",
     "estimated_truth",
     "integrate",
+    "law_input",
     "simulate",
     "terms_for",
 ]

@@ -23,6 +23,7 @@ from twolink_pin.simulation.containment import contained
 from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.engine import Samples, _validate
 from twolink_pin.simulation.forward import SingleRunDynamics
+from twolink_pin.simulation.task_reference import task_reference
 from twolink_pin.simulation.terms import SingleRunTerms
 from twolink_pin.trajectory import Trajectory
 
@@ -66,8 +67,11 @@ def integrate_adaptive(
     def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         last[0] = time
         ref = trajectory.sample(time)
+        task = task_reference(controller, trajectory, np.array([time]), ref)
         try:
-            out = compute(LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None]), terms)
+            out = compute(
+                LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None], *(x[0] for x in task)), terms
+            )
         except ControllerError:
             raise
         except TwolinkPinError as exc:

@@ -47,6 +47,7 @@ from twolink_pin.simulation.containment import contained, read_only
 from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
+from twolink_pin.simulation.task_reference import reference_rows
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
 
@@ -170,8 +171,8 @@ def integrate(
     if events is not None and events.noise is not None:
 
         def compute(x: LawInput, terms: Any) -> LawOutput:  # the law measures the state + noise
-            t, q, v, z, q_des, v_des, a_des = x
-            return law(new(LawInput, (t, q + noise[0], v + noise[1], z, q_des, v_des, a_des)), terms)
+            t, q, v, z, *reference = x
+            return law(new(LawInput, (t, q + noise[0], v + noise[1], z, *reference)), terms)
 
     sampled = hold is not None or line is not None  # the law evaluated once per step or period
     every = hold if hold is not None else 1
@@ -208,12 +209,14 @@ def integrate(
         for k0 in range(0, total, BLOCK):
             k1 = min(k0 + BLOCK, total)
             last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
-            half = trajectory.sample(np.arange(2 * k0, last_half + 1) * (dt / 2))
+            half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
+            half = trajectory.sample(half_t)
             rq, rv, ra = (
                 read_only(x[:, None, :]) for x in (half.q, half.v, half.a)
             )  # shared: law can't write
             if events is not None:
                 events.draw(k0, k1)
+            ref = reference_rows(controller, trajectory, half_t, half, rq, rv, ra)  # + task fields
             off = 0 if record else k0
             filled = k0 - off
             try:
@@ -226,7 +229,7 @@ def integrate(
                             noise[:] = events.noise_at(k)
                     if not sampled or k % every == 0:
                         now = t
-                        out = compute(new(LawInput, (t, q, v, z, rq[i], rv[i], ra[i])), terms)
+                        out = compute(new(LawInput, (t, q, v, z, *ref[i])), terms)
                         if first:
                             _validate(controller, out, runs, nv, nz, t)
                             first = False
@@ -246,22 +249,16 @@ def integrate(
                         now = t + dt / 2
                         q2, v2 = q + h2 * v, v + h2 * a1
                         z2 = z + h2z * dz1 if nz else z
-                        tau2, dz2 = compute(
-                            new(LawInput, (now, q2, v2, z2, rq[i + 1], rv[i + 1], ra[i + 1])), terms
-                        )
+                        tau2, dz2 = compute(new(LawInput, (now, q2, v2, z2, *ref[i + 1])), terms)
                         a2 = accel(q2, v2, tau2)
                         q3, v3 = q + h2 * v2, v + h2 * a2
                         z3 = z + h2z * dz2 if nz else z
-                        tau3, dz3 = compute(
-                            new(LawInput, (now, q3, v3, z3, rq[i + 1], rv[i + 1], ra[i + 1])), terms
-                        )
+                        tau3, dz3 = compute(new(LawInput, (now, q3, v3, z3, *ref[i + 1])), terms)
                         a3 = accel(q3, v3, tau3)
                         now = t + dt
                         q4, v4 = q + h * v3, v + h * a3
                         z4 = z + hz * dz3 if nz else z
-                        tau4, dz4 = compute(
-                            new(LawInput, (now, q4, v4, z4, rq[i + 2], rv[i + 2], ra[i + 2])), terms
-                        )
+                        tau4, dz4 = compute(new(LawInput, (now, q4, v4, z4, *ref[i + 2])), terms)
                         a4 = accel(q4, v4, tau4)
                         if nz:
                             z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)

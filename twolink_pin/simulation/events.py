@@ -57,7 +57,7 @@ class PlantEvents:
         self._payload_time = plant.payload_step.time if plant.payload_step is not None else np.inf
         self._wrench = plant.wrench
         self._kinematics = RigidBodyTerms(plant.robot, None) if self._wrench is not None else None
-        self._force = None if self._wrench is None else np.array(self._wrench.force)
+        self._force = None if self._wrench is None else self._wrench.forces(runs)
         self.noise = plant.sensor_noise
         self._generators = self.noise.generators(runs) if self.noise is not None else []
         self._block: tuple[np.ndarray, np.ndarray] | None = None

@@ -21,6 +21,19 @@ from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
 from twolink_pin.metrics import NORMS, SIGNALS, Metrics, compute_metrics
 from twolink_pin.simulation import SimulationResult
+from twolink_pin.task_metrics import TaskMetrics
+
+TASK_COLUMNS = TaskMetrics._fields
+"""Columns of the task-space rows (CSV), in :class:`~twolink_pin.task_metrics.TaskMetrics` order."""
+TASK_HEADERS = (
+    "RMS ‖Δp‖ [mm]",
+    "max ‖Δp‖ [mm]",
+    "last period max ‖Δp‖ [mm]",
+    "RMS angle [deg]",
+    "max angle [deg]",
+    "last period max angle [deg]",
+)
+"""Markdown headers of the task-space table (no "|" inside a cell: ‖·‖ for the norm)."""
 
 
 def columns(nv: int) -> list[str]:
@@ -56,6 +69,8 @@ class ComparisonTable:
     """The plant each law ran on, in a few words, by law name."""
     gains: dict[str, dict[str, Any]] = field(default_factory=dict)
     """The gains each law ran with, by law name."""
+    task: dict[str, TaskMetrics] = field(default_factory=dict)
+    """Task-space metrics (mm, deg) of the task-space laws, by law name."""
 
     @property
     def nv(self) -> int:
@@ -73,6 +88,7 @@ class ComparisonTable:
             "failed": dict(self.failed),
             "plants": dict(self.plants),
             "gains": dict(self.gains),
+            "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
         }
 
     def csv(self) -> str:
@@ -88,6 +104,10 @@ class ComparisonTable:
             writer.writerow([name, "last_period_max_abs_e", *e_last, *([""] * (len(cols) - len(e_last)))])
         for name, what in self.failed.items():
             writer.writerow([name, "failed", what, *([""] * (len(cols) - 1))])
+        if self.task:
+            writer.writerow(["controller", "task_metric", *TASK_COLUMNS])
+            for name, t in self.task.items():
+                writer.writerow([name, "task", *(f"{x:.6g}" for x in t)])
         return buffer.getvalue()
 
     def markdown(self) -> str:
@@ -106,6 +126,12 @@ class ComparisonTable:
         out.append("|---|" + "---:|" * self.nv)
         for name, m in self.metrics.items():
             out.append(f"| {name} | " + " | ".join(f"{x:.3g}" for x in m.final_period_max_abs_e) + " |")
+        if self.task:
+            out.append("\n### task space: end-effector position [mm] and orientation [deg] errors\n")
+            out.append("| controller | " + " | ".join(TASK_HEADERS) + " |")
+            out.append("|---|" + "---:|" * len(TASK_HEADERS))
+            for name, t in self.task.items():
+                out.append(f"| {name} | " + " | ".join(f"{x:.4g}" for x in t) + " |")
         if self.plants or self.failed:
             out.append("\n### the runs\n")
             out.append("| controller | plant | outcome |")

@@ -23,7 +23,9 @@ case depends only on the seed and its index, whatever the chunking or where it r
 * ``δ ~ U(−param_error, param_error)`` per parameter of the map: the law believes
   ``p ⊙ (1 + δ)`` (model-based laws use it in their model, the adaptive laws start from
   ``p̂(0) = initial_estimate × p ⊙ (1 + δ)``);
-* each ``--gain NAME=LO:HI``: ``U(LO, HI)``, in the order given.
+* each ``--gain NAME=LO:HI``: ``U(LO, HI)``, in the order given;
+* with ``--wrench-scale LO:HI``: the run's factor ``U(LO, HI)`` on the plant's ``--wrench``
+  (column ``wrench_scale``).
 
 A gain is any field of the law's gains class (``kp``, ``k``, ``lam``, ``gamma``,
 ``model_scale``, ... — what a law's gains are, its class declares): a per-joint or
@@ -257,6 +259,7 @@ def run_sweep(
                 "q0_spread": config.q0_spread,
                 "param_error": config.param_error,
                 "gains": {g.name: [g.low, g.high] for g in config.gains},
+                "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
                 "duration": config.simulation.duration,
                 "dt": config.simulation.dt,
                 "control_period": config.simulation.control_period,

@@ -128,6 +128,9 @@ class SweepConfig:
             ``simulation.q0_offset`` [rad], >= 0.
         param_error: Half-width of the relative parameter error δ, in [0, 1).
         gains: Gain ranges.
+        wrench_scale: ``(LO, HI)``: each run's factor on the plant's wrench (``--wrench``),
+            drawn uniformly (after the other draws, so a study without it draws the same);
+            None: every run feels the wrench as given.
         chunk: Runs advanced together (one task on a cluster; bounds memory), 1 to
             :data:`MAX_CHUNK`; None: :func:`auto_chunk`.
         threads: Threads of the batch engine per chunk (None: all cores in-process, one
@@ -140,6 +143,7 @@ class SweepConfig:
     q0_spread: float = 0.0
     param_error: float = 0.0
     gains: tuple[GainRange, ...] = ()
+    wrench_scale: tuple[float, float] | None = None
     chunk: int | None = None
     threads: int | None = None
 
@@ -185,6 +189,16 @@ class SweepConfig:
             raise InvalidParameterError("q0_spread", self.q0_spread, "a finite angle >= 0 rad")
         if not (math.isfinite(self.param_error) and 0 <= self.param_error < 1):
             raise InvalidParameterError("param_error", self.param_error, "a fraction in [0, 1)")
+        if self.wrench_scale is not None:
+            low, high = self.wrench_scale
+            if not (math.isfinite(low) and math.isfinite(high) and low <= high):
+                raise InvalidParameterError("wrench_scale", self.wrench_scale, "finite factors LO <= HI")
+            if self.run.plant.wrench is None:
+                raise InvalidParameterError(
+                    "wrench_scale",
+                    self.wrench_scale,
+                    "a wrench to scale (--wrench FX,FY,FZ[,MX,MY,MZ]@T0:T1)",
+                )
         if self.simulation.method != "rk4":
             raise InvalidParameterError("method", self.simulation.method, "'rk4' (the batch engine)")
         names = [g.name for g in self.gains]
@@ -212,12 +226,16 @@ class Cases:
         """``1 + δ`` per parameter, shape (n, n_p)."""
         self.gains = {g.name: np.empty(n) for g in config.gains}
         """Drawn value of each gain range, shape (n,) each."""
+        self.wrench_scale = np.ones(n)
+        """Each run's factor on the plant's wrench, shape (n,) (1 unless drawn)."""
         for r, i in enumerate(range(start, stop)):
             rng = np.random.default_rng(np.random.SeedSequence(config.seed, spawn_key=(i,)))
             self.q0_offset[r] = nominal + rng.uniform(-config.q0_spread, config.q0_spread, nv)
             self.param_factor[r] = 1.0 + rng.uniform(-config.param_error, config.param_error, n_p)
             for g in config.gains:
                 self.gains[g.name][r] = rng.uniform(g.low, g.high)
+            if config.wrench_scale is not None:  # last: the draws above are those of a study without it
+                self.wrench_scale[r] = rng.uniform(*config.wrench_scale)
 
 
 def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Controller) -> Controller:

@@ -54,6 +54,8 @@ def input_columns(config: SweepConfig, nv: int, parameter_names: Sequence[str]) 
     columns = ["run", *_joint_columns("q0_offset", nv)]
     columns += [f"param_factor_{name}" for name in parameter_names]
     columns += [f"gain_{g.name}" for g in config.gains]
+    if config.wrench_scale is not None:
+        columns.append("wrench_scale")
     return columns
 
 
@@ -69,6 +71,8 @@ def _chunk_rows(
     stop = start + result.n_runs
     inputs = [np.arange(start, stop, dtype=float)[:, None], cases.q0_offset, cases.param_factor]
     inputs += [cases.gains[g.name][:, None] for g in config.gains]
+    if config.wrench_scale is not None:
+        inputs.append(cases.wrench_scale[:, None])
     exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & ~result.diverged
     flags = np.column_stack([exceeded, result.diverged, result.diverged_at]).astype(float)
     parts = [metric_array(m, stem) for stem in METRIC_UNITS]
@@ -181,6 +185,8 @@ class _Prepared:
         for g in config.gains:
             key, _ = gain_target(cls, g.name)
             units[f"gain_{g.name}"] = spec_of(cls.Gains, key).unit
+        if config.wrench_scale is not None:
+            units["wrench_scale"] = ""
         units.update(limit_exceeded="", diverged="", diverged_at="s")
         for stem, unit in METRIC_UNITS.items():
             units.update({c: unit for c in _joint_columns(stem, nv)})
@@ -207,6 +213,10 @@ class _Prepared:
         if noise is not None:  # run i of the sweep draws stream i, whatever the chunking
             plant = copy.copy(plant)
             plant.sensor_noise = dataclasses.replace(noise, stream=noise.stream + start)
+        wrench = plant.wrench
+        if config.wrench_scale is not None and wrench is not None:  # each run its drawn wrench
+            plant = copy.copy(plant)
+            plant.wrench = dataclasses.replace(wrench, scale=tuple(cases.wrench_scale))
         result = simulate_batch(
             law,
             plant,

@@ -165,6 +165,7 @@ def sweep_metadata(
         "param_error": config.param_error,
         "parameters": list(robot.parameter_map.names),
         "gains": {g.name: [g.low, g.high] for g in config.gains},
+        "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
         "lam": config.lam,
         "saturate": config.saturate,
         "friction_smoothing": config.friction_smoothing,

@@ -1,4 +1,4 @@
-"""References the arm tracks: periodic joint trajectories.
+"""References the arm tracks: periodic joint trajectories, and SE(3) references of the end effector.
 
 ==========================  ================================================================
 ``base.py``                 :class:`Trajectory` (what the engine samples), :class:`TrajectorySample`
@@ -6,6 +6,8 @@
 ``cartesian.py``            end-effector via points: planar 2R analytic IK or any arm's DLS IK
 ``defaults.py``             each robot's default reference (its profile's, or a swing about home), :func:`build_trajectory`
 ``fourier.py``              :class:`FourierTrajectory`: a periodic finite Fourier series (excitations)
+``se3.py``                  :class:`PoseTrajectory`: the end-effector frame through via poses on SE(3), its joint path
+``pose_ik.py``              :func:`solve_pose`: 6-D (position and orientation) damped least-squares IK
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ==========================  ================================================================
 """
@@ -31,11 +33,15 @@ from twolink_pin.trajectory.file import (
 )
 from twolink_pin.trajectory.fourier import FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
+from twolink_pin.trajectory.pose_ik import solve_pose
+from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory, pose_trajectory
 
 __all__ = [
     "NEUTRAL_AMPLITUDE",
     "FourierTrajectory",
     "JointTrajectory",
+    "PoseSample",
+    "PoseTrajectory",
     "Trajectory",
     "TrajectorySample",
     "ViaPoints",
@@ -47,6 +53,8 @@ __all__ = [
     "default_via_points",
     "home_configuration",
     "neutral_motion",
+    "pose_trajectory",
     "read_trajectory_file",
+    "solve_pose",
     "write_trajectory_file",
 ]

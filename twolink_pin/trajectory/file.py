@@ -13,6 +13,21 @@ or through end-effector positions of the robot's end-effector frame (solved by
     positions = [[0.45, 0.10, 0.40], ...]       # m: (x, y, z), or (x, y) for a planar arm
     seed = [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]   # rad, optional IK seed (default: home)
 
+or through end-effector poses: ``positions`` (3 coordinates) and, per row, the orientation
+as roll, pitch, yaw [rad] (``R = Rz(yaw) Ry(pitch) Rx(roll)``, the URDF's ``rpy``, what
+Pinocchio's ``rpy.rpyToMatrix`` builds; chosen over a quaternion because three angles are
+what one writes by hand and need no normalisation; the last row may differ from the first by
+2π, only the rotation must repeat)::
+
+    times = [0.0, 2.0, 4.0, 6.0, 8.0]
+    positions = [[0.45, 0.10, 0.40], ...]       # m
+    rpy = [[3.14159, 0.0, -1.5708], ...]        # rad: roll, pitch, yaw of the end-effector frame
+
+an SE(3) reference (:class:`~twolink_pin.trajectory.se3.PoseTrajectory`: straight lines and
+one-axis rotations between the via poses, continuous velocity and acceleration; arms with
+6 joints or more), whose desired pose, twist and acceleration task-space laws see, its joint
+path solved by a 6-D inverse kinematics;
+
 or a periodic finite Fourier series (:class:`~twolink_pin.trajectory.fourier.FourierTrajectory`,
 Swevers et al. 1997; what ``twolink-pin excite`` writes), a table of its own::
 
@@ -40,6 +55,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pinocchio as pin
 
 from twolink_pin.documents import load_json, load_toml
 from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError
@@ -49,6 +65,7 @@ from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
+from twolink_pin.trajectory.se3 import PoseTrajectory, pose_trajectory
 
 MAX_TRAJECTORY_BYTES = 1 << 20
 """Largest trajectory file read (1 MiB)."""
@@ -66,7 +83,7 @@ MIN_TIME_STEP = 1e-3
 CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
-KEYS = frozenset({"times", "joints", "positions", "period", "seed"})
+KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed"})
 FOURIER_KEYS = frozenset({"period", "harmonics", "a", "b", "offset"})
 """Keys of a ``fourier`` table."""
 
@@ -142,7 +159,7 @@ def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str
 
 def read_trajectory_file(
     path: str | os.PathLike[str], robot: RobotModel
-) -> JointTrajectory | FourierTrajectory:
+) -> JointTrajectory | FourierTrajectory | PoseTrajectory:
     """The trajectory a TOML or JSON file describes for ``robot`` (see the module docstring).
 
     Raises:
@@ -193,6 +210,8 @@ def read_trajectory_file(
         isinstance(period, (int, float)) and not isinstance(period, bool) and math.isfinite(period)
     ):
         raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
+    if "rpy" in document and "positions" not in document:
+        raise InvalidParameterError(f"{file}: rpy", document["rpy"], "orientations beside 'positions' (m)")
     given = [key for key in ("joints", "positions") if key in document]
     if len(given) != 1:
         raise InvalidParameterError(
@@ -233,6 +252,8 @@ def read_trajectory_file(
                     f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
                 )
             check_within_limits(robot, seed[None, :], f"{file}: seed")
+        if "rpy" in document:
+            return _pose_file(file, document, robot, times, points, seed, period)
         try:
             via_q = cartesian_via_q(robot, points, seed)
         except InverseKinematicsError as err:
@@ -251,6 +272,49 @@ def read_trajectory_file(
         )
     except InvalidParameterError as err:
         raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    check_trajectory_limits(robot, trajectory, f"{file}")
+    return trajectory
+
+
+def _pose_file(
+    file: Path,
+    document: dict[str, Any],
+    robot: RobotModel,
+    times: np.ndarray,
+    points: np.ndarray,
+    seed: np.ndarray | None,
+    period: Any,
+) -> PoseTrajectory:
+    """The SE(3) reference of a file with ``positions`` and ``rpy`` (see the module docstring)."""
+    rows = document["rpy"]
+    if (
+        not isinstance(rows, list)
+        or len(rows) != times.size
+        or any(not isinstance(row, list) or len(row) != 3 for row in rows)
+    ):
+        raise InvalidParameterError(
+            f"{file}: rpy", rows, f"one row (roll, pitch, yaw) [rad] per time ({times.size})"
+        )
+    rpy = _numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]")
+    if points.shape[1] != 3:
+        raise InvalidParameterError(
+            f"{file}: positions", document["positions"], "3 coordinates (x, y, z) [m] per row beside 'rpy'"
+        )
+    if robot.nv < 6:
+        raise InvalidParameterError(
+            f"{file}: rpy",
+            rows[0],
+            f"no orientations for {robot.name}: its {robot.nv} joints cannot set a full pose",
+        )
+    rotations = np.array([pin.rpy.rpyToMatrix(*row) for row in rpy])
+    try:
+        trajectory = pose_trajectory(
+            robot, tuple(times), points, rotations, None if period is None else float(period), seed
+        )
+    except InvalidParameterError as err:
+        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    except InverseKinematicsError as err:
+        raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
     check_trajectory_limits(robot, trajectory, f"{file}")
     return trajectory
 
@@ -321,13 +385,29 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
 
 
 def write_trajectory_file(
-    path: str | os.PathLike[str], trajectory: JointTrajectory | FourierTrajectory
+    path: str | os.PathLike[str], trajectory: JointTrajectory | FourierTrajectory | PoseTrajectory
 ) -> Path:
-    """Write ``trajectory`` as a trajectory file (atomically): its joint via points, or a
+    """Write ``trajectory`` as a trajectory file (atomically): its joint via points, an SE(3)
+    reference's via poses (positions, rpy, and its first configuration as the seed), or a
     Fourier trajectory's ``fourier`` table; TOML if ``path`` ends in ``.toml``, else JSON."""
     from twolink_pin.files import atomic_write, write_json
 
     toml = Path(os.fspath(path)).suffix.lower() == ".toml"
+    if isinstance(trajectory, PoseTrajectory):
+        poses = {
+            "times": trajectory.times.tolist(),
+            "positions": trajectory.positions.tolist(),
+            "rpy": [pin.rpy.matrixToRpy(R).tolist() for R in trajectory.rotations],
+            "period": trajectory.period,
+            "seed": trajectory.via_q[0].tolist(),
+        }
+        if not toml:
+            return write_json(path, poses)
+        with atomic_write(path) as f:
+            f.write("# via poses: times [s], positions [m], rpy [rad], period [s], seed [rad]\n")
+            for key, value in poses.items():
+                f.write(f"{key} = {json.dumps(value)}\n")
+        return Path(os.fspath(path))
     if isinstance(trajectory, FourierTrajectory):
         table = trajectory.as_dict()
         if not toml:

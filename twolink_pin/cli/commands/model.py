@@ -219,7 +219,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
 
 def cmd_trajectory(args: argparse.Namespace) -> int:
     from twolink_pin.feasibility import check_torques
-    from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, default_via_points
+    from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, PoseTrajectory, default_via_points
 
     robot = _robot(args)
     traj = _trajectory(args, robot)
@@ -236,6 +236,10 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         print(f"reference saved to {args.save} (read by --trajectory and --reference)", file=sys.stderr)
     if isinstance(traj, FourierTrajectory):  # an excitation: no via points, no polynomial
         return _fourier_trajectory(args, robot, traj, check)
+    if isinstance(traj, PoseTrajectory):  # via poses on SE(3): no polynomial
+        from twolink_pin.cli.task_space import pose_trajectory_command
+
+        return pose_trajectory_command(args, robot, traj, check)
     assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
     figures: list[str] = []
     if args.plot:

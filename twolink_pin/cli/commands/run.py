@@ -14,6 +14,7 @@ import numpy as np
 
 from twolink_pin.cli.commands.common import _identified, _robot, _run_one, _trajectory, run_spec
 from twolink_pin.cli.output import emit, fmt, progress_bar
+from twolink_pin.cli.task_space import is_task_space, save_task_figure, task_lines, task_summary
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -21,6 +22,7 @@ if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
     from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationResult
+    from twolink_pin.task_metrics import TaskMetrics
     from twolink_pin.trajectory import Trajectory
 
 
@@ -54,6 +56,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     result = simulate(*scenario, _trajectory(args, robot), spec.simulation)
     metrics = compute_metrics(result)
     payload = _result_payload(result, metrics)
+    task = task_summary(scenario.controller, result, robot)  # None unless a task-space law
+    if task is not None:
+        payload["task_metrics"] = task.as_dict()
     q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
     payload |= {
         "gains": gains_used(scenario.controller),
@@ -68,6 +73,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
         with removed_on_failure(args.plot) as folder:
             figures = [str(p) for p in save_simulation_figures(result, folder)]
+            if task is not None:
+                figures.append(str(save_task_figure(robot, result, folder, result.controller)))
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
@@ -85,6 +92,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             if result.duration < result.reference_period
             else ""
         ),
+        *task_lines(task),
     ]
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
         if over:
@@ -139,6 +147,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
                 save_simulation_figures(
                     result, stage / "figures", prefix=name, title=law_class(by_name[name]).title
                 )
+                if is_task_space(law_class(by_name[name])):
+                    save_task_figure(robot, result, stage / "figures", name, law_class(by_name[name]).title)
 
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
@@ -148,6 +158,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
         plants: dict[str, str] = {}
         gains: dict[str, dict[str, Any]] = {}
+        tasks: dict[str, TaskMetrics] = {}
 
         def run(name: str) -> SimulationResult:
             from twolink_pin.run_spec import gains_used, plant_description
@@ -156,13 +167,17 @@ def cmd_compare(args: argparse.Namespace) -> int:
             spec = shared.for_law(by_name[name])
             scenario = spec.build(robot, identified)
             plants[name], gains[name] = plant_description(scenario), gains_used(scenario.controller)
-            return simulate(*scenario, reference, spec.simulation)
+            result = simulate(*scenario, reference, spec.simulation)
+            task = task_summary(scenario.controller, result, robot)
+            if task is not None:
+                tasks[name] = task
+            return result
 
         try:
             table = run_comparison(run, names, progress, on_result)
         finally:
             bar.close()
-        table = replace(table, plants=plants, gains=gains)
+        table = replace(table, plants=plants, gains=gains, task=tasks)
         files = [Path(args.out) / p.name for p in table.write(stage)]
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
         _say_failed(table.failed, f"the other laws' results are in {args.out}")

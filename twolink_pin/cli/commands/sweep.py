@@ -33,6 +33,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         q0_spread=args.q0_spread,
         param_error=args.param_error,
         gains=tuple(args.gain),
+        wrench_scale=args.wrench_scale,
         chunk=args.chunk,
         threads=args.threads,
     )

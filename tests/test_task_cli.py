@@ -1,0 +1,99 @@
+"""Task-space metrics in the commands (simulate's summary and --json, compare's table) and the
+task-error figure, for laws whose class declares task_space = True — checked against the
+errors recomputed here with Pinocchio's forward kinematics and log3 from the saved run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from twolink_pin.cli import main
+from twolink_pin.model import load_robot
+from twolink_pin.plotting.task import _task_error_figure
+from twolink_pin.simulation.storage import load_result
+
+ROOT = Path(__file__).resolve().parents[1]
+SQUARE = str(ROOT / "examples" / "ur5_square_pose.toml")
+UR5 = load_robot("ur5")
+
+
+def _errors(q: np.ndarray, q_des: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """|p − p_d| [mm] and the angle of R R_dᵀ [deg] per sample, by Pinocchio directly."""
+    model, data, fid = UR5.model, UR5.model.createData(), UR5.ee_frame_id
+    mm, deg = np.empty(len(q)), np.empty(len(q))
+    for k in range(len(q)):
+        pin.framesForwardKinematics(model, data, q[k])
+        p, R = data.oMf[fid].translation.copy(), data.oMf[fid].rotation.copy()
+        pin.framesForwardKinematics(model, data, q_des[k])
+        mm[k] = 1e3 * np.linalg.norm(p - data.oMf[fid].translation)
+        deg[k] = np.degrees(np.linalg.norm(pin.log3(R @ data.oMf[fid].rotation.T)))
+    return mm, deg
+
+
+def test_simulate_shows_a_task_space_laws_errors_in_mm_and_deg(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    saved = tmp_path / "run.npz"
+    argv = ["simulate", "osc", "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.3"]
+    assert main([*argv, "--json", "--save", str(saved), "--plot", str(tmp_path / "fig")]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    result = load_result(saved)
+    mm, deg = _errors(np.asarray(result.q), np.asarray(result.q_des))
+    task = payload["task_metrics"]
+    assert task["position_rms_mm"] == pytest.approx(np.sqrt(np.mean(mm**2)), rel=1e-9)
+    assert task["position_max_mm"] == pytest.approx(mm.max(), rel=1e-9)
+    assert task["orientation_max_deg"] == pytest.approx(deg.max(), rel=1e-9)
+    assert task["orientation_last_period_max_deg"] == pytest.approx(deg.max(), rel=1e-9)  # < a period
+    assert mm.max() > 10.0 and mm[-1] < 0.5 * mm.max()  # it starts off and converges
+    assert any(f.endswith("osc_task_error.png") for f in payload["figures"])
+    # the figure draws those errors
+    fig = _task_error_figure(UR5, result)
+    lines = {ax.get_label(): ax.get_lines()[0].get_ydata() for ax in fig.axes}
+    np.testing.assert_allclose(lines["mm"], mm, rtol=1e-9)
+    np.testing.assert_allclose(lines["deg"], deg, rtol=1e-9, atol=1e-12)
+    assert main(argv) == 0
+    text = capsys.readouterr().out
+    assert f"task |p − p_d| RMS {task['position_rms_mm']:.4g} mm" in text
+    assert f"max {task['orientation_max_deg']:.4g} deg" in text
+
+
+def test_a_joint_space_law_has_no_task_metrics(capsys: pytest.CaptureFixture[str]) -> None:
+    assert main(["simulate", "pd", "--robot", "ur5", "--duration", "0.1", "--json"]) == 0
+    assert "task_metrics" not in json.loads(capsys.readouterr().out)
+
+
+def test_compare_tabulates_the_task_space_laws(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    out = tmp_path / "cmp"
+    argv = ["compare", "osc", "pd", "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.2"]
+    assert main([*argv, "--out", str(out), "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert set(payload["task_metrics"]) == {"osc"}
+    saved = tmp_path / "osc.npz"
+    assert (
+        main(
+            [
+                "simulate",
+                "osc",
+                "--robot",
+                "ur5",
+                "--trajectory",
+                SQUARE,
+                "--duration",
+                "0.2",
+                "--save",
+                str(saved),
+            ]
+        )
+        == 0
+    )
+    result = load_result(saved)
+    mm, _ = _errors(np.asarray(result.q), np.asarray(result.q_des))
+    assert payload["task_metrics"]["osc"]["position_max_mm"] == pytest.approx(mm.max(), rel=1e-9)
+    markdown = (out / "comparison.md").read_text()
+    section = markdown.split("### task space")[1]
+    assert f"| osc | {np.sqrt(np.mean(mm**2)):.4g} | {mm.max():.4g} |" in section
+    assert "| pd |" not in section.split("###")[0]
