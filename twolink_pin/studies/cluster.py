@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import importlib.util
+import logging
 import queue
 import socket
 import threading
@@ -389,6 +390,41 @@ def _dashboard(link: str | None) -> str | None:
 
 
 @contextlib.contextmanager
+def _startup_log() -> Iterator[list[logging.LogRecord]]:
+    """While a LocalCluster starts: distributed's log records at WARNING and above are kept
+    (the list yielded) instead of printed, so a nanny that cannot spawn its worker is one
+    line naming the cause (:func:`_startup_cause`), not Dask's own tracebacks on stderr."""
+    logger = logging.getLogger("distributed")
+    records: list[logging.LogRecord] = []
+
+    class _Keep(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            records.append(record)
+
+    saved = logger.handlers[:], logger.propagate
+    logger.handlers, logger.propagate = [_Keep(logging.WARNING)], False
+    started = False
+    try:
+        yield records
+        started = True
+    finally:
+        logger.handlers, logger.propagate = saved
+        if started:  # a warning of a cluster that did start (a slow start, a deprecation) still shows
+            for record in records:
+                logger.handle(record)
+
+
+def _startup_cause(exc: BaseException, records: list[logging.LogRecord]) -> str:
+    """The cause of a failed start: the first exception distributed logged (a nanny's
+    ``ValueError: cannot find context for 'bogus'``), else ``exc`` itself."""
+    for record in records:
+        if record.exc_info and record.exc_info[1] is not None:
+            inner = record.exc_info[1]
+            return f"{type(inner).__name__}: {str(inner)[:300]}; {record.getMessage()[:120]}"
+    return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+@contextlib.contextmanager
 def open_cluster(
     scheduler: str | None = None,
     workers: int | None = None,
@@ -440,24 +476,25 @@ def open_cluster(
     else:
         assert workers is not None
         try:
-            cluster = LocalCluster(
-                n_workers=workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                scheduler_port=0,
-                dashboard_address="127.0.0.1:0",
-                preload=list(preload) or [__name__],
-                env={LOCAL_WORKER: "1"},
-            )
+            with _startup_log() as records:
+                cluster = LocalCluster(
+                    n_workers=workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    scheduler_port=0,
+                    dashboard_address="127.0.0.1:0",
+                    preload=list(preload) or [__name__],
+                    env={LOCAL_WORKER: "1"},
+                )
             client = Client(cluster, set_as_default=False)
         except Exception as exc:
             if cluster is not None:
                 with contextlib.suppress(Exception):
                     cluster.close()
             raise ClusterError(
-                address, f"the LocalCluster did not start ({type(exc).__name__}: {exc})"
-            ) from exc
+                address, f"the LocalCluster did not start ({_startup_cause(exc, records)})"
+            ) from None
         engine = DaskEngine(
             client,
             str(cluster.scheduler_address),
