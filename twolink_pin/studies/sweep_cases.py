@@ -15,7 +15,6 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import make_scenario
-from twolink_pin.simulation import SimulationConfig
 from twolink_pin.simulation.config import joint_offsets
 
 MAX_SAMPLES = 10_000_000
@@ -111,6 +110,12 @@ def gain_target(cls: type[Controller], name: str) -> tuple[str, int | None]:
     )
 
 
+def law_reference(run: RunSpec) -> str:
+    """The law of ``run`` as given (a registered name, ``file.py:Class``, ``module:Class``)."""
+    law = run.law
+    return law if isinstance(law, str) else f"{law.__module__}:{law.__qualname__}" if law else ""
+
+
 @dataclass(frozen=True)
 class SweepConfig:
     """A Monte Carlo study of one law (see the module docstring for the draws).
@@ -143,32 +148,6 @@ class SweepConfig:
     chunk: int | None = None
     threads: int | None = None
 
-    @property
-    def controller(self) -> str:
-        """The law's reference, as given."""
-        law = self.run.law
-        return law if isinstance(law, str) else f"{law.__module__}:{law.__qualname__}" if law else ""
-
-    @property
-    def simulation(self) -> SimulationConfig:
-        """The run's simulation settings."""
-        return self.run.simulation
-
-    @property
-    def lam(self) -> float | None:
-        """``λ`` [1/s] (None: the law's default)."""
-        return self.run.lam
-
-    @property
-    def saturate(self) -> bool:
-        """Whether the plant clips torques."""
-        return self.run.plant.saturate
-
-    @property
-    def friction_smoothing(self) -> float:
-        """ε [rad/s] of the friction sign."""
-        return self.run.friction_smoothing
-
     def __post_init__(self) -> None:
         if not isinstance(self.run, RunSpec) or self.run.law is None:
             raise InvalidParameterError("run", self.run, "a RunSpec of one law")
@@ -185,15 +164,15 @@ class SweepConfig:
             raise InvalidParameterError("q0_spread", self.q0_spread, "a finite angle >= 0 rad")
         if not (math.isfinite(self.param_error) and 0 <= self.param_error < 1):
             raise InvalidParameterError("param_error", self.param_error, "a fraction in [0, 1)")
-        if self.simulation.method != "rk4":
-            raise InvalidParameterError("method", self.simulation.method, "'rk4' (the batch engine)")
+        if self.run.simulation.method != "rk4":
+            raise InvalidParameterError("method", self.run.simulation.method, "'rk4' (the batch engine)")
         names = [g.name for g in self.gains]
         if len(set(names)) != len(names):
             raise InvalidParameterError("gains", names, "each gain at most once")
         for g in self.gains:
             gain_target(cls, g.name)
-        if self.lam is not None and not cls.takes("lam"):
-            raise InvalidParameterError("lambda", self.lam, f"no λ for controller '{cls.name}'")
+        if self.run.lam is not None and not cls.takes("lam"):
+            raise InvalidParameterError("lambda", self.run.lam, f"no λ for controller '{cls.name}'")
 
 
 # -- the cases ---------------------------------------------------------------------------------
@@ -204,7 +183,7 @@ class Cases:
 
     def __init__(self, config: SweepConfig, robot: RobotModel, start: int, stop: int) -> None:
         nv, n_p = robot.nv, robot.parameter_map.size
-        nominal = joint_offsets("q0_offset", config.simulation.q0_offset, robot.profile.q0_offset, nv)
+        nominal = joint_offsets("q0_offset", config.run.simulation.q0_offset, robot.profile.q0_offset, nv)
         n = stop - start
         self.q0_offset = np.empty((n, nv))
         """``q(0) − q_d(0)`` [rad], shape (n, nv)."""
@@ -247,7 +226,7 @@ def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Contr
         cls,
         robot,
         gains={**resolved, **gains},
-        saturate=config.saturate,
-        friction_smoothing=config.friction_smoothing,
+        saturate=config.run.plant.saturate,
+        friction_smoothing=config.run.friction_smoothing,
         model_parameters=believed,
     ).controller
