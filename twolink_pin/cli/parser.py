@@ -308,6 +308,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--port", type=port, default=None, help="port of the viewer (default: a free one)")
     p.add_argument("--no-browser", action="store_true", help="do not open a browser")
     p.add_argument("--loop", action="store_true", help="repeat the motion")
+    add_disturbance_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_animate)
 

@@ -7,6 +7,8 @@ What the scene holds (node paths below ``/meshcat``):
 * its translucent "ghost" following ``q_des`` (``ghost/...``, :func:`ghost_visual_model`);
 * the end-effector trail (``trail/<k>``: pieces that appear as the arm draws them), the
   desired end-effector path (``desired_path``) and the via-point markers (``via/<i>``);
+* when asked, the external force as an arrow (``wrench``) and the desired frame as a triad
+  (``desired_frame``): :mod:`.overlays`;
 * a floor grid sized to the motion (``grid``, :func:`.camera._grid`) and a camera framing the
   whole motion (:func:`.camera._camera`): from above for planar motion, obliquely otherwise.
 
@@ -379,6 +381,10 @@ class Scene(NamedTuple):
     """Every meshcat command (lowered dicts, ready for msgpack), the animation last."""
     grid_spacing: float
     """Spacing of the floor grid's lines [m]."""
+    wrench_scale: float | None = None
+    """Length of the force arrow per newton [m/N] (None: no wrench drawn)."""
+    axis_length: float | None = None
+    """Length of the desired frame's axes [m] (None: no triad drawn)."""
 
 
 def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, play: bool = True) -> Scene:
@@ -441,6 +447,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
             node.set_transform(pin.SE3(np.eye(3), point).homogeneous)
         framing.append(motion.via_points)
     joint_points = np.vstack(joints)
+    wrench_scale, axis_length = _add_overlays(vis, animation, robot, motion, joint_points, framing)
     in_view = np.vstack([joint_points, *framing])
     centre, camera = _camera(joint_points, in_view, desired_path)
     spacing, (minor, major) = _grid(in_view, centre, camera)
@@ -455,4 +462,28 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
     vis[CAMERA_TARGET_NODE].set_transform(pin.SE3(np.eye(3), centre).homogeneous)
     vis[CAMERA_NODE].set_property("position", _threejs(camera - centre))
     vis.set_animation(animation, play=play, repetitions=math.inf if loop else 1)
-    return Scene(window.commands, spacing)
+    return Scene(window.commands, spacing, wrench_scale, axis_length)
+
+
+def _add_overlays(
+    vis: Any,
+    animation: Any,
+    robot: RobotModel,
+    motion: _Motion,
+    joints: np.ndarray,
+    framing: list[np.ndarray],
+) -> tuple[float | None, float | None]:
+    """The force arrow and the desired frame's triad (:mod:`.overlays`), if the motion has
+    them: their scale [m/N] and axis length [m]; the arrow's tips join ``framing``."""
+    from twolink_pin.visualization import overlays
+
+    extent = float(max(np.max(np.ptp(joints, axis=0)), 1e-3))  # the motion's size [m]
+    keys = [_key(frame) for frame in motion.frames]
+    scale = length = None
+    if motion.wrench is not None:
+        poses = overlays.frame_poses(robot, motion.q, overlays.frame_id(robot, motion.wrench_frame))
+        scale, tips = overlays.add_wrench(vis, animation, motion.frames, keys, poses, motion.wrench, extent)
+        framing.append(tips)
+    if motion.desired_poses is not None:
+        length = overlays.add_desired_frame(vis, animation, keys, motion.desired_poses, extent)
+    return scale, length
