@@ -182,12 +182,13 @@ def _prepare(
     forces = _check_wrench(wrench, len(t_arr))
     poses = _check_desired(robot, desired_frame, q_des_arr, len(t_arr))
     q_des_frames = None if q_des_arr is None else _resample(t_arr, q_des_arr, times)
+    desired: np.ndarray | None = None
     if desired_frame is True and q_des_frames is not None:
         from twolink_pin.visualization.overlays import frame_poses
 
         desired = frame_poses(robot, q_des_frames, int(robot.ee_frame_id))
-    else:
-        desired = None if poses is None else _held(t_arr, poses, times)
+    elif poses is not None:
+        desired = _held(t_arr, poses, times)
     return _Motion(
         frames=frames,
         fps=fps,
