@@ -132,7 +132,9 @@ class SweepConfig:
         q0_spread: Half-width of the uniform initial position error around the nominal
             ``simulation.q0_offset`` [rad], >= 0.
         param_error: Half-width of the relative parameter error δ, in [0, 1).
-        gains: Gain ranges.
+        gains: Gain ranges. A matrix gain (``osc``'s Kp, ``impedance``'s K) ``NAME=LO:HI`` is
+            ``s I`` with s drawn, ``NAMEi=LO:HI`` the nominal matrix with entry (i, i) drawn
+            (:func:`_matrix_draws`): per run an (N, k, k) stack, checked SPD.
         chunk: Runs advanced together (one task on a cluster; bounds memory), 1 to
             :data:`MAX_CHUNK`; None: :func:`auto_chunk`.
         threads: Threads of the batch engine per chunk (None: all cores in-process, one
@@ -199,13 +201,49 @@ class Cases:
                 self.gains[g.name][r] = rng.uniform(g.low, g.high)
 
 
+def _matrix_draws(config: SweepConfig, cases: Cases, base: Controller) -> dict[str, np.ndarray]:
+    """The drawn matrix gains of the chunk's runs, shape (n, k, k) each.
+
+    ``NAME=LO:HI`` draws s and gives ``s I`` (s is the gain's value, as for a scalar gain:
+    ``--gain kp=50:150`` on ``osc`` is Kp = s I); ``NAMEi=LO:HI`` draws diagonal entry
+    (i, i) of the law's nominal matrix (its resolved gain), the others kept; both together
+    give ``s I`` with the drawn entries. The gains check each run's matrix (symmetric
+    positive definite) when the law is built.
+    """
+    cls = type(base)
+    n = len(cases.q0_offset)
+    out: dict[str, np.ndarray] = {}
+    targets = [(g, *gain_target(cls, g.name)) for g in config.gains]
+    for g, key, index in sorted(targets, key=lambda target: target[2] is not None):  # NAME before NAMEi
+        if not spec_of(cls.Gains, key).matrix:
+            continue
+        if key not in out:
+            nominal = np.asarray(getattr(base.gains, key), dtype=float)
+            k = nominal.shape[-1] if nominal.ndim == 3 else 1
+            out[key] = np.array(np.broadcast_to(nominal.reshape(-1, k, k), (n, k, k)))
+        current = out[key]
+        k = current.shape[-1]
+        drawn = cases.gains[g.name]
+        if index is None:
+            current[:] = drawn[:, None, None] * np.eye(k)
+        elif index < k:
+            current[:, index, index] = drawn
+        else:
+            raise InvalidParameterError(
+                "gain", g.name, f"a diagonal entry from 1 to {k} of the {k}×{k} matrix"
+            )
+    return out
+
+
 def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Controller) -> Controller:
     """One law object for the chunk: drawn gains and believed parameters per run."""
     cls = type(base)
     n = len(cases.q0_offset)
-    gains: dict[str, Any] = {}
+    gains: dict[str, Any] = dict(_matrix_draws(config, cases, base))
     for g in config.gains:
         key, index = gain_target(cls, g.name)
+        if spec_of(cls.Gains, key).matrix:
+            continue  # drawn above
         drawn = cases.gains[g.name][:, None]
         if index is None:
             gains[key] = drawn if spec_of(cls.Gains, key).per != "scalar" else drawn[:, 0]
