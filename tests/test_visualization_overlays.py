@@ -162,3 +162,22 @@ def test_animate_draws_the_runs_wrench_and_the_desired_frame(tmp_path: Path) -> 
     shown = with_wrench.read_text()
     assert 'id="wrench-scale">force arrow' in shown and 'id="axis-length">desired frame' in shown
     assert 'id="wrench-scale"' not in without.read_text() and 'id="axis-length"' in without.read_text()
+
+
+def test_the_live_viewer_states_the_same_scale_as_the_page(tmp_path: Path) -> None:
+    """serve draws the same arrow as write_html: its scale [m/N] (the live page has no legend)
+    is the one the file's legend states, a round number that draws the largest force between
+    0.12 and 0.3 of the motion's extent."""
+    from twolink_pin.kinematics import joint_positions
+    from twolink_pin.visualization import serve
+
+    t, q, q_des = RUN
+    page = write_html(ROBOT, t, q, q_des, path=tmp_path / "w.html", wrench=_wrench(t)).read_text()
+    stated = float(re.search(r'id="wrench-scale">force arrow (\S+) m per N', page).group(1))  # type: ignore[union-attr]
+    with serve(ROBOT, t, q, q_des, wrench=_wrench(t), quiet=True) as viewer:
+        assert viewer.wrench_scale == stated
+    points = np.vstack([joint_positions(ROBOT, x).reshape(-1, 3) for x in (q[::25], q_des[::25])])
+    extent = float(np.ptp(points, axis=0).max())
+    assert 0.12 * extent <= np.linalg.norm(FORCE) * stated <= 0.3 * extent + 1e-12
+    with serve(ROBOT, t, q, q_des, quiet=True) as viewer:
+        assert viewer.wrench_scale is None

@@ -45,6 +45,8 @@ class LiveViewer:
         self._socket.setsockopt(zmq.LINGER, 0)
         self._socket.connect(bridge.zmq_url)
         self._closed = False
+        self.wrench_scale: float | None = None
+        """Length of the force arrow per newton [m/N] (the live page has no legend); None: no arrow."""
         self.host: str = bridge.host
         """Address the HTTP/WebSocket server listens on."""
         self.port: int = bridge.port
@@ -159,6 +161,7 @@ def serve(
     )
     scene = scene_commands(robot, motion, loop=loop)
     viewer = LiveViewer(start_bridge(host, port))
+    viewer.wrench_scale = scene.wrench_scale
     try:
         for command in scene.commands:
             viewer._send(command)

@@ -280,7 +280,8 @@ def cmd_animate(args: argparse.Namespace) -> int:
         emit(
             args,
             {"url": viewer.url, "host": viewer.host, "port": viewer.port, "gains": gains},
-            f"meshcat viewer at {viewer.url}\n  {result.controller} gains {gains_text}",
+            f"meshcat viewer at {viewer.url}\n  {result.controller} gains {gains_text}"
+            + ("" if viewer.wrench_scale is None else f"\n  force arrow {viewer.wrench_scale:g} m per N"),
         )
         print("press Ctrl-C to stop", file=sys.stderr, flush=True)
         try:
