@@ -257,22 +257,29 @@ def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask work
 
 if __name__ == "__main__":
     samples, duration, out, workers = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
+    scheduler = sys.argv[5] if len(sys.argv) > 5 else None  # a running cluster of `workers` workers
     robot = load_robot(); trajectory = default_trajectory(robot)
     config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1, q0_spread=0.05)
     before = high_water_mib()
     tracemalloc.start()
-    output = run_sweep(config, robot, trajectory, out, plot=True, workers=workers or None)
+    where = {"scheduler": scheduler} if scheduler else {"workers": workers or None}
+    output = run_sweep(config, robot, trajectory, out, plot=True, **where)
     traced = tracemalloc.get_traced_memory()[1]
     print(before, high_water_mib(), traced / 2**20, output.seconds)
 """
 
 
-def _client_memory(samples: int, duration: float, workers: int, out: str) -> dict[str, float]:
-    """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0)."""
+def _client_memory(
+    samples: int, duration: float, workers: int, out: str, scheduler: str | None = None
+) -> dict[str, float]:
+    """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0;
+    on the running cluster at ``scheduler`` of ``workers`` workers when given, else on a
+    LocalCluster of its own)."""
+    where = () if scheduler is None else (scheduler,)
     return {
         "samples": samples,
         "workers": workers,
-        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers),
+        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers, *where),
     }
 
 
@@ -337,19 +344,24 @@ def sweep_section(quick: bool) -> dict[str, Any]:
                     f"  {name:8s} {duration:6.2f} s {samples:6d} {row['chunk_1w']:>5d}/{row['chunk_2w']:<6d} "
                     f"{row['in_process']:9.1f}/s {row['1w']:7.1f}/s {row['2w']:8.1f}/s {row['speedup']:5.2f}x"
                 )
-    reached = {}
-    for name in horizons:
-        good = [r["duration"] for r in rows if r["robot"] == name and r["speedup"] >= TARGET_SPEEDUP]
-        reached[name] = min(good) if good else None
-        where = f"from {reached[name]:g} s horizons on" if good else "at none of the horizons measured"
-        print(f"  {name}: 2 workers reach {TARGET_SPEEDUP:g}x the 1-worker throughput {where}")
-    memory = []
-    sizes = (500,) if quick else (10_000, 100_000)
-    print("\nclient memory of a pd sweep of 0.05-s runs (fresh process, VmHWM; figure on; chunks auto)")
-    with tempfile.TemporaryDirectory() as tmp:
+        reached = {}
+        for name in horizons:
+            good = [r["duration"] for r in rows if r["robot"] == name and r["speedup"] >= TARGET_SPEEDUP]
+            reached[name] = min(good) if good else None
+            where = f"from {reached[name]:g} s horizons on" if good else "at none of the horizons measured"
+            print(f"  {name}: 2 workers reach {TARGET_SPEEDUP:g}x the 1-worker throughput {where}")
+        memory = []
+        sizes = (500,) if quick else (10_000, 100_000)
+        print(
+            "\nclient memory of a pd sweep of 0.05-s runs (fresh process, VmHWM; figure on; chunks auto; "
+            "--workers 2: the client of the 2-worker cluster above, the workers being other processes)"
+        )
         for samples in sizes:
             for workers in (0, 2):
-                mem = _client_memory(samples, 0.05, workers, os.path.join(tmp, f"{samples}-{workers}"))
+                scheduler = engines["2w"].address if workers else None
+                mem = _client_memory(
+                    samples, 0.05, workers, os.path.join(tmp, f"{samples}-{workers}"), scheduler
+                )
                 memory.append(mem)
                 label = "in-process" if workers == 0 else "--workers 2 (client only)"
                 print(
@@ -462,36 +474,47 @@ SWEEP_200 = 200
 """Runs of the issue's sweep (in-process 36.9 s against 46.7 s on ``--workers 2``: one chunk)."""
 
 
-def sweep_200_section(duration: float = 30.0) -> dict[str, Any]:
-    """The twolink pd sweep of 200 runs of ``duration``: in-process against ``--workers 2``
-    (LocalCluster start included, as the command line pays it)."""
+def sweep_200_section(duration: float = 30.0, repeats: int = 3) -> dict[str, Any]:
+    """Sweep throughput, 200 runs, in-process vs ``--workers 2``: the twolink pd sweep of
+    :data:`SWEEP_200` runs of ``duration`` [s] as the command line runs it (a fresh
+    ``twolink-pin sweep`` process each time: imports, robot, LocalCluster start and its
+    workers' imports included), the two modes alternated ``repeats`` times so that a change
+    of load hits both; the medians and every pair are printed with the load average."""
+    import statistics
+    import subprocess
     import tempfile
 
     from twolink_pin.studies import cluster
-    from twolink_pin.studies.sweep import run_sweep
 
     if not cluster.available():
         print(f"\nsweep of {SWEEP_200} runs: skipped, Dask is not installed ({cluster.INSTALL_HINT})")
         return {}
-    robot = load_robot()
-    trajectory = default_trajectory(robot)
-    study = _throughput_study(SWEEP_200, duration)
-    seconds: dict[str, float] = {}
-    chunks: dict[str, int] = {}
+    command = [sys.executable, "-m", "twolink_pin.cli", "sweep", "pd", "--samples", str(SWEEP_200)]
+    command += ["--duration", f"{duration:g}", "--no-plot", "--json"]
+    seconds: dict[str, list[float]] = {"in_process": [], "workers_2": []}
+    loads = []
     with tempfile.TemporaryDirectory() as tmp:
-        for label, workers in (("in_process", None), ("workers_2", 2)):
-            start = time.perf_counter()
-            output = run_sweep(study, robot, trajectory, f"{tmp}/{label}", plot=False, workers=workers)
-            seconds[label] = time.perf_counter() - start
-            chunks[label] = output.chunk
+        for k in range(repeats):
+            for label, extra in (("in_process", []), ("workers_2", ["--workers", "2"])):
+                start = time.perf_counter()
+                subprocess.run(
+                    [*command, "--out", f"{tmp}/{label}-{k}", *extra], check=True, capture_output=True
+                )
+                seconds[label].append(time.perf_counter() - start)
+            loads.append(round(os.getloadavg()[0], 2))
+    median = {label: statistics.median(values) for label, values in seconds.items()}
     print(
-        f"\nsweep of {SWEEP_200} twolink pd runs of {duration:g} s (wall, cluster start included; load average "
-        f"{[round(x, 2) for x in os.getloadavg()]}): in-process {seconds['in_process']:.1f} s "
-        f"({SWEEP_200 / seconds['in_process']:.1f} runs/s, chunk {chunks['in_process']}), --workers 2 "
-        f"{seconds['workers_2']:.1f} s ({SWEEP_200 / seconds['workers_2']:.1f} runs/s, chunks of "
-        f"{chunks['workers_2']}): {seconds['in_process'] / seconds['workers_2']:.2f}x"
+        f"\nsweep throughput, {SWEEP_200} runs, in-process vs --workers 2 (twolink pd, {duration:g}-s runs, wall "
+        f"of the whole command, {repeats} alternated pairs; 1-min load average after each pair {loads}):"
     )
-    return {"sweep_200": {"duration": duration, "seconds": seconds, "chunk": chunks}}
+    for label, values in seconds.items():
+        shown = ", ".join(f"{x:.1f}" for x in values)
+        print(
+            f"  {label:10s} median {median[label]:6.1f} s ({SWEEP_200 / median[label]:5.1f} runs/s; each: {shown} s)"
+        )
+    ratio = median["in_process"] / median["workers_2"]
+    print(f"  in-process / --workers 2 (medians): {ratio:.2f} (above 1: the 2 workers are faster)")
+    return {"sweep_200": {"duration": duration, "seconds": seconds, "median": median, "load_average": loads}}
 
 
 def _batch_case(spec: str, robot: Any, n: int) -> tuple[Any, Any, np.ndarray]:
@@ -740,7 +763,19 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
     )
+    parser.add_argument(
+        "--sweep-200",
+        type=float,
+        default=None,
+        metavar="S",
+        help="only the row 'sweep throughput, 200 runs, in-process vs --workers 2', with runs of S seconds",
+    )
     args = parser.parse_args(argv)
+    if args.sweep_200 is not None:
+        results = sweep_200_section(args.sweep_200, args.repeats or 3)
+        if args.json:
+            print(json.dumps(results))
+        return 0
     quick = args.quick
     repeats = args.repeats or (1 if quick else 5)
     single_duration = 0.5 if quick else 10.0

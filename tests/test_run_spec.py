@@ -149,6 +149,31 @@ def test_simulate_echoes_the_gains_it_used(capsys: pytest.CaptureFixture[str]) -
     assert payload["q0_offset"] == [0.1, -0.1] and payload["plant"] == "no friction"
 
 
+def test_sweep_and_animate_echo_the_gains_they_used(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """sweep and animate say the gains as simulate does: the report's Kp = (350, 300),
+    Kd = (40, 50) for the twolink's pd, a --gain where given (text and --json); the sweep's
+    drawn ranges stay its "gains"; animate --from rebuilds them from the run the file records."""
+    argv = ["sweep", "pd", "--samples", "2", "--duration", "0.02", "--gain", "kd=30:60"]
+    assert main([*argv, "--out", str(tmp_path / "s"), "--no-plot", "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["gains_used"] == {"kp": [350.0, 300.0], "kd": [40.0, 50.0]}
+    assert payload["gains"] == {"kd": [30.0, 60.0]}
+    assert main([*argv, "--out", str(tmp_path / "t"), "--no-plot"]) == 0
+    text = capsys.readouterr().out
+    assert "gains kp = (350, 300)" in text and "kd drawn per run from U(30, 60)" in text
+    html, saved = tmp_path / "a.html", tmp_path / "run.npz"
+    assert (
+        main(["animate", "pd", "--gain", "kp=200", "--duration", "0.02", "--html", str(html), "--json"]) == 0
+    )
+    assert json.loads(capsys.readouterr().out)["gains"] == {"kp": 200.0, "kd": [40.0, 50.0]}
+    assert main(["simulate", "pd", "--gain", "kp=210", "--duration", "0.02", "--save", str(saved)]) == 0
+    capsys.readouterr()
+    assert main(["animate", "--from", str(saved), "--html", str(html)]) == 0
+    assert "pd gains kp = 210 " in capsys.readouterr().out
+
+
 BLOWUP = """
 from dataclasses import dataclass
 

@@ -430,3 +430,44 @@ def test_an_output_folder_that_is_a_mount_point_is_refused_before_any_run(
     assert main(["sweep", "pd", "--samples", "2", "--duration", "0.05", "--out", str(mounted)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "mount point" in err
+
+
+def test_a_drawn_matrix_gain_is_a_per_run_stack_and_run_i_is_that_single_run(tmp_path: Path) -> None:
+    """On osc (matrix gains Kp, Kd, 3×3 SPD): kd=LO:HI is s·I per run, kp1=LO:HI the nominal
+    Kp with entry (1, 1) drawn; the chunk's law holds (N, 3, 3) stacks, and row 2 of the
+    table is a single simulate with those matrices."""
+    study = _study(
+        controller="osc",
+        samples=4,
+        q0_spread=0.0,
+        param_error=0.0,
+        gains=(GainRange("kp1", 50.0, 150.0), GainRange("kd", 5.0, 15.0)),
+    )
+    nominal = make_scenario("osc", ROBOT).controller
+    cases = Cases(study, ROBOT, 0, 4)
+    law = _chunk_law(study, ROBOT, cases, nominal)
+    assert np.shape(law.gains.kp) == (4, 3, 3) and np.shape(law.gains.kd) == (4, 3, 3)
+    np.testing.assert_array_equal(law.gains.kd, cases.gains["kd"][:, None, None] * np.eye(3))
+    np.testing.assert_array_equal(law.gains.kp[:, 0, 0], cases.gains["kp1"])
+    np.testing.assert_array_equal(
+        law.gains.kp[:, 1:, 1:], np.broadcast_to(nominal.gains.kp[:, 1:, 1:], (4, 2, 2))
+    )
+    run_sweep(study, ROBOT, TRAJECTORY, tmp_path, plot=False)
+    row = _rows(tmp_path / "runs.csv")[2]
+    kp = np.array(nominal.gains.kp[0])
+    kp[0, 0] = float(row["gain_kp1"])
+    kd = float(row["gain_kd"]) * np.eye(3)
+    single = simulate(*make_scenario("osc", ROBOT, gains={"kp": kp, "kd": kd}), TRAJECTORY, SHORT)
+    metrics = compute_metrics(single)
+    np.testing.assert_allclose([float(row["rms_e1"]), float(row["rms_e2"])], metrics.rms.e, rtol=1e-9)
+    np.testing.assert_allclose([float(row["max_tau1"]), float(row["max_tau2"])], metrics.max.tau, rtol=1e-9)
+
+
+def test_a_drawn_matrix_that_is_not_positive_definite_is_refused_naming_the_run(tmp_path: Path) -> None:
+    study = _study(controller="osc", samples=3, gains=(GainRange("kp1", -10.0, -1.0),))
+    with pytest.raises(InvalidParameterError, match=r"kp\[0\].*positive definite"):
+        run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "o", plot=False)
+    with pytest.raises(InvalidParameterError, match="diagonal entry from 1 to 3"):
+        bad = _study(controller="osc", samples=3, gains=(GainRange("kp4", 1.0, 2.0),))
+        _chunk_law(bad, ROBOT, Cases(bad, ROBOT, 0, 3), make_scenario("osc", ROBOT).controller)
+    assert not (tmp_path / "o").exists()

@@ -12,9 +12,10 @@ for ``x`` in ``e`` [rad], ``ė`` [rad/s], ``τ`` [N·m] (the torque applied to t
 plus ``max |e|`` over the last reference period (the steady-state tracking error), the peak
 commanded torque and the first time it exceeded each joint's limit.
 
-One implementation: :class:`RunningMetrics` takes samples block by block (the engine hands
-it each block of N runs, so a batch's memory stays O(N)); :func:`compute_metrics` feeds it
-a recorded run in one block.
+One definition, :class:`Metrics` (batch first; a single run is its N = 1 row), and one
+implementation: :class:`RunningMetrics` takes samples block by block (the engine hands it
+each block of N runs, so a batch's memory stays O(N)); :func:`compute_metrics` feeds it a
+recorded run in one block.
 """
 
 from __future__ import annotations
@@ -31,9 +32,9 @@ if TYPE_CHECKING:
 SIGNALS = (("e", "e", "rad"), ("edot", "ė", "rad/s"), ("tau", "τ", "N·m"))
 """``(field of Norms, symbol, SI unit)`` of each signal: the one list every table reads."""
 NORMS = {"rms": ("RMS = sqrt((1/T)∫x² dt)", ""), "l2": ("L2 = sqrt(∫x² dt)", "·√s"), "max": ("max |x|", "")}
-"""Title and unit suffix of each norm (a field of :class:`Metrics` / :class:`BatchMetrics`)."""
+"""Title and unit suffix of each norm (a field of :class:`Metrics`)."""
 RUN_METRICS = {"final_period_max_abs_e": "rad", "peak_command": "N·m"}
-"""Per-joint metrics beyond the norms, and their SI units (fields of :class:`BatchMetrics`)."""
+"""Per-joint metrics beyond the norms, and their SI units (fields of :class:`Metrics`)."""
 TABLE_NORMS = ("rms", "max")
 """The norms a one-row-per-run table (the sweep's) carries (L2 is RMS·√T there)."""
 
@@ -45,7 +46,7 @@ def metric_units(norms: tuple[str, ...] = TABLE_NORMS) -> dict[str, str]:
     return units | RUN_METRICS
 
 
-def metric_array(metrics: BatchMetrics, stem: str) -> np.ndarray:
+def metric_array(metrics: Metrics, stem: str) -> np.ndarray:
     """The array of metric ``stem`` (a key of :func:`metric_units`), shape (N, nv)."""
     kind, _, field = stem.partition("_")
     if kind in NORMS and field in Norms._fields:
@@ -65,36 +66,20 @@ class Norms(NamedTuple):
 
 
 class Metrics(NamedTuple):
-    """Norms of one run (see module docstring); arrays of shape (nv,)."""
+    """The metrics of N runs (see the module docstring), batch first: arrays of shape
+    (N, nv), rows of diverged runs NaN. One run's (:func:`compute_metrics`, :meth:`run`) is
+    the same class with the run axis taken away: arrays of shape (nv,).
+
+    The one definition behind the summary line, the comparison table, the sweep's columns
+    (:func:`metric_array`) and the report.
+    """
 
     rms: Norms
-    """Root mean square over the run."""
+    """Root mean square of ``e`` [rad], ``ė`` [rad/s], applied ``τ`` [N·m] over the run."""
     l2: Norms
-    """``sqrt(∫ x² dt)`` over the run."""
+    """``sqrt(∫ x² dt)`` of the same signals over the run."""
     max: Norms
-    """``max |x|`` over the run."""
-    final_period_max_abs_e: np.ndarray
-    """``max |e|`` over the last reference period [rad], shape (nv,)."""
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready nested dict of lists."""
-        out: dict[str, Any] = {
-            kind: {name: getattr(getattr(self, kind), name).tolist() for name in Norms._fields}
-            for kind in ("rms", "l2", "max")
-        }
-        out["final_period_max_abs_e"] = self.final_period_max_abs_e.tolist()
-        return out
-
-
-class BatchMetrics(NamedTuple):
-    """Each run's metrics; arrays of shape (N, nv). Rows of diverged runs are NaN."""
-
-    rms: Norms
-    """Root mean square of ``e`` [rad], ``ė`` [rad/s], applied ``τ`` [N·m]."""
-    l2: Norms
-    """``sqrt(∫ x² dt)`` of the same signals."""
-    max: Norms
-    """``max |x|`` of the same signals."""
+    """``max |x|`` of the same signals over the run."""
     final_period_max_abs_e: np.ndarray
     """``max |e|`` over the last reference period [rad]."""
     peak_command: np.ndarray
@@ -103,12 +88,32 @@ class BatchMetrics(NamedTuple):
     """First time [s] ``|τ_command|`` exceeded the joint's limit; NaN if never."""
 
     def run(self, i: int) -> Metrics:
-        """Run ``i``'s metrics as a :class:`Metrics`."""
+        """Run ``i``'s metrics: arrays of shape (nv,)."""
 
         def pick(n: Norms) -> Norms:
             return Norms(n.e[i], n.edot[i], n.tau[i])
 
-        return Metrics(pick(self.rms), pick(self.l2), pick(self.max), self.final_period_max_abs_e[i])
+        return Metrics(
+            pick(self.rms),
+            pick(self.l2),
+            pick(self.max),
+            self.final_period_max_abs_e[i],
+            self.peak_command[i],
+            self.first_exceeded_at[i],
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready nested dict of lists: the norms and ``final_period_max_abs_e``."""
+        out: dict[str, Any] = {
+            kind: {name: np.asarray(getattr(getattr(self, kind), name)).tolist() for name in Norms._fields}
+            for kind in ("rms", "l2", "max")
+        }
+        out["final_period_max_abs_e"] = np.asarray(self.final_period_max_abs_e).tolist()
+        return out
+
+
+BatchMetrics = Metrics
+"""The former name of :class:`Metrics` of N runs (the same class)."""
 
 
 _SIGNALS = Norms._fields
@@ -173,7 +178,7 @@ class RunningMetrics:
             first = np.argmax(over, axis=0)
             self.first_exceeded[newly] = samples.t[first[newly]]
 
-    def result(self, dead: np.ndarray | None = None) -> BatchMetrics:
+    def result(self, dead: np.ndarray | None = None) -> Metrics:
         """The metrics so far; rows of ``dead`` runs (mask, shape (N,)) are NaN."""
         l2 = Norms(*(np.sqrt(self.dt * (self.square[k] - 0.5 * self.ends[k])) for k in _SIGNALS))
         rms = Norms(*(x / np.sqrt(self.duration) for x in l2))
@@ -186,7 +191,7 @@ class RunningMetrics:
             x.setflags(write=False)
             return x
 
-        return BatchMetrics(
+        return Metrics(
             Norms(*(clean(x) for x in rms)),
             Norms(*(clean(x) for x in l2)),
             Norms(*(clean(x) for x in mx)),

@@ -498,7 +498,10 @@ TRACEBACK = [
     C("traceback-trajectory-file-period-shorter-than-span", "trajectory --trajectory via.json", 2, err=("period", "2"), setup=(via("via.json", '{"times": [0, 1, 2], "joints": [[0, 0], [0.5, 0.3], [0, 0]], "period": 1}\n'),)),
     C("traceback-trajectory-file-missing", "trajectory --trajectory nosuch.json", 2, err=("nosuch.json", "no such|not found")),
     C("traceback-trajectory-file-directory", "trajectory --trajectory via.json", 2, err=("via.json", "directory"), setup=(folder("via.json"),)),
-    C("traceback-trajectory-file-unreadable", "trajectory --trajectory via.json", 2, err=("via.json", "Permission denied|cannot be read"), setup=(via("via.json", VIA_JSON), chmod("via.json", 0)), run="setpriv")
+    C("traceback-trajectory-file-unreadable", "trajectory --trajectory via.json", 2, err=("via.json", "Permission denied|cannot be read"), setup=(via("via.json", VIA_JSON), chmod("via.json", 0)), run="setpriv"),
+    # -- Dask that cannot start its workers: one line naming the cause, none of distributed's tracebacks (issue 23)
+    C("traceback-sweep-dask-nanny-cannot-spawn", f"sweep pd --samples 4 {SIM} --no-plot --workers 1 --out s", (1, 2), err=("LocalCluster did not start", "bogus"), env=(("DASK_DISTRIBUTED__WORKER__MULTIPROCESSING_METHOD", "bogus"),), run="proc", absent=("s",), timeout=120, note="a nanny that cannot spawn its worker: distributed logs its traceback unless the start-up is silenced"),
+    C("traceback-sweep-dask-temporary-directory-missing", f"sweep pd --samples 4 {SIM} --no-plot --workers 1 --out s", (1, 2), err=("LocalCluster did not start", "/proc/nonexistent-dask-tmp"), env=(("DASK_TEMPORARY_DIRECTORY", "/proc/nonexistent-dask-tmp"),), run="proc", absent=("s",), timeout=120, note="a temporary folder that cannot be created (under /proc): distributed's 'Cluster closed without starting up' warning is not printed"),
 ]
 
 

@@ -1,7 +1,7 @@
 """``twolink-pin``: the command-line shell over the library.
 
 ==============  ===================================================================
-``parser.py``   commands and options
+``parser.py``   commands and options (``identify_parser.py``: those of ``identify`` and ``excite``)
 ``arguments.py`` the argument types that check numbers against their bounds
 ``commands/``   one module per family of commands, each command a thin shell over the library
 ``output.py``   text or JSON on stdout, the progress display on stderr

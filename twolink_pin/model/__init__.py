@@ -8,6 +8,7 @@
 ``parameters.py``           parameter maps ``Y_p = Y_π P`` from Pinocchio's inertial parameters
 ``base_parameters.py``      the identifiable base parameters of any model (Gautier's QR)
 ``urdf_validation.py``      checks a URDF before Pinocchio sees it
+``urdf_elements.py``        its checks of one link and one joint, and how URDF numbers are read
 ``payload.py``              payload variants written as URDF (yourdfpy)
 ``urdf_write.py``           a URDF with other inertias and joint friction written in
 ==========================  ================================================================

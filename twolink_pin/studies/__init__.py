@@ -10,6 +10,7 @@
 ``sweep_transport.py`` what a Dask worker gets (robot, law file) and the chunk task
 ``cluster.py``      Dask for sweeps: a LocalCluster on 127.0.0.1 or a scheduler, tasks as
                     completed, cancelled on exit (optional: ``twolink-pin[cluster]``)
+``cluster_startup.py`` distributed's log kept while a LocalCluster starts: one line naming the cause
 ``comparison.py``   every law side by side: our Table 2
 ==================  ===================================================================
 """

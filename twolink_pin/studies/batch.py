@@ -20,7 +20,7 @@ import numpy as np
 from twolink_pin.arrays import readonly, readonly_or_none
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.metrics import BatchMetrics, RunningMetrics
+from twolink_pin.metrics import Metrics, RunningMetrics
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
@@ -44,7 +44,7 @@ class BatchResult:
     """``q(0) − q_d(0)`` of each run [rad], shape (N, nv)."""
     v0_offset: np.ndarray = field(repr=False)
     """``q̇(0) − q̇_d(0)`` of each run [rad/s], shape (N, nv)."""
-    metrics: BatchMetrics = field(repr=False)
+    metrics: Metrics = field(repr=False)
     """Each run's metrics (NaN rows for diverged runs)."""
     diverged_at: np.ndarray = field(repr=False)
     """Time [s] at which each run diverged (as :func:`~twolink_pin.simulate` would report

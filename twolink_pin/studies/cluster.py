@@ -33,6 +33,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
+from twolink_pin.studies.cluster_startup import _startup_cause, _startup_log
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -440,24 +441,25 @@ def open_cluster(
     else:
         assert workers is not None
         try:
-            cluster = LocalCluster(
-                n_workers=workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                scheduler_port=0,
-                dashboard_address="127.0.0.1:0",
-                preload=list(preload) or [__name__],
-                env={LOCAL_WORKER: "1"},
-            )
+            with _startup_log() as records:
+                cluster = LocalCluster(
+                    n_workers=workers,
+                    threads_per_worker=1,
+                    processes=True,
+                    host="127.0.0.1",
+                    scheduler_port=0,
+                    dashboard_address="127.0.0.1:0",
+                    preload=list(preload) or [__name__],
+                    env={LOCAL_WORKER: "1"},
+                )
             client = Client(cluster, set_as_default=False)
         except Exception as exc:
             if cluster is not None:
                 with contextlib.suppress(Exception):
                     cluster.close()
             raise ClusterError(
-                address, f"the LocalCluster did not start ({type(exc).__name__}: {exc})"
-            ) from exc
+                address, f"the LocalCluster did not start ({_startup_cause(exc, records)})"
+            ) from None
         engine = DaskEngine(
             client,
             str(cluster.scheduler_address),

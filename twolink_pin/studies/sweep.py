@@ -65,7 +65,6 @@ from typing import Any
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.files import atomic_write, check_output_directory, output_directory, write_json
 from twolink_pin.model import RobotModel
-from twolink_pin.scenario import law_class
 from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError
 from twolink_pin.studies.cluster import (
     dask_setup as dask_setup,  # the workers' preload hook (--preload this module)
@@ -180,7 +179,7 @@ def run_sweep(
         ClusterError: Dask missing, the cluster unreachable, a worker that differs.
         OutputError: ``out_dir`` is someone else's folder or cannot be written.
     """
-    cls = law_class(config.controller)
+    cls = config.run.law_class()
     prepared = _Prepared(config, cls, robot, trajectory, keep_trajectories)
     check_output_directory(out_dir, MARKER)  # before a cluster is started or reached
     schema = table_schema(prepared.header, prepared.units, sweep_metadata(config, robot, cls, trajectory))
@@ -260,13 +259,13 @@ def run_sweep(
                 "param_error": config.param_error,
                 "gains": {g.name: [g.low, g.high] for g in config.gains},
                 "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
-                "duration": config.simulation.duration,
-                "dt": config.simulation.dt,
-                "control_period": config.simulation.control_period,
-                "method": config.simulation.method,
-                "lam": config.lam,
-                "saturate": config.saturate,
-                "friction_smoothing": config.friction_smoothing,
+                "duration": config.run.simulation.duration,
+                "dt": config.run.simulation.dt,
+                "control_period": config.run.simulation.control_period,
+                "method": config.run.simulation.method,
+                "lam": config.run.lam,
+                "saturate": config.run.plant.saturate,
+                "friction_smoothing": config.run.friction_smoothing,
                 "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
                 **summary,
             }

@@ -15,7 +15,6 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import make_scenario
-from twolink_pin.simulation import SimulationConfig
 from twolink_pin.simulation.config import joint_offsets
 
 MAX_SAMPLES = 10_000_000
@@ -111,6 +110,12 @@ def gain_target(cls: type[Controller], name: str) -> tuple[str, int | None]:
     )
 
 
+def law_reference(run: RunSpec) -> str:
+    """The law of ``run`` as given (a registered name, ``file.py:Class``, ``module:Class``)."""
+    law = run.law
+    return law if isinstance(law, str) else f"{law.__module__}:{law.__qualname__}" if law else ""
+
+
 @dataclass(frozen=True)
 class SweepConfig:
     """A Monte Carlo study of one law (see the module docstring for the draws).
@@ -127,7 +132,9 @@ class SweepConfig:
         q0_spread: Half-width of the uniform initial position error around the nominal
             ``simulation.q0_offset`` [rad], >= 0.
         param_error: Half-width of the relative parameter error δ, in [0, 1).
-        gains: Gain ranges.
+        gains: Gain ranges. A matrix gain (``osc``'s Kp, ``impedance``'s K) ``NAME=LO:HI`` is
+            ``s I`` with s drawn, ``NAMEi=LO:HI`` the nominal matrix with entry (i, i) drawn
+            (:func:`_matrix_draws`): per run an (N, k, k) stack, checked SPD.
         wrench_scale: ``(LO, HI)``: each run's factor on the plant's wrench (``--wrench``),
             drawn uniformly (after the other draws, so a study without it draws the same);
             None: every run feels the wrench as given.
@@ -146,32 +153,6 @@ class SweepConfig:
     wrench_scale: tuple[float, float] | None = None
     chunk: int | None = None
     threads: int | None = None
-
-    @property
-    def controller(self) -> str:
-        """The law's reference, as given."""
-        law = self.run.law
-        return law if isinstance(law, str) else f"{law.__module__}:{law.__qualname__}" if law else ""
-
-    @property
-    def simulation(self) -> SimulationConfig:
-        """The run's simulation settings."""
-        return self.run.simulation
-
-    @property
-    def lam(self) -> float | None:
-        """``λ`` [1/s] (None: the law's default)."""
-        return self.run.lam
-
-    @property
-    def saturate(self) -> bool:
-        """Whether the plant clips torques."""
-        return self.run.plant.saturate
-
-    @property
-    def friction_smoothing(self) -> float:
-        """ε [rad/s] of the friction sign."""
-        return self.run.friction_smoothing
 
     def __post_init__(self) -> None:
         if not isinstance(self.run, RunSpec) or self.run.law is None:
@@ -199,15 +180,15 @@ class SweepConfig:
                     self.wrench_scale,
                     "a wrench to scale (--wrench FX,FY,FZ[,MX,MY,MZ]@T0:T1)",
                 )
-        if self.simulation.method != "rk4":
-            raise InvalidParameterError("method", self.simulation.method, "'rk4' (the batch engine)")
+        if self.run.simulation.method != "rk4":
+            raise InvalidParameterError("method", self.run.simulation.method, "'rk4' (the batch engine)")
         names = [g.name for g in self.gains]
         if len(set(names)) != len(names):
             raise InvalidParameterError("gains", names, "each gain at most once")
         for g in self.gains:
             gain_target(cls, g.name)
-        if self.lam is not None and not cls.takes("lam"):
-            raise InvalidParameterError("lambda", self.lam, f"no λ for controller '{cls.name}'")
+        if self.run.lam is not None and not cls.takes("lam"):
+            raise InvalidParameterError("lambda", self.run.lam, f"no λ for controller '{cls.name}'")
 
 
 # -- the cases ---------------------------------------------------------------------------------
@@ -218,7 +199,7 @@ class Cases:
 
     def __init__(self, config: SweepConfig, robot: RobotModel, start: int, stop: int) -> None:
         nv, n_p = robot.nv, robot.parameter_map.size
-        nominal = joint_offsets("q0_offset", config.simulation.q0_offset, robot.profile.q0_offset, nv)
+        nominal = joint_offsets("q0_offset", config.run.simulation.q0_offset, robot.profile.q0_offset, nv)
         n = stop - start
         self.q0_offset = np.empty((n, nv))
         """``q(0) − q_d(0)`` [rad], shape (n, nv)."""
@@ -238,13 +219,49 @@ class Cases:
                 self.wrench_scale[r] = rng.uniform(*config.wrench_scale)
 
 
+def _matrix_draws(config: SweepConfig, cases: Cases, base: Controller) -> dict[str, np.ndarray]:
+    """The drawn matrix gains of the chunk's runs, shape (n, k, k) each.
+
+    ``NAME=LO:HI`` draws s and gives ``s I`` (s is the gain's value, as for a scalar gain:
+    ``--gain kp=50:150`` on ``osc`` is Kp = s I); ``NAMEi=LO:HI`` draws diagonal entry
+    (i, i) of the law's nominal matrix (its resolved gain), the others kept; both together
+    give ``s I`` with the drawn entries. The gains check each run's matrix (symmetric
+    positive definite) when the law is built.
+    """
+    cls = type(base)
+    n = len(cases.q0_offset)
+    out: dict[str, np.ndarray] = {}
+    targets = [(g, *gain_target(cls, g.name)) for g in config.gains]
+    for g, key, index in sorted(targets, key=lambda target: target[2] is not None):  # NAME before NAMEi
+        if not spec_of(cls.Gains, key).matrix:
+            continue
+        if key not in out:
+            nominal = np.asarray(getattr(base.gains, key), dtype=float)
+            k = nominal.shape[-1] if nominal.ndim == 3 else 1
+            out[key] = np.array(np.broadcast_to(nominal.reshape(-1, k, k), (n, k, k)))
+        current = out[key]
+        k = current.shape[-1]
+        drawn = cases.gains[g.name]
+        if index is None:
+            current[:] = drawn[:, None, None] * np.eye(k)
+        elif index < k:
+            current[:, index, index] = drawn
+        else:
+            raise InvalidParameterError(
+                "gain", g.name, f"a diagonal entry from 1 to {k} of the {k}×{k} matrix"
+            )
+    return out
+
+
 def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Controller) -> Controller:
     """One law object for the chunk: drawn gains and believed parameters per run."""
     cls = type(base)
     n = len(cases.q0_offset)
-    gains: dict[str, Any] = {}
+    gains: dict[str, Any] = dict(_matrix_draws(config, cases, base))
     for g in config.gains:
         key, index = gain_target(cls, g.name)
+        if spec_of(cls.Gains, key).matrix:
+            continue  # drawn above
         drawn = cases.gains[g.name][:, None]
         if index is None:
             gains[key] = drawn if spec_of(cls.Gains, key).per != "scalar" else drawn[:, 0]
@@ -265,7 +282,7 @@ def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Contr
         cls,
         robot,
         gains={**resolved, **gains},
-        saturate=config.saturate,
-        friction_smoothing=config.friction_smoothing,
+        saturate=config.run.plant.saturate,
+        friction_smoothing=config.run.friction_smoothing,
         model_parameters=believed,
     ).controller

@@ -165,13 +165,13 @@ class _Prepared:
         self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
         nv = robot.nv
         if record:
-            kept = config.samples * (config.simulation.steps + 1) * 3 * nv
+            kept = config.samples * (config.run.simulation.steps + 1) * 3 * nv
             if kept > MAX_KEPT_VALUES:
                 raise InvalidParameterError(
                     "keep_trajectories",
                     True,
                     f"at most {MAX_KEPT_VALUES:.3g} recorded values over the whole sweep (8 GB: samples × "
-                    f"(steps + 1) × 3 nv); {config.samples} runs of {config.simulation.steps} steps need "
+                    f"(steps + 1) × 3 nv); {config.samples} runs of {config.run.simulation.steps} steps need "
                     f"{kept:.3g} ({8 * kept / 1e9:.3g} GB): fewer samples, a larger dt or a shorter duration",
                 )
         self.parameter_names = tuple(robot.parameter_map.names)
@@ -221,7 +221,7 @@ class _Prepared:
             law,
             plant,
             self.trajectory,
-            config.simulation,
+            config.run.simulation,
             runs=size,
             q0_offsets=cases.q0_offset,
             threads=threads,

@@ -17,7 +17,6 @@ import numpy as np
 
 from twolink_pin.controllers import Controller
 from twolink_pin.model import RobotModel
-from twolink_pin.scenario import law_class
 from twolink_pin.studies.cluster import ClusterError
 from twolink_pin.studies.sweep_cases import SweepConfig
 from twolink_pin.studies.sweep_rows import ChunkRows, _Prepared
@@ -133,7 +132,7 @@ class SweepJob:
             path = _stored(*self.law_file)
             cls = load_controller(f"{path}:{self.law_class_name}")
         else:
-            cls = law_class(self.config.controller)
+            cls = self.config.run.law_class()
         return _Prepared(self.config, cls, robot, self.trajectory, self.record)
 
 

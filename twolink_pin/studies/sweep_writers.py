@@ -25,7 +25,7 @@ from twolink_pin.studies.parquet import (
     read_part,
     write_part,
 )
-from twolink_pin.studies.sweep_cases import SweepConfig
+from twolink_pin.studies.sweep_cases import SweepConfig, law_reference
 from twolink_pin.studies.sweep_rows import METRIC_UNITS, ChunkRows, _joint_columns, _Prepared, _stats
 from twolink_pin.trajectory import Trajectory
 
@@ -150,11 +150,11 @@ def sweep_metadata(
     which chunks they ran."""
     from twolink_pin.version import __version__
 
-    nominal = joint_offsets("q0_offset", config.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
+    nominal = joint_offsets("q0_offset", config.run.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
     return {
         "twolink_pin": __version__,
         "controller": cls.name,
-        "controller_spec": config.controller,
+        "controller_spec": law_reference(config.run),
         "robot": robot.name,
         "payload": float(robot.payload),
         "samples": config.samples,
@@ -166,13 +166,13 @@ def sweep_metadata(
         "parameters": list(robot.parameter_map.names),
         "gains": {g.name: [g.low, g.high] for g in config.gains},
         "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
-        "lam": config.lam,
-        "saturate": config.saturate,
-        "friction_smoothing": config.friction_smoothing,
-        "method": config.simulation.method,
-        "duration": config.simulation.duration,
-        "dt": config.simulation.dt,
-        "control_period": config.simulation.control_period,
+        "lam": config.run.lam,
+        "saturate": config.run.plant.saturate,
+        "friction_smoothing": config.run.friction_smoothing,
+        "method": config.run.simulation.method,
+        "duration": config.run.simulation.duration,
+        "dt": config.run.simulation.dt,
+        "control_period": config.run.simulation.control_period,
         "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
         "trajectory": _trajectory_metadata(trajectory),
         "run": config.run.as_dict(),

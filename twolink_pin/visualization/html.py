@@ -22,6 +22,7 @@ from twolink_pin.files import atomic_write
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import import_meshcat
 from twolink_pin.visualization.motion import _prepare
+from twolink_pin.visualization.overlays import AXIS_COLORS, WRENCH_COLOR
 from twolink_pin.visualization.scene import (
     DESIRED_PATH_COLOR,
     GHOST_RGB,
@@ -80,9 +81,15 @@ window.sceneLoaded = true;
 """
 
 
-def _legend(has_ghost: bool, has_via: bool, grid_spacing: float) -> str:
-    """The HTML legend under the scene: what each colour is, the grid's spacing [m] and
-    where the player is."""
+def _legend(
+    has_ghost: bool,
+    has_via: bool,
+    grid_spacing: float,
+    wrench_scale: float | None = None,
+    axis_length: float | None = None,
+) -> str:
+    """The HTML legend under the scene: what each colour is, the grid's spacing [m], the
+    force arrow's scale [m/N] and the triad's axis length [m], and where the player is."""
     ghost = int.from_bytes(bytes(round(c * 255) for c in GHOST_RGB), "big")  # 0xRRGGBB
     items: list[tuple[int | None, str]] = [(None, "arm (q)")]
     if has_ghost:
@@ -92,6 +99,15 @@ def _legend(has_ghost: bool, has_via: bool, grid_spacing: float) -> str:
         items.append((DESIRED_PATH_COLOR, "desired path"))
     if has_via:
         items.append((VIA_COLOR, "via points"))
+    if wrench_scale is not None:
+        items.append((WRENCH_COLOR, f'<label id="wrench-scale">force arrow {wrench_scale:g} m per N</label>'))
+    if axis_length is not None:
+        items.append(
+            (
+                AXIS_COLORS[0],
+                f'<label id="axis-length">desired frame (x y z red green blue) {axis_length:g} m</label>',
+            )
+        )
     html = "".join(
         text if color is None else f'<span style="background:#{color:06x}"></span>{text}'
         for color, text in items
@@ -118,6 +134,9 @@ def scene_page(
     fps: float = 25.0,
     loop: bool = False,
     title: str = "twolink-pin: arm motion",
+    wrench: npt.ArrayLike | None = None,
+    wrench_frame: str | None = None,
+    desired_frame: bool | npt.ArrayLike = False,
 ) -> str:
     """The self-contained HTML page of the animated scene, as text (what :func:`write_html`
     writes and :func:`~twolink_pin.visualization.notebook.inline_animation` embeds).
@@ -127,12 +146,28 @@ def scene_page(
     Returns:
         The whole page: the viewer's JavaScript and the scene's commands inlined.
     """
-    motion = _prepare(robot, t, q, q_des, via_points, fps)
+    motion = _prepare(
+        robot,
+        t,
+        q,
+        q_des,
+        via_points,
+        fps,
+        wrench=wrench,
+        wrench_frame=wrench_frame,
+        desired_frame=desired_frame,
+    )
     scene = scene_commands(robot, motion, loop=loop)
     encoded = ",\n".join(f'"{base64.b64encode(pack(c)).decode("ascii")}"' for c in scene.commands)
     return _HTML.format(
         title=title.replace("&", "&amp;").replace("<", "&lt;"),
-        legend=_legend(motion.q_des is not None, motion.via_points is not None, scene.grid_spacing),
+        legend=_legend(
+            motion.q_des is not None,
+            motion.via_points is not None,
+            scene.grid_spacing,
+            scene.wrench_scale,
+            scene.axis_length,
+        ),
         viewer_js=_viewer_js(),
         commands=encoded,
     )
@@ -149,6 +184,9 @@ def write_html(
     fps: float = 25.0,
     loop: bool = False,
     title: str = "twolink-pin: arm motion",
+    wrench: npt.ArrayLike | None = None,
+    wrench_frame: str | None = None,
+    desired_frame: bool | npt.ArrayLike = False,
 ) -> Path:
     """Write the animated scene as one self-contained HTML file.
 
@@ -173,6 +211,14 @@ def write_html(
         fps: Animation frames per second of motion [1/s], > 0.
         loop: Repeat the animation forever instead of playing it once.
         title: The page's title.
+        wrench: The external wrench on ``wrench_frame`` per sample [N, N·m], world axes,
+            shape (N, 3) or (N, 6) (zero where it does not act): its force is drawn as an
+            arrow from the frame on the arm, ``|F| · s`` long (``s`` [m/N] a round number
+            stated in the legend), while it acts (:mod:`.overlays`); or ``None``.
+        wrench_frame: The frame the wrench acts on (None: the end effector).
+        desired_frame: Draw the desired end-effector frame as a triad: ``True`` at the
+            forward kinematics of ``q_des``, or the desired poses per sample (world, shape
+            (N, 4, 4): a task-space reference); ``False`` for none.
 
     Returns:
         ``path`` as a :class:`~pathlib.Path`.
@@ -184,7 +230,19 @@ def write_html(
         OutputError: ``path`` is a directory or cannot be written.
     """
     target = Path(path)
-    page = scene_page(robot, t, q, q_des, via_points=via_points, fps=fps, loop=loop, title=title)
+    page = scene_page(
+        robot,
+        t,
+        q,
+        q_des,
+        via_points=via_points,
+        fps=fps,
+        loop=loop,
+        title=title,
+        wrench=wrench,
+        wrench_frame=wrench_frame,
+        desired_frame=desired_frame,
+    )
     with atomic_write(target) as f:
         f.write(page)
     return target

@@ -31,6 +31,13 @@ class _Motion:
     """Desired joint angles at the frames [rad], shape (F, nq), or ``None``."""
     via_points: np.ndarray | None
     """End-effector via points [m], shape (M, 3) (z = 0 when given as (x, y)), or ``None``."""
+    wrench: np.ndarray | None = None
+    """Force on :attr:`wrench_frame` at the frames [N], world axes, shape (F, 3) (held from
+    each sample time to the next), or ``None``."""
+    wrench_frame: str | None = None
+    """The frame the force acts on (None: the end effector)."""
+    desired_poses: np.ndarray | None = None
+    """Desired pose of the end effector at the frames (world), shape (F, 4, 4), or ``None``."""
 
 
 def _finite_array(name: str, value: npt.ArrayLike, unit: str) -> np.ndarray:
@@ -103,6 +110,45 @@ def _resample(t: np.ndarray, q: np.ndarray, times: np.ndarray) -> np.ndarray:
     return np.column_stack([np.interp(times, t, q[:, j]) for j in range(q.shape[1])])
 
 
+def _held(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarray:
+    """``values`` (shape (N, …)) at ``times``, each sample held until the next one."""
+    return values[
+        np.clip(np.searchsorted(t, times + 1e-9 * max(1.0, abs(float(t[-1]))), side="right") - 1, 0, None)
+    ]
+
+
+def _check_wrench(wrench: npt.ArrayLike | None, n: int) -> np.ndarray | None:
+    """The force columns [N] of a wrench per sample, shape (n, 3) from (n, 3) or (n, 6)."""
+    if wrench is None:
+        return None
+    array = _finite_array("wrench", wrench, "[N, N·m]")
+    if array.ndim != 2 or array.shape[0] != n or array.shape[1] not in (3, 6):
+        raise InvalidParameterError(
+            "wrench.shape", array.shape, f"({n}, 3) or ({n}, 6) = (len(t), force [N] (and moment [N·m]))"
+        )
+    return array[:, :3]
+
+
+def _check_desired(
+    robot: RobotModel, desired_frame: bool | npt.ArrayLike, q_des: np.ndarray | None, n: int
+) -> np.ndarray | None:
+    """The desired poses per sample (shape (n, 4, 4)): the caller's, or FK of ``q_des`` (True)."""
+    if desired_frame is False or desired_frame is None:
+        return None
+    if desired_frame is True:
+        if q_des is None:
+            raise InvalidParameterError(
+                "desired_frame", True, "q_des (the triad is the FK of q_des) or poses"
+            )
+        return None  # from q_des at the frames (the scene computes it)
+    poses = _finite_array("desired_frame", desired_frame, "[m]")
+    if poses.shape != (n, 4, 4):
+        raise InvalidParameterError(
+            "desired_frame.shape", poses.shape, f"({n}, 4, 4): a homogeneous pose per sample, or True"
+        )
+    return poses
+
+
 def _prepare(
     robot: RobotModel,
     t: npt.ArrayLike,
@@ -110,8 +156,16 @@ def _prepare(
     q_des: npt.ArrayLike | None,
     via_points: npt.ArrayLike | None,
     fps: float,
+    *,
+    wrench: npt.ArrayLike | None = None,
+    wrench_frame: str | None = None,
+    desired_frame: bool | npt.ArrayLike = False,
 ) -> _Motion:
     """Check the caller's arrays against ``robot`` and resample them at ``fps`` [1/s].
+
+    ``wrench`` (per sample, shape (N, 3) or (N, 6) [N, N·m]) and ``desired_frame`` (poses
+    per sample, shape (N, 4, 4), or True: the FK of ``q_des``) are held from each sample
+    to the next: a force that starts at a sample is drawn from that sample's frame on.
 
     Raises:
         InvalidParameterError: a shape mismatch, a non-finite value, times not strictly
@@ -125,10 +179,23 @@ def _prepare(
     frames = _frame_numbers(t_arr, fps)
     times = t_arr[0] + frames / fps
     times[-1] = min(times[-1], t_arr[-1])  # rounding
+    forces = _check_wrench(wrench, len(t_arr))
+    poses = _check_desired(robot, desired_frame, q_des_arr, len(t_arr))
+    q_des_frames = None if q_des_arr is None else _resample(t_arr, q_des_arr, times)
+    desired: np.ndarray | None = None
+    if desired_frame is True and q_des_frames is not None:
+        from twolink_pin.visualization.overlays import frame_poses
+
+        desired = frame_poses(robot, q_des_frames, int(robot.ee_frame_id))
+    elif poses is not None:
+        desired = _held(t_arr, poses, times)
     return _Motion(
         frames=frames,
         fps=fps,
         q=_resample(t_arr, q_arr, times),
-        q_des=None if q_des_arr is None else _resample(t_arr, q_des_arr, times),
+        q_des=q_des_frames,
         via_points=via,
+        wrench=None if forces is None else _held(t_arr, forces, times),
+        wrench_frame=wrench_frame,
+        desired_poses=desired,
     )

@@ -54,6 +54,9 @@ def inline_animation(
     fps: float = 25.0,
     loop: bool = False,
     height: int = 420,
+    wrench: npt.ArrayLike | None = None,
+    wrench_frame: str | None = None,
+    desired_frame: bool | npt.ArrayLike = False,
 ) -> InlineAnimation:
     """The animated scene of a run, for display in a notebook cell.
 
@@ -71,6 +74,8 @@ def inline_animation(
         fps: Animation frames per second of motion [1/s], > 0.
         loop: Repeat the animation forever.
         height: Height of the frame in the notebook [px], 100 to 2000.
+        wrench, wrench_frame, desired_frame: the force arrow and the desired frame's triad,
+            as :func:`~twolink_pin.visualization.write_html`.
 
     Returns:
         The animation; its ``_repr_html_`` is the ``<iframe srcdoc=…>``.
@@ -82,5 +87,17 @@ def inline_animation(
     """
     if not (isinstance(height, int) and not isinstance(height, bool) and 100 <= height <= 2000):
         raise InvalidParameterError("height", height, "a whole number of pixels from 100 to 2000")
-    page = scene_page(robot, t, q, q_des, via_points=via_points, fps=fps, loop=loop, title="arm motion")
+    page = scene_page(
+        robot,
+        t,
+        q,
+        q_des,
+        via_points=via_points,
+        fps=fps,
+        loop=loop,
+        title="arm motion",
+        wrench=wrench,
+        wrench_frame=wrench_frame,
+        desired_frame=desired_frame,
+    )
     return InlineAnimation(page, height)

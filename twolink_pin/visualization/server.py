@@ -45,6 +45,8 @@ class LiveViewer:
         self._socket.setsockopt(zmq.LINGER, 0)
         self._socket.connect(bridge.zmq_url)
         self._closed = False
+        self.wrench_scale: float | None = None
+        """Length of the force arrow per newton [m/N] (the live page has no legend); None: no arrow."""
         self.host: str = bridge.host
         """Address the HTTP/WebSocket server listens on."""
         self.port: int = bridge.port
@@ -108,6 +110,9 @@ def serve(
     loop: bool = False,
     open_browser: bool = False,
     quiet: bool = False,
+    wrench: npt.ArrayLike | None = None,
+    wrench_frame: str | None = None,
+    desired_frame: bool | npt.ArrayLike = False,
 ) -> LiveViewer:
     """Serve the animated scene live with meshcat, on ``host`` only.
 
@@ -129,6 +134,9 @@ def serve(
         loop: Repeat the motion forever.
         open_browser: Open :attr:`LiveViewer.url` with :mod:`webbrowser`.
         quiet: Do not print the URL on stdout.
+        wrench, wrench_frame, desired_frame: the force arrow and the desired frame's triad,
+            as :func:`~twolink_pin.visualization.write_html` (the live page has no legend:
+            the arrow's scale is :func:`~twolink_pin.visualization.overlays.wrench_scale`).
 
     Raises:
         InvalidParameterError: bad arrays (as ``write_html``), ``host`` empty or ``port``
@@ -140,9 +148,20 @@ def serve(
         raise InvalidParameterError("port", port, "None (any free port) or an integer in 0..65535")
     if not isinstance(host, str) or not host:
         raise InvalidParameterError("host", host, "an address to listen on, e.g. '127.0.0.1'")
-    motion = _prepare(robot, t, q, q_des, via_points, fps)
+    motion = _prepare(
+        robot,
+        t,
+        q,
+        q_des,
+        via_points,
+        fps,
+        wrench=wrench,
+        wrench_frame=wrench_frame,
+        desired_frame=desired_frame,
+    )
     scene = scene_commands(robot, motion, loop=loop)
     viewer = LiveViewer(start_bridge(host, port))
+    viewer.wrench_scale = scene.wrench_scale
     try:
         for command in scene.commands:
             viewer._send(command)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.cli.commands.common import _identified, _robot, _run_one, _trajectory, run_spec
+from twolink_pin.cli.commands.common import _gains_echo, _identified, _robot, _trajectory, run_spec
 from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.cli.task_space import is_task_space, save_task_figure, task_lines, task_summary
 from twolink_pin.errors import InvalidParameterError
@@ -46,7 +46,7 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
 
 def cmd_simulate(args: argparse.Namespace) -> int:
     from twolink_pin.metrics import compute_metrics
-    from twolink_pin.run_spec import gains_used, plant_description
+    from twolink_pin.run_spec import plant_description
     from twolink_pin.simulation import simulate
     from twolink_pin.simulation.config import joint_offsets
 
@@ -60,8 +60,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if task is not None:
         payload["task_metrics"] = task.as_dict()
     q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
+    gains, gains_text = _gains_echo(scenario.controller)
     payload |= {
-        "gains": gains_used(scenario.controller),
+        "gains": gains,
         "plant": plant_description(scenario),
         "q0_offset": q0_offset.tolist(),
         "run": spec.as_dict(),
@@ -82,7 +83,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     payload["figures"] = figures
     lines = [
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
-        f"  gains {scenario.controller.gains.describe()}",
+        f"  gains {gains_text}",
         f"  plant {payload['plant']}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
@@ -207,6 +208,11 @@ RUN_OPTIONS = frozenset(
         "--gain",
         "--p0",
         "--model",
+        "--wrench",
+        "--payload-step",
+        "--sensor-noise",
+        "--noise-seed",
+        "--delay",
     }
 )
 """Options that shape a run: meaningless with ``animate --from`` (a saved run)."""
@@ -227,15 +233,23 @@ def cmd_animate(args: argparse.Namespace) -> int:
             )
     if args.from_file:
         robot, reference, result = _saved_run(args)
+        spec = _saved_spec(args)
+        controller = _saved_controller(spec, robot)
     elif args.controller is None:
         raise InvalidParameterError(
             "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
         )
     else:
+        from twolink_pin.simulation import simulate
+
         robot = _robot(args)
         reference = _trajectory(args, robot)
         spec = run_spec(args, args.controller)
-        result = _run_one(spec, robot, reference, _identified(spec, robot))
+        scenario = spec.build(robot, _identified(spec, robot))
+        controller = scenario.controller
+        result = simulate(*scenario, reference, spec.simulation)
+    gains, gains_text = _gains_echo(controller) if controller is not None else (None, "not recorded")
+    overlays = _overlays(spec, result)
     from twolink_pin.kinematics import joint_positions
 
     via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
@@ -244,9 +258,20 @@ def cmd_animate(args: argparse.Namespace) -> int:
         from twolink_pin.visualization import write_html
 
         path = write_html(
-            robot, result.t, result.q, result.q_des, path=args.html, via_points=points, loop=args.loop
+            robot,
+            result.t,
+            result.q,
+            result.q_des,
+            path=args.html,
+            via_points=points,
+            loop=args.loop,
+            **overlays,
         )
-        emit(args, {"html": str(path), "controller": result.controller}, f"animation written to {path}")
+        emit(
+            args,
+            {"html": str(path), "controller": result.controller, "gains": gains},
+            f"animation written to {path}\n  {result.controller} gains {gains_text}",
+        )
         return 0
     from twolink_pin.visualization import serve
 
@@ -265,11 +290,13 @@ def cmd_animate(args: argparse.Namespace) -> int:
         loop=args.loop,
         open_browser=not args.no_browser,
         quiet=True,
+        **overlays,
     ) as viewer:
         emit(
             args,
-            {"url": viewer.url, "host": viewer.host, "port": viewer.port},
-            f"meshcat viewer at {viewer.url}",
+            {"url": viewer.url, "host": viewer.host, "port": viewer.port, "gains": gains},
+            f"meshcat viewer at {viewer.url}\n  {result.controller} gains {gains_text}"
+            + ("" if viewer.wrench_scale is None else f"\n  force arrow {viewer.wrench_scale:g} m per N"),
         )
         print("press Ctrl-C to stop", file=sys.stderr, flush=True)
         try:
@@ -362,3 +389,40 @@ def _saved_run(args: argparse.Namespace) -> tuple[RobotModel, Trajectory, Simula
     path = args.trajectory or record.get("trajectory")
     reference = read_trajectory_file(path, robot) if path else default_trajectory(robot)
     return robot, reference, result
+
+
+def _saved_spec(args: argparse.Namespace) -> RunSpec | None:
+    """``animate --from FILE``: the run the file records, or None (an older file)."""
+    from twolink_pin.errors import TwolinkPinError
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.simulation.storage import load_record
+
+    run = (load_record(args.from_file) or {}).get("run")
+    try:
+        return RunSpec.from_dict(run) if run else None
+    except TwolinkPinError:
+        return None
+
+
+def _saved_controller(spec: RunSpec | None, robot: RobotModel) -> Any:
+    """The law a saved run used, rebuilt from the run it records (for its gains); None when
+    the file records no run or the law cannot be rebuilt here."""
+    from twolink_pin.errors import TwolinkPinError
+
+    if spec is None or spec.law is None:
+        return None
+    try:
+        return spec.build(robot).controller
+    except TwolinkPinError:
+        return None
+
+
+def _overlays(spec: RunSpec | None, result: SimulationResult) -> dict[str, Any]:
+    """What ``animate`` draws beside the arm: the run's external force while it acts (the
+    plant's window, sample by sample) and the desired end-effector frame (FK of ``q_des``)."""
+    wrench = None if spec is None else spec.plant.wrench
+    if wrench is None:
+        return {"desired_frame": True}
+    acting = np.array([wrench.active(float(tk)) for tk in result.t])
+    forces = np.where(acting[:, None], np.asarray(wrench.force[:3]), 0.0)
+    return {"desired_frame": True, "wrench": forces, "wrench_frame": wrench.frame}

@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import _robot, _trajectory, run_spec
+from twolink_pin.cli.commands.common import _gains_echo, _robot, _trajectory, run_spec
 from twolink_pin.cli.output import emit, progress_bar
 
 if TYPE_CHECKING:
@@ -41,7 +41,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     def progress(done: int, total: int) -> None:
         if not bars:
-            bars.append(progress_bar(config.samples, "run", f"sweep {config.controller}"))
+            bars.append(progress_bar(config.samples, "run", f"sweep {args.controller}"))
         bars[0].update(done - bars[0].n)
 
     def notify(line: str) -> None:
@@ -68,14 +68,23 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         if bars:
             bars[0].close()
     summary = output.summary
+    gains, gains_text = _gains_echo(config.run.build(robot).controller)  # the nominal law's
+    drawn = {g.name: [g.low, g.high] for g in config.gains}
     if args.json:
-        payload = {**summary, "files": [str(f) for f in output.files], "seconds": output.seconds}
+        payload = {
+            **summary,
+            "gains_used": gains,  # the nominal law's; "gains" (the summary's) are the drawn ranges
+            "files": [str(f) for f in output.files],
+            "seconds": output.seconds,
+        }
         emit(args, {**payload, "engine": output.engine, "chunk": output.chunk}, "")
         return 0
     lines = [
         f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
         f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
         f"  ran {'' if output.engine == 'in-process' else 'on '}{output.engine}, in chunks of {output.chunk} runs",
+        f"  gains {gains_text}"
+        + "".join(f"; {name} drawn per run from U({lo:g}, {hi:g})" for name, (lo, hi) in drawn.items()),
         f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
     ]
     for name, stat in summary["metrics"].items():
