@@ -153,8 +153,16 @@ def _build(
 
                 points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
                 try:
+                    from twolink_pin.visualization.overlays import run_overlays
+
                     write_html(
-                        robot, res.t, res.q, res.q_des, path=stage / "animation.html", via_points=points
+                        robot,
+                        res.t,
+                        res.q,
+                        res.q_des,
+                        path=stage / "animation.html",
+                        via_points=points,
+                        **run_overlays(options.run.plant.wrench, res.t),
                     )
                     animation = "animation.html"
                 except InvalidURDFError as exc:  # a missing mesh: the report without its animation

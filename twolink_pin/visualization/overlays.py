@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.disturbances import Wrench
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -193,3 +194,16 @@ def add_desired_frame(vis: Any, animation: Any, keys: list[Any], poses: np.ndarr
         with animation.at_frame(vis, key)[DESIRED_FRAME_NODE] as frame_vis:
             frame_vis.set_transform(pose)
     return length
+
+
+def run_overlays(wrench: Wrench | None, t: np.ndarray) -> dict[str, Any]:
+    """The keyword arguments of :func:`~twolink_pin.visualization.write_html` (and
+    ``scene_page``, ``serve``) that draw a run's overlays: the desired end-effector frame
+    (forward kinematics of ``q_des``) always, and the plant's external force (``wrench``:
+    :attr:`~twolink_pin.run_spec.PlantOptions.wrench`, None for none) at the sample times
+    ``t`` [s] where it acts, zero elsewhere. One definition for ``animate`` and the report."""
+    if wrench is None:
+        return {"desired_frame": True}
+    acting = np.array([wrench.active(float(tk)) for tk in np.asarray(t, dtype=float)])
+    forces = np.where(acting[:, None], np.asarray(wrench.force[:3], dtype=float), 0.0)
+    return {"desired_frame": True, "wrench": forces, "wrench_frame": wrench.frame}

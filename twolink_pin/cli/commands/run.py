@@ -249,7 +249,9 @@ def cmd_animate(args: argparse.Namespace) -> int:
         controller = scenario.controller
         result = simulate(*scenario, reference, spec.simulation)
     gains, gains_text = _gains_echo(controller) if controller is not None else (None, "not recorded")
-    overlays = _overlays(spec, result)
+    from twolink_pin.visualization.overlays import run_overlays
+
+    overlays = run_overlays(None if spec is None else spec.plant.wrench, result.t)
     from twolink_pin.kinematics import joint_positions
 
     via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
@@ -415,14 +417,3 @@ def _saved_controller(spec: RunSpec | None, robot: RobotModel) -> Any:
         return spec.build(robot).controller
     except TwolinkPinError:
         return None
-
-
-def _overlays(spec: RunSpec | None, result: SimulationResult) -> dict[str, Any]:
-    """What ``animate`` draws beside the arm: the run's external force while it acts (the
-    plant's window, sample by sample) and the desired end-effector frame (FK of ``q_des``)."""
-    wrench = None if spec is None else spec.plant.wrench
-    if wrench is None:
-        return {"desired_frame": True}
-    acting = np.array([wrench.active(float(tk)) for tk in result.t])
-    forces = np.where(acting[:, None], np.asarray(wrench.force[:3]), 0.0)
-    return {"desired_frame": True, "wrench": forces, "wrench_frame": wrench.frame}
