@@ -89,3 +89,21 @@ def test_compare_stops_the_run_that_never_returns_and_keeps_the_others(
         )
         e = np.asarray(alone.q) - np.asarray(alone.q_des)
         np.testing.assert_allclose(table["controllers"][name]["max"]["e"], np.abs(e).max(axis=0), rtol=1e-12)
+
+
+def test_a_sweep_on_dask_workers_stops_the_chunk_that_never_returns(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A worker runs its task in a thread (no signal reaches it): the client bounds the chunk,
+    names the law and the bound, kills the LocalCluster's workers and writes nothing. The law
+    sleeps a day, so only the bound can end the run (no dependence on the machine's speed)."""
+    pytest.importorskip("distributed")
+    out = tmp_path / "s"
+    argv = ["sweep", f"{SPINNER}:Sleeper", "--samples", "4", "--duration", "0.05", "--workers", "1"]
+    code = main([*argv, "--timeout", "2", "--no-plot", "--out", str(out)])
+    assert code == 1
+    err = [x for x in capsys.readouterr().err.splitlines() if x.startswith("twolink-pin")]
+    assert len(err) == 1, err
+    assert "corpus-sleeper" in err[0] and "Sleeper" in err[0] and "--timeout 2 s" in err[0]
+    assert "runs 0–3" in err[0] and "Dask worker" in err[0] and "workers were stopped" in err[0]
+    assert not out.exists()

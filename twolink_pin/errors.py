@@ -131,7 +131,7 @@ class ControllerError(TwolinkPinError):
 
     Attributes:
         controller: The law's name.
-        time: Simulated time [s] of the evaluation.
+        time: Simulated time [s] of the evaluation (NaN where it is not known).
         detail: What went wrong (the law's own exception, or the bad shape).
     """
 
@@ -141,7 +141,8 @@ class ControllerError(TwolinkPinError):
         self.controller = controller
         self.time = time
         self.detail = detail
-        super().__init__(f"controller '{controller}' failed at t = {time:.6g} s: {detail}")
+        at = f" at t = {time:.6g} s" if time == time else ""  # NaN: the time is not known (a Dask task)
+        super().__init__(f"controller '{controller}' failed{at}: {detail}")
 
 
 class ControllerSpecError(TwolinkPinError):

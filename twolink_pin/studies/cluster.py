@@ -23,7 +23,6 @@ from __future__ import annotations
 import contextlib
 import importlib.util
 import queue
-import socket
 import threading
 import time
 import uuid
@@ -32,8 +31,9 @@ from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import urlsplit
 
-from twolink_pin.errors import InvalidParameterError, TwolinkPinError
-from twolink_pin.studies.cluster_startup import _startup_cause, _startup_log
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
+from twolink_pin.studies.cluster_startup import _handshake, _probe, _startup_cause, _startup_log
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -50,23 +50,6 @@ PROGRESS_INTERVAL = 0.5
 ALLOWED_FAILURES = 3
 """Dask's default ``distributed.scheduler.allowed-failures``: a task whose workers died
 while running it more than this many times fails with ``KilledWorker``."""
-
-
-class ClusterError(TwolinkPinError):
-    """A Dask cluster that cannot run the work: not installed, unreachable, without workers,
-    a worker that differs from the client, or a task that keeps killing its workers.
-
-    Attributes:
-        address: The scheduler's address (or what was being started).
-        reason: What went wrong and what to do.
-    """
-
-    _fields = ("address", "reason")
-
-    def __init__(self, address: str, reason: str) -> None:
-        self.address = address
-        self.reason = reason
-        super().__init__(f"Dask cluster {address}: {reason}")
 
 
 def available() -> bool:
@@ -122,65 +105,8 @@ def scheduler_address(text: str) -> str:
     return f"{parts.scheme}://{host}:{port or DEFAULT_PORT}"
 
 
-def _probe(address: str, timeout: float) -> None:
-    """Fail fast if nothing listens at ``address`` (Dask itself would retry until its timeout)."""
-    parts = urlsplit(address)
-    assert parts.hostname is not None and parts.port is not None
-    try:
-        with socket.create_connection((parts.hostname, parts.port), timeout=timeout):
-            pass
-    except TimeoutError:
-        raise ClusterError(
-            address, f"no answer within {timeout:g} s; is the scheduler running there?"
-        ) from None
-    except OSError as exc:
-        reason = exc.strerror or type(exc).__name__
-        raise ClusterError(
-            address,
-            f"cannot be reached ({reason}); start one with `dask scheduler` (see docs/cluster.md) or check the address",
-        ) from None
-
-
 LOCAL_WORKER = "TWOLINK_PIN_LOCAL_WORKER"
 """Environment variable set in the LocalCluster's worker processes."""
-
-
-def _handshake(address: str, timeout: float) -> None:
-    """Fail within ``timeout`` if what listens at ``address`` is no Dask scheduler: Dask's
-    own connect waits for the peer's handshake without a time limit."""
-    import asyncio
-
-    from distributed.comm import connect
-    from distributed.security import Security
-
-    failure: list[BaseException] = []
-
-    async def probe() -> None:
-        args = Security().get_connection_args("client")
-        comm = await asyncio.wait_for(connect(address, timeout=timeout, **args), timeout)
-        await comm.close()
-
-    def run() -> None:
-        try:
-            asyncio.run(probe())
-        except BaseException as exc:  # reported to the caller's thread below
-            failure.append(exc)
-
-    thread = threading.Thread(target=run, name="twolink-pin-handshake", daemon=True)
-    thread.start()
-    thread.join(timeout + 1.0)
-    if thread.is_alive() or (failure and isinstance(failure[0], (TimeoutError, asyncio.TimeoutError))):
-        raise ClusterError(
-            address, f"cannot connect within {timeout:g} s: it does not answer as a Dask scheduler"
-        )
-    if failure and not isinstance(failure[0], OSError):  # it answered, with no Dask message
-        # (Dask reads the first bytes as a frame length: an SSH or HTTP greeting asks for exabytes)
-        raise ClusterError(
-            address,
-            "answers, but not as a Dask scheduler (what it sent is no Dask message); check the host and port",
-        )
-    if failure:
-        raise ClusterError(address, f"cannot connect ({type(failure[0]).__name__}: {failure[0]})")
 
 
 def dask_setup(worker: Any) -> None:
@@ -244,6 +170,7 @@ class DaskEngine:
         name: str = "task",
         progress: Callable[[dict[int, int]], None] | None = None,
         window: int | None = None,
+        limit_s: float | None = None,
     ) -> Generator[tuple[int, str, Any], None, None]:
         """``fn(*items[i], progress=...)`` on the cluster: ``(i, worker address, result)``
         as each task completes (in any order).
@@ -256,10 +183,15 @@ class DaskEngine:
                 workers report them (at least every :data:`PROGRESS_INTERVAL` s while
                 waiting).
             window: Most tasks submitted at once (default 2 per worker thread + 2).
+            limit_s: Wall-clock bound of one task [s] from its first progress report (a task
+                should report ``progress(0)`` when its work starts); past it,
+                :class:`TaskTimeout` (None: no bound). A worker thread cannot be interrupted:
+                the caller stops the workers (a LocalCluster's are killed on the error).
 
         Raises:
             ClusterError: a task killed too many workers, a worker cannot
                 import the code, or the scheduler dropped the tasks.
+            TaskTimeout: a task ran past ``limit_s``.
             Exception: what a task raised (a twolink-pin error arrives whole).
         """
         from distributed import KilledWorker
@@ -268,12 +200,14 @@ class DaskEngine:
         topic = f"twolink-pin-{name}-{token}"
         done_queue: queue.Queue[Any] = queue.Queue()
         partial: dict[int, int] = {}
+        started: dict[int, float] = {}  # task -> when its first report arrived [monotonic s]
         lock = threading.Lock()
 
         def on_event(event: Any) -> None:
             index, runs = event[1]
             with lock:
                 partial[int(index)] = max(partial.get(int(index), 0), int(runs))
+                started.setdefault(int(index), time.monotonic())  # its first report: running
 
         self.client.subscribe_topic(topic, on_event)
         index_of: dict[str, int] = {}
@@ -302,6 +236,8 @@ class DaskEngine:
                     raise ClusterError(
                         self.address, f"lost the connection to the scheduler during the {name}"
                     )
+                if limit_s is not None:
+                    self._check_bound(started, lock, limit_s, name)
                 if future is None or future.key not in self._pending:
                     if progress is not None:
                         with lock:
@@ -312,6 +248,7 @@ class DaskEngine:
                 del self._pending[future.key]
                 with lock:
                     partial.pop(index, None)
+                    started.pop(index, None)
                 if future.status == "cancelled":
                     raise ClusterError(
                         self.address,
@@ -341,6 +278,16 @@ class DaskEngine:
             self.cancel()
             with contextlib.suppress(Exception):
                 self.client.unsubscribe_topic(topic)
+
+    def _check_bound(
+        self, started: dict[int, float], lock: threading.Lock, limit_s: float, name: str
+    ) -> None:
+        """Raise :class:`TaskTimeout` for the first task running for longer than ``limit_s``."""
+        now = time.monotonic()
+        with lock:
+            late = [i for i, t0 in started.items() if now - t0 > limit_s]
+        if late:
+            raise TaskTimeout(self.address, name, min(late), limit_s, owned=self.cluster is not None)
 
     def cancel(self) -> None:
         """Cancel every task still pending (idempotent)."""
@@ -490,6 +437,7 @@ __all__ = [
     "MAX_WORKERS",
     "ClusterError",
     "DaskEngine",
+    "TaskTimeout",
     "available",
     "engine_for",
     "open_cluster",

@@ -57,15 +57,17 @@ import contextlib
 import math
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.controllers import Controller
+from twolink_pin.errors import ControllerError, InvalidParameterError
 from twolink_pin.files import atomic_write, check_output_directory, output_directory, write_json
 from twolink_pin.model import RobotModel
-from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError
+from twolink_pin.simulation.deadline import run_limit
+from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError, TaskTimeout
 from twolink_pin.studies.cluster import (
     dask_setup as dask_setup,  # the workers' preload hook (--preload this module)
 )
@@ -132,6 +134,23 @@ class SweepOutput:
     """Where the runs ran: ``in-process``, a LocalCluster or a scheduler."""
     chunk: int = 0
     """Runs per chunk."""
+
+
+@contextlib.contextmanager
+def _named_timeout(cls: type[Controller], ranges: list[tuple[int, int]]) -> Iterator[None]:
+    """A chunk past ``--timeout`` on a Dask worker as the failed run it is: an error naming
+    the law and the bound (as in-process, :func:`~twolink_pin.simulation.deadline.timed_out`)."""
+    try:
+        yield
+    except TaskTimeout as exc:
+        start, stop = ranges[exc.index]
+        raise ControllerError(
+            cls.name,
+            math.nan,
+            f"runs {start}–{stop - 1} did not finish within --timeout {exc.seconds:g} s of wall-clock time "
+            f"on a Dask worker (the law {cls.__qualname__} may never return; {exc.stopped}); give a larger "
+            "--timeout for a longer run",
+        ) from None
 
 
 def run_sweep(
@@ -234,9 +253,10 @@ def run_sweep(
                             progress(finished[1], config.samples)
 
                     tasks = [(job, start, stop) for start, stop in ranges]
-                    with contextlib.closing(
-                        engine.run(run_chunk_task, tasks, name="sweep", progress=partial)
-                    ) as results:
+                    results = engine.run(
+                        run_chunk_task, tasks, name="sweep", progress=partial, limit_s=run_limit()
+                    )
+                    with _named_timeout(cls, ranges), contextlib.closing(results):
                         for _, worker, rows in results:
                             if rows.environment != here:
                                 raise ClusterError(

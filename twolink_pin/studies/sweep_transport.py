@@ -175,6 +175,8 @@ def run_chunk_task(
             _PREPARED[job.token] = prepared
             while len(_PREPARED) > _PREPARED_KEEP:
                 _PREPARED.popitem(last=False)
+    if progress is not None:
+        progress(0)  # the runs start: the client's per-run bound (--timeout) counts from here
     return prepared.run(start, stop, job.threads, progress)
 
 
