@@ -1,12 +1,13 @@
 """``twolink-pin``: the command-line shell over the library.
 
-==============  ===================================================================
-``parser.py``   commands and options (``identify_parser.py``: those of ``identify`` and ``excite``)
-``arguments.py`` the argument types that check numbers against their bounds
-``commands/``   one module per family of commands, each command a thin shell over the library
-``output.py``   text or JSON on stdout, the progress display on stderr
-``guard.py``    around a command: ``--timeout``, ``--json`` stdout kept for the JSON, outputs ≠ inputs
-==============  ===================================================================
+=====================  ====================================================================================
+``parser.py``          commands and options (``identify_parser.py``: those of ``identify`` and ``excite``)
+``common_options.py``  the options every family shares: the robot, the payload, the trajectory
+``arguments.py``       the argument types that check numbers against their bounds
+``commands/``          one module per family of commands, each command a thin shell over the library
+``output.py``          text or JSON on stdout, the progress display on stderr
+``guard.py``           around a command: ``--json`` stdout kept for the JSON, outputs ≠ inputs
+=====================  ====================================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
 simulation, a law that raised) exit status 1; Ctrl-C exit status 130, SIGTERM 143. An

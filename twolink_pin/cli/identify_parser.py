@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from twolink_pin.cli.arguments import bounded, whole
-from twolink_pin.cli.parser import add_robot_options, add_trajectory_option
+from twolink_pin.cli.common_options import add_robot_options, add_trajectory_option
 
 
 def add_identification_commands(sub: Any, c: Any) -> None:

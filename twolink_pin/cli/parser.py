@@ -6,15 +6,14 @@ import argparse
 from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
+from twolink_pin.cli.common_options import add_robot_options, add_trajectory_option
 from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT
+from twolink_pin.cli.identify_parser import add_identification_commands
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
     "or package.module:ClassName"
-)
-ROBOT_HELP = (
-    "robot: a catalog name (twolink-pin robots lists them) or a path to a .urdf file (default twolink)"
 )
 
 
@@ -32,35 +31,10 @@ class Parser(argparse.ArgumentParser):
 
 MAX_DURATION = 1e6
 """Largest simulated time accepted on the command line [s] (the step count is bounded too)."""
-MAX_PAYLOAD = 1e4
-"""Largest payload accepted on the command line [kg]."""
 MAX_OFFSET = 100.0
 """Largest initial offset accepted on the command line [rad]."""
 MAX_GAIN = 1e12
 """Largest gain accepted on the command line (any unit)."""
-
-
-def add_robot_options(p: argparse.ArgumentParser, json_flag: bool = True) -> None:
-    p.add_argument("--robot", "--urdf", dest="robot", metavar="NAME|PATH", help=ROBOT_HELP)
-    p.add_argument(
-        "--payload",
-        type=bounded(0.0, MAX_PAYLOAD, unit="kg"),
-        default=0.0,
-        help="point mass at the end effector [kg] (0 to 1e4)",
-    )
-    if json_flag:
-        p.add_argument("--json", action="store_true", help="print JSON instead of text")
-
-
-TRAJECTORY_HELP = (
-    "the reference: a TOML or JSON file of via points, joint (times, joints [rad]) or end-effector "
-    "(times, positions [m]), or a Fourier series (a fourier table: twolink-pin excite writes one); "
-    "default: the robot's own"
-)
-
-
-def add_trajectory_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--trajectory", "--via", dest="trajectory", metavar="FILE", help=TRAJECTORY_HELP)
 
 
 def add_sim_options(p: argparse.ArgumentParser) -> None:
@@ -432,8 +406,6 @@ def build_parser() -> argparse.ArgumentParser:
     add_sim_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_sweep)
-
-    from twolink_pin.cli.identify_parser import add_identification_commands  # it uses this module's options
 
     add_identification_commands(sub, c)
     return parser
