@@ -1,6 +1,20 @@
 """Closed-loop simulation: one engine for one run or thousands.
 
-======================  ==================================================================
+=====================  ======================================================================================
+``config.py``          :class:`SimulationConfig`, the divergence limit and step bounds
+``terms.py``           the Pinocchio terms a law asks for, for one run or N (``terms_for``)
+``rigid_terms.py``     M̂, ĝ, Ĉq̇ + ĝ, M̂⁻¹b and the frame kinematics a law asks for
+``forward.py``         the plant's accelerations (ABA) for one run or N
+``engine.py``          :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks, plant events
+``events.py``          what a plant that pushes back does to a step: wrench, payload step, noise, delay
+``task_reference.py``  the desired pose, twist and acceleration a task-space law sees (``law_input``)
+``adaptive_step.py``   DOP853 with error control, one run
+``containment.py``     the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
+``deadline.py``        the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law
+``result.py``          :class:`SimulationResult`
+``run.py``             :func:`simulate` (N = 1, recorded)
+``storage.py``         results as ``.npz``
+=====================  ======================================================================================
 
 N runs with streamed metrics (the batch) and studies over them are in
 :mod:`twolink_pin.studies`.
