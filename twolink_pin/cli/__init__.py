@@ -25,21 +25,17 @@ import threading
 from collections.abc import Sequence
 from typing import Any
 
+from twolink_pin import interrupts
 from twolink_pin.cli import guard
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.interrupts import Terminated
 from twolink_pin.readiness import ready
 
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM, raised where the program is so that every ``with`` block cleans up (staging
-    folders removed, worker processes stopped) as for Ctrl-C."""
-
-
-_signalled: list[int] = []
+_signalled = interrupts.received
 """The signals received while the command ran: whatever exception then reaches :func:`main`
 (an import that turned the ``KeyboardInterrupt`` into an ``ImportError``, a library that
-caught it), the outcome is the interrupt."""
+caught it), the outcome is the interrupt; long loops check it (:func:`interrupts.check`)."""
 
 
 def _terminate(signum: int, frame: object) -> None:

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any
 from urllib.parse import urlsplit
 
+from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
 from twolink_pin.studies.cluster_startup import _handshake, _probe, _startup_cause, _startup_log
@@ -230,6 +231,7 @@ class DaskEngine:
                     future = done_queue.get(timeout=PROGRESS_INTERVAL)
                 except queue.Empty:
                     future = None
+                interrupts.check()  # a Ctrl-C that a Dask call caught on its way still stops the loop
                 if window is None and time.monotonic() - refreshed > 5.0:  # workers come and go
                     limit, refreshed = 2 * self.slots + 2, time.monotonic()
                 if future is None and self.client.status in ("closing", "closed"):
