@@ -402,9 +402,10 @@ CONTENTION_N, CONTENTION_DURATION = 1000, 0.2
 """The issue's contention case: pd, N = 1000, 0.2 s simulated."""
 
 
-def _two_at_once(threads: str) -> tuple[list[float], int]:
-    """Two copies of the pd batch started together (each in its own process, both ready
-    first); their seconds per 30-s simulation and the thread count they used."""
+def _two_at_once(threads: str, copies: int = 2) -> tuple[list[float], int]:
+    """``copies`` copies of the pd batch started together (each in its own process, all ready
+    first; one copy: the batch alone, the machine otherwise free); their seconds per 30-s
+    simulation and the thread count they used."""
     children = [
         subprocess.Popen(
             [sys.executable, "-c", _CONTENDER, threads],
@@ -412,7 +413,7 @@ def _two_at_once(threads: str) -> tuple[list[float], int]:
             stdout=subprocess.PIPE,
             text=True,
         )
-        for _ in range(2)
+        for _ in range(copies)
     ]
     try:
         for child in children:  # the readiness line of each, then go for both
@@ -435,7 +436,8 @@ def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) 
     simulation against the baseline timed in between (the issue: default 6.2 s, 1 thread
     0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
     rows: dict[str, list[float]] = {"default": [], "1": [], "2": []}
-    used = 0
+    alone: dict[str, list[float]] = {"default": [], "1": []}  # one copy: the machine free
+    used = used_alone = 0
     base_times = []
     for _ in range(repeats):  # interleaved: load drift hits all alike
         base_times.append(_timed(baseline))
@@ -443,6 +445,10 @@ def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) 
             seconds, count = _two_at_once(threads)
             rows[threads].append(max(seconds))  # the slower copy: what the user waits for
             used = count if threads == "default" else used
+        for threads in alone:
+            seconds, count = _two_at_once(threads, copies=1)
+            alone[threads].append(seconds[0])
+            used_alone = count if threads == "default" else used_alone
     base = min(base_times) * scale
     print(
         f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {CONTENTION_DURATION:g} s simulated, "
@@ -460,12 +466,28 @@ def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) 
         print(f"  {label:22s} {best:8.4f} s {best / base:7.3f}x   (median {statistics.median(times):.4f} s)")
     verdict = min(rows["default"]) <= min(rows["1"]) * 1.1
     print(f"  default not slower than 1 thread when shared (within 10 %): {'met' if verdict else 'NOT met'}")
+    print("one copy alone (the same batch, nothing else started by the benchmark)")
+    for threads, times in alone.items():
+        label = (
+            f"default ({used_alone} thread{'s' if used_alone != 1 else ''})"
+            if threads == "default"
+            else "1 thread(s)"
+        )
+        best = min(times)
+        print(f"  {label:22s} {best:8.4f} s {best / base:7.3f}x   (median {statistics.median(times):.4f} s)")
+    free = min(alone["default"]) < min(alone["1"]) and statistics.median(
+        alone["default"]
+    ) < statistics.median(alone["1"])
+    print(f"  default faster than 1 thread when alone (min and median): {'met' if free else 'NOT met'}")
     return {
         "contention": {
             "baseline_seconds": base,
             "default_threads": used,
             "seconds_per_sim": {k: min(v) for k, v in rows.items()},
             "median_seconds_per_sim": {k: statistics.median(v) for k, v in rows.items()},
+            "alone_default_threads": used_alone,
+            "alone_seconds_per_sim": {k: min(v) for k, v in alone.items()},
+            "alone_median_seconds_per_sim": {k: statistics.median(v) for k, v in alone.items()},
         }
     }
 
@@ -764,6 +786,11 @@ def main(argv: list[str] | None = None) -> int:
         help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
     )
     parser.add_argument(
+        "--contention-only",
+        action="store_true",
+        help="only the contention row: two batches at once, and one alone (default threads against 1)",
+    )
+    parser.add_argument(
         "--sweep-200",
         type=float,
         default=None,
@@ -810,9 +837,9 @@ def main(argv: list[str] | None = None) -> int:
         return baseline_pd(trajectory, robot.p, pd_gains, q0, v0, DT, n)
 
     scale = FULL / single_duration
-    if args.shared_only:
+    if args.shared_only or args.contention_only:
         results.update(contention_section(baseline, scale, repeats))
-        if not quick:
+        if not quick and not args.contention_only:
             results.update(sweep_200_section())
         if args.json:
             print(json.dumps(results))

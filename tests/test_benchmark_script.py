@@ -55,3 +55,6 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
     contention = results["contention"]  # two batches at once: default, 1 and 2 threads
     assert set(contention["seconds_per_sim"]) == {"default", "1", "2"}
     assert all(x > 0 for x in contention["seconds_per_sim"].values()) and contention["default_threads"] >= 1
+    assert set(contention["alone_seconds_per_sim"]) == {"default", "1"}  # one copy alone: default vs 1
+    assert all(x > 0 for x in contention["alone_seconds_per_sim"].values())
+    assert contention["alone_default_threads"] >= 1
