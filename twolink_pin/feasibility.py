@@ -35,6 +35,17 @@ class TorqueCheck(NamedTuple):
     within_limits: bool
     """Whether every joint stays within its limit."""
 
+    def summary(self) -> dict[str, object]:
+        """The check's JSON fields, as every command prints them: ``peak_torque`` [N·m],
+        ``peak_time`` [s], ``torque_limits`` [N·m], ``margin`` [N·m], ``within_limits``."""
+        return {
+            "peak_torque": self.peak.tolist(),
+            "peak_time": self.peak_time.tolist(),
+            "torque_limits": self.limits.tolist(),
+            "margin": self.margin.tolist(),
+            "within_limits": self.within_limits,
+        }
+
     def verdict(self) -> str:
         """One line: feasible or not, with the tightest joint's peak and limit (a joint
         without an effort limit in its model has limit inf: "no limit")."""

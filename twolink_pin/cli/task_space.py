@@ -76,11 +76,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
         "rpy": [r.tolist() for r in rpy],
         "via_q": traj.via_q.tolist(),
         "ik_error": {"position_m": traj.ik_error[0], "angle_rad": traj.ik_error[1]},
-        "peak_torque": check.peak.tolist(),
-        "peak_time": check.peak_time.tolist(),
-        "torque_limits": check.limits.tolist(),
-        "margin": check.margin.tolist(),
-        "within_limits": check.within_limits,
+        **check.summary(),
         "figures": figures,
     }
     lines = ["via poses (t [s], position [m], roll-pitch-yaw [rad], q [rad]):"]

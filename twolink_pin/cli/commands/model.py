@@ -253,11 +253,7 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         "via_xy": None if via is None else [list(p) for p in via.xy],
         "via_q": traj.via_q.tolist(),
         "coefficients": traj.coefficients.tolist(),
-        "peak_torque": check.peak.tolist(),
-        "peak_time": check.peak_time.tolist(),
-        "torque_limits": check.limits.tolist(),
-        "margin": check.margin.tolist(),
-        "within_limits": check.within_limits,
+        **check.summary(),
         "figures": figures,
     }
     lines = ["via points (t [s], q [rad]" + (", end effector (x, y) [m])" if via is not None else ")") + ":"]
@@ -292,11 +288,7 @@ def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, 
         "bounds": {"q_minus_offset": q_bound.tolist(), "v": v_bound.tolist(), "a": a_bound.tolist()},
         "condition_number": measures.condition_number,
         "gram_min_eigenvalue_per_s": measures.gram_min_eigenvalue_per_s,
-        "peak_torque": check.peak.tolist(),
-        "peak_time": check.peak_time.tolist(),
-        "torque_limits": check.limits.tolist(),
-        "margin": check.margin.tolist(),
-        "within_limits": check.within_limits,
+        **check.summary(),
         "figures": figures,
     }
     lines = [
