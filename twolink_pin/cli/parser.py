@@ -300,7 +300,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="a law to run (repeatable; default: the report's five on the twolink, every built-in law elsewhere)",
     )
     p.add_argument(
-        "--workers", type=whole(1, 64), default=2, help="processes for the runs (1 to 64, default 2)"
+        "--workers",
+        type=whole(1, 64),
+        default=None,
+        help="processes for the runs and figures (1 to 64; default: the cores this process may use)",
     )
     p.add_argument("--no-animation", action="store_true", help="skip the 3-D animation")
     p.add_argument(

@@ -128,7 +128,7 @@ def _build(
     warnings: list[str] = []
     tried, shown = False, animated
     animation = None
-    workers = min(options.workers, len(order) + 1)
+    workers = min(options.workers or 1, len(order) + 1)  # None was resolved to the cores
     with _pool(workers) as pool:
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.

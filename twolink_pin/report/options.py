@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.openmp import available_cores
 from twolink_pin.run_spec import RunSpec
 
 MAX_WORKERS = 64
@@ -26,7 +27,9 @@ class ReportOptions:
         payload: End-effector payload [kg].
         controllers: The laws to run (names, ``file.py:Class``, ``module:Class``); None for
             the course report's five on the twolink, every built-in law elsewhere.
-        workers: Processes for the runs and figures (1: in this process), 1 to 64.
+        workers: Processes for the runs and figures (1: in this process), 1 to 64; None
+            (default): the cores this process may use (``os.sched_getaffinity``; 2 on a
+            2-core machine), at most 64.
         animation: Whether to write the self-contained animation.
         identification: Whether the twolink's report has its identification section (beside
             Fig. 27: the adaptive law along two excitations and an identification; about
@@ -41,12 +44,14 @@ class ReportOptions:
     robot: str | None = None
     payload: float = 0.0
     controllers: tuple[str, ...] | None = None
-    workers: int = 2
+    workers: int | None = None
     animation: bool = True
     identification: bool = True
     trajectory: str | None = None
 
     def __post_init__(self) -> None:
+        if self.workers is None:
+            object.__setattr__(self, "workers", min(available_cores(), MAX_WORKERS))
         if not (
             isinstance(self.workers, int)
             and not isinstance(self.workers, bool)
