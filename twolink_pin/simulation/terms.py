@@ -119,16 +119,24 @@ class _PairInputs:
         T[2 * nv : 3 * nv, 3 * nv : 4 * nv] = -0.5 * eye  # −w/2 -> copy B
         T[3 * nv :, 4 * nv : 5 * nv] = eye  # a -> copy A; copy B's acceleration stays 0
         self._T = T
+        # Written in place at every call: the arguments and the product live in these two
+        # buffers, and (Q, V, A) are views of the product made once. They only ever reach
+        # Pinocchio, which copies them; never a law.
+        self._x = np.empty((1, 4 * nv))
+        self._b = np.empty((1, 6 * nv))
+        b = self._b[0]
+        self._views = (b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :])
 
     def fill(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(Q, V, A)``, each of shape (2 nv,)."""
-        nv = self.nv
+        """``(Q, V, A)``, each of shape (2 nv,), valid until the next call."""
+        x = self._x
         try:
-            x = np.concatenate((q, v, w, a), axis=1)
+            np.concatenate((q, v, w, a), axis=1, out=x)
         except (ValueError, np.exceptions.AxisError):  # a (nv,) argument: bring it to (1, nv)
-            x = np.concatenate([np.reshape(y, (1, nv)) for y in (q, v, w, a)], axis=1)
-        b = (x @ self._T)[0]
-        return b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :]
+            nv = self.nv
+            np.concatenate([np.reshape(y, (1, nv)) for y in (q, v, w, a)], axis=1, out=x)
+        np.matmul(x, self._T, out=self._b)
+        return self._views
 
 
 class SingleRunTerms(RigidBodyTermsMixin):
