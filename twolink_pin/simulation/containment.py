@@ -57,9 +57,9 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
         # engine samples it (once per block).
         # setflags(False) is setflags(write=False) without keyword parsing (half the cost).
         t = x[0]
-        x[1].setflags(False)
-        x[2].setflags(False)
-        x[3].setflags(False)
+        x[1].setflags(False)  # type: ignore[call-arg]
+        x[2].setflags(False)  # type: ignore[call-arg]
+        x[3].setflags(False)  # type: ignore[call-arg]
         try:
             return compute(x, terms)
         except SystemExit as exc:
