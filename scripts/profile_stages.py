@@ -17,15 +17,27 @@ wrappers and one without (the plain wall time). Split per stage (4 stages per st
 The least disturbed of ``--repeats`` runs is kept (on a shared machine the spread is other
 processes).
 
+``--instructions`` counts instead of timing, which does not depend on the machine's load:
+the script runs itself under valgrind's callgrind (instrumentation switched on after the
+imports and a warm-up run per law), each law for 0.05 s and 0.15 s simulated with a
+callgrind dump around each run, and prints the difference of the two runs' instruction
+counts per RK4 stage (0.1 s = 400 stages: setup and first-call costs cancel).
+
 Usage::
 
     .venv/bin/python scripts/profile_stages.py [--duration 2] [--robot twolink|ur5|panda] [--laws pd,...]
+    .venv/bin/python scripts/profile_stages.py --instructions [--robot ur5] [--laws pd,...]
 """
 
 from __future__ import annotations
 
 import argparse
+import glob
 import os
+import shutil
+import subprocess
+import sys
+import tempfile
 import time
 from typing import Any
 
@@ -80,6 +92,7 @@ def _instrument(clock: _Clock) -> tuple[Any, Any, Any]:
                 finally:
                     ns["terms"] += now() - start
 
+            setattr(self, name, timed)  # made once: later calls do not pay for the wrapper in "law"
             return timed
 
     def timed_terms_for(*args: Any, **kwargs: Any) -> Any:
@@ -138,14 +151,69 @@ def profile(robot_name: str, spec: str, duration: float, repeats: int) -> dict[s
     return best
 
 
+SHORT, LONG = 0.05, 0.15
+"""Simulated seconds of the two counted runs per law (``--instructions``)."""
+
+
+def _counted_runs(robot_name: str, laws: list[str]) -> None:
+    """Under callgrind (``--instr-atstart=no --dump-before=getppid``): warm up, switch the
+    instrumentation on, then each law for SHORT and LONG seconds between ``os.getppid()``
+    calls (each call ends a dump)."""
+    robot = load_robot(robot_name)
+    reference = default_trajectory(robot)
+    offset = 0.05 if robot_name != "twolink" else None
+    for spec in laws:
+        controller, plant = make_scenario(spec, robot)
+        simulate(controller, plant, reference, SimulationConfig(duration=0.01, dt=1e-3, q0_offset=offset))
+    subprocess.run(["callgrind_control", "-i", "on", str(os.getpid())], check=True, capture_output=True)
+    for spec in laws:
+        for duration in (SHORT, LONG):
+            controller, plant = make_scenario(spec, robot)
+            config = SimulationConfig(duration=duration, dt=1e-3, q0_offset=offset)
+            os.getppid()
+            simulate(controller, plant, reference, config)
+            os.getppid()
+
+
+def instructions(robot_name: str, laws: list[str]) -> dict[str, float]:
+    """Instructions per RK4 stage of each law's single run (callgrind, see module doc)."""
+    if shutil.which("valgrind") is None or shutil.which("callgrind_control") is None:
+        raise SystemExit("--instructions needs valgrind (apt-get install valgrind)")
+    with tempfile.TemporaryDirectory() as folder:
+        out = os.path.join(folder, "cg.out")
+        command = ["valgrind", "--tool=callgrind", "--instr-atstart=no", "--dump-before=getppid"]
+        command += [f"--callgrind-out-file={out}", sys.executable, __file__, "--robot", robot_name]
+        command += ["--laws", ",".join(laws), "--counted-child"]
+        subprocess.run(command, check=True, capture_output=True)
+        totals = []
+        for path in sorted(glob.glob(out + ".*"), key=lambda f: int(f.rsplit(".", 1)[1])):
+            with open(path) as dump:
+                totals.append(next(int(line.split()[1]) for line in dump if line.startswith("totals:")))
+    runs = totals[1::2]  # dump 0 ends at the first marker; then run, gap, run, gap, ...
+    stages = 4 * round((LONG - SHORT) / 1e-3)
+    return {spec: (runs[2 * i + 1] - runs[2 * i]) / stages for i, spec in enumerate(laws)}
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--duration", type=float, default=2.0, help="simulated seconds per run (default 2)")
     parser.add_argument("--robot", default="twolink", help="twolink, ur5 or panda (default twolink)")
     parser.add_argument("--laws", default=None, help="comma-separated laws (default: the robot's set)")
     parser.add_argument("--repeats", type=int, default=3, help="runs per law, the least disturbed kept")
+    parser.add_argument(
+        "--instructions", action="store_true", help="instructions per stage under callgrind instead of µs"
+    )
+    parser.add_argument("--counted-child", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
-    laws = args.laws.split(",") if args.laws else DEFAULT_LAWS[args.robot]
+    laws = args.laws.split(",") if args.laws else list(DEFAULT_LAWS[args.robot])
+    if args.counted_child:
+        _counted_runs(args.robot, laws)
+        return 0
+    if args.instructions:
+        print(f"{args.robot}: instructions per RK4 stage (callgrind, {LONG:g} s run less {SHORT:g} s run)")
+        for spec, count in instructions(args.robot, laws).items():
+            print(f"  {spec:20s} {count / 1e3:8.1f} k")
+        return 0
     print(
         f"{args.robot}, {args.duration:g} s simulated, dt = 1 ms, min of {args.repeats}; "
         f"load average {[round(x, 2) for x in os.getloadavg()]}"

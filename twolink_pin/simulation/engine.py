@@ -211,9 +211,10 @@ def integrate(
             last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
             half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
             half = trajectory.sample(half_t)
-            rq, rv, ra = (
-                read_only(x[:, None, :]) for x in (half.q, half.v, half.a)
-            )  # shared: law can't write
+            # Shared with later steps: the law can't write. C-contiguous rows: a trajectory may
+            # sample column-major, and a strided (1, nv) row takes numpy's slow broadcasting
+            # path in every operation of the law and the Terms that touches it.
+            rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
             if events is not None:
                 events.draw(k0, k1)
             ref = reference_rows(controller, trajectory, half_t, half, rq, rv, ra)  # + task fields
