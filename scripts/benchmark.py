@@ -599,11 +599,21 @@ def ur5_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats:
     return {"ur5": {"baseline_seconds": base, "batch_n": batch_n, "seconds": rows}}
 
 
-SINGLE_RUN_LAWS = {
-    "twolink": ("pd", "computed-torque", "robust", "adaptive", "adaptive-friction"),
-    "ur5": ("pd", "computed-torque", "adaptive"),
-}
-"""The single-run rows: every built-in joint-space law on the twolink, and the UR5's set."""
+SINGLE_RUN_ROBOTS = ("twolink", "ur5")
+"""The single-run rows: every built-in law (the package's registry, not a table here) on these arms."""
+
+
+def _built_in_laws() -> list[str]:
+    """The names of the package's own laws, in registry order (plugins and files left out)."""
+    from twolink_pin.controllers.loading import available_controllers
+
+    return [
+        n
+        for n, cls in available_controllers().items()
+        if cls.__module__.startswith("twolink_pin.controllers")
+    ]
+
+
 MUJOCO_RATIO = 12.8
 """Issue 22 item 4: MuJoCo 4.0 with a Python law at every RK4 stage, × the baseline of the same run."""
 
@@ -618,7 +628,8 @@ def single_runs_section(
     duration = 0.2 if quick else 2.0
     load_before = [round(x, 2) for x in os.getloadavg()]
     rows: dict[str, dict[str, Any]] = {}
-    for robot_name, laws in SINGLE_RUN_LAWS.items():
+    for robot_name in SINGLE_RUN_ROBOTS:
+        laws = _built_in_laws()
         robot = load_robot(robot_name)
         reference = default_trajectory(robot)
         config = SimulationConfig(
