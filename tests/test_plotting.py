@@ -21,6 +21,7 @@ import warnings
 import weakref
 from pathlib import Path
 
+import matplotlib.image
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -934,7 +935,12 @@ def test_failed_write_keeps_the_old_file_and_leaves_no_temp(
         f.write(b"\x89PNG partial")
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(Figure, "savefig", broken_savefig)
+    def broken_imsave(f, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
+        f.write(b"\x89PNG partial")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(Figure, "savefig", broken_savefig)  # SVG, PDF
+    monkeypatch.setattr(matplotlib.image, "imsave", broken_imsave)  # a PNG: the drawn canvas's pixels
     with pytest.raises(RuntimeError, match="disk full"):
         plotting.save_distribution_figure({"x": np.arange(5.0)}, target)
     assert target.read_bytes() == b"previous"
