@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Literal
 
 import matplotlib
+import matplotlib.image
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -29,6 +30,27 @@ from matplotlib.transforms import Bbox
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.files import atomic_write
+
+
+@dataclass(frozen=True)
+class Margins:
+    """Fixed room around and between a figure's panels [in], set once per figure type instead
+    of a layout engine (constrained layout measures every tick label of every panel, twice,
+    on each save: half of a figure's CPU time).
+
+    Attributes:
+        left, right, bottom, top: Room between the panels and the figure's edges [in]
+            (tick labels, axis labels, the suptitle).
+        wspace, hspace: Room between neighbouring columns and rows [in].
+    """
+
+    left: float
+    right: float
+    bottom: float
+    top: float
+    wspace: float = 0.0
+    hspace: float = 0.0
+
 
 DPI = 110
 """Resolution of every saved figure [dots per inch]."""
@@ -64,12 +86,17 @@ SUPTITLE_HEIGHT = 0.75
 WORKSPACE_3D_FIGSIZE = (16.0, 5.8)
 """Size of the workspace figure of an arm moving in 3-D (a 3-D view, two projections) [in]."""
 
-STATE_MARGINS_IN = (0.9, 0.15, 0.5, 0.58, 0.85, 0.55)
-"""A state figure's fixed margins [in]: left, right, bottom, top (two-line suptitle), between
-columns, between rows (a panel title above, tick labels and an x label below); see
-:class:`Margins`."""
-SIM_TORQUE_MARGINS_IN = (0.8, 0.22, 0.5, 0.75, 0.75, 0.25)
-"""A run's torque figure's fixed margins [in], as :data:`STATE_MARGINS_IN`."""
+STATE_MARGINS = Margins(left=0.9, right=0.15, bottom=0.5, top=0.58, wspace=0.85, hspace=0.55)
+"""A run's state figure: a two-line suptitle; between rows a panel title above, tick labels
+and an x label below; the late-error panel's tick labels between the columns."""
+SIM_TORQUE_MARGINS = Margins(left=0.8, right=0.22, bottom=0.5, top=0.75, wspace=0.75, hspace=0.25)
+"""A run's torque figure: a two-line suptitle and the column titles above."""
+JOINT_MARGINS = Margins(left=0.92, right=0.18, bottom=0.5, top=0.36, hspace=0.16)
+"""A trajectory joint figure: one suptitle line, four panels sharing t."""
+TORQUE_MARGINS = Margins(left=0.8, right=0.18, bottom=0.5, top=0.36, hspace=0.2)
+"""The desired-torque figure: one suptitle line, a panel per joint sharing t."""
+PARAM_MARGINS = Margins(left=0.95, right=0.15, bottom=0.5, top=0.6, hspace=0.2)
+"""A parameter-error figure with its legends inside the panels: a two-line suptitle."""
 
 OFF_SCALE_RATIO = 3.0
 """A torque limit more than this many times the plotted peak is noted, not drawn in view."""
@@ -105,26 +132,6 @@ made (see :func:`_unblock_legends`)."""
 
 
 # ------------------------------------------------------------------ figures and files
-
-
-@dataclass(frozen=True)
-class Margins:
-    """Fixed room around and between a figure's panels [in], set once per figure type instead
-    of a layout engine (constrained layout measures every tick label of every panel, twice,
-    on each save: half of a figure's CPU time).
-
-    Attributes:
-        left, right, bottom, top: Room between the panels and the figure's edges [in]
-            (tick labels, axis labels, the suptitle).
-        wspace, hspace: Room between neighbouring columns and rows [in].
-    """
-
-    left: float
-    right: float
-    bottom: float
-    top: float
-    wspace: float = 0.0
-    hspace: float = 0.0
 
 
 def _new_figure(figsize: tuple[float, float]) -> Figure:
@@ -163,9 +170,9 @@ def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tu
 
 
 def _drawn_labels(ax: Axes) -> list[Text]:
-    """The texts around ``ax`` whose size depends on the data: its drawn tick labels, its
-    axis labels and the axis offsets (``1e−3``)."""
-    texts = [ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText, ax.yaxis.offsetText]
+    """The texts around ``ax`` whose size depends on the data or the caller: its drawn tick
+    labels, its axis labels, the axis offsets (``1e−3``) and its title."""
+    texts = [ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText, ax.yaxis.offsetText, ax.title]
     for axis, (lo, hi) in ((ax.xaxis, sorted(ax.get_xlim())), (ax.yaxis, sorted(ax.get_ylim()))):
         index = 0 if axis is ax.xaxis else 1
         for tick in axis.majorTicks:
@@ -176,11 +183,17 @@ def _drawn_labels(ax: Axes) -> list[Text]:
 
 
 def _labels_fit(fig: Figure) -> bool:
-    """After a draw: every tick label, axis label and offset lies inside the figure and
-    outside every other panel's plotting area (1 px of rounding allowed)."""
+    """After a draw: every tick label, axis label, offset and panel title lies inside the
+    figure and outside every other panel's plotting area, and the suptitle overlaps none of
+    them (1 px of rounding allowed)."""
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]  # the Agg canvas has one
     areas = [ax.get_window_extent() for ax in fig.axes]
     box = fig.bbox
+    suptitle = fig._suptitle  # type: ignore[attr-defined]  # the Text of fig.suptitle, or None
+    top = None
+    if suptitle is not None and suptitle.get_text():
+        top = suptitle.get_window_extent(renderer)
+        areas.append(top)  # no panel's text may reach into it
     for k, ax in enumerate(fig.axes):
         for text in _drawn_labels(ax):
             extent = text.get_window_extent(renderer)
@@ -194,7 +207,7 @@ def _labels_fit(fig: Figure) -> bool:
             inner = Bbox.from_extents(extent.x0 + 1, extent.y0 + 1, extent.x1 - 1, extent.y1 - 1)
             if any(i != k and inner.overlaps(area) for i, area in enumerate(areas)):
                 return False
-    return True
+    return top is None or not any(top.overlaps(area) for area in areas[:-1])
 
 
 def _save(fig: Figure, path: Path) -> Path:

@@ -31,10 +31,9 @@ from twolink_pin.plotting._style import (
     LOG_FLOOR,
     NOTE_BOX,
     SIM_TORQUE_FIGSIZE,
-    SIM_TORQUE_MARGINS_IN,
+    SIM_TORQUE_MARGINS,
     STATE_FIGSIZE,
-    STATE_MARGINS_IN,
-    Margins,
+    STATE_MARGINS,
     _check_figure_numbers,
     _envelope,
     _fix_margins,
@@ -136,7 +135,7 @@ def _state_figure(
     fig.suptitle(
         _title(f"joint {j + 1} {what}: actual vs desired, error", key, figure_numbers, heading), fontsize=11
     )
-    _fix_margins(fig, Margins(*STATE_MARGINS_IN))
+    _fix_margins(fig, STATE_MARGINS)
     return fig
 
 
@@ -205,7 +204,7 @@ def _torque_figure(
     sat = "saturated at the limits" if result.saturate else "no saturation"
     heading = heading if heading is not None else _heading(result, None)
     fig.suptitle(_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
-    _fix_margins(fig, Margins(*SIM_TORQUE_MARGINS_IN))
+    _fix_margins(fig, SIM_TORQUE_MARGINS)
     shown = np.concatenate([result.tau, result.tau_command]) if clipped else result.tau
     times = np.concatenate([t, t]) if clipped else t
     _unblock_legends(fig, [(axes[j, 0], times, shown[:, j]) for j in range(nv)])
