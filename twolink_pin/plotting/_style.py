@@ -243,7 +243,7 @@ def _save(fig: Figure, path: Path) -> Path:
         canvas.draw()
     with atomic_write(path, "wb") as f:
         matplotlib.image.imsave(
-            f,
+            f,  # type: ignore[arg-type]  # a binary file (mode "wb")
             canvas.buffer_rgba(),
             format="png",
             origin="upper",
@@ -401,10 +401,10 @@ def _unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.nd
     :data:`LEGEND_PLACES` that covers no point and no text (annotation, note), else to the
     one covering fewest points, then fewest texts. Call once the figure is complete.
 
-    The test is conservative: it runs before the layout, on axes of the plain subplot grid
-    (smaller than constrained layout makes them), with an upper estimate of the legend's
-    size (:func:`_legend_size`), so a legend is judged larger than it will be drawn, and
-    no layout pass is needed. Matplotlib's ``loc="best"`` does a similar search at each
+    The test is conservative: it runs on the axes as placed when it is called (their fixed
+    :class:`Margins`, or the plain subplot grid, smaller than constrained layout makes them),
+    with an upper estimate of the legend's size (:func:`_legend_size`), so a legend is
+    judged at least as large as it will be drawn, and no layout pass is needed. Matplotlib's ``loc="best"`` does a similar search at each
     draw, but also avoids the ±limit lines the legend is meant to sit above, and it warns
     on long runs.
     """
