@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import gc
 import math
+import re
 import subprocess
 import sys
 import types
@@ -21,11 +22,14 @@ import warnings
 import weakref
 from pathlib import Path
 
+import matplotlib.image
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
 from matplotlib.image import imread
 from matplotlib.lines import Line2D
+from matplotlib.ticker import FuncFormatter, LogFormatterSciNotation
+from matplotlib.transforms import Bbox
 
 from twolink_pin import plotting
 from twolink_pin.errors import InvalidParameterError, OutputError
@@ -774,6 +778,81 @@ def test_six_joints_and_36_parameters_fit_in_their_figures(many: SimulationResul
     assert figures["param_error"].get_size_inches()[1] >= 36 * _style.BAR_HEIGHT
 
 
+def test_the_report_figures_fit_their_fixed_margins(
+    trajectory_figures: dict[str, Figure], pd_figures: dict[str, Figure], friction: SimulationResult
+) -> None:
+    """The twolink's figures drawn with fixed margins (no layout engine: the report's state,
+    torque, trajectory and parameter-error figures) keep every legend, drawn tick label, axis
+    label and title inside the figure, and no panel's decorations (matplotlib's own tight
+    box of each axes) reach into another panel's or into the suptitle: saving them never
+    needs the constrained-layout fallback."""
+    figures = {f"trajectory_{k}": fig for k, fig in trajectory_figures.items()}
+    figures |= {f"pd_{k}": fig for k, fig in pd_figures.items()}
+    figures |= {f"friction_{k}": fig for k, fig in _simulation_figures(friction).items()}
+    fixed = {k for k, fig in figures.items() if getattr(fig, "_twolink_margins", None) is not None}
+    assert fixed == set(figures) - {"trajectory_workspace"}, sorted(set(figures) - fixed)
+    for key in sorted(fixed):
+        fig = figures[key]
+        _assert_inside_figure(fig)  # draws it
+        renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+        boxes = [ax.get_tightbbox(renderer) for ax in fig.axes]
+        suptitle = fig._suptitle.get_window_extent(renderer)  # type: ignore[attr-defined]
+        for i, box in enumerate(boxes):
+            assert not box.overlaps(suptitle), (key, fig.axes[i].get_label())
+            for k in range(i + 1, len(boxes)):
+                overlap = Bbox.intersection(box, boxes[k])
+                assert overlap is None or min(overlap.width, overlap.height) < 1.0, (
+                    key,
+                    fig.axes[i].get_label(),
+                    fig.axes[k].get_label(),
+                    overlap,
+                )
+        assert _style._labels_fit(fig), key
+
+
+def test_a_label_wider_than_the_fixed_margins_gets_constrained_layout(tmp_path: Path) -> None:
+    """Fixed margins too narrow for a panel's tick labels (they would be cut at the left edge)
+    are replaced by constrained layout when the figure is saved: the labels then lie inside
+    the figure and the PNG has the figure's size."""
+    fig = _style._new_figure((4.0, 3.0))
+    ax = fig.subplots()
+    ax.plot([0.0, 1.0], [0.0, 1.0])
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:.1f} rad, a wide tick label"))
+    _style._fix_margins(fig, _style.Margins(left=0.3, right=0.1, bottom=0.4, top=0.2))
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
+    assert min(t.get_window_extent(renderer).x0 for t in ax.get_yticklabels()) < 0  # cut off
+    path = _style._save(fig, tmp_path / "wide.png")
+    _assert_inside_figure(fig)
+    assert ax.get_position().x0 * 4.0 > 1.0  # room made for the labels
+    _assert_png(path, (4.0, 3.0))
+
+
+def test_log_tick_labels_read_as_matplotlibs(pd_figures: dict[str, Figure]) -> None:
+    """The plain-text log labels (10⁻⁸, 2×10⁻³) say what matplotlib's mathtext ones say, tick
+    for tick, and the state figure's log panel uses them."""
+    fig = _style._new_figure((4.0, 3.0))
+    ax = fig.subplots()
+    ax.set_yscale("log")
+    ax.set_ylim(1e-16, 1e6)
+    ours, theirs = _style.PowerOfTenFormatter(), LogFormatterSciNotation()
+    ours.set_axis(ax.yaxis)
+    theirs.set_axis(ax.yaxis)
+    digits = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
+    for x in (1e-16, 1e-8, 1e-3, 0.1, 1.0, 10.0, 1e5):
+        text = theirs(x)
+        exponent = re.search(r"10\^\{(-?\d+)\}", text)
+        expected = exponent.group(1) if exponent else {"1": "0", "10": "1"}[re.sub(r"[^0-9]", "", text)]
+        got = ours(x)
+        assert got.startswith("10") and "$" not in got, (x, got)
+        assert got[2:].translate(digits) == expected, (x, got, text)
+    between = _style.PowerOfTenFormatter(labelOnlyBase=False)
+    between.set_axis(ax.yaxis)
+    assert between(2e-3) == "2×10⁻³"
+    log = _axes(pd_figures["theta1"], "error-log")
+    assert isinstance(log.yaxis.get_major_formatter(), _style.PowerOfTenFormatter)
+
+
 def test_a_torque_legend_moves_off_a_curve_near_the_top(pd_figures: dict[str, Figure]) -> None:
     """A torque that stays near its peak (like the Panda's τ4, 20–24 N·m) would run under
     the "upper right" legend: the legend goes where it covers no point of the curve. The
@@ -934,7 +1013,12 @@ def test_failed_write_keeps_the_old_file_and_leaves_no_temp(
         f.write(b"\x89PNG partial")
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(Figure, "savefig", broken_savefig)
+    def broken_imsave(f, *args, **kwargs) -> None:  # type: ignore[no-untyped-def]
+        f.write(b"\x89PNG partial")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(Figure, "savefig", broken_savefig)  # SVG, PDF
+    monkeypatch.setattr(matplotlib.image, "imsave", broken_imsave)  # a PNG: the drawn canvas's pixels
     with pytest.raises(RuntimeError, match="disk full"):
         plotting.save_distribution_figure({"x": np.arange(5.0)}, target)
     assert target.read_bytes() == b"previous"

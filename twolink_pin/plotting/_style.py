@@ -13,22 +13,50 @@ import math
 import os
 import re
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
 import matplotlib
+import matplotlib.image
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.legend import Legend
+from matplotlib.text import Text
+from matplotlib.ticker import LogFormatter
 from matplotlib.transforms import Bbox
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.files import atomic_write
 
+
+@dataclass(frozen=True)
+class Margins:
+    """Fixed room around and between a figure's panels [in], set once per figure type instead
+    of a layout engine (constrained layout measures every tick label of every panel, twice,
+    on each save: half of a figure's CPU time).
+
+    Attributes:
+        left, right, bottom, top: Room between the panels and the figure's edges [in]
+            (tick labels, axis labels, the suptitle).
+        wspace, hspace: Room between neighbouring columns and rows [in].
+    """
+
+    left: float
+    right: float
+    bottom: float
+    top: float
+    wspace: float = 0.0
+    hspace: float = 0.0
+
+
 DPI = 110
 """Resolution of every saved figure [dots per inch]."""
+PNG_COMPRESS_LEVEL = 1
+"""zlib level of the PNG writer: 1 encodes a figure in about half the time of the default 6
+for files about 7 % larger."""
 JOINT_FIGSIZE = (8.0, 8.0)
 """Size of a trajectory joint figure (four stacked panels) [in]."""
 WORKSPACE_FIGSIZE = (12.0, 5.5)
@@ -57,6 +85,18 @@ SUPTITLE_HEIGHT = 0.75
 """Height of a figure's (two- or three-line) title [in]."""
 WORKSPACE_3D_FIGSIZE = (16.0, 5.8)
 """Size of the workspace figure of an arm moving in 3-D (a 3-D view, two projections) [in]."""
+
+STATE_MARGINS = Margins(left=0.9, right=0.15, bottom=0.5, top=0.58, wspace=0.85, hspace=0.55)
+"""A run's state figure: a two-line suptitle; between rows a panel title above, tick labels
+and an x label below; the late-error panel's tick labels between the columns."""
+SIM_TORQUE_MARGINS = Margins(left=0.8, right=0.22, bottom=0.5, top=0.75, wspace=0.75, hspace=0.25)
+"""A run's torque figure: a two-line suptitle and the column titles above."""
+JOINT_MARGINS = Margins(left=0.92, right=0.18, bottom=0.5, top=0.36, hspace=0.16)
+"""A trajectory joint figure: one suptitle line, four panels sharing t."""
+TORQUE_MARGINS = Margins(left=0.8, right=0.18, bottom=0.5, top=0.36, hspace=0.2)
+"""The desired-torque figure: one suptitle line, a panel per joint sharing t."""
+PARAM_MARGINS = Margins(left=0.95, right=0.15, bottom=0.5, top=0.6, hspace=0.2)
+"""A parameter-error figure with its legends inside the panels: a two-line suptitle."""
 
 OFF_SCALE_RATIO = 3.0
 """A torque limit more than this many times the plotted peak is noted, not drawn in view."""
@@ -95,10 +135,33 @@ made (see :func:`_unblock_legends`)."""
 
 
 def _new_figure(figsize: tuple[float, float]) -> Figure:
-    """A non-GUI figure with its own Agg canvas and constrained layout."""
+    """A non-GUI figure with its own Agg canvas and constrained layout (a figure type with
+    fixed :class:`Margins` replaces it with :func:`_fix_margins` once its panels exist)."""
     fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
+
+
+def _fix_margins(fig: Figure, margins: Margins) -> None:
+    """Place the panels of ``fig`` (one grid) with ``margins`` [in] instead of constrained
+    layout. :func:`_save` checks after drawing that the tick and axis labels fit and falls
+    back to constrained layout when they do not (an unusually long tick label)."""
+    width, height = fig.get_size_inches()
+    spec = fig.axes[0].get_subplotspec()
+    assert spec is not None  # every fixed-margin figure is a grid of subplots
+    rows, cols = spec.get_gridspec().get_geometry()
+    panel_w = (width - margins.left - margins.right - (cols - 1) * margins.wspace) / cols
+    panel_h = (height - margins.bottom - margins.top - (rows - 1) * margins.hspace) / rows
+    fig.set_layout_engine(None)
+    fig.subplots_adjust(
+        left=margins.left / width,
+        right=1.0 - margins.right / width,
+        bottom=margins.bottom / height,
+        top=1.0 - margins.top / height,
+        wspace=margins.wspace / panel_w,
+        hspace=margins.hspace / panel_h,
+    )
+    fig._twolink_margins = margins  # type: ignore[attr-defined]  # read by _save
 
 
 def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tuple[float, float]:
@@ -106,8 +169,54 @@ def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tu
     return (base[0], base[1] + row_height * (rows - 2))
 
 
+def _drawn_labels(ax: Axes) -> list[Text]:
+    """The texts around ``ax`` whose size depends on the data or the caller: its drawn tick
+    labels, its axis labels, the axis offsets (``1e−3``) and its title."""
+    texts = [ax.xaxis.label, ax.yaxis.label, ax.xaxis.offsetText, ax.yaxis.offsetText, ax.title]
+    for axis, (lo, hi) in ((ax.xaxis, sorted(ax.get_xlim())), (ax.yaxis, sorted(ax.get_ylim()))):
+        index = 0 if axis is ax.xaxis else 1
+        for tick in axis.majorTicks:
+            for label in (tick.label1, tick.label2):
+                if label.get_visible() and lo <= label.get_position()[index] <= hi:
+                    texts.append(label)
+    return [t for t in texts if t.get_visible() and t.get_text()]
+
+
+def _labels_fit(fig: Figure) -> bool:
+    """After a draw: every tick label, axis label, offset and panel title lies inside the
+    figure and outside every other panel's plotting area, and the suptitle overlaps none of
+    them (1 px of rounding allowed)."""
+    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]  # the Agg canvas has one
+    areas = [ax.get_window_extent() for ax in fig.axes]
+    box = fig.bbox
+    suptitle = fig._suptitle  # type: ignore[attr-defined]  # the Text of fig.suptitle, or None
+    top = None
+    if suptitle is not None and suptitle.get_text():
+        top = suptitle.get_window_extent(renderer)
+        areas.append(top)  # no panel's text may reach into it
+    for k, ax in enumerate(fig.axes):
+        for text in _drawn_labels(ax):
+            extent = text.get_window_extent(renderer)
+            if not (
+                box.x0 - 1 <= extent.x0
+                and extent.x1 <= box.x1 + 1
+                and box.y0 - 1 <= extent.y0
+                and extent.y1 <= box.y1 + 1
+            ):
+                return False
+            inner = Bbox.from_extents(extent.x0 + 1, extent.y0 + 1, extent.x1 - 1, extent.y1 - 1)
+            if any(i != k and inner.overlaps(area) for i, area in enumerate(areas)):
+                return False
+    return top is None or not any(top.overlaps(area) for area in areas[:-1])
+
+
 def _save(fig: Figure, path: Path) -> Path:
-    """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default)."""
+    """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default).
+
+    A PNG is drawn once on the figure's Agg canvas and its pixels written as they are
+    (zlib level :data:`PNG_COMPRESS_LEVEL`); a figure with fixed :class:`Margins` whose
+    labels do not fit (:func:`_labels_fit`) is laid out by constrained layout and drawn
+    again."""
     fmt = path.suffix[1:].lower() or "png"
     engine = fig.get_layout_engine()
     if engine is not None and fig.axes:
@@ -117,9 +226,55 @@ def _save(fig: Figure, path: Path) -> Path:
         engine.execute(fig)
         with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
             fig.set_layout_engine(None)  # None (not "none", a placeholder savefig still pre-draws for)
+    if fmt != "png":
+        with atomic_write(path, "wb") as f:
+            fig.savefig(f, format=fmt, dpi=DPI)
+        return path
+    canvas = fig.canvas
+    assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (_new_figure)
+    canvas.draw()
+    if getattr(fig, "_twolink_margins", None) is not None and fig.axes and not _labels_fit(fig):
+        fig.set_layout_engine("constrained")
+        layout = fig.get_layout_engine()
+        assert layout is not None
+        layout.execute(fig)
+        with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+            fig.set_layout_engine(None)
+        canvas.draw()
     with atomic_write(path, "wb") as f:
-        fig.savefig(f, format=fmt, dpi=DPI)
+        matplotlib.image.imsave(
+            f,  # type: ignore[arg-type]  # a binary file (mode "wb")
+            canvas.buffer_rgba(),
+            format="png",
+            origin="upper",
+            dpi=fig.dpi,
+            pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL},
+        )
     return path
+
+
+class PowerOfTenFormatter(LogFormatter):
+    """Log-axis tick labels as ``10⁻⁸`` (``2×10⁻³`` between decades) in plain Unicode text,
+    where matplotlib's default writes mathtext (``$10^{-8}$``), parsed by pyparsing on each
+    first draw: the labels look the same and cost nothing to lay out. Which ticks get a label
+    is :class:`~matplotlib.ticker.LogFormatter`'s choice."""
+
+    _SUPERSCRIPT = str.maketrans("-0123456789", "⁻⁰¹²³⁴⁵⁶⁷⁸⁹")
+
+    def __call__(self, x: float, pos: int | None = None) -> str:
+        if not super().__call__(x, pos) or x <= 0 or not math.isfinite(x):
+            return ""
+        exponent = math.floor(math.log10(x) + 1e-9)
+        mantissa = round(x / 10.0**exponent, 6)
+        power = "10" + str(exponent).translate(self._SUPERSCRIPT)
+        return power if mantissa == 1 else f"{mantissa:g}×{power}"
+
+
+def _plain_log_ticks(ax: Axes, axis: Literal["x", "y"] = "y") -> None:
+    """Label ``ax``'s log ``axis`` with :class:`PowerOfTenFormatter` (major and minor ticks)."""
+    target = ax.yaxis if axis == "y" else ax.xaxis
+    target.set_major_formatter(PowerOfTenFormatter())
+    target.set_minor_formatter(PowerOfTenFormatter(labelOnlyBase=False))  # as matplotlib's default
 
 
 def _save_all(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], prefix: str) -> list[Path]:
@@ -246,10 +401,10 @@ def _unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.nd
     :data:`LEGEND_PLACES` that covers no point and no text (annotation, note), else to the
     one covering fewest points, then fewest texts. Call once the figure is complete.
 
-    The test is conservative: it runs before the layout, on axes of the plain subplot grid
-    (smaller than constrained layout makes them), with an upper estimate of the legend's
-    size (:func:`_legend_size`), so a legend is judged larger than it will be drawn, and
-    no layout pass is needed. Matplotlib's ``loc="best"`` does a similar search at each
+    The test is conservative: it runs on the axes as placed when it is called (their fixed
+    :class:`Margins`, or the plain subplot grid, smaller than constrained layout makes them),
+    with an upper estimate of the legend's size (:func:`_legend_size`), so a legend is
+    judged at least as large as it will be drawn, and no layout pass is needed. Matplotlib's ``loc="best"`` does a similar search at each
     draw, but also avoids the ±limit lines the legend is meant to sit above, and it warns
     on long runs.
     """

@@ -33,7 +33,10 @@ from twolink_pin.plotting._style import (
     DESIRED_COLOR,
     ERROR_COLOR,
     LIMIT_COLOR,
+    Margins,
+    _fix_margins,
     _new_figure,
+    _plain_log_ticks,
     _save,
     _save_all,
 )
@@ -46,6 +49,12 @@ SHOWN_SECONDS = 10.0
 """Longest stretch of the validation period drawn [s] (its start)."""
 LABEL_CHARACTERS = 34
 """Parameter names are cut to this many characters on an axis."""
+VALIDATION_MARGINS = Margins(left=0.8, right=0.12, bottom=0.5, top=0.75, wspace=0.95, hspace=0.6)
+"""The validation figure [in]: a two-line suptitle, the error panels' titles and y labels."""
+EXCITATION_MARGINS = Margins(left=0.65, right=0.15, bottom=0.5, top=0.5, wspace=0.55, hspace=0.2)
+"""The excitation figure [in]: one suptitle line and the column titles above, a row per joint."""
+CONVERGENCE_MARGINS = Margins(left=0.85, right=0.12, bottom=0.5, top=0.95, hspace=0.58)
+"""The convergence figure [in]: a two-line suptitle, a titled panel per run."""
 
 
 def _short(name: str) -> str:
@@ -93,6 +102,7 @@ def _validation_figure(identification: Any) -> Figure:
         f"({t[0]:.3g}–{t[-1]:.3g} s, not fitted)\nfiltered at {identification.cutoff_hz:g} Hz; "
         f"condition number {identification.condition_number:.3g}"
     )
+    _fix_margins(fig, VALIDATION_MARGINS)
     return fig
 
 
@@ -227,6 +237,7 @@ def _excitation_figure(
     )
     which = "the limits it was designed within" if limits is not None else "the URDF's limits"
     fig.suptitle(f"{robot.name}: excitation ({extra}) over one period; dashed: {which}")
+    _fix_margins(fig, EXCITATION_MARGINS)
     return fig
 
 
@@ -288,6 +299,7 @@ def _convergence_figure(runs: Mapping[str, Mapping[str, Any]], fraction: float, 
         ax.set_title(f"{label}: {note}" + (f"; {extra}" if extra else ""), fontsize=10)
         ax.set_ylabel("|p̂ − p| / |p|")
         ax.set_ylim(1e-10, 10.0)
+        _plain_log_ticks(ax)
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(loc="lower left", fontsize=8, ncols=len(run["names"]) + 1)
     axes[-1].set_xlabel("t [s]")
@@ -295,6 +307,7 @@ def _convergence_figure(runs: Mapping[str, Mapping[str, Any]], fraction: float, 
         title
         or "adaptive estimates along different references (solid: simulated; dotted: averaged model exp(−ΓG t))"
     )
+    _fix_margins(fig, CONVERGENCE_MARGINS)
     return fig
 
 

@@ -33,9 +33,11 @@ from twolink_pin.plotting._style import (
     NORM_PANEL_HEIGHT,
     PANEL_DECORATION_HEIGHT,
     PARAM_FIGSIZE,
+    PARAM_MARGINS,
     PARAM_ROW_HEIGHT,
     SUMMARY_WIDTH,
     SUPTITLE_HEIGHT,
+    _fix_margins,
     _new_figure,
     _title,
     _unblock_legends,
@@ -191,6 +193,8 @@ def _parameter_curves_figure(
     fig.set_size_inches(PARAM_FIGSIZE[0] + legend_width, fig.get_size_inches()[1])
     what = f"{kind} parameter estimation error p̂ − p"
     fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    if legend_width == 0.0:  # every legend inside its panel (an outside one: constrained layout)
+        _fix_margins(fig, PARAM_MARGINS)
     return fig
 
 

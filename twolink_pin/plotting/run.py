@@ -31,12 +31,16 @@ from twolink_pin.plotting._style import (
     LOG_FLOOR,
     NOTE_BOX,
     SIM_TORQUE_FIGSIZE,
+    SIM_TORQUE_MARGINS,
     STATE_FIGSIZE,
+    STATE_MARGINS,
     _check_figure_numbers,
     _envelope,
+    _fix_margins,
     _free_spot,
     _limit_lines,
     _new_figure,
+    _plain_log_ticks,
     _rows_figsize,
     _save_all,
     _title,
@@ -115,6 +119,7 @@ def _state_figure(
     log.semilogy(
         te, env, color=ERROR_COLOR, lw=1.2, drawstyle="steps-post", label=f"max $|{esym}|$ per window"
     )
+    _plain_log_ticks(log)
     log.set_ylim(max(LOG_FLOOR, 0.3 * float(env.min())), 3.0 * float(env.max()))
     width = float(te[1] - te[0]) if len(te) > 1 else duration
     log.set_ylabel(f"$|{esym}|$ [{unit}]")
@@ -130,6 +135,7 @@ def _state_figure(
     fig.suptitle(
         _title(f"joint {j + 1} {what}: actual vs desired, error", key, figure_numbers, heading), fontsize=11
     )
+    _fix_margins(fig, STATE_MARGINS)
     return fig
 
 
@@ -198,6 +204,7 @@ def _torque_figure(
     sat = "saturated at the limits" if result.saturate else "no saturation"
     heading = heading if heading is not None else _heading(result, None)
     fig.suptitle(_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
+    _fix_margins(fig, SIM_TORQUE_MARGINS)
     shown = np.concatenate([result.tau, result.tau_command]) if clipped else result.tau
     times = np.concatenate([t, t]) if clipped else t
     _unblock_legends(fig, [(axes[j, 0], times, shown[:, j]) for j in range(nv)])

@@ -27,14 +27,17 @@ from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     ERROR_COLOR,
     JOINT_FIGSIZE,
+    JOINT_MARGINS,
     LEGEND_BOX,
     NOTE_BOX,
     REACH_COLOR,
     TORQUE_FIGSIZE,
+    TORQUE_MARGINS,
     TORQUE_ROW_HEIGHT,
     WORKSPACE_3D_FIGSIZE,
     WORKSPACE_FIGSIZE,
     _check_figure_numbers,
+    _fix_margins,
     _free_spot,
     _limit_lines,
     _new_figure,
@@ -93,6 +96,7 @@ def _joint_trajectory_figure(
     axes[-1].set_xlim(t[0], t[-1])
     what = f"desired {name} and its derivatives over one period (T = {trajectory.period:g} s)"
     fig.suptitle(_title(what, f"theta{j + 1}", figure_numbers))
+    _fix_margins(fig, JOINT_MARGINS)
     return fig
 
 
@@ -376,6 +380,7 @@ def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]
         verdict = ("within" if check.within_limits else "EXCEEDS") + " the motor limits"
     what = f"desired torques M q̈ + C q̇ + g along one period: {verdict}"
     fig.suptitle(_title(what, "desired_torque", figure_numbers))
+    _fix_margins(fig, TORQUE_MARGINS)
     _unblock_legends(fig, [(ax, check.t, check.tau[:, j]) for j, ax in enumerate(axes)])
     return fig
 
