@@ -39,12 +39,14 @@ GROUPS: dict[str, str] = {
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 
 FIRST: tuple[str, ...] = (
-    "test_cluster.py",
-    "test_docs_task_space.py",
-    "test_benchmark_script.py",
-    "test_docs.py",
+    "test_docs.py",  # the "docs" group: the site build (~3 min under load) and the tutorial
     "test_tutorial.py",
-    "test_report.py",
+    "test_cluster.py",  # Ctrl-C on a cluster (15-83 s), the sweep-throughput benchmark (55 s), ...
+    "test_docs_task_space.py",  # four UR5 runs of 16 s and a sweep (compare: 82 s)
+    "test_benchmark_script.py",  # scripts/benchmark.py --quick (~50 s)
+    "test_report.py",  # report builds, Chromium
+    "test_visualization.py",
+    "test_errata.py",  # a 30-s adaptive run (60 s under load)
 )
 """Test files (or groups of them), longest first; the rest keep their collection order after them."""
 
