@@ -9,7 +9,8 @@ which tests xdist hands out together (without ``-n``, only the order applies).
   report build, the executed tutorial and the site built from it, Chromium on a page), its
   tests are one unit of xdist's ``loadgroup`` scheduling (:data:`GROUPS`), so it is made once,
   not once per worker (or once per stretch of the module a worker gets).
-- **The longest start first** (:data:`FIRST`, by measured duration on the 2-core VM): xdist
+- **The longest start first** (:data:`FIRST`, by the sum of their tests' durations in one
+  ``-n 2`` run on the 2-core VM at load 4-6, 2026-12-02: 6238 s in all): xdist
   hands tests (and groups) out in collection order to whichever worker is free
   (``--no-loadscope-reorder``: not by group size), so the run does not end with one worker
   idle while the other is still in an 80-s test.
@@ -39,14 +40,20 @@ GROUPS: dict[str, str] = {
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 
 FIRST: tuple[str, ...] = (
-    "test_docs.py",  # the "docs" group: the site build (~3 min under load) and the tutorial
+    "test_identification.py",  # the "identification" group: 724 s of test time at load ~6
+    "test_report.py",  # 624 s: report builds, Chromium
+    "test_cluster.py",  # 449 s: Ctrl-C on a cluster, the sweep-throughput benchmark (140 s), ...
+    "test_docs_task_space.py",  # 549 s, ungrouped: compare alone 273 s
+    "test_docs.py",  # the "docs" group, 248 s: the site build (178 s) and the tutorial
     "test_tutorial.py",
-    "test_cluster.py",  # Ctrl-C on a cluster (15-83 s), the sweep-throughput benchmark (55 s), ...
-    "test_docs_task_space.py",  # four UR5 runs of 16 s and a sweep (compare: 82 s)
-    "test_benchmark_script.py",  # scripts/benchmark.py --quick (~50 s)
-    "test_report.py",  # report builds, Chromium
-    "test_visualization.py",
-    "test_errata.py",  # a 30-s adaptive run (60 s under load)
+    "test_benchmark_script.py",  # 195 s: scripts/benchmark.py --quick
+    "test_docs_images.py",  # 218 s
+    "test_plotting.py",  # 210 s, grouped
+    "test_new_laws.py",  # 345 s, ungrouped
+    "test_visualization.py",  # 114 s, grouped
+    "test_physical.py",  # 110 s, grouped
+    "test_bags.py",  # 93 s, grouped
+    "test_se3_trajectory.py",  # 95 s
 )
 """Test files (or groups of them), longest first; the rest keep their collection order after them."""
 
