@@ -33,6 +33,8 @@ demo: $(VENV)/.installed
 
 # tests/test_docs.py runs the same strict build as `make docs` (into a temporary folder),
 # on the tutorial that tests/test_tutorial.py has just executed on a fresh kernel.
+# Which tests share a worker and which start first: pyproject.toml's addopts
+# (--dist loadgroup --no-loadscope-reorder) and tests/conftest.py.
 test: $(VENV)/.installed-test
 	$(BIN)/ruff check .
 	$(BIN)/python -m pytest -n $(TEST_WORKERS)
