@@ -15,7 +15,7 @@ from twolink_pin.controllers.task_space import (
     block_gain,
     desired_frame,
     null_space_torque,
-    pose_error,
+    task_error,
     task_rows,
 )
 from twolink_pin.dynamics import joint_inertia
@@ -131,7 +131,7 @@ class Impedance(Controller[ImpedanceGains]):
         f = terms.frame(x.q, x.v)
         J = f.jacobian[:, rows]
         d = desired_frame(x)  # x_des, R_des, twist_des
-        e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
+        e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
         e_dot = np.matvec(J, x.v) - d.twist[:, rows]
         force = -(np.matvec(self._K, e) + np.matvec(self._D, e_dot))
         tau = terms.gravity(x.q) + np.vecmat(force, J)

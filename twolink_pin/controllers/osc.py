@@ -14,7 +14,7 @@ from twolink_pin.controllers.task_space import (
     block_gain,
     desired_frame,
     null_space_torque,
-    pose_error,
+    task_error,
     task_rows,
 )
 from twolink_pin.model import RobotModel
@@ -106,7 +106,7 @@ class OperationalSpace(Controller[OSCGains]):
         d = desired_frame(x)  # x_des, R_des, twist_des, accel_des
         x_dot_des = d.twist[:, rows]
         x_ddot_des = d.accel[:, rows]
-        e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
+        e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
         e_dot = np.matvec(J, x.v) - x_dot_des
         desired = x_ddot_des - np.matvec(self._D, e_dot) - np.matvec(self._K, e)
         MinvJt = terms.solve_mass(x.q, np.swapaxes(J, -1, -2))
