@@ -97,11 +97,15 @@ class RigidBodyTerms:
         return self._models, self._data
 
     def _rows(self, *arrays: np.ndarray) -> tuple[int, list[pin.Model], pin.Data]:
+        # ``arrays``: 2-D ndarrays (:meth:`_matrix`); a plain loop (called at every RK4 stage)
         models, data = self._dynamics()
-        n = max(max(np.shape(a)[0] for a in arrays), len(models))
-        if len(models) > 1 and any(np.shape(a)[0] not in (1, n) for a in arrays):
+        n = len(models)
+        for a in arrays:
+            if a.shape[0] > n:
+                n = a.shape[0]
+        if len(models) > 1 and any(a.shape[0] not in (1, n) for a in arrays):
             raise InvalidParameterError(
-                "q", f"shape {np.shape(arrays[0])}", f"one row, or one per run ({len(models)})"
+                "q", f"shape {arrays[0].shape}", f"one row, or one per run ({len(models)})"
             )
         return n, models, data
 
