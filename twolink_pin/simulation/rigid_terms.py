@@ -7,7 +7,7 @@ parameters, built the first time a law asks):
 
 ==============  ================================================================
 ``mass``        ``pin.crba`` (upper triangle), symmetrised; read-only, and reused when
-                asked again for the same array of the same values
+                asked again for the same values (same dtype, shape and bytes)
 ``gravity``     ``pin.computeGeneralizedGravity``
 ``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
 ``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
