@@ -15,6 +15,7 @@ from twolink_pin.controllers.task_space import (
     block_gain,
     desired_frame,
     null_space_torque,
+    row_index,
     task_error,
     task_rows,
 )
@@ -88,6 +89,7 @@ class Impedance(Controller[ImpedanceGains]):
         self._K = block_gain(g.k, g.k_rot, self.rows)
         self._D = block_gain(g.d, g.d_rot, self.rows)
         self._redundant = len(self.rows) < robot.nv
+        self._index = row_index(self.rows)  # a slice when the rows are consecutive: views
         self._inertia = TaskInertia(self.name)
 
     @property
@@ -127,7 +129,7 @@ class Impedance(Controller[ImpedanceGains]):
         }
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        rows = self.rows
+        rows = self._index
         f = terms.frame(x.q, x.v)
         J = f.jacobian[:, rows]
         d = desired_frame(x)  # x_des, R_des, twist_des
@@ -138,7 +140,7 @@ class Impedance(Controller[ImpedanceGains]):
         if self._redundant:
             g = self.gains
             tau0 = -(g.kp_null * (x.q - x.q_des) + g.kd_null * (x.v - x.v_des))
-            MinvJt = terms.solve_mass(x.q, np.swapaxes(J, -1, -2))
+            MinvJt = terms.solve_mass(x.q, J.transpose(0, 2, 1))
             Lam = self._inertia(np.matmul(J, MinvJt), x.t)
             tau = tau + null_space_torque(J, MinvJt, Lam, tau0)
         return LawOutput(tau)
