@@ -15,7 +15,8 @@ from twolink_pin.controllers.task_space import (
     block_gain,
     desired_frame,
     null_space_torque,
-    pose_error,
+    row_index,
+    task_error,
     task_rows,
 )
 from twolink_pin.dynamics import joint_inertia
@@ -88,6 +89,7 @@ class Impedance(Controller[ImpedanceGains]):
         self._K = block_gain(g.k, g.k_rot, self.rows)
         self._D = block_gain(g.d, g.d_rot, self.rows)
         self._redundant = len(self.rows) < robot.nv
+        self._index = row_index(self.rows)  # a slice when the rows are consecutive: views
         self._inertia = TaskInertia(self.name)
 
     @property
@@ -127,18 +129,18 @@ class Impedance(Controller[ImpedanceGains]):
         }
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        rows = self.rows
+        rows = self._index
         f = terms.frame(x.q, x.v)
         J = f.jacobian[:, rows]
         d = desired_frame(x)  # x_des, R_des, twist_des
-        e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
+        e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
         e_dot = np.matvec(J, x.v) - d.twist[:, rows]
         force = -(np.matvec(self._K, e) + np.matvec(self._D, e_dot))
         tau = terms.gravity(x.q) + np.vecmat(force, J)
         if self._redundant:
             g = self.gains
             tau0 = -(g.kp_null * (x.q - x.q_des) + g.kd_null * (x.v - x.v_des))
-            MinvJt = terms.solve_mass(x.q, np.swapaxes(J, -1, -2))
+            MinvJt = terms.solve_mass(x.q, J.transpose(0, 2, 1))
             Lam = self._inertia(np.matmul(J, MinvJt), x.t)
             tau = tau + null_space_torque(J, MinvJt, Lam, tau0)
         return LawOutput(tau)

@@ -14,7 +14,8 @@ from twolink_pin.controllers.task_space import (
     block_gain,
     desired_frame,
     null_space_torque,
-    pose_error,
+    row_index,
+    task_error,
     task_rows,
 )
 from twolink_pin.model import RobotModel
@@ -92,6 +93,7 @@ class OperationalSpace(Controller[OSCGains]):
         self._K = block_gain(g.kp, g.kp_rot, self.rows)
         self._D = block_gain(g.kd, g.kd_rot, self.rows)
         self._redundant = len(self.rows) < robot.nv
+        self._index = row_index(self.rows)  # a slice when the rows are consecutive: views
         self._inertia = TaskInertia(self.name)
 
     @property
@@ -100,16 +102,16 @@ class OperationalSpace(Controller[OSCGains]):
         return self._inertia.damped
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        rows = self.rows
+        rows = self._index
         f = terms.frame(x.q, x.v)
         J = f.jacobian[:, rows]
         d = desired_frame(x)  # x_des, R_des, twist_des, accel_des
         x_dot_des = d.twist[:, rows]
         x_ddot_des = d.accel[:, rows]
-        e = pose_error(f.position, f.rotation, d.position, d.rotation)[:, rows]
+        e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
         e_dot = np.matvec(J, x.v) - x_dot_des
         desired = x_ddot_des - np.matvec(self._D, e_dot) - np.matvec(self._K, e)
-        MinvJt = terms.solve_mass(x.q, np.swapaxes(J, -1, -2))
+        MinvJt = terms.solve_mass(x.q, J.transpose(0, 2, 1))
         Lam = self._inertia(np.matmul(J, MinvJt), x.t)
         tau = np.vecmat(np.matvec(Lam, desired - f.drift[:, rows]), J) + terms.bias(x.q, x.v)
         if self._redundant:

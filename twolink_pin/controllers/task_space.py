@@ -36,6 +36,10 @@ from twolink_pin.model import RobotModel
 SINGULAR_RATIO = 1e-3
 """ε: the task inertia is damped when the smallest eigenvalue of ``J M⁻¹ Jᵀ`` normalised to a
 unit diagonal is below ε (its largest is at most k: a condition number above about 1000 k)."""
+_SKEW_PLUS = np.array([7, 2, 3])
+"""Flat indices (row-major 3 × 3) of E₂₁, E₀₂, E₁₀."""
+_SKEW_MINUS = np.array([5, 6, 1])
+"""Flat indices of E₁₂, E₂₀, E₀₁."""
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 """Names of the six task rows (world axes; linear first)."""
 
@@ -88,16 +92,21 @@ def task_rows(robot: RobotModel) -> np.ndarray:
 
 def rotation_error(R: np.ndarray, R_des: np.ndarray) -> np.ndarray:
     """``log(R R_dᵀ)`` [rad] in world axes, shape (N, 3), for (N, 3, 3) and (1 or N, 3, 3)."""
-    E = R @ np.swapaxes(R_des, -1, -2)
-    w = 0.5 * np.stack((E[:, 2, 1] - E[:, 1, 2], E[:, 0, 2] - E[:, 2, 0], E[:, 1, 0] - E[:, 0, 1]), axis=1)
-    sin = np.linalg.norm(w, axis=1)
+    E = R @ R_des.transpose(0, 2, 1)
+    # The skew part (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2 from E's rows of 9 (few numpy calls:
+    # this runs at every RK4 stage of a task-space law).
+    flat = E.reshape(-1, 9)
+    w = 0.5 * (flat.take(_SKEW_PLUS, axis=1) - flat.take(_SKEW_MINUS, axis=1))
+    sin = np.sqrt(np.add.reduce(w * w, axis=1))  # |w|, as numpy.linalg.norm computes it
     cos = 0.5 * (E[:, 0, 0] + E[:, 1, 1] + E[:, 2, 2] - 1.0)
     angle = np.arctan2(sin, cos)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        factor = np.where(sin > 1e-9, angle / sin, 1.0 + angle**2 / 6.0)
+    factor = 1.0 + angle * angle / 6.0  # θ / sin θ: its series near 0, else the quotient
+    np.divide(angle, sin, out=factor, where=sin > 1e-9)
     out = factor[:, None] * w
-    for i in np.flatnonzero(angle > np.pi - 1e-6):  # near π the skew part vanishes
-        out[i] = pin.log3(E[i])
+    near_pi = angle > np.pi - 1e-6
+    if near_pi.any():  # near π the skew part vanishes
+        for i in np.flatnonzero(near_pi):
+            out[i] = pin.log3(E[i])
     return out
 
 
@@ -106,6 +115,30 @@ def pose_error(
 ) -> np.ndarray:
     """``(p − p_d, log(R R_dᵀ))`` [m, rad], shape (N, 6)."""
     return np.concatenate((position - position_des, rotation_error(rotation, rotation_des)), axis=1)
+
+
+def row_index(rows: np.ndarray) -> slice | np.ndarray:
+    """``rows`` as a slice when they are consecutive (a view, cheaper than fancy indexing at
+    every RK4 stage: the twolink's 0:2, a 6-D task's 0:6), else the array itself."""
+    if rows.size and np.array_equal(rows, np.arange(rows[0], rows[0] + rows.size)):
+        return slice(int(rows[0]), int(rows[0]) + rows.size)
+    return rows
+
+
+def task_error(
+    position: np.ndarray,
+    rotation: np.ndarray,
+    position_des: np.ndarray,
+    rotation_des: np.ndarray,
+    rows: slice | np.ndarray,
+) -> np.ndarray:
+    """:func:`pose_error` on the task's ``rows`` (increasing, as :func:`task_rows` gives them,
+    or their :func:`row_index`), shape (N, k); the orientation error is computed only when a
+    row needs it."""
+    last = rows.stop - 1 if isinstance(rows, slice) else (rows[-1] if rows.size else -1)
+    if last >= 3:
+        return pose_error(position, rotation, position_des, rotation_des)[:, rows]
+    return (position - position_des)[:, rows]  # a position task (the twolink: x, y)
 
 
 def block_gain(linear: np.ndarray, angular: np.ndarray, rows: np.ndarray) -> np.ndarray:
@@ -130,11 +163,12 @@ class TaskInertia:
 
     def __call__(self, A: np.ndarray, t: float) -> np.ndarray:
         """Λ from ``A = J M⁻¹ Jᵀ`` (N, k, k) at time ``t`` [s]."""
-        scale = 1.0 / np.sqrt(np.einsum("nii->ni", A))  # the rows' units (1/kg, 1/(kg·m²)) out
-        s, U = np.linalg.eigh(A * scale[:, :, None] * scale[:, None, :])
+        scale = 1.0 / np.sqrt(A.diagonal(0, 1, 2))  # the rows' units (1/kg, 1/(kg·m²)) out
+        rows, cols = scale[:, :, None], scale[:, None, :]
+        s, U = np.linalg.eigh(A * rows * cols)
         rho2 = np.maximum(SINGULAR_RATIO**2 - s[:, :1] ** 2, 0.0)
-        near = rho2[:, 0] > 0
-        if near.any():
+        if rho2.any():
+            near = rho2[:, 0] > 0
             self.damped += 1
             if not self._warned:
                 self._warned = True
@@ -146,8 +180,8 @@ class TaskInertia:
                     stacklevel=3,
                 )
         inverse = s / (s * s + rho2)
-        core = np.matmul(U * inverse[:, None, :], np.swapaxes(U, -1, -2))
-        return core * scale[:, :, None] * scale[:, None, :]
+        core = np.matmul(U * inverse[:, None, :], U.transpose(0, 2, 1))
+        return core * rows * cols
 
 
 def null_space_torque(J: np.ndarray, MinvJt: np.ndarray, Lam: np.ndarray, tau0: np.ndarray) -> np.ndarray:

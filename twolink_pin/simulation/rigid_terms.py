@@ -7,7 +7,7 @@ parameters, built the first time a law asks):
 
 ==============  ================================================================
 ``mass``        ``pin.crba`` (upper triangle), symmetrised; read-only, and reused when
-                asked again for the same array of the same values
+                asked again for the same values (same dtype, shape and bytes)
 ``gravity``     ``pin.computeGeneralizedGravity``
 ``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
 ``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
@@ -78,7 +78,7 @@ class RigidBodyTerms:
         self._frames: dict[str | None, int] = {None: robot.ee_frame_id}
         self._zero = np.zeros(robot.nv)
         self._lower = np.tril_indices(robot.nv, -1)
-        self._last_mass: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._last_mass: tuple[tuple[np.dtype, tuple[int, ...], bytes], np.ndarray] | None = None
         self._frame_cache: dict[tuple[object, ...], FrameTerms] = {}
 
     # -- models ------------------------------------------------------------------------
@@ -97,11 +97,15 @@ class RigidBodyTerms:
         return self._models, self._data
 
     def _rows(self, *arrays: np.ndarray) -> tuple[int, list[pin.Model], pin.Data]:
+        # ``arrays``: 2-D ndarrays (:meth:`_matrix`); a plain loop (called at every RK4 stage)
         models, data = self._dynamics()
-        n = max(max(np.shape(a)[0] for a in arrays), len(models))
-        if len(models) > 1 and any(np.shape(a)[0] not in (1, n) for a in arrays):
+        n = len(models)
+        for a in arrays:
+            if a.shape[0] > n:
+                n = a.shape[0]
+        if len(models) > 1 and any(a.shape[0] not in (1, n) for a in arrays):
             raise InvalidParameterError(
-                "q", f"shape {np.shape(arrays[0])}", f"one row, or one per run ({len(models)})"
+                "q", f"shape {arrays[0].shape}", f"one row, or one per run ({len(models)})"
             )
         return n, models, data
 
@@ -113,13 +117,23 @@ class RigidBodyTerms:
             q = q[None]
         return np.broadcast_to(q, (n, self._nv))
 
+    @staticmethod
+    def _matrix(a: np.ndarray) -> np.ndarray:
+        """``a`` as a 2-D array (the engine's (N, nv) state as it is)."""
+        if type(a) is np.ndarray and a.ndim == 2:
+            return a
+        return np.atleast_2d(a)
+
     # -- terms -------------------------------------------------------------------------
 
     def mass(self, q: np.ndarray) -> np.ndarray:
-        q = np.atleast_2d(q)
+        q = self._matrix(q)
+        # Asked twice per law call (solve_mass, then mass): reused when q has the same shape
+        # and the same bytes (exact values; no copy kept, no array_equal).
+        key = (q.dtype, q.shape, q.tobytes())
         last = self._last_mass
-        if last is not None and last[0] is q and np.array_equal(last[1], q):  # asked twice per law
-            return last[2]
+        if last is not None and last[0] == key:
+            return last[1]
         n, models, data = self._rows(q)
         Q = self._states(q, n)
         out = np.empty((n, self._nv, self._nv))
@@ -127,12 +141,12 @@ class RigidBodyTerms:
             out[i] = pin.crba(models[i % len(models)], data, Q[i])  # the upper triangle
         lower = self._lower
         out[:, lower[0], lower[1]] = out[:, lower[1], lower[0]]
-        out.setflags(write=False)
-        self._last_mass = (q, q.copy(), out)
+        frozen(out)
+        self._last_mass = (key, out)
         return out
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
-        q = np.atleast_2d(q)
+        q = self._matrix(q)
         n, models, data = self._rows(q)
         Q = self._states(q, n)
         out = np.empty((n, self._nv))
@@ -141,7 +155,7 @@ class RigidBodyTerms:
         return frozen(out)
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-        q, v = np.atleast_2d(q), np.atleast_2d(v)
+        q, v = self._matrix(q), self._matrix(v)
         n, models, data = self._rows(q, v)
         Q, V = self._states(q, n), self._states(v, n)
         out = np.empty((n, self._nv))
@@ -159,10 +173,11 @@ class RigidBodyTerms:
             )
         M = self.mass(q)
         n = max(M.shape[0], b.shape[0])
-        M = np.broadcast_to(M, (n, self._nv, self._nv))
+        if M.shape[0] != n:
+            M = np.broadcast_to(M, (n, self._nv, self._nv))
         if b.ndim == 2:
             return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
-        return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, *b.shape[1:]))))
+        return frozen(np.linalg.solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
 
     def frame_id(self, frame: str | None) -> int:
         """Index of ``frame`` in the model (None: the end effector)."""
@@ -178,7 +193,7 @@ class RigidBodyTerms:
 
     def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
         fid = self.frame_id(frame)
-        q, v = np.atleast_2d(q), np.atleast_2d(v)
+        q, v = self._matrix(q), self._matrix(v)
         # The same (q, q̇) is asked again within a step (the reference's frame at RK4 stages 2
         # and 3, and at stage 4 and the next step's stage 1): the last FRAME_CACHE results by
         # value (read-only, so sharing them is safe).
