@@ -309,7 +309,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--no-identification",
         action="store_true",
-        help="skip the twolink's identification section (beside Fig. 27; ~6 s of the report's time)",
+        help="skip the twolink's identification section (beside Fig. 27; about a third of the report's CPU time)",
     )
     add_robot_options(p)
     add_disturbance_options(p)

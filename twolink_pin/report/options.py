@@ -32,8 +32,8 @@ class ReportOptions:
             2-core machine), at most 64.
         animation: Whether to write the self-contained animation.
         identification: Whether the twolink's report has its identification section (beside
-            Fig. 27: the adaptive law along two excitations and an identification; about
-            14 s of CPU: without it the report takes 11–13 s on 2 cores instead of 17–19 s).
+            Fig. 27: the adaptive law along two excitations and an identification from a
+            logged 2-kHz run; about a third of the report's CPU time, docs/performance.md).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
