@@ -210,37 +210,37 @@ def _labels_fit(fig: Figure) -> bool:
     return top is None or not any(top.overlaps(area) for area in areas[:-1])
 
 
-def _save(fig: Figure, path: Path) -> Path:
-    """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default).
-
-    A PNG is drawn once on the figure's Agg canvas and its pixels written as they are
-    (zlib level :data:`PNG_COMPRESS_LEVEL`); a figure with fixed :class:`Margins` whose
-    labels do not fit (:func:`_labels_fit`) is laid out by constrained layout and drawn
-    again."""
-    fmt = path.suffix[1:].lower() or "png"
+def _lay_out_once(fig: Figure) -> None:
+    """Run ``fig``'s layout engine once, then remove it: with a layout engine set, savefig
+    draws the whole figure twice (a first pass with drawing disabled that runs the layout,
+    then the real one). Same layout, same pixels (checked byte for byte)."""
     engine = fig.get_layout_engine()
     if engine is not None and fig.axes:
-        # The layout once, then one plain draw: with a layout engine set, savefig draws the
-        # whole figure twice (a first pass with drawing disabled that runs the layout, then
-        # the real one). Same layout, same pixels (checked byte for byte).
         engine.execute(fig)
         with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
             fig.set_layout_engine(None)  # None (not "none", a placeholder savefig still pre-draws for)
-    if fmt != "png":
-        with atomic_write(path, "wb") as f:
-            fig.savefig(f, format=fmt, dpi=DPI)
-        return path
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default).
+
+    The figure is drawn once on its Agg canvas; a figure with fixed :class:`Margins` whose
+    labels do not fit (:func:`_labels_fit`) is then laid out by constrained layout and drawn
+    again. A PNG's pixels are written as drawn (zlib level :data:`PNG_COMPRESS_LEVEL`); other
+    formats go through ``savefig``."""
+    fmt = path.suffix[1:].lower() or "png"
+    _lay_out_once(fig)
     canvas = fig.canvas
     assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (_new_figure)
     canvas.draw()
     if getattr(fig, "_twolink_margins", None) is not None and fig.axes and not _labels_fit(fig):
         fig.set_layout_engine("constrained")
-        layout = fig.get_layout_engine()
-        assert layout is not None
-        layout.execute(fig)
-        with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
-            fig.set_layout_engine(None)
+        _lay_out_once(fig)
         canvas.draw()
+    if fmt != "png":
+        with atomic_write(path, "wb") as f:
+            fig.savefig(f, format=fmt, dpi=DPI)
+        return path
     with atomic_write(path, "wb") as f:
         matplotlib.image.imsave(
             f,  # type: ignore[arg-type]  # a binary file (mode "wb")
