@@ -5,11 +5,18 @@ The CLI's handlers record each signal here and raise :class:`KeyboardInterrupt` 
 catch that exception on its way (a Dask client call in progress, a callback wrapper): the
 loop then calls :func:`check` between its steps, which raises it again, so Ctrl-C stops a
 sweep on a cluster within one step of the loop however the first exception fared.
+
+Some places drop an exception raised in them: ``os.fork``'s at-fork hooks (logging registers
+some), finalisers. A signal that arrives while the report forks its workers was lost that way
+(the report ran on to its end). Code that forks runs inside :func:`deferred`: the handlers
+then only record the signal, and leaving the block raises it where the program is.
 """
 
 from __future__ import annotations
 
 import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 
 class Terminated(KeyboardInterrupt):
@@ -26,10 +33,33 @@ def note(signum: int) -> None:
     received.append(signum)
 
 
+_deferring: list[int] = []
+"""One entry per :func:`deferred` block being run (a forked child inherits its parent's)."""
+
+
+def deferring() -> bool:
+    """True inside :func:`deferred`: a handler records its signal and returns."""
+    return bool(_deferring)
+
+
+@contextmanager
+def deferred() -> Iterator[None]:
+    """Run the block with SIGINT and SIGTERM recorded, not raised; on leaving it, raise the
+    last one received meanwhile (:class:`Terminated` or :class:`KeyboardInterrupt`)."""
+    before = len(received)
+    _deferring.append(1)
+    try:
+        yield
+    finally:
+        _deferring.pop()
+    if len(received) > before and not _deferring:
+        raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
+
+
 def check() -> None:
     """Raise :class:`Terminated` or :class:`KeyboardInterrupt` if a signal was received."""
     if received:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
-__all__ = ["Terminated", "check", "note", "received"]
+__all__ = ["Terminated", "check", "deferred", "deferring", "note", "received"]

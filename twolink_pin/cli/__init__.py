@@ -40,12 +40,14 @@ caught it), the outcome is the interrupt; long loops check it (:func:`interrupts
 
 def _terminate(signum: int, frame: object) -> None:
     _signalled.append(signum)
-    raise Terminated
+    if not interrupts.deferring():  # else raised when the block that forks ends
+        raise Terminated
 
 
 def _interrupt(signum: int, frame: object) -> None:
     _signalled.append(signum)
-    raise KeyboardInterrupt
+    if not interrupts.deferring():
+        raise KeyboardInterrupt
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -1,5 +1,11 @@
 """The report's worker processes: a pool that never outlives the report, or the runs in
-this process (``workers = 1``)."""
+this process (``workers = 1``).
+
+Ctrl-C and SIGTERM are the report's to handle: the workers ignore SIGINT (a terminal sends it
+to the whole process group) and die on SIGTERM, and the report, on either, cancels what is
+pending and kills them. Workers are started (forked) inside :func:`interrupts.deferred`, so a
+signal that arrives during the fork is raised after it, not dropped by an at-fork hook.
+"""
 
 from __future__ import annotations
 
@@ -8,6 +14,9 @@ from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ProcessPoolExecutor
 from contextlib import contextmanager
 from typing import Any
+
+from twolink_pin import interrupts
+from twolink_pin.interrupts import Terminated
 
 
 class _InProcess:
@@ -31,6 +40,23 @@ class _InProcess:
         return None
 
 
+def _worker_start() -> None:
+    """In each worker before its first task: the report, not the worker, acts on Ctrl-C."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+
+
+class _Workers:
+    """The process pool, with each ``submit`` (which may fork workers) run deferred."""
+
+    def __init__(self, pool: ProcessPoolExecutor) -> None:
+        self._pool = pool
+
+    def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
+        with interrupts.deferred():
+            return self._pool.submit(fn, *args)
+
+
 @contextmanager
 def _pool(workers: int) -> Iterator[Any]:
     """Worker processes that never outlive the report: on an error, Ctrl-C or SIGTERM the
@@ -39,17 +65,19 @@ def _pool(workers: int) -> Iterator[Any]:
         with _InProcess() as serial:
             yield serial
         return
-    pool = ProcessPoolExecutor(max_workers=workers)
+    pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
     previous = signal.getsignal(signal.SIGTERM)
 
     def _terminate(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt
+        interrupts.note(signum)
+        if not interrupts.deferring():
+            raise Terminated
 
     in_main = _is_main_thread()
     if in_main:
         signal.signal(signal.SIGTERM, _terminate)
     try:
-        yield pool
+        yield _Workers(pool)
     except BaseException:
         processes = list(getattr(pool, "_processes", {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
