@@ -63,3 +63,39 @@ def test_a_signal_during_the_workers_fork_stops_the_report(tmp_path: Path, signa
     assert "Exception ignored" not in done.stderr and "Traceback" not in done.stderr, done.stderr
     assert not (tmp_path / "r").exists()
     assert [p.name for p in tmp_path.iterdir()] == []  # no staging folder left either
+
+
+def test_a_signal_some_library_swallowed_stops_the_report_at_its_next_step(tmp_path: Path) -> None:
+    """The handlers record every signal (interrupts.received) before raising; if the exception
+    is dropped on its way (an at-fork hook, a finaliser), the report's next step raises it: no
+    report, no staging folder. A signal recorded before this build (an earlier, finished call
+    in the same process) does not stop the next one."""
+    from twolink_pin import interrupts
+    from twolink_pin.report import ReportOptions, build_report
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.simulation import SimulationConfig
+
+    small = ReportOptions(
+        run=RunSpec(simulation=SimulationConfig(duration=0.5)),
+        workers=2,
+        animation=False,
+        identification=False,
+        controllers=("pd", "computed-torque"),
+    )
+    seen: list[str] = []
+
+    def progress(what: str, done: int, total: int) -> None:
+        seen.append(what)
+        if what == "model and trajectory":
+            interrupts.note(signal.SIGINT)  # as the handler does; its exception "was dropped"
+
+    mark = len(interrupts.received)
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            build_report(tmp_path / "out", small, progress=progress)
+        assert seen == ["model and trajectory"]  # stopped at the very next step
+        assert list(tmp_path.iterdir()) == []
+        results = build_report(tmp_path / "again", small)  # the old entry is not this build's
+        assert set(results["controllers"]) == {"pd", "computed-torque"}
+    finally:
+        del interrupts.received[mark:]

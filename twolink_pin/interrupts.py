@@ -56,9 +56,11 @@ def deferred() -> Iterator[None]:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
-def check() -> None:
-    """Raise :class:`Terminated` or :class:`KeyboardInterrupt` if a signal was received."""
-    if received:
+def check(since: int = 0) -> None:
+    """Raise :class:`Terminated` or :class:`KeyboardInterrupt` if a signal was received
+    (after the first ``since`` entries of :data:`received`: a caller that marked where it
+    started ignores the signals of an earlier, finished call in the same process)."""
+    if len(received) > since:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from twolink_pin import interrupts
 from twolink_pin.errors import (
     ControllerError,
     InvalidParameterError,
@@ -86,9 +87,11 @@ def build_report(
     options.run.check_law_gains(specs)
     steps = 4 + len(specs) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
     done = 0
+    heard = len(interrupts.received)
 
     def tick(what: str) -> None:
         nonlocal done
+        interrupts.check(since=heard)  # a signal some library caught on its way stops the report here
         done += 1
         if progress:
             progress(what, done, steps)
