@@ -78,17 +78,17 @@ def _pool(workers: int) -> Iterator[Any]:
         signal.signal(signal.SIGTERM, _terminate)
     try:
         yield _Workers(pool)
+        pool.shutdown(wait=True)  # inside the try: interrupted here too, the workers are killed
     except BaseException:
-        processes = list(getattr(pool, "_processes", {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
-            if process.is_alive():
-                process.kill()
-        for process in processes:
-            process.join(timeout=5)
+        with interrupts.deferred():  # a second Ctrl-C does not stop the clean-up half-way
+            processes = list(getattr(pool, "_processes", {}).values())
+            pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                if process.is_alive():
+                    process.kill()
+            for process in processes:
+                process.join(timeout=5)
         raise
-    else:
-        pool.shutdown(wait=True)
     finally:
         if in_main:
             signal.signal(signal.SIGTERM, previous)
