@@ -56,6 +56,20 @@ def deferred() -> Iterator[None]:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
+@contextmanager
+def spared_children() -> Iterator[None]:
+    """Run the block with SIGINT blocked in this thread. Threads started inside inherit the
+    mask, and so do the processes they start, even across ``exec`` (a spawned Python keeps
+    it): the workers that a terminal's Ctrl-C reaches through the process group never see
+    it, and their parent, which then stops them, acts for them. A SIGINT that arrives
+    meanwhile waits and is delivered when the block ends (run it inside :func:`deferred`)."""
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
+
+
 def check(since: int = 0) -> None:
     """Raise :class:`Terminated` or :class:`KeyboardInterrupt` if a signal was received
     (after the first ``since`` entries of :data:`received`: a caller that marked where it
@@ -64,4 +78,4 @@ def check(since: int = 0) -> None:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
-__all__ = ["Terminated", "check", "deferred", "deferring", "note", "received"]
+__all__ = ["Terminated", "check", "deferred", "deferring", "note", "received", "spared_children"]

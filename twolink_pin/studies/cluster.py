@@ -34,7 +34,7 @@ from urllib.parse import urlsplit
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
-from twolink_pin.studies.cluster_startup import _handshake, _probe, _startup_cause, _startup_log
+from twolink_pin.studies.cluster_startup import _handshake, _kill_workers, _probe, _start_local
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -307,17 +307,8 @@ class DaskEngine:
         minutes); their nannies' complaints are silenced.
         """
         if kill and self.cluster is not None:
-            import logging
-            import os
-            import signal
-
-            logging.getLogger("distributed").setLevel(logging.CRITICAL)
             self._pending.clear()  # the tasks die with the workers
-            for nanny in list(getattr(self.cluster, "workers", {}).values()):
-                with contextlib.suppress(Exception):
-                    pid = nanny.pid
-                    if pid:
-                        os.kill(pid, signal.SIGKILL)
+            _kill_workers(self.cluster)
         self.cancel()
         with contextlib.suppress(Exception):
             self.client.close(timeout=5)
@@ -374,9 +365,8 @@ def open_cluster(
         raise InvalidParameterError("workers", workers, f"a whole number from 1 to {MAX_WORKERS}")
     address = scheduler_address(scheduler) if scheduler is not None else "127.0.0.1 (LocalCluster)"
     require_dask()
-    from distributed import Client, LocalCluster
+    from distributed import Client
 
-    cluster = None
     if scheduler is not None:
         _probe(address, timeout)
         _handshake(address, timeout)
@@ -389,26 +379,19 @@ def open_cluster(
         )
     else:
         assert workers is not None
-        try:
-            with _startup_log() as records:
-                cluster = LocalCluster(
-                    n_workers=workers,
-                    threads_per_worker=1,
-                    processes=True,
-                    host="127.0.0.1",
-                    scheduler_port=0,
-                    dashboard_address="127.0.0.1:0",
-                    preload=list(preload) or [__name__],
-                    env={LOCAL_WORKER: "1"},
-                )
-            client = Client(cluster, set_as_default=False)
-        except Exception as exc:
-            if cluster is not None:
-                with contextlib.suppress(Exception):
-                    cluster.close()
-            raise ClusterError(
-                address, f"the LocalCluster did not start ({_startup_cause(exc, records)})"
-            ) from None
+        cluster, client = _start_local(
+            address,
+            dict(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                scheduler_port=0,
+                dashboard_address="127.0.0.1:0",
+                preload=list(preload) or [__name__],
+                env={LOCAL_WORKER: "1"},
+            ),
+        )
         engine = DaskEngine(
             client,
             str(cluster.scheduler_address),

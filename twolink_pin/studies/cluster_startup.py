@@ -4,7 +4,7 @@ or that answers with no Dask message, fails fast and says so (:func:`_probe`,
 :func:`_handshake`); what Dask logs while a LocalCluster starts is kept rather than printed: a nanny that cannot spawn its worker (a
 bad ``multiprocessing-method`` in the user's Dask configuration) or a temporary folder that
 cannot be made is then one line naming the cause, not distributed's own tracebacks and
-warnings on stderr. Imports no Dask."""
+warnings on stderr (:func:`_start_local`). Imports no Dask until called."""
 
 from __future__ import annotations
 
@@ -13,8 +13,10 @@ import logging
 import socket
 import threading
 from collections.abc import Iterator
+from typing import Any
 from urllib.parse import urlsplit
 
+from twolink_pin import interrupts
 from twolink_pin.studies.cluster_errors import ClusterError
 
 
@@ -51,6 +53,58 @@ def _startup_cause(exc: BaseException, records: list[logging.LogRecord]) -> str:
             inner = record.exc_info[1]
             return f"{type(inner).__name__}: {str(inner)[:300]}; {record.getMessage()[:120]}"
     return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+def _start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
+    """A LocalCluster of ``options`` and a client of it, or :class:`ClusterError` naming
+    the cause. Ctrl-C and SIGTERM are held while it starts: Dask cannot close a cluster that
+    is half started (its exit hook then fails on a worker still starting, with a traceback),
+    so the signal is raised once it has started, and the cluster is then stopped. Its
+    worker processes start with SIGINT blocked: a Ctrl-C sent to the process group stops
+    them through this process, not in the middle of their imports with a traceback each."""
+    from multiprocessing import resource_tracker
+
+    from distributed import Client, LocalCluster
+
+    # The tracker unblocks SIGINT in the thread that starts it (after blocking it for its own
+    # start): started here first, it cannot undo spared_children in Dask's threads below.
+    resource_tracker.ensure_running()
+    cluster = client = None
+    records: list[logging.LogRecord] = []
+    try:
+        with _startup_log() as records, interrupts.deferred(), interrupts.spared_children():
+            cluster = LocalCluster(**options)
+            client = Client(cluster, set_as_default=False)
+        return cluster, client
+    except BaseException as exc:
+        if cluster is not None:
+            with interrupts.deferred():  # a second Ctrl-C does not stop the clean-up half-way
+                if not isinstance(exc, Exception):
+                    _kill_workers(cluster)
+                if client is not None:
+                    with contextlib.suppress(Exception):
+                        client.close(timeout=5)
+                with contextlib.suppress(Exception):
+                    cluster.close(timeout=10)
+        if not isinstance(exc, Exception):
+            raise
+        raise ClusterError(
+            address, f"the LocalCluster did not start ({_startup_cause(exc, records)})"
+        ) from None
+
+
+def _kill_workers(cluster: Any) -> None:
+    """Kill a LocalCluster's worker processes at once, their nannies' complaints silenced
+    (a task they are in can take minutes)."""
+    import os
+    import signal
+
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    for nanny in list(getattr(cluster, "workers", {}).values()):
+        with contextlib.suppress(Exception):
+            pid = nanny.pid
+            if pid:
+                os.kill(pid, signal.SIGKILL)
 
 
 def _probe(address: str, timeout: float) -> None:
