@@ -9,7 +9,10 @@ sweep on a cluster within one step of the loop however the first exception fared
 Some places drop an exception raised in them: ``os.fork``'s at-fork hooks (logging registers
 some), finalisers. A signal that arrives while the report forks its workers was lost that way
 (the report ran on to its end). Code that forks runs inside :func:`deferred`: the handlers
-then only record the signal, and leaving the block raises it where the program is.
+then only record the signal, and leaving the block raises it where the program is. Code that
+starts worker processes a terminal's Ctrl-C would reach through the process group (a Dask
+LocalCluster's) also runs inside :func:`spared_children`: they start with SIGINT blocked and
+are stopped by their parent.
 """
 
 from __future__ import annotations
