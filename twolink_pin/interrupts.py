@@ -55,8 +55,8 @@ def deferred() -> Iterator[None]:
         yield
     finally:
         _deferring.pop()
-    if len(received) > before and not _deferring:
-        raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
+    if not _deferring:
+        check(since=before)
 
 
 @contextmanager
@@ -73,6 +73,14 @@ def spared_children() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
+def on_signal(signum: int, frame: object) -> None:
+    """The handler for SIGINT and SIGTERM while a command runs: record ``signum`` and raise
+    it where the program is (:func:`check`), or, inside :func:`deferred`, only record it."""
+    note(signum)
+    if not _deferring:
+        check()
+
+
 def check(since: int = 0) -> None:
     """Raise :class:`Terminated` or :class:`KeyboardInterrupt` if a signal was received
     (after the first ``since`` entries of :data:`received`: a caller that marked where it
@@ -81,4 +89,4 @@ def check(since: int = 0) -> None:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
-__all__ = ["Terminated", "check", "deferred", "deferring", "note", "received", "spared_children"]
+__all__ = ["Terminated", "check", "deferred", "deferring", "note", "on_signal", "received", "spared_children"]

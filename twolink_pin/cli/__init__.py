@@ -38,18 +38,6 @@ _signalled = interrupts.received
 caught it), the outcome is the interrupt; long loops check it (:func:`interrupts.check`)."""
 
 
-def _terminate(signum: int, frame: object) -> None:
-    _signalled.append(signum)
-    if not interrupts.deferring():  # else raised when the block that forks ends
-        raise Terminated
-
-
-def _interrupt(signum: int, frame: object) -> None:
-    _signalled.append(signum)
-    if not interrupts.deferring():
-        raise KeyboardInterrupt
-
-
 def _run(args: argparse.Namespace) -> int:
     """The command under its guards; an exception after a signal is the interrupt, whatever
     it turned into on its way (an ``ImportError`` from an interrupted import)."""
@@ -124,9 +112,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     previous: dict[int, Any] = {}
     del _signalled[:]
     if threading.current_thread() is threading.main_thread():
-        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _terminate)}
+        previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, interrupts.on_signal)}
         if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job ignores Ctrl-C
-            previous[signal.SIGINT] = signal.signal(signal.SIGINT, _interrupt)
+            previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupts.on_signal)
     try:
         ready("running")
         return _run(args)

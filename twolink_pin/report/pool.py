@@ -16,7 +16,6 @@ from contextlib import contextmanager
 from typing import Any
 
 from twolink_pin import interrupts
-from twolink_pin.interrupts import Terminated
 
 
 class _InProcess:
@@ -67,15 +66,9 @@ def _pool(workers: int) -> Iterator[Any]:
         return
     pool = ProcessPoolExecutor(max_workers=workers, initializer=_worker_start)
     previous = signal.getsignal(signal.SIGTERM)
-
-    def _terminate(signum: int, frame: object) -> None:
-        interrupts.note(signum)
-        if not interrupts.deferring():
-            raise Terminated
-
     in_main = _is_main_thread()
-    if in_main:
-        signal.signal(signal.SIGTERM, _terminate)
+    if in_main:  # SIGTERM too cleans up, also when the library is used without the CLI
+        signal.signal(signal.SIGTERM, interrupts.on_signal)
     try:
         yield _Workers(pool)
         pool.shutdown(wait=True)  # inside the try: interrupted here too, the workers are killed
