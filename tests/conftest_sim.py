@@ -18,7 +18,7 @@ from twolink_pin.controllers import Adaptive, Controller, Gains, LawInput, LawOu
 from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import mass_matrix
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, law_input, simulate, terms_for
 from twolink_pin.trajectory import JointTrajectory, default_trajectory
 

@@ -36,7 +36,7 @@ from twolink_pin.errors import InvalidParameterError, SimulationDivergedError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.plant import Plant
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.simulation.terms import BatchTerms, BatchUnavailableError, SingleRunTerms
 from twolink_pin.studies.batch import BatchResult, simulate_batch

@@ -40,7 +40,7 @@ from twolink_pin.controllers import (
 from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import Friction, joint_inertia
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.twolink import closed_form
 
 P_TRUE = np.asarray(ROBOT.p)

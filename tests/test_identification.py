@@ -19,7 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from twolink_pin import InvalidParameterError, load_robot, make_scenario, simulate
+from twolink_pin import InvalidParameterError, RunSpec, load_robot, make_scenario, simulate
 from twolink_pin.cli import main
 from twolink_pin.errors import InputFileError
 from twolink_pin.identification import (
@@ -36,7 +36,6 @@ from twolink_pin.identification import (
     optimise_excitation,
     read_log,
     read_parameter_file,
-    seeded_scenario,
     simulate_log,
     write_log,
 )
@@ -510,19 +509,22 @@ def test_identify_then_control_with_what_was_identified(tmp_path: Path, twolink,
     path = write_json(tmp_path / "p.json", identification_document(found, twolink))
     identified = read_parameter_file(path, twolink)
     b = found.estimate
-    controller, plant = seeded_scenario("adaptive-friction", twolink, identified, "p0")
+    def seeded(law: str, use: str):
+        return RunSpec(law=law, parameters=str(path), parameters_use=use).build(twolink, identified)
+
+    controller, plant = seeded("adaptive-friction", "p0")
     np.testing.assert_allclose(
         controller.initial_state(), [b[0] + b[3], b[3], 0.38 * b[1], *b[4:]], rtol=1e-12
     )
     assert plant.friction.parameters.tolist() == [0.4, 0.2, 0.2, 0.1]  # the plant is the true arm
-    model, _ = seeded_scenario("computed-torque", twolink, identified, "model")
+    model, _ = seeded("computed-torque", "model")
     np.testing.assert_allclose(model.believed_parameters(), [b[0] + b[3], b[3], 0.38 * b[1]], rtol=1e-12)
     result = simulate(controller, plant, default_trajectory(twolink), SimulationConfig(duration=0.2))
     np.testing.assert_allclose(result.p_hat[0], controller.initial_state(), rtol=0, atol=0)
     with pytest.raises(
         InvalidParameterError, match="'computed-torque' estimates none: give its model with --model"
     ):
-        seeded_scenario("computed-torque", twolink, identified, "p0")
+        seeded("computed-torque", "p0")
 
 
 def test_a_parameter_file_of_another_robot_is_refused(tmp_path: Path, twolink) -> None:

@@ -16,7 +16,7 @@ from scipy.integrate import cumulative_trapezoid
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.twolink import closed_form
 

@@ -30,7 +30,7 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import simulate_batch
 

@@ -46,7 +46,7 @@ from twolink_pin.plotting.parameters import (
 )
 from twolink_pin.plotting.run import _simulation_figures, _torque_figure
 from twolink_pin.plotting.trajectory import _motion_plane, _trajectory_figures
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
 from twolink_pin.trajectory import JointTrajectory, default_trajectory
 from twolink_pin.twolink import closed_form

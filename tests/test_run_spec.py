@@ -20,8 +20,7 @@ from twolink_pin.cli.commands.common import run_spec
 from twolink_pin.cli.parser import build_parser
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import load_robot
-from twolink_pin.run_spec import PlantOptions, RunSpec
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import PlantOptions, RunSpec, make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.trajectory import default_trajectory
 

@@ -23,7 +23,7 @@ from twolink_pin.controllers import (
 from twolink_pin.errors import ControllerError, InvalidParameterError, SimulationDivergedError
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.plant import Plant
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import DIVERGENCE_LIMIT, SimulationConfig, simulate
 
 COMPARISON_DURATION = 3.0

@@ -29,8 +29,7 @@ from twolink_pin.errors import ControllerSpecError, InvalidParameterError, Outpu
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
-from twolink_pin.run_spec import RunSpec
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import RunSpec, make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.parquet import METADATA_KEY, read_columns, read_metadata
 from twolink_pin.studies.sweep import (

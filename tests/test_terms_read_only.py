@@ -14,7 +14,7 @@ from twolink_pin.controllers import Controller, LawInput, LawOutput, Terms
 from twolink_pin.controllers.gains import Gains
 from twolink_pin.errors import ControllerError
 from twolink_pin.plant import Plant
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate, terms_for
 
 OUTPUTS: dict[str, Callable[[Terms, np.ndarray, np.ndarray], list[np.ndarray]]] = {

@@ -30,7 +30,7 @@ from browser import scene_js as js  # the scene helpers (node, seek, link2End, â
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError, OutputError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.trajectory import default_trajectory
 from twolink_pin.twolink.reference import REPORT_VIA_XY

@@ -24,7 +24,7 @@ from browser import scene_js as js
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import load_robot
-from twolink_pin.scenario import make_scenario
+from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.trajectory import default_trajectory
 from twolink_pin.visualization import write_html

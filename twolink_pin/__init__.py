@@ -71,8 +71,8 @@ from twolink_pin.identification import (
 from twolink_pin.metrics import BatchMetrics, Metrics, RunningMetrics, compute_metrics
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
 from twolink_pin.plant import Plant
-from twolink_pin.run_spec import PlantOptions, RunSpec
-from twolink_pin.scenario import Scenario, make_scenario
+from twolink_pin.run_spec import PlantOptions, RunSpec, make_scenario
+from twolink_pin.scenario import Scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (

@@ -9,14 +9,19 @@ and the report hold one beside their own options; a saved result records it
 (:meth:`RunSpec.as_dict`), so a run can be replayed from its file alone.
 
 :meth:`RunSpec.build` is the only function that turns a description into a controller and
-its plant (it calls :func:`~twolink_pin.scenario.make_scenario` or, with identified
-parameters, :func:`~twolink_pin.identification.seeded_scenario`).
+its plant: the law once (:func:`~twolink_pin.scenario.make_controller`, believing identified
+parameters from :func:`~twolink_pin.identification.believed` when it is given some), the
+plant once (:meth:`PlantOptions.plant <twolink_pin.plant.PlantOptions.plant>`);
+:func:`make_scenario` is a :class:`RunSpec` built at once. Before building, it refuses an
+option that would do nothing for this law on this robot (:meth:`RunSpec.check_effective`).
 
-Adding a run option: one field here (of :class:`RunSpec` or, for the plant,
-:class:`PlantOptions`, with its check in ``__post_init__`` and its use in :meth:`build`), one
-line in ``cli/parser.py`` and one in :func:`twolink_pin.cli.commands.common.run_spec`, and a
-test that the option reaches the built plant or law (``tests/test_run_spec.py`` shows the
-pattern).
+Adding a run option: one field (of :class:`RunSpec` here or, for the plant,
+:class:`~twolink_pin.plant.PlantOptions` in ``plant.py``, with its check in ``__post_init__``
+and its use in :meth:`build` or :meth:`PlantOptions.plant`), one ``add_argument`` in
+``cli/parser.py``'s run-option group and one line in
+:func:`twolink_pin.cli.commands.common.run_spec`, and a test that the option reaches the
+built plant or law (``tests/test_run_spec.py`` shows the pattern; it also checks that the
+parser's run options and the fields here agree).
 """
 
 from __future__ import annotations
@@ -27,27 +32,22 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from twolink_pin.controllers import Controller
-from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.plant import Plant
-from twolink_pin.scenario import Scenario, law_class, make_scenario
+from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, PlantOptions, robot_friction
+from twolink_pin.scenario import Scenario, law_class, make_controller
 from twolink_pin.simulation import SimulationConfig
 
 if TYPE_CHECKING:
+    from twolink_pin.dynamics import Friction
     from twolink_pin.identification import IdentifiedParameters
 
-FRICTION_CHOICES = ("law", "on", "off")
-"""``PlantOptions.friction``: the profile's friction in the plant of a law that estimates
-friction only (``law``, the report's experiments), in every plant (``on``), in none (``off``)."""
 PARAMETER_USES = ("p0", "model")
 """How identified parameters are used: the estimates start there (``p0``), or the law's
 model believes them (``model``)."""
-ADAPTIVE_SMOOTHING = 1e-3
-"""ε [rad/s] of the friction sign with the adaptive integrator when none is given (the
-exact sign stalls its step-size control); RK4 uses the exact sign (0)."""
-
 Gains = tuple[tuple[str, Any], ...]
 """Gains by field name, as ``((name, value), ...)`` (a value: a number or a tuple)."""
 
@@ -55,59 +55,6 @@ Gains = tuple[tuple[str, Any], ...]
 def _frozen_gains(gains: Mapping[str, Any] | Gains) -> Gains:
     items = gains.items() if isinstance(gains, Mapping) else gains
     return tuple((str(k), tuple(v) if isinstance(v, (list, tuple)) else v) for k, v in items)
-
-
-@dataclass(frozen=True)
-class PlantOptions:
-    """The simulated arm's options (every law of a command runs on the same ones).
-
-    Attributes:
-        friction: ``law`` (default: the profile's friction for a law that estimates friction,
-            none otherwise), ``on`` (every plant) or ``off`` (no plant).
-        saturate: Clip torques at the URDF effort limits.
-        friction_smoothing: ε [rad/s] of ``tanh(q̇/ε)`` for Coulomb friction; None: 0 with
-            RK4, :data:`ADAPTIVE_SMOOTHING` with the adaptive integrator.
-        wrench: An external wrench on a frame over a time window (world axes, N and N·m).
-        payload_step: A payload picked up at a time (the law is not told).
-        sensor_noise: Seeded Gaussian noise on the q [rad] and q̇ [rad/s] the law measures.
-        delay: Steps between a measurement and the torque it produces.
-
-    The last four are the plant's events (:mod:`twolink_pin.disturbances`: what each does,
-    and when, on the engine's grid); all off by default, as in the course report.
-    """
-
-    friction: str = "law"
-    saturate: bool = False
-    friction_smoothing: float | None = None
-    wrench: Wrench | None = None
-    payload_step: PayloadStep | None = None
-    sensor_noise: SensorNoise | None = None
-    delay: int = 0
-
-    def __post_init__(self) -> None:
-        # as_dict / from_dict: the events come back from JSON as mappings
-        for name, kind in (("wrench", Wrench), ("payload_step", PayloadStep), ("sensor_noise", SensorNoise)):
-            value = getattr(self, name)
-            if isinstance(value, Mapping):
-                object.__setattr__(self, name, kind(**value))
-            elif value is not None and not isinstance(value, kind):
-                raise InvalidParameterError(
-                    name, value, f"a twolink_pin.disturbances.{kind.__name__} or None"
-                )
-        check_delay(self.delay)
-        if self.friction not in FRICTION_CHOICES:
-            raise InvalidParameterError(
-                "plant friction", self.friction, f"one of {', '.join(FRICTION_CHOICES)}"
-            )
-        eps = self.friction_smoothing
-        if eps is not None and not (isinstance(eps, (int, float)) and math.isfinite(eps) and eps >= 0):
-            raise InvalidParameterError("friction_smoothing", eps, "a finite ε >= 0 rad/s or None")
-
-    def smoothing(self, method: str) -> float:
-        """ε [rad/s] for the integrator ``method``."""
-        if self.friction_smoothing is not None:
-            return float(self.friction_smoothing)
-        return ADAPTIVE_SMOOTHING if method == "adaptive" else 0.0
 
 
 @dataclass(frozen=True)
@@ -225,34 +172,119 @@ class RunSpec:
             ControllerSpecError: no such law, or it could not be built.
         """
         cls = self.law_class()
-        gains = dict(self.gains)
-        smoothing = self.friction_smoothing
+        gains: dict[str, Any] = dict(self.gains)
+        plant = self.plant.plant(
+            robot, estimates_friction="friction" in cls.estimates, method=self.simulation.method
+        )
+        friction = self.law_friction(cls, robot)
+        parameters = None
         if self.parameters is not None:
-            from twolink_pin.identification import seeded_scenario
+            from twolink_pin.identification import believed
 
             if identified is None:
                 identified = self.read_parameters(robot)
             assert identified is not None
-            scenario: Scenario = seeded_scenario(
-                cls,
-                robot,
-                identified,
-                self.parameters_use,
-                lam=self.lam,
-                gains=gains,
-                saturate=self.plant.saturate,
-                friction_smoothing=smoothing,
+            belief = believed(cls, robot, identified, self.parameters_use, gains)
+            parameters, gains = belief.parameters, belief.gains
+            if belief.friction is not None:
+                smoothing = plant.friction.smoothing if plant.friction is not None else 0.0
+                friction = dataclasses.replace(
+                    belief.friction, smoothing=smoothing or belief.friction.smoothing
+                )
+        controller = make_controller(
+            cls, robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
+        )
+        return Scenario(controller, plant)
+
+    def law_friction(self, cls: type[Controller], robot: RobotModel) -> Friction | None:
+        """The friction a friction-estimating law believes without identified parameters: its
+        robot's profile friction (None for the other laws, or without one)."""
+        if "friction" in cls.estimates and robot.profile.friction is not None:
+            return robot_friction(robot, self.friction_smoothing)[0]
+        return None
+
+    def check_effective(self, robot: RobotModel, laws: Sequence[str | type[Controller]] = ()) -> None:
+        """Refuse an option that would do nothing on ``robot`` for this spec's law, or for every
+        one of ``laws`` (a shared spec): a silent no-op is a wrong answer. The commands call it
+        once, before their runs (λ and gains a law lacks are refused when it is built).
+
+        Raises:
+            InvalidParameterError: the option, its value and why it would do nothing.
+        """
+        classes = [law_class(law) for law in laws] if laws else [self.law_class()]
+        names = ", ".join(f"'{cls.name}'" for cls in classes)
+        plant, sim = self.plant, self.simulation
+        if plant.saturate and not np.isfinite(robot.torque_limits).any():
+            raise InvalidParameterError(
+                "--saturate",
+                True,
+                f"a robot with effort limits ({robot.name}'s URDF gives none: nothing to clip)",
             )
-        else:
-            scenario = make_scenario(
-                cls,
-                robot,
-                lam=self.lam,
-                gains=gains,
-                saturate=self.plant.saturate,
-                friction_smoothing=smoothing,
+        built = [
+            plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
+            for cls in classes
+        ]
+        if (
+            plant.friction == "off"
+            and all(f is None for f in built)
+            and all(
+                self.law_friction(cls, robot) is None and "friction" not in cls.estimates for cls in classes
             )
-        return _with_events(_with_plant(scenario, robot, self.plant, smoothing), self.plant)
+        ):
+            raise InvalidParameterError(
+                "--plant-friction",
+                "off",
+                f"a law whose plant has friction ({names} runs without it already)",
+            )
+        if plant.friction_smoothing is not None and all(
+            f is None and "friction" not in cls.estimates for f, cls in zip(built, classes, strict=True)
+        ):
+            raise InvalidParameterError(
+                "--friction-smoothing",
+                plant.friction_smoothing,
+                f"a run with friction (the plant of {names} has none here and the law models none: "
+                "add --plant-friction on)",
+            )
+        if self.lam is not None and laws and not any(cls.takes("lam") for cls in classes):
+            raise InvalidParameterError(
+                "--lambda", self.lam, f"a law with a λ gain among those that run ({names})"
+            )
+        if self.parameters_use == "p0" and laws and not any(cls.estimates for cls in classes):
+            raise InvalidParameterError(
+                "--p0", self.parameters, f"a law that estimates parameters among those that run ({names})"
+            )
+        self._check_events(sim)
+
+    def _check_events(self, sim: SimulationConfig) -> None:
+        """Refuse a plant event that acts on no step of the run (steps ``t_k = k dt``,
+        ``k < steps``), or that adds nothing."""
+        plant, steps = self.plant, sim.steps
+        dt = sim.duration / steps
+
+        def first_step(t: float) -> int:  # the first k with t_k >= t
+            return math.ceil(t / dt - 1e-9)
+
+        wrench = plant.wrench
+        if wrench is not None:
+            k = first_step(wrench.start)
+            if k >= steps or k * dt >= wrench.stop:
+                raise InvalidParameterError(
+                    "--wrench",
+                    f"@{wrench.start:g}:{wrench.stop:g} s",
+                    f"a window that holds a step of the run (steps at k·{dt:g} s up to {(steps - 1) * dt:g} s;"
+                    f" --duration {sim.duration:g} s)",
+                )
+        if plant.payload_step is not None and first_step(plant.payload_step.time) >= steps:
+            raise InvalidParameterError(
+                "--payload-step",
+                f"at {plant.payload_step.time:g} s",
+                f"a time within the run (before its last step at {(steps - 1) * dt:g} s; --duration {sim.duration:g} s)",
+            )
+        noise = plant.sensor_noise
+        if noise is not None and noise.sigma_q == 0 and noise.sigma_v == 0:
+            raise InvalidParameterError(
+                "--sensor-noise", "0,0", "a standard deviation > 0 on q or q̇ (0,0 adds no noise)"
+            )
 
     def as_dict(self) -> dict[str, Any]:
         """The spec as JSON-ready data (:meth:`from_dict` reads it back)."""
@@ -291,49 +323,9 @@ class RunSpec:
         )
 
 
-def _with_plant(scenario: Scenario, robot: RobotModel, options: PlantOptions, smoothing: float) -> Scenario:
-    """``scenario`` with the plant friction ``options.friction`` asks for (the law's belief unchanged)."""
-    if options.friction == "law":
-        return scenario
-    from twolink_pin.dynamics import Friction
-
-    friction = None
-    if options.friction == "on":
-        friction = scenario.plant.friction
-        if friction is None and robot.profile.friction is not None:
-            viscous, coulomb = robot.profile.friction
-            friction = Friction(viscous, coulomb, smoothing=smoothing)
-    return scenario._replace(plant=Plant(robot, friction=friction, saturate=options.saturate))
-
-
-def _with_events(scenario: Scenario, options: PlantOptions) -> Scenario:
-    """``scenario`` whose plant carries the events ``options`` asks for (the same when none)."""
-    if (
-        options.wrench is None
-        and options.payload_step is None
-        and options.sensor_noise is None
-        and not options.delay
-    ):
-        return scenario
-    plant = scenario.plant
-    return scenario._replace(
-        plant=Plant(
-            plant.robot,
-            plant.friction,
-            plant.saturate,
-            wrench=options.wrench,
-            payload_step=options.payload_step,
-            sensor_noise=options.sensor_noise,
-            delay=options.delay,
-        )
-    )
-
-
 def gains_used(controller: Controller) -> dict[str, Any]:
     """The gains a law ran with (the robot's presets and derived values resolved), JSON-ready:
     a number, a list per joint or per parameter, or None."""
-    import numpy as np
-
     used: dict[str, Any] = {}
     for name, value in controller.gains.values().items():
         if value is None or isinstance(value, (bool, str)):
@@ -348,19 +340,51 @@ def gains_used(controller: Controller) -> dict[str, Any]:
 
 def plant_description(scenario: Scenario) -> str:
     """Which plant a law ran on, in a few words (the comparison table's column)."""
-    plant = scenario.plant
-    parts = ["friction" if plant.friction is not None else "no friction"]
-    if plant.saturate:
-        parts.append("saturated")
-    if plant.wrench is not None:
-        parts.append("wrench")
-    if plant.payload_step is not None:
-        parts.append(f"payload {plant.payload_step.mass:g} kg at {plant.payload_step.time:g} s")
-    if plant.sensor_noise is not None:
-        parts.append("sensor noise")
-    if plant.delay:
-        parts.append(f"delay {plant.delay} steps")
-    return ", ".join(parts)
+    return scenario.plant.describe()
 
 
-__all__ = ["FRICTION_CHOICES", "PARAMETER_USES", "PlantOptions", "RunSpec", "gains_used", "plant_description"]
+def make_scenario(
+    law: str | type[Controller],
+    robot: RobotModel,
+    *,
+    lam: float | None = None,
+    gains: Mapping[str, Any] | None = None,
+    saturate: bool = False,
+    friction_smoothing: float = 0.0,
+) -> Scenario:
+    """The law on ``robot`` with its default gains (the robot's presets), and its plant: the
+    :class:`RunSpec` of these options, built (:meth:`RunSpec.build`).
+
+    Args:
+        law: The law (class, registered name, ``file.py:Class`` or ``module:Class``).
+        robot: The arm (plant and law model).
+        lam: ``λ`` [1/s] for a law whose gains have ``lam``; refused for one without.
+        gains: Other gains by field name (one value, one per joint, ...), over the defaults.
+        saturate: Clip torques at the URDF limits in the plant.
+        friction_smoothing: ε [rad/s] of ``tanh(q̇/ε)`` for Coulomb friction (0: exact sgn).
+
+    Raises:
+        InvalidParameterError: ``lam`` or a gain the law does not have.
+        ControllerSpecError: no such law.
+    """
+    cls = law_class(law)
+    smoothing = (friction_smoothing or None) if "friction" in cls.estimates else None
+    spec = RunSpec(
+        law=cls,
+        gains=tuple((gains or {}).items()),
+        lam=lam,
+        plant=PlantOptions(saturate=saturate, friction_smoothing=smoothing),
+    )
+    return spec.build(robot)
+
+
+__all__ = [
+    "ADAPTIVE_SMOOTHING",
+    "FRICTION_CHOICES",
+    "PARAMETER_USES",
+    "PlantOptions",
+    "RunSpec",
+    "gains_used",
+    "make_scenario",
+    "plant_description",
+]

@@ -1,15 +1,16 @@
-"""A law and the plant it drives: :func:`make_scenario`.
+"""A law and the plant it drives (:class:`Scenario`), and the law's half of building one
+(:func:`make_controller`).
 
-The plant is the robot itself, with the friction of its profile when the law estimates
-friction (the twolink: the report's V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m), as in
-the report's experiments; the law believes that same friction (its estimates start from
+:meth:`twolink_pin.run_spec.RunSpec.build` is the one place a run is assembled: the law from
+:func:`make_controller`, its plant from :meth:`twolink_pin.plant.PlantOptions.plant`.
+A friction-estimating law believes its robot's profile friction (the twolink: the report's
+V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m; its estimates start from
 ``friction_initial_estimate`` × it). Nothing here knows a law by name: what a law
 estimates and which gains it has, its class declares.
 """
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Mapping
 from typing import Any, NamedTuple
 
@@ -48,34 +49,30 @@ def builtin_laws() -> tuple[str, ...]:
     return tuple(n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers."))
 
 
-def make_scenario(
+def make_controller(
     law: str | type[Controller],
     robot: RobotModel,
     *,
     lam: float | None = None,
     gains: Mapping[str, Any] | None = None,
-    saturate: bool = False,
-    friction_smoothing: float = 0.0,
     friction: Friction | None = None,
     model_parameters: Any = None,
-) -> Scenario:
-    """The law on ``robot`` with its default gains (the robot's presets), and its plant.
+) -> Controller:
+    """The law on ``robot`` with its default gains (the robot's presets) over ``gains``: the
+    law's half of :meth:`~twolink_pin.run_spec.RunSpec.build` (built once per run).
 
     Args:
         law: The law (class, registered name, ``file.py:Class`` or ``module:Class``).
-        robot: The arm (plant and law model).
+        robot: The arm (the law's nominal model).
         lam: ``λ`` [1/s] for a law whose gains have ``lam``; refused for one without.
         gains: Other gains by field name (one value, one per joint, ...), over the defaults.
-        saturate: Clip torques at the URDF limits in the plant.
-        friction_smoothing: ε [rad/s] of ``tanh(q̇/ε)`` for Coulomb friction (0: exact sgn).
-        friction: The plant's friction; default the profile's for a friction-estimating
-            law, else none.
+        friction: The friction a friction-estimating law believes (ignored by the others).
         model_parameters: The parameters the law's model believes (see
             :class:`~twolink_pin.controllers.Controller`); one row per run for a batch.
 
     Raises:
         InvalidParameterError: ``lam`` or a gain the law does not have.
-        ControllerSpecError: no such law.
+        ControllerSpecError: no such law, or it could not be built.
     """
     cls = law_class(law)
     changes: dict[str, Any] = dict(gains or {})
@@ -102,16 +99,11 @@ def make_scenario(
             f"{cls.__module__}:{cls.__qualname__}",
             f"its gains {cls.Gains.__name__} could not be built: {type(exc).__name__}: {str(exc)[:300]}",
         ) from exc
-    if friction is None and "friction" in cls.estimates and robot.profile.friction is not None:
-        viscous, coulomb = robot.profile.friction
-        friction = Friction(viscous, coulomb, smoothing=friction_smoothing)
-    elif friction is not None and friction_smoothing and not friction.smoothing:
-        friction = dataclasses.replace(friction, smoothing=friction_smoothing)
     kwargs: dict[str, Any] = {}
     if "friction" in cls.estimates:
         kwargs["friction"] = friction
     try:
-        controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
+        return cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
     except TwolinkPinError:
         raise
     except Exception as exc:  # a user's law whose constructor (or scaled_gains) raised
@@ -119,4 +111,3 @@ def make_scenario(
             f"{cls.__module__}:{cls.__qualname__}",
             f"could not be built on {robot.name}: {type(exc).__name__}: {str(exc)[:300]}",
         ) from exc
-    return Scenario(controller, Plant(robot, friction=friction, saturate=saturate))

@@ -35,8 +35,40 @@ TRAJECTORY_HELP = (
 )
 
 
+RUN_GROUP = "run options"
+"""The title of the argument group of the options that shape a simulated run (a field of
+:class:`~twolink_pin.run_spec.RunSpec`): what ``animate --from`` refuses, what a saved result
+records; ``tests/test_run_spec.py`` checks that each reaches the run."""
+
+
+def run_group(p: argparse.ArgumentParser) -> argparse._ArgumentGroup:
+    """The parser's group of run options (:data:`RUN_GROUP`), made at its first use."""
+    group = getattr(p, "twolink_run_group", None)
+    if group is None:
+        group = p.add_argument_group(RUN_GROUP, "what shapes the simulated run (saved results record them)")
+        p.twolink_run_group = group  # type: ignore[attr-defined]
+    return group
+
+
+def run_option_strings(p: argparse.ArgumentParser) -> frozenset[str]:
+    """Every option string of ``p``'s run options (``--lambda``, ``--delay``, ...)."""
+    group = getattr(p, "twolink_run_group", None)
+    if group is None:
+        return frozenset()
+    return frozenset(s for action in group._group_actions for s in action.option_strings)
+
+
 def add_trajectory_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trajectory", "--via", dest="trajectory", metavar="FILE", help=TRAJECTORY_HELP)
 
 
-__all__ = ["MAX_PAYLOAD", "ROBOT_HELP", "TRAJECTORY_HELP", "add_robot_options", "add_trajectory_option"]
+__all__ = [
+    "MAX_PAYLOAD",
+    "ROBOT_HELP",
+    "RUN_GROUP",
+    "TRAJECTORY_HELP",
+    "add_robot_options",
+    "add_trajectory_option",
+    "run_group",
+    "run_option_strings",
+]

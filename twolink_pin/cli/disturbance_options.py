@@ -13,8 +13,9 @@ import math
 from typing import Any
 
 from twolink_pin.cli.arguments import MAX_TEXT, finite, whole
+from twolink_pin.cli.common_options import run_group
 from twolink_pin.disturbances import PayloadStep, Wrench
-from twolink_pin.errors import TwolinkPinError
+from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 
 MAX_FORCE = 1e6
 """Largest force [N] or moment [N·m] accepted on the command line."""
@@ -104,29 +105,33 @@ def scale_range(text: str) -> tuple[float, float]:
 
 
 def add_disturbance_options(p: argparse.ArgumentParser) -> None:
-    """The plant's events, on a command that simulates."""
-    p.add_argument(
+    """The plant's events, on a command that simulates (in its run options)."""
+    group = run_group(p)
+    group.add_argument(
         "--wrench",
         type=wrench,
         metavar="FX,FY,FZ[,MX,MY,MZ]@T0:T1",
         help="external force [N] (and moment [N·m]) on the end effector, world axes, from T0 to T1 [s]",
     )
-    p.add_argument(
+    group.add_argument(
         "--payload-step",
         type=payload_step,
         metavar="KG@T",
         help="a point mass [kg] picked up at the end effector at time T [s] (the law is not told)",
     )
-    p.add_argument(
+    group.add_argument(
         "--sensor-noise",
         type=sensor_noise,
         metavar="SIGMA_Q[,SIGMA_V]",
         help="Gaussian noise [rad, rad/s] on the q and q̇ the law measures (seeded: --noise-seed)",
     )
-    p.add_argument(
-        "--noise-seed", type=whole(0, 2**63 - 1), default=0, help="seed of the sensor noise (default 0)"
+    group.add_argument(
+        "--noise-seed",
+        type=whole(0, 2**63 - 1),
+        default=None,
+        help="seed of the sensor noise (default 0; only with --sensor-noise)",
     )
-    p.add_argument(
+    group.add_argument(
         "--delay",
         type=whole(0, MAX_DELAY),
         default=0,
@@ -141,11 +146,16 @@ def plant_events(args: Any) -> dict[str, Any]:
     from twolink_pin.disturbances import SensorNoise
 
     noise = getattr(args, "sensor_noise", None)
+    seed = getattr(args, "noise_seed", None)
+    if noise is None and seed is not None:
+        raise InvalidParameterError(
+            "--noise-seed",
+            seed,
+            "--sensor-noise SIGMA_Q[,SIGMA_V] with it (without noise a seed does nothing)",
+        )
     return {
         "wrench": getattr(args, "wrench", None),
         "payload_step": getattr(args, "payload_step", None),
-        "sensor_noise": None
-        if noise is None
-        else SensorNoise(noise[0], noise[1], seed=getattr(args, "noise_seed", 0)),
+        "sensor_noise": None if noise is None else SensorNoise(noise[0], noise[1], seed=seed or 0),
         "delay": getattr(args, "delay", 0) or 0,
     }

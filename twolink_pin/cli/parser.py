@@ -6,7 +6,12 @@ import argparse
 from typing import Any, NoReturn
 
 from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
-from twolink_pin.cli.common_options import add_robot_options, add_trajectory_option
+from twolink_pin.cli.common_options import (
+    add_robot_options,
+    add_trajectory_option,
+    run_group,
+    run_option_strings,
+)
 from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
@@ -37,8 +42,11 @@ MAX_GAIN = 1e12
 """Largest gain accepted on the command line (any unit)."""
 
 
-def add_sim_options(p: argparse.ArgumentParser) -> None:
-    add_trajectory_option(p)
+def add_sim_options(parser: argparse.ArgumentParser) -> None:
+    """The run options every simulating command has (in its :func:`run_group`), ``--trajectory``
+    and ``--timeout``."""
+    add_trajectory_option(parser)
+    p = run_group(parser)
     p.add_argument(
         "--duration",
         type=bounded(0.0, MAX_DURATION, low_open=True, unit="s"),
@@ -75,7 +83,7 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
         metavar="T",
         help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
     )
-    p.add_argument(
+    parser.add_argument(
         "--timeout",
         type=bounded(0.0, 1e7, unit="s"),
         default=DEFAULT_TIMEOUT,
@@ -99,7 +107,7 @@ def add_sim_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
-    p.add_argument(
+    run_group(p).add_argument(
         "--gain",
         action="append",
         default=[],
@@ -110,7 +118,7 @@ def add_gain_option(p: argparse.ArgumentParser) -> None:
 
 def add_law_gain_option(p: argparse.ArgumentParser) -> None:
     """``--gain LAW.NAME=VALUE`` of the commands that run several laws."""
-    p.add_argument(
+    run_group(p).add_argument(
         "--gain",
         action="append",
         default=[],
@@ -123,7 +131,7 @@ def add_law_gain_option(p: argparse.ArgumentParser) -> None:
 def add_identified_options(p: argparse.ArgumentParser, several: bool = False) -> None:
     """``--p0 FILE`` / ``--model FILE``: a parameter file of ``twolink-pin identify --save``."""
     laws = "the laws that estimate parameters (others run as usual)" if several else "a law that estimates"
-    group = p.add_mutually_exclusive_group()
+    group = run_group(p).add_mutually_exclusive_group()
     group.add_argument(
         "--p0",
         metavar="FILE",
@@ -284,7 +292,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--loop", action="store_true", help="repeat the motion")
     add_disturbance_options(p)
     add_robot_options(p)
-    p.set_defaults(func=c.cmd_animate)
+    p.set_defaults(func=c.cmd_animate, run_options=run_option_strings(p))
 
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")

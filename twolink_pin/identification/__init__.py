@@ -24,7 +24,7 @@ and the command line use it, never the reverse.
 ``excitation_check.py``  whether an excitation may be saved (within limits, moving); excite's work bound
 ``simulated.py``         :func:`simulate_log`: a closed-loop identification run, logged
 ``parameters_file.py``   the identified-parameter file; mapping onto a law's parameters;
-                         :func:`seeded_scenario` for ``--p0`` / ``--model``
+                         :func:`believed` for ``--p0`` / ``--model``
 =======================  ===================================================================
 """
 
@@ -52,16 +52,18 @@ from twolink_pin.identification.measures import (
 )
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.identification.parameters_file import (
+    Belief,
     IdentifiedParameters,
+    believed,
     identification_document,
     map_parameters,
     read_parameter_file,
-    seeded_scenario,
 )
 from twolink_pin.identification.simulated import FrictionCompensatedTracking, plant_friction, simulate_log
 
 __all__ = [
     "AveragedAdaptation",
+    "Belief",
     "Excitation",
     "ExcitationDesign",
     "ExcitationLimits",
@@ -77,6 +79,7 @@ __all__ = [
     "ZeroPhaseFilter",
     "add_noise",
     "averaged_adaptation",
+    "believed",
     "excitation_measures",
     "excitation_trajectory",
     "filter_log",
@@ -88,7 +91,6 @@ __all__ = [
     "read_log",
     "read_parameter_file",
     "register_excitation",
-    "seeded_scenario",
     "simulate_log",
     "write_log",
 ]

@@ -327,7 +327,7 @@ def optimise_excitation(
     design = design if design is not None else ExcitationDesign()
     if design.criterion == "adaptation":
         if controller is None:
-            from twolink_pin.scenario import make_scenario
+            from twolink_pin.run_spec import make_scenario
 
             controller = make_scenario("adaptive", robot).controller
         if not controller.estimates or not hasattr(controller.gains, "gamma"):

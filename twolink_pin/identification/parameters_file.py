@@ -15,7 +15,8 @@ map can express ``β``: for the twolink ``p1 = β1 + β4``, ``p2 = β4``, ``p3 =
 ``β`` the map cannot express (the twolink's ``link2.mcy``) is dropped when it is noise (within
 3σ of 0, or negligible torque), and refused, naming the parameter, when it is significant.
 
-:func:`seeded_scenario` builds a law and its plant from them: ``mode="model"`` (``--model``)
+:func:`believed` gives what a law takes from them (:meth:`~twolink_pin.run_spec.RunSpec.build`
+builds the law once with it): ``mode="model"`` (``--model``)
 makes the identified values what the law *believes* (model-based laws' model; adaptive laws'
 ``p̂(0) = initial_estimate × p``; a friction-estimating law's friction), ``mode="p0"``
 (``--p0``, laws that estimate) starts the estimates *at* them (initial-estimate factors 1).
@@ -26,7 +27,6 @@ from __future__ import annotations
 import math
 import os
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -260,26 +260,29 @@ def map_parameters(robot: RobotModel, identified: IdentifiedParameters) -> np.nd
     return L @ expressible
 
 
-def seeded_scenario(
-    law: Any,
-    robot: RobotModel,
-    identified: IdentifiedParameters,
-    mode: str,
-    *,
-    lam: float | None = None,
-    gains: Mapping[str, Any] | None = None,
-    saturate: bool = False,
-    friction_smoothing: float = 0.0,
-) -> Any:
-    """:func:`~twolink_pin.scenario.make_scenario` with the identified parameters as the law's
-    belief (``mode="model"``) or its estimates' start (``mode="p0"``); the plant stays the
-    true robot (with the profile's friction for a friction-estimating law).
+class Belief(NamedTuple):
+    """What a law takes from identified parameters (:func:`believed`)."""
+
+    parameters: np.ndarray
+    """The parameters of the robot's map the law's model believes."""
+    friction: Friction | None
+    """The friction a friction-estimating law believes (None: its robot's)."""
+    gains: dict[str, Any]
+    """The law's gains, with ``initial_estimate`` 1 for ``p0`` (the estimates start there)."""
+
+
+def believed(
+    law: Any, robot: RobotModel, identified: IdentifiedParameters, mode: str, gains: Mapping[str, Any]
+) -> Belief:
+    """What the law ``law`` believes of ``identified`` (``mode="model"``: its model;
+    ``mode="p0"``: its estimates' start); :meth:`~twolink_pin.run_spec.RunSpec.build` builds
+    the law with it once, on the true robot's plant.
 
     Raises:
         InvalidParameterError: an unknown mode, ``p0`` for a law that estimates nothing, or
             parameters the robot's map cannot express (:func:`map_parameters`).
     """
-    from twolink_pin.scenario import law_class, make_scenario
+    from twolink_pin.scenario import law_class
 
     if mode not in MODES:
         raise InvalidParameterError("mode", mode, f"one of {', '.join(MODES)}")
@@ -291,26 +294,10 @@ def seeded_scenario(
             f"a law that estimates parameters ('{cls.name}' estimates none: give its model with --model FILE)",
         )
     p = map_parameters(robot, identified)
-    changes = dict(gains or {})
+    changes = dict(gains)
     if mode == "p0":
         for name in ("initial_estimate", "friction_initial_estimate"):
             if cls.takes(name):
                 changes.setdefault(name, 1.0)
-    scenario = make_scenario(
-        cls,
-        robot,
-        lam=lam,
-        gains=changes,
-        saturate=saturate,
-        friction_smoothing=friction_smoothing,
-        model_parameters=p,
-    )
-    if "friction" in cls.estimates and identified.friction is not None:
-        believed = identified.friction
-        plant_friction = scenario.plant.friction
-        if plant_friction is not None and plant_friction.smoothing:
-            believed = replace(believed, smoothing=plant_friction.smoothing)
-        estimating: Any = cls  # a friction-estimating law takes the friction it believes
-        controller = estimating(robot, scenario.controller.gains, model_parameters=p, friction=believed)
-        scenario = scenario._replace(controller=controller)
-    return scenario
+    friction = identified.friction if "friction" in cls.estimates else None
+    return Belief(p, friction, changes)

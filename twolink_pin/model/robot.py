@@ -89,6 +89,17 @@ class RobotModel:
         return np.where(finite, 0.5 * (np.where(finite, lower, 0.0) + np.where(finite, upper, 0.0)), 0.0)
 
     @property
+    def urdf_friction(self) -> tuple[tuple[float, ...], tuple[float, ...]] | None:
+        """The URDF's joint friction ``(damping [N·m·s/rad], friction [N·m])`` per joint, from
+        its ``<dynamics damping friction>`` (read by Pinocchio's parser into ``model.damping``
+        and ``model.friction``); None when every value is 0 or absent."""
+        damping = tuple(float(x) for x in self.model.damping)
+        coulomb = tuple(float(x) for x in self.model.friction)
+        if not any(damping) and not any(coulomb):
+            return None
+        return damping, coulomb
+
+    @property
     def nq(self) -> int:
         """Size of the configuration vector."""
         return int(self.model.nq)

@@ -85,6 +85,7 @@ def build_report(
     sections = robot.profile.report.sections  # the robot's own sections (the twolink's course report)
     specs = laws_to_run(options, robot)
     options.run.check_law_gains(specs)
+    options.run.check_effective(robot, specs)
     steps = 4 + len(specs) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
     done = 0
     heard = len(interrupts.received)

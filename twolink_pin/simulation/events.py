@@ -21,6 +21,7 @@ divergence checks are the engine's.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 
 import numpy as np
@@ -39,10 +40,7 @@ def payload_plant(plant: Plant) -> Plant:
     assert step is not None
     robot = plant.robot
     model = step.model(robot.model, robot.ee_frame_id)
-    heavier = Plant.__new__(Plant)
-    heavier.__dict__.update(plant.__dict__)
-    heavier.model = model
-    return heavier
+    return dataclasses.replace(plant, model=model)
 
 
 class PlantEvents:

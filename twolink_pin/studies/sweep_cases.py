@@ -14,7 +14,7 @@ from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.run_spec import RunSpec
-from twolink_pin.scenario import make_scenario
+from twolink_pin.scenario import make_controller
 from twolink_pin.simulation.config import joint_offsets
 
 MAX_SAMPLES = 10_000_000
@@ -278,11 +278,10 @@ def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Contr
     if config.param_error > 0:
         believed = np.asarray(robot.p) * cases.param_factor
     resolved = {k: v for k, v in base.gains.values().items() if k not in gains}
-    return make_scenario(
+    return make_controller(
         cls,
         robot,
         gains={**resolved, **gains},
-        saturate=config.run.plant.saturate,
-        friction_smoothing=config.run.friction_smoothing,
+        friction=config.run.law_friction(cls, robot),
         model_parameters=believed,
-    ).controller
+    )

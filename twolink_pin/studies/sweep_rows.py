@@ -3,7 +3,6 @@ and the summary statistics over them."""
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -211,12 +210,14 @@ class _Prepared:
 
         plant, noise = self.base.plant, self.base.plant.sensor_noise
         if noise is not None:  # run i of the sweep draws stream i, whatever the chunking
-            plant = copy.copy(plant)
-            plant.sensor_noise = dataclasses.replace(noise, stream=noise.stream + start)
+            plant = dataclasses.replace(
+                plant, sensor_noise=dataclasses.replace(noise, stream=noise.stream + start)
+            )
         wrench = plant.wrench
         if config.wrench_scale is not None and wrench is not None:  # each run its drawn wrench
-            plant = copy.copy(plant)
-            plant.wrench = dataclasses.replace(wrench, scale=tuple(cases.wrench_scale))
+            plant = dataclasses.replace(
+                plant, wrench=dataclasses.replace(wrench, scale=tuple(cases.wrench_scale))
+            )
         result = simulate_batch(
             law,
             plant,

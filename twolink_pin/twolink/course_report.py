@@ -90,7 +90,8 @@ class CourseReport:
         lams: Mapping[str, float],
     ) -> list[dict[str, Any]]:
         """Where the course report is wrong or silent, with the evidence of these runs."""
-        from twolink_pin.scenario import law_class, make_scenario
+        from twolink_pin.run_spec import make_scenario
+        from twolink_pin.scenario import law_class
         from twolink_pin.trajectory import default_trajectory
         from twolink_pin.twolink import errata
         from twolink_pin.twolink.reference import LAMBDA

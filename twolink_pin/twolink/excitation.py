@@ -135,7 +135,7 @@ def trajectories(robot: RobotModel) -> dict[str, Trajectory]:
 
 def report_adaptive(robot: RobotModel) -> Any:
     """The report's adaptive law on the twolink (its gains, p̂(0) = 0.5 p) and its plant."""
-    from twolink_pin.scenario import make_scenario
+    from twolink_pin.run_spec import make_scenario
 
     return make_scenario("adaptive", robot)
 

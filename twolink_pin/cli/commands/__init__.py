@@ -23,11 +23,10 @@ from twolink_pin.cli.commands.model import (
     cmd_robots,
     cmd_trajectory,
 )
-from twolink_pin.cli.commands.run import RUN_OPTIONS, cmd_animate, cmd_compare, cmd_report, cmd_simulate
+from twolink_pin.cli.commands.run import cmd_animate, cmd_compare, cmd_report, cmd_simulate
 from twolink_pin.cli.commands.sweep import cmd_sweep
 
 __all__ = [
-    "RUN_OPTIONS",
     "cmd_animate",
     "cmd_compare",
     "cmd_controllers",

@@ -259,7 +259,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
     if robot.name == "twolink":
         payload["report_condition_number"] = default.condition_number
     try:
-        from twolink_pin.scenario import make_scenario
+        from twolink_pin.run_spec import make_scenario
 
         law = make_scenario("adaptive", robot).controller
         payload["adaptive_slowest_time_constant_s"] = averaged_adaptation(

@@ -52,6 +52,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     robot = _robot(args)
     spec = run_spec(args, args.controller)
+    spec.check_effective(robot)
     scenario = spec.build(robot, _identified(spec, robot))
     result = simulate(*scenario, _trajectory(args, robot), spec.simulation)
     metrics = compute_metrics(result)
@@ -64,6 +65,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     payload |= {
         "gains": gains,
         "plant": plant_description(scenario),
+        "plant_friction": scenario.plant.friction_dict(),
         "q0_offset": q0_offset.tolist(),
         "run": spec.as_dict(),
     }
@@ -84,7 +86,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     lines = [
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
         f"  gains {gains_text}",
-        f"  plant {payload['plant']}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
+        f"  plant {scenario.plant.describe(values=True)}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
         f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
@@ -136,6 +138,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     by_name = dict(zip(names, specs))
     shared = run_spec(args)
     shared.check_law_gains(specs)
+    shared.check_effective(robot, specs)
     identified = _identified(shared, robot)
     reference = _trajectory(args, robot)
     with output_directory(args.out, ".twolink-pin-compare") as stage:
@@ -194,36 +197,12 @@ def _say_failed(failed: dict[str, str], where: str) -> None:
     print(f"twolink-pin: {len(failed)} law(s) did not finish ({what}); {where}", file=sys.stderr)
 
 
-RUN_OPTIONS = frozenset(
-    {
-        "--duration",
-        "--dt",
-        "--lambda",
-        "--q0-offset",
-        "--saturate",
-        "--method",
-        "--control-period",
-        "--friction-smoothing",
-        "--plant-friction",
-        "--gain",
-        "--p0",
-        "--model",
-        "--wrench",
-        "--payload-step",
-        "--sensor-noise",
-        "--noise-seed",
-        "--delay",
-    }
-)
-"""Options that shape a run: meaningless with ``animate --from`` (a saved run)."""
-
-
 def cmd_animate(args: argparse.Namespace) -> int:
     import signal
 
     if args.from_file:
         typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
-        ignored = sorted(typed & RUN_OPTIONS)
+        ignored = sorted(typed & args.run_options)  # the parser's run options (cli.common_options.run_group)
         if args.controller is not None or ignored:
             raise InvalidParameterError(
                 "--from",
@@ -245,6 +224,7 @@ def cmd_animate(args: argparse.Namespace) -> int:
         robot = _robot(args)
         reference = _trajectory(args, robot)
         spec = run_spec(args, args.controller)
+        spec.check_effective(robot)
         scenario = spec.build(robot, _identified(spec, robot))
         controller = scenario.controller
         result = simulate(*scenario, reference, spec.simulation)

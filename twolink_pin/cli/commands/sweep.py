@@ -37,6 +37,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         chunk=args.chunk,
         threads=args.threads,
     )
+    config.run.check_effective(robot)
     bars: list[Any] = []  # shown from the first runs on: its rate and ETA leave out a cluster's start
 
     def progress(done: int, total: int) -> None:
