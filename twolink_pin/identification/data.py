@@ -257,6 +257,11 @@ def _read_npz(path: Path, nv: int) -> RunLog:
             f"missing array{'s' if len(missing) > 1 else ''} {', '.join(repr(m) for m in missing)} "
             f"(expected t (K,), q (K, {nv}), tau (K, {nv}), optionally v; found {sorted(arrays) or 'nothing'})",
         )
+    source = str(path)
+    if "q_measured" in arrays and "v_measured" in arrays:
+        # a saved simulation with sensor noise: what the law measured, as a real log records it
+        arrays["q"], arrays["v"] = arrays.pop("q_measured"), arrays.pop("v_measured")
+        source = f"{path} (q_measured, v_measured: what the law measured, with its sensor noise)"
     t = arrays["t"]
     if t.ndim != 1:
         raise InputFileError(str(path), f"array 't' has shape {t.shape}; expected (K,)")
@@ -270,7 +275,7 @@ def _read_npz(path: Path, nv: int) -> RunLog:
             raise InputFileError(str(path), f"array '{key}' holds {arrays[key].dtype}, not numbers")
     if not np.issubdtype(t.dtype, np.number):
         raise InputFileError(str(path), f"array 't' holds {t.dtype}, not numbers")
-    log = RunLog(t=t, q=arrays["q"], tau=arrays["tau"], v=arrays.get("v"), source=str(path))
+    log = RunLog(t=t, q=arrays["q"], tau=arrays["tau"], v=arrays.get("v"), source=source)
     check_sample_count(str(path), log.samples, MIN_SAMPLES, "identification")
     names: dict[str, tuple[str, int | None]] = {"t": ("t", None)}
     for key in ("q", "tau", "v"):

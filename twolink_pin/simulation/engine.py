@@ -76,6 +76,11 @@ class Samples(NamedTuple):
     """Reference velocities [rad/s], shape (B, 1, nv)."""
     a_des: np.ndarray
     """Reference accelerations [rad/s²], shape (B, 1, nv)."""
+    q_measured: np.ndarray | None = None
+    """The positions the law measured [rad] (``q`` + sensor noise), shape (B, N, nv); None
+    without sensor noise (the law measures ``q``) or outside the full record."""
+    v_measured: np.ndarray | None = None
+    """The velocities the law measured [rad/s], as ``q_measured``."""
 
 
 class Observer(Protocol):
@@ -181,6 +186,8 @@ def integrate(
     Q, V, T = (np.empty((size, runs, nv)) for _ in range(3))
     Z = np.empty((size, runs, nz))
     RQ, RV, RA = (np.empty((size, 1, nv)) for _ in range(3))
+    measured = record and events is not None and events.noise is not None
+    MQ, MV = (np.empty((size, runs, nv)) for _ in range(2)) if measured else (None, None)
     times = np.arange(total) * dt
     diverged_at = np.full(runs, np.nan)
     detail: list[str | None] = [None] * runs
@@ -240,6 +247,8 @@ def integrate(
                     tau_k, dz_k = (tau1, dz1) if line is None else line.at(k)  # the torque applied
                     b = k - off
                     Q[b], V[b], T[b] = q, v, tau_k
+                    if MQ is not None and MV is not None:
+                        MQ[b], MV[b] = q + noise[0], v + noise[1]  # as the law measured it
                     if nz:
                         Z[b] = z
                     filled = b + 1
@@ -325,7 +334,7 @@ def integrate(
                 )
             if progress is not None:
                 progress(min(k1, n), n)
-    recorded = Samples(0, times, Q, V, Z, T, RQ, RV, RA) if record else None
+    recorded = Samples(0, times, Q, V, Z, T, RQ, RV, RA, MQ, MV) if record else None
     return EngineRun(times, recorded, z, diverged_at, tuple(detail))
 
 

@@ -60,6 +60,12 @@ class SimulationResult:
     """Name of each entry of ``state``."""
     state_units: tuple[str, ...] = ()
     """SI unit of each entry of ``state``."""
+    q_measured: np.ndarray | None = field(repr=False, default=None)
+    """Joint positions the law measured [rad], shape (K, nv): ``q`` plus the sensor noise of
+    each step (a delay shifts the torque, not the measurement); None without sensor noise,
+    where the law measures ``q``. A saved run keeps it, so that it reads as a real log."""
+    v_measured: np.ndarray | None = field(repr=False, default=None)
+    """Joint velocities the law measured [rad/s], as ``q_measured``."""
 
     @property
     def duration(self) -> float:

@@ -156,4 +156,6 @@ def simulate(
         state=readonly(z) if z.shape[1] else None,
         state_names=names,
         state_units=units,
+        q_measured=None if samples.q_measured is None else readonly(samples.q_measured[:, 0, :]),
+        v_measured=None if samples.v_measured is None else readonly(samples.v_measured[:, 0, :]),
     )

@@ -78,7 +78,7 @@ def _check_arrays(path: str, kwargs: dict[str, Any]) -> None:
     t = kwargs["t"]
     if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
         raise InputFileError(path, "its t is not a finite, strictly increasing list of at least 2 times [s]")
-    for name in ("q", "v", "q_des", "v_des", "tau"):
+    for name in ("q", "v", "q_des", "v_des", "tau", "q_measured", "v_measured"):
         if name not in kwargs:
             continue
         array = kwargs[name]
