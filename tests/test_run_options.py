@@ -12,6 +12,7 @@ import argparse
 import dataclasses
 import json
 import xml.etree.ElementTree as ET
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -196,3 +197,33 @@ def test_a_saved_noisy_run_records_what_the_law_measured_and_identify_uses_it(tm
     measured, true = identified(noisy), identified(clean)
     assert "q_measured, v_measured: what the law measured" in measured["source"]
     assert min(measured["residual_rms"]) > 100 * max(true["residual_rms"])
+
+
+def test_model_accepts_a_urdf_the_law_believes_while_the_plant_stays_the_robot(tmp_path, capsys) -> None:
+    """--model FILE.urdf: the law believes the URDF's inertias (here the twolink with 2 kg at the
+    tool: its p is load_robot(payload=2).p), the plant stays the twolink, and every output names
+    the believed model; a URDF of another arm is refused."""
+    heavy = tmp_path / "heavy.urdf"
+    assert main(["info", "--payload", "2", "--write-urdf", str(heavy)]) == 0
+    capsys.readouterr()
+    spec = run_spec(
+        build_parser().parse_args(["simulate", "computed-torque", "--model", str(heavy)]), "computed-torque"
+    )
+    robot = load_robot()
+    controller, plant = spec.build(robot)
+    np.testing.assert_allclose(controller.believed_parameters(), load_robot(payload=2.0).p, rtol=1e-12)
+    assert plant.model is robot.model
+    saved = tmp_path / "run.npz"
+    argv = ["simulate", "computed-torque", "--duration", "0.5", "--model", str(heavy)]
+    assert main([*argv, "--save", str(saved)]) == 0
+    assert f"law's model believes the inertias of the URDF {heavy} (--model); the plant is twolink's own" in (
+        capsys.readouterr().out
+    )
+    assert main([*argv, "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["believed"] == {"file": str(heavy), "use": "model"}
+    from twolink_pin.simulation.storage import load_record
+
+    assert load_record(saved)["run"]["parameters"] == str(heavy)
+    other = Path(__file__).parent / "corpus" / "urdf" / "arm3.urdf"
+    assert main(["simulate", "computed-torque", "--duration", "0.1", "--model", str(other)]) == 2
+    assert "expected twolink's" in capsys.readouterr().err

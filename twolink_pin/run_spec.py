@@ -151,11 +151,14 @@ class RunSpec:
                 )
 
     def read_parameters(self, robot: RobotModel) -> IdentifiedParameters | None:
-        """The identified parameters of ``parameters`` for ``robot`` (None without a file)."""
+        """The parameters of ``parameters`` for ``robot`` (None without a file): an identified
+        parameter file (``identify --save``), or a URDF whose inertias the law believes."""
         if self.parameters is None:
             return None
-        from twolink_pin.identification import read_parameter_file
+        from twolink_pin.identification import read_parameter_file, urdf_parameters
 
+        if str(self.parameters).lower().endswith(".urdf"):
+            return urdf_parameters(self.parameters, robot)
         return read_parameter_file(self.parameters, robot)
 
     def build(self, robot: RobotModel, identified: IdentifiedParameters | None = None) -> Scenario:

@@ -142,8 +142,9 @@ def add_identified_options(p: argparse.ArgumentParser, several: bool = False) ->
         "--model",
         metavar="FILE",
         default=None,
-        help="the law's model believes the identified parameters of FILE (adaptive laws: p̂(0) = "
-        "initial_estimate × them; friction-estimating laws: their friction too)",
+        help="the law's model believes the parameters of FILE: identified (identify --save P.json) or a "
+        "URDF's inertias (the plant stays the robot's; adaptive laws: p̂(0) = initial_estimate × them; "
+        "friction-estimating laws: their friction too)",
     )
 
 

@@ -58,6 +58,7 @@ from twolink_pin.identification.parameters_file import (
     identification_document,
     map_parameters,
     read_parameter_file,
+    urdf_parameters,
 )
 from twolink_pin.identification.simulated import FrictionCompensatedTracking, plant_friction, simulate_log
 
@@ -92,5 +93,6 @@ __all__ = [
     "read_parameter_file",
     "register_excitation",
     "simulate_log",
+    "urdf_parameters",
     "write_log",
 ]

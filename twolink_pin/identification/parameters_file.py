@@ -111,6 +111,33 @@ def _number(path: str, where: str, value: Any, what: str) -> float:
     return float(value)
 
 
+def urdf_parameters(path: str | os.PathLike[str], robot: RobotModel) -> IdentifiedParameters:
+    """The parameters a URDF's inertias give ``robot``'s base map (``--model FILE.urdf``: the law
+    believes them while the plant stays ``robot``); its ``<dynamics damping friction>`` is the
+    believed friction when it has any.
+
+    Raises:
+        InvalidURDFError: not a URDF twolink-pin can load.
+        InputFileError: a URDF of another arm (joint count or names).
+    """
+    from twolink_pin.model import load_robot
+
+    file = str(path)
+    believed_robot = load_robot(path)
+    names = tuple(robot.model.names)[1:]
+    if believed_robot.nv != robot.nv or tuple(believed_robot.model.names)[1:] != names:
+        raise InputFileError(
+            file,
+            f"has the joints {list(believed_robot.model.names)[1:]}; expected {robot.name}'s {list(names)} "
+            "(a model of the same arm, e.g. from info or identify --write-urdf)",
+        )
+    base = ParameterSet.of(robot, friction=False).base.values(believed_robot.model)
+    urdf = believed_robot.urdf_friction
+    return IdentifiedParameters(
+        file, np.asarray(base, dtype=float), np.zeros(len(base)), None if urdf is None else Friction(*urdf)
+    )
+
+
 def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> IdentifiedParameters:
     """The identified parameters a file gives ``robot`` (see the module docstring).
 

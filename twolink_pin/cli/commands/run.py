@@ -66,6 +66,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         "gains": gains,
         "plant": plant_description(scenario),
         "plant_friction": scenario.plant.friction_dict(),
+        "believed": _believed(spec),
         "q0_offset": q0_offset.tolist(),
         "run": spec.as_dict(),
     }
@@ -87,6 +88,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
         f"  gains {gains_text}",
         f"  plant {scenario.plant.describe(values=True)}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
+        *([] if spec.parameters is None else [f"  {_believed_text(spec, robot.name)}"]),
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
         f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
@@ -123,6 +125,22 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         lines.append(f"  saved {args.save}")
     emit(args, payload, "\n".join(lines))
     return 0
+
+
+def _believed(spec: RunSpec) -> dict[str, str] | None:
+    """``--model`` / ``--p0``: the file the law's model believes or its estimates start at."""
+    if spec.parameters is None:
+        return None
+    return {"file": spec.parameters, "use": spec.parameters_use}
+
+
+def _believed_text(spec: RunSpec, robot: str) -> str:
+    kind = (
+        "the inertias of the URDF" if str(spec.parameters).lower().endswith(".urdf") else "the parameters of"
+    )
+    if spec.parameters_use == "model":
+        return f"law's model believes {kind} {spec.parameters} (--model); the plant is {robot}'s own"
+    return f"estimates start at {kind} {spec.parameters} (--p0); the plant is {robot}'s own"
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
