@@ -171,14 +171,8 @@ def integrate(
     events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
     line = DelayLine(plant.delay) if plant.delay > 0 else None
     accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
-    compute = law = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
-    noise: list[np.ndarray] = []
-    if events is not None and events.noise is not None:
-
-        def compute(x: LawInput, terms: Any) -> LawOutput:  # the law measures the state + noise
-            t, q, v, z, *reference = x
-            return law(new(LawInput, (t, q + noise[0], v + noise[1], z, *reference)), terms)
-
+    noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
+    compute = _law_call(controller, noise if events is not None and events.noise is not None else None)
     sampled = hold is not None or line is not None  # the law evaluated once per step or period
     every = hold if hold is not None else 1
     total = n + 1
@@ -196,8 +190,11 @@ def integrate(
     q, v, z = np.array(q0, dtype=float), np.array(v0, dtype=float), z_start.copy()
     # The steps as (1, width) rows: numpy multiplies two 2-D operands on its fast path, while
     # a Python float (or a 1-D row) against a (1, nv) array costs twice as much at N = 1.
-    h, h2, h6, two = (np.full((1, nv), x) for x in (dt, dt / 2, dt / 6, 2.0))
-    hz, h2z, h6z, twoz = (np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0))
+    steps = _Steps(
+        dt,
+        *(np.full((1, nv), x) for x in (dt, dt / 2, dt / 6, 2.0)),
+        *(np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0)),
+    )
     no_state = np.zeros((runs, 0))
 
     # LawInput(...) through tuple.__new__ (``new`` above): the NamedTuple's own __new__ is a
@@ -205,26 +202,16 @@ def integrate(
     # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
     tau1: Any = None
     dz1: Any = None
-    dz2: Any
-    dz3: Any
-    dz4: Any
     first = True
-    now = 0.0  # time of the law evaluation under way (for error messages)
+    clock = _Clock()  # time of the law evaluation under way (for error messages)
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
     # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
-    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, now, seconds)):
+    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, clock.now, seconds)):
         for k0 in range(0, total, BLOCK):
             k1 = min(k0 + BLOCK, total)
-            last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
-            half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
-            half = trajectory.sample(half_t)
-            # Shared with later steps: the law can't write. C-contiguous rows: a trajectory may
-            # sample column-major, and a strided (1, nv) row takes numpy's slow broadcasting
-            # path in every operation of the law and the Terms that touches it.
-            rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
+            rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt)
             if events is not None:
                 events.draw(k0, k1)
-            ref = reference_rows(controller, trajectory, half_t, half, rq, rv, ra)  # + task fields
             off = 0 if record else k0
             filled = k0 - off
             try:
@@ -236,7 +223,7 @@ def integrate(
                         if events.noise is not None:
                             noise[:] = events.noise_at(k)
                     if not sampled or k % every == 0:
-                        now = t
+                        clock.now = t
                         out = compute(new(LawInput, (t, q, v, z, *ref[i])), terms)
                         if first:
                             _validate(controller, out, runs, nv, nz, t)
@@ -254,35 +241,12 @@ def integrate(
                     filled = b + 1
                     if k == n:
                         break
-                    a1 = accel(q, v, tau_k)
-                    if not sampled:
-                        now = t + dt / 2
-                        q2, v2 = q + h2 * v, v + h2 * a1
-                        z2 = z + h2z * dz1 if nz else z
-                        tau2, dz2 = compute(new(LawInput, (now, q2, v2, z2, *ref[i + 1])), terms)
-                        a2 = accel(q2, v2, tau2)
-                        q3, v3 = q + h2 * v2, v + h2 * a2
-                        z3 = z + h2z * dz2 if nz else z
-                        tau3, dz3 = compute(new(LawInput, (now, q3, v3, z3, *ref[i + 1])), terms)
-                        a3 = accel(q3, v3, tau3)
-                        now = t + dt
-                        q4, v4 = q + h * v3, v + h * a3
-                        z4 = z + hz * dz3 if nz else z
-                        tau4, dz4 = compute(new(LawInput, (now, q4, v4, z4, *ref[i + 2])), terms)
-                        a4 = accel(q4, v4, tau4)
-                        if nz:
-                            z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)
-                    else:  # zero-order hold (or delay): τ and ż fixed over the step
-                        q2, v2 = q + h2 * v, v + h2 * a1
-                        a2 = accel(q2, v2, tau_k)
-                        q3, v3 = q + h2 * v2, v + h2 * a2
-                        a3 = accel(q3, v3, tau_k)
-                        q4, v4 = q + h * v3, v + h * a3
-                        a4 = accel(q4, v4, tau_k)
-                        if nz:
-                            z = z + hz * dz_k
-                    q = q + h6 * (v + two * (v2 + v3) + v4)
-                    v = v + h6 * (a1 + two * (a2 + a3) + a4)
+                    if sampled:  # zero-order hold (or delay): τ and ż fixed over the step
+                        q, v, z = _held_step(accel, q, v, z, tau_k, dz_k, steps, nz)
+                    else:
+                        q, v, z = _stage_step(
+                            compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
+                        )
             except (KeyboardInterrupt, SystemExit, MemoryError):
                 raise
             except Exception as exc:
@@ -293,7 +257,7 @@ def integrate(
                 if isinstance(exc, ControllerError):
                     raise
                 what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
-                raise ControllerError(name, now, what + raised_at(exc, controller)) from exc
+                raise ControllerError(name, clock.now, what + raised_at(exc, controller)) from exc
             rows = slice(k0 - off, k1 - off)
             RQ[rows], RV[rows], RA[rows] = (x[: 2 * (k1 - k0) : 2] for x in (rq, rv, ra))
             newly = _flag_block(
@@ -312,16 +276,10 @@ def integrate(
                 stop_on_divergence,
             )
             if k1 <= n:  # the state after the block's last step is sample k1
-                current = _bad_rows(q[None])[0] | _bad_rows(v[None])[0] | _bad_rows(z[None])[0]
-                late = alive & current
-                if late.any():
-                    if stop_on_divergence:
-                        raise SimulationDivergedError(name, k1 * dt, _state_detail(q, v, z, late))
-                    for r in np.flatnonzero(late):
-                        diverged_at[r] = k1 * dt
-                        detail[r] = _state_detail(q, v, z, np.eye(runs, dtype=bool)[r])
-                    alive &= ~late
-                    newly |= late
+                late = _late_divergence(
+                    q, v, z, alive, k1 * dt, diverged_at, detail, name, stop_on_divergence
+                )
+                newly |= late
                 if newly.any():  # park them on the reference, keep the batch going
                     j = 2 * (k1 - k0)
                     q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
@@ -338,6 +296,122 @@ def integrate(
     return EngineRun(times, recorded, z, diverged_at, tuple(detail))
 
 
+def _block_reference(
+    controller: Controller, trajectory: Trajectory, k0: int, k1: int, n: int, dt: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
+    """The reference of steps ``k0 … k1 − 1`` on the half-step grid: ``q_des``, ``q̇_des``,
+    ``q̈_des`` as read-only (H, 1, nv) rows and the law's input rows (task fields included)."""
+    last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
+    half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
+    half = trajectory.sample(half_t)
+    # Shared with later steps: the law can't write. C-contiguous rows: a trajectory may
+    # sample column-major, and a strided (1, nv) row takes numpy's slow broadcasting
+    # path in every operation of the law and the Terms that touches it.
+    rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
+    return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra)
+
+
+class _Clock:
+    """The simulated time of the law evaluation under way [s] (error messages, ``--timeout``)."""
+
+    now = 0.0
+
+
+class _Steps(NamedTuple):
+    """The step's factors as (1, width) rows: numpy multiplies two 2-D operands on its fast
+    path, while a Python float (or a 1-D row) against a (1, nv) array costs twice as much at N = 1."""
+
+    dt: float
+    h: np.ndarray
+    h2: np.ndarray
+    h6: np.ndarray
+    two: np.ndarray
+    hz: np.ndarray
+    h2z: np.ndarray
+    h6z: np.ndarray
+    twoz: np.ndarray
+
+
+def _stage_step(
+    compute: Callable[[Any, Any], Any],
+    terms: Any,
+    accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+    q: np.ndarray,
+    v: np.ndarray,
+    z: np.ndarray,
+    tau1: np.ndarray,
+    dz1: np.ndarray,
+    ref: Any,
+    i: int,
+    t: float,
+    steps: _Steps,
+    nz: int,
+    clock: _Clock,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One classical RK4 step from ``(q, v, z)`` at ``t`` with the law at every stage (its first
+    output ``tau1``, ``dz1`` given; ``ref[i]``: the reference rows of half-step i)."""
+    new = tuple.__new__  # LawInput(...) through tuple.__new__: twice as cheap as its __new__
+    dt, h, h2, h6, two, hz, h2z, h6z, twoz = steps
+    a1 = accel(q, v, tau1)
+    clock.now = now = t + dt / 2
+    q2, v2 = q + h2 * v, v + h2 * a1
+    z2 = z + h2z * dz1 if nz else z
+    tau2, dz2 = compute(new(LawInput, (now, q2, v2, z2, *ref[i + 1])), terms)
+    a2 = accel(q2, v2, tau2)
+    q3, v3 = q + h2 * v2, v + h2 * a2
+    z3 = z + h2z * dz2 if nz else z
+    tau3, dz3 = compute(new(LawInput, (now, q3, v3, z3, *ref[i + 1])), terms)
+    a3 = accel(q3, v3, tau3)
+    clock.now = now = t + dt
+    q4, v4 = q + h * v3, v + h * a3
+    z4 = z + hz * dz3 if nz else z
+    tau4, dz4 = compute(new(LawInput, (now, q4, v4, z4, *ref[i + 2])), terms)
+    a4 = accel(q4, v4, tau4)
+    if nz:
+        z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)
+    return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z
+
+
+def _held_step(
+    accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
+    q: np.ndarray,
+    v: np.ndarray,
+    z: np.ndarray,
+    tau: np.ndarray,
+    dz: np.ndarray,
+    steps: _Steps,
+    nz: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One RK4 step of the plant under the held torque ``tau``; ``z ← z + dt ż``."""
+    _, h, h2, h6, two, hz = steps[:6]
+    a1 = accel(q, v, tau)
+    q2, v2 = q + h2 * v, v + h2 * a1
+    a2 = accel(q2, v2, tau)
+    q3, v3 = q + h2 * v2, v + h2 * a2
+    a3 = accel(q3, v3, tau)
+    q4, v4 = q + h * v3, v + h * a3
+    a4 = accel(q4, v4, tau)
+    if nz:
+        z = z + hz * dz
+    return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z
+
+
+def _law_call(controller: Controller, noise: list[np.ndarray] | None) -> Callable[[Any, Any], Any]:
+    """The law as the loop calls it: contained (read-only inputs; ``sys.exit`` and
+    ``MemoryError`` name it) and, with sensor noise, measuring the state plus ``noise``
+    (the list the loop fills with the current step's offsets)."""
+    law = contained(controller)
+    if noise is None:
+        return law
+    new = tuple.__new__
+
+    def compute(x: LawInput, terms: Any) -> LawOutput:  # the law measures the state + noise
+        t, q, v, z, *reference = x
+        return law(new(LawInput, (t, q + noise[0], v + noise[1], z, *reference)), terms)
+
+    return compute
+
+
 def _raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
     """Whether ``exc`` was raised inside the law (its ``compute`` is on the traceback)."""
     code = getattr(getattr(compute, "__func__", compute), "__code__", None)
@@ -347,6 +421,30 @@ def _raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
             return True
         tb = tb.tb_next
     return isinstance(exc, ControllerError)
+
+
+def _late_divergence(
+    q: np.ndarray,
+    v: np.ndarray,
+    z: np.ndarray,
+    alive: np.ndarray,
+    t: float,
+    diverged_at: np.ndarray,
+    detail: list[str | None],
+    name: str,
+    stop_on_divergence: bool,
+) -> np.ndarray:
+    """Flag the live runs whose state after a block (at ``t`` [s]) has diverged; returns them."""
+    current = _bad_rows(q[None])[0] | _bad_rows(v[None])[0] | _bad_rows(z[None])[0]
+    late = alive & current
+    if late.any():
+        if stop_on_divergence:
+            raise SimulationDivergedError(name, t, _state_detail(q, v, z, late))
+        for r in np.flatnonzero(late):
+            diverged_at[r] = t
+            detail[r] = _state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r])
+        alive &= ~late
+    return late
 
 
 def _state_detail(q: np.ndarray, v: np.ndarray, z: np.ndarray, mask: np.ndarray) -> str:
