@@ -170,10 +170,8 @@ def scheduler_option(text: str) -> str:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    """The ``twolink-pin`` argument parser."""
+    """The ``twolink-pin`` argument parser: each family of commands added by its own function."""
     from twolink_pin.cli import commands as c
-    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
-    from twolink_pin.studies.sweep import MAX_CHUNK, MAX_SAMPLES
 
     parser = Parser(
         prog="twolink-pin",
@@ -186,6 +184,15 @@ def build_parser() -> argparse.ArgumentParser:
     )
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
+    _add_model_commands(sub, c)
+    _add_run_commands(sub, c)
+    _add_sweep_command(sub, c)
+    add_identification_commands(sub, c)
+    return parser
+
+
+def _add_model_commands(sub: Any, c: Any) -> None:
+    """The commands about the model alone: ``info``, ``robots``, ``controllers``, ``fk``, ``ik``, ``trajectory``."""
     p = sub.add_parser("info", help="model summary: sizes, link lengths, torque limits, parameters")
     p.add_argument("--write-urdf", metavar="FILE", help="also write the payload variant as a URDF file")
     p.add_argument(
@@ -243,6 +250,9 @@ def build_parser() -> argparse.ArgumentParser:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_trajectory)
 
+
+def _add_run_commands(sub: Any, c: Any) -> None:
+    """The commands that run laws: ``simulate``, ``compare``, ``animate``, ``report``."""
     p = sub.add_parser("simulate", help="closed-loop simulation of one control law")
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
@@ -323,6 +333,12 @@ def build_parser() -> argparse.ArgumentParser:
     add_robot_options(p)
     add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)
+
+
+def _add_sweep_command(sub: Any, c: Any) -> None:
+    """``sweep``: the Monte Carlo study."""
+    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
+    from twolink_pin.studies.sweep import MAX_CHUNK, MAX_SAMPLES
 
     p = sub.add_parser(
         "sweep", help="Monte Carlo study of one law on the batch engine: table, summary, histograms"
@@ -418,6 +434,3 @@ def build_parser() -> argparse.ArgumentParser:
     add_sim_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_sweep)
-
-    add_identification_commands(sub, c)
-    return parser
