@@ -189,10 +189,12 @@ class RunSpec:
             assert identified is not None
             belief = believed(cls, robot, identified, self.parameters_use, gains)
             parameters, gains = belief.parameters, belief.gains
-            if belief.friction is not None:
-                smoothing = plant.friction.smoothing if plant.friction is not None else 0.0
-                friction = dataclasses.replace(
-                    belief.friction, smoothing=smoothing or belief.friction.smoothing
+            if belief.friction is not None:  # with the ε of the friction it replaces
+                smoothing = friction.smoothing if friction is not None else 0.0
+                friction = (
+                    dataclasses.replace(belief.friction, smoothing=smoothing)
+                    if smoothing
+                    else belief.friction
                 )
         controller = make_controller(
             cls, robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters

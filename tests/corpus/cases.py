@@ -583,7 +583,7 @@ NONFINITE = [
     C("nonfinite-info-no-limits", "info --robot no_limits.urdf", 0, out=("no limit|none",), setup=(urdf("no_limits"),)),
     C("nonfinite-info-no-limits-json", "info --robot no_limits.urdf --json", 0, setup=(urdf("no_limits"),), checks=(strict_json(),)),
     C("nonfinite-simulate-no-limits-json", f"simulate pd {SIM} --robot no_limits.urdf --json", 0, setup=(urdf("no_limits"),), checks=(strict_json(),)),
-    C("nonfinite-simulate-no-limits-saturate", f"simulate pd {SIM} --robot no_limits.urdf --saturate", 0, setup=(urdf("no_limits"),)),
+    C("nonfinite-simulate-no-limits-saturate", f"simulate pd {SIM} --robot no_limits.urdf --saturate", 2, err=("--saturate", "effort limits"), setup=(urdf("no_limits"),), note="issue 30: --saturate would clip nothing without effort limits: refused rather than ignored"),
     C("nonfinite-trajectory-no-limits", "trajectory --robot no_limits.urdf", 0, setup=(urdf("no_limits"),)),
     C("nonfinite-trajectory-no-limits-json", "trajectory --robot no_limits.urdf --json", 0, setup=(urdf("no_limits"),), checks=(strict_json(),)),
     C("nonfinite-compare-no-limits-json", f"compare pd {SIM} --robot no_limits.urdf --no-plot --json --out c", 0, setup=(urdf("no_limits"),), checks=(strict_json(),)),
