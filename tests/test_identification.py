@@ -509,6 +509,7 @@ def test_identify_then_control_with_what_was_identified(tmp_path: Path, twolink,
     path = write_json(tmp_path / "p.json", identification_document(found, twolink))
     identified = read_parameter_file(path, twolink)
     b = found.estimate
+
     def seeded(law: str, use: str):
         return RunSpec(law=law, parameters=str(path), parameters_use=use).build(twolink, identified)
 
