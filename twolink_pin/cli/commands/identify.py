@@ -19,17 +19,18 @@ if TYPE_CHECKING:
 
 def _excitation(robot: RobotModel) -> tuple[Trajectory, str]:
     """The robot's excitation and where it came from (stored, or optimised now)."""
-    from twolink_pin.identification.excitation import _STORED, _is_catalog_robot, excitation_trajectory
+    from twolink_pin.identification.excitation import optimise_excitation, stored_excitation
 
-    stored = robot.name in _STORED and robot.payload == 0 and _is_catalog_robot(robot)
-    if not stored:
-        print(
-            f"twolink-pin: optimising an excitation for {robot.name} (none is stored): this can take minutes; "
-            "save one with twolink-pin excite --out FILE and pass --trajectory FILE",
-            file=sys.stderr,
-            flush=True,
-        )
-    return excitation_trajectory(robot), "stored excitation" if stored else "excitation optimised now"
+    stored = stored_excitation(robot)
+    if stored is not None:
+        return stored, "stored excitation"
+    print(
+        f"twolink-pin: optimising an excitation for {robot.name} (none is stored): this can take minutes; "
+        "save one with twolink-pin excite --out FILE and pass --trajectory FILE",
+        file=sys.stderr,
+        flush=True,
+    )
+    return optimise_excitation(robot).trajectory, "excitation optimised now"
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
@@ -222,7 +223,11 @@ def cmd_excite(args: argparse.Namespace) -> int:
         seed=args.seed,
         limits=limits,
     )
-    from twolink_pin.identification.excitation_check import check_excitation_work, excitation_problem
+    from twolink_pin.identification.excitation_check import (
+        check_excitation_work,
+        excitation_problem,
+        excitation_verdict,
+    )
 
     check_excitation_work(robot.nv, args.harmonics, args.samples, args.starts, args.max_iterations)
     bar = progress_bar(args.starts * args.max_iterations, "it", f"excite {robot.name}")
@@ -250,6 +255,10 @@ def cmd_excite(args: argparse.Namespace) -> int:
         "starts": excitation.starts,
         "seed": design.seed,
         "success": excitation.success,
+        "converged": excitation.converged,
+        "verdict": excitation_verdict(
+            excitation.peaks, excitation.limits, excitation.converged, excitation.message
+        ),
         "message": excitation.message,
         "design": {"harmonics": design.harmonics, "period_s": design.period, "samples": design.samples},
         "limits": excitation.limits,
@@ -288,12 +297,9 @@ def cmd_excite(args: argparse.Namespace) -> int:
         f"excitation for {robot.name} ({design.criterion}): {design.harmonics} harmonics, period {design.period:g} s "
         f"-> {written}",
         f"  optimiser: SLSQP from {design.starts} seeded starts (seed {design.seed}), {excitation.iterations} iterations, "
-        f"{excitation.evaluations} evaluations, {excitation.seconds:.1f} s; {excitation.message}"
-        + (
-            ""
-            if excitation.success
-            else " (NOT converged to a feasible point: more --max-iterations or --starts)"
-        ),
+        f"{excitation.evaluations} evaluations, {excitation.seconds:.1f} s; {excitation.message}",
+        "  "
+        + excitation_verdict(excitation.peaks, excitation.limits, excitation.converged, excitation.message),
         f"  cond(W) of {len(excitation.measures.names)} parameters (base + friction) over a period: "
         f"{excitation.measures.condition_number:.4g}; {which}: {default.condition_number:.4g}",
         f"  smallest Gram eigenvalue per second {excitation.measures.gram_min_eigenvalue_per_s:.4g}; {which}: "
