@@ -13,6 +13,7 @@ from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
+    from twolink_pin.identification import RunLog
     from twolink_pin.model import RobotModel
     from twolink_pin.trajectory import Trajectory
 
@@ -33,81 +34,76 @@ def _excitation(robot: RobotModel) -> tuple[Trajectory, str]:
     return optimise_excitation(robot).trajectory, "excitation optimised now"
 
 
-def cmd_identify(args: argparse.Namespace) -> int:
-    from twolink_pin.files import write_json
-    from twolink_pin.identification import (
-        IdentificationOptions,
-        ZeroPhaseFilter,
-        add_noise,
-        identification_document,
-        identify,
-        read_log,
-        simulate_log,
-        write_log,
-    )
-    from twolink_pin.identification.simulated import DEFAULT_DT
+def _data_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog, str, Any]:
+    """``--data``: the user's log (CSV/NPZ, or a ROS bag with its summary), checked; the
+    refusals of options that only shape a simulated run."""
+    from twolink_pin.identification import read_log
 
-    robot = _robot(args)
-    if args.data:
-        given = [
-            name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None
-        ]
-        if given:
-            raise InvalidParameterError(
-                given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
-            )
-        from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
+    given = [name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None]
+    if given:
+        raise InvalidParameterError(
+            given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
+        )
+    from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
 
-        bag_summary = None
-        if is_bag(args.data):
-            joints = [str(n) for n in robot.model.names[1:]]
-            log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
-        else:
-            if args.topic or args.torque_topic:
-                raise InvalidParameterError(
-                    "--topic" if args.topic else "--torque-topic",
-                    args.topic or args.torque_topic,
-                    "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
-                )
-            log = read_log(args.data, robot.nv)
-        from twolink_pin.identification.diagnostics import check_log
-
-        check_log(log, robot)
-        reference = f"data {args.data}"
-        if args.reference:
-            from dataclasses import replace
-
-            from twolink_pin.trajectory import read_trajectory_file
-
-            log = replace(log, reference=read_trajectory_file(args.reference, robot))
-            reference += f", reference {args.reference}"
+    bag_summary = None
+    if is_bag(args.data):
+        joints = [str(n) for n in robot.model.names[1:]]
+        log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
     else:
+        if args.topic or args.torque_topic:
+            raise InvalidParameterError(
+                "--topic" if args.topic else "--torque-topic",
+                args.topic or args.torque_topic,
+                "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
+            )
+        log = read_log(args.data, robot.nv)
+    from twolink_pin.identification.diagnostics import check_log
+
+    check_log(log, robot)
+    reference = f"data {args.data}"
+    if args.reference:
+        from dataclasses import replace
+
         from twolink_pin.trajectory import read_trajectory_file
 
-        bag_summary = None
-        if args.reference or args.topic or args.torque_topic:
-            flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
-            raise InvalidParameterError(
-                flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
-            )
-        if args.trajectory:
-            trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
-            reference = f"trajectory {args.trajectory}"
-        else:
-            trajectory, reference = _excitation(robot)
-        log = simulate_log(
-            robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
+        log = replace(log, reference=read_trajectory_file(args.reference, robot))
+        reference += f", reference {args.reference}"
+    return log, reference, bag_summary
+
+
+def _simulated_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog, str]:
+    """No ``--data``: a simulated run along ``--trajectory`` or the robot's excitation; the
+    refusals of options that only apply to a log."""
+    from twolink_pin.identification import simulate_log
+    from twolink_pin.identification.simulated import DEFAULT_DT
+    from twolink_pin.trajectory import read_trajectory_file
+
+    if args.reference or args.topic or args.torque_topic:
+        flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
+        raise InvalidParameterError(
+            flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
         )
-    log = add_noise(log, args.noise_q, args.noise_tau, args.seed)
-    options = IdentificationOptions(
-        zero_phase=ZeroPhaseFilter(args.cutoff, args.order, reversal_guard=args.reversal_guard),
-        friction=not args.no_friction,
-        validation=args.validation,
-        weighted=not args.ols,
-        instruments=not args.no_instruments,
+    if args.trajectory:
+        trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
+        reference = f"trajectory {args.trajectory}"
+    else:
+        trajectory, reference = _excitation(robot)
+    log = simulate_log(
+        robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
     )
-    result = identify(log, robot, options)
-    document = identification_document(result, robot)
+    return log, reference
+
+
+def _physical_and_urdf(
+    args: argparse.Namespace,
+    log: RunLog,
+    robot: RobotModel,
+    options: Any,
+    result: Any,
+    document: dict[str, Any],
+) -> list[str]:
+    """``--physical`` (the constrained fit, into ``document``) and ``--write-urdf``; their lines."""
     physical_lines: list[str] = []
     fit = None
     if args.physical:
@@ -125,28 +121,14 @@ def cmd_identify(args: argparse.Namespace) -> int:
             f"  URDF with the identified inertias{' and friction (<dynamics>)' if options.friction else ''} "
             f"written to {args.write_urdf} (use with --robot/--urdf)"
         )
-    figures: list[str] = []
-    if args.plot:
-        from twolink_pin.files import removed_on_failure
-        from twolink_pin.plotting.identification import save_identification_figures
+    return physical_lines
 
-        with removed_on_failure(args.plot) as folder:
-            figures = [str(p) for p in save_identification_figures(result, folder)]
-    if args.save:
-        write_json(args.save, document)
-    if args.save_data:
-        write_log(args.save_data, log)
-    within = result.within(3.0)
-    document |= {
-        "reference": reference,
-        "noise": {"q_rad": args.noise_q, "tau_Nm": args.noise_tau, "seed": args.seed},
-        "within_3_sigma": None if within is None else within.tolist(),
-        "figures": figures,
-        "saved": args.save,
-        "data_saved": args.save_data,
-    }
-    lines = [] if bag_summary is None else bag_summary.lines()
-    lines += [
+
+def _result_lines(
+    args: argparse.Namespace, robot: RobotModel, log: RunLog, result: Any, reference: str, within: Any
+) -> list[str]:
+    """The fit as text: source, method, filter, one row per parameter, conditioning, ±3σ."""
+    lines = [
         f"identified {result.size} parameters of {robot.name} from {log.source}",
         f"  {reference}; {result.fit_samples} samples fitted (every {result.stride}th valid one of {result.samples}, "
         f"{result.fit_interval[0]:.3g}–{result.fit_interval[1]:.3g} s)"
@@ -184,6 +166,59 @@ def cmd_identify(args: argparse.Namespace) -> int:
                 else ""
             )
         )
+    return lines
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    from twolink_pin.files import write_json
+    from twolink_pin.identification import (
+        IdentificationOptions,
+        ZeroPhaseFilter,
+        add_noise,
+        identification_document,
+        identify,
+        write_log,
+    )
+
+    robot = _robot(args)
+    if args.data:
+        log, reference, bag_summary = _data_log(args, robot)
+    else:
+        bag_summary = None
+        log, reference = _simulated_log(args, robot)
+    log = add_noise(log, args.noise_q, args.noise_tau, args.seed)
+    options = IdentificationOptions(
+        zero_phase=ZeroPhaseFilter(args.cutoff, args.order, reversal_guard=args.reversal_guard),
+        friction=not args.no_friction,
+        validation=args.validation,
+        weighted=not args.ols,
+        instruments=not args.no_instruments,
+    )
+    result = identify(log, robot, options)
+    document = identification_document(result, robot)
+    physical_lines = _physical_and_urdf(args, log, robot, options, result, document)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_identification_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_identification_figures(result, folder)]
+    if args.save:
+        write_json(args.save, document)
+    if args.save_data:
+        write_log(args.save_data, log)
+    within = result.within(3.0)
+    document |= {
+        "reference": reference,
+        "noise": {"q_rad": args.noise_q, "tau_Nm": args.noise_tau, "seed": args.seed},
+        "within_3_sigma": None if within is None else within.tolist(),
+        "figures": figures,
+        "saved": args.save,
+        "data_saved": args.save_data,
+    }
+    lines = [] if bag_summary is None else bag_summary.lines()
+    lines += _result_lines(args, robot, log, result, reference, within)
     from twolink_pin.identification.diagnostics import fit_warnings
 
     warnings = fit_warnings(result)

@@ -88,7 +88,15 @@ def cmd_info(args: argparse.Namespace) -> int:
                 args.write_urdf,
                 "a file other than the robot's own URDF (it would be replaced)",
             )
-        written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
+        from twolink_pin.model.catalog import catalog_profile_name
+
+        written = write_payload_urdf(
+            robot.urdf_path,
+            robot.payload,
+            args.write_urdf,
+            robot.ee_frame,
+            catalog_profile_name(robot.profile),
+        )
         payload["urdf_written"] = str(written)
         text += f"\nwrote      {written}"
     emit(args, payload, text)
