@@ -808,7 +808,11 @@ def ur5_commands_section(quick: bool) -> dict[str, Any]:
                 ],
                 EXCITE_UR5_DOCUMENTED * iterations / 100,
             ),
-            ("identify_ur5_cli", ["identify", "--robot", "ur5"], None),
+            (
+                "identify_ur5_cli",
+                ["identify", "--robot", "ur5", *(["--duration", "8"] if quick else [])],
+                None,
+            ),
         ):
             wall, cpu = time.perf_counter(), time.process_time()
             with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
