@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import os
 import xml.etree.ElementTree as ET
-from pathlib import Path
+
+from twolink_pin.errors import InvalidURDFError
+from twolink_pin.model.urdf_validation import validate_urdf_file
 
 PROFILE_ELEMENT = "twolink_pin"
 """Tag of the element, a child of ``<robot>``, whose ``profile`` attribute names the profile."""
@@ -42,9 +44,9 @@ def declare_profile(urdf_text: str, name: str) -> str:
 def declared_profile(path: str | os.PathLike[str]) -> str | None:
     """The profile name a URDF file declares, or None (no declaration, or a file that does not
     parse: the loader reports that with its own message)."""
-    try:
-        root = ET.parse(Path(path)).getroot()
-    except (OSError, ET.ParseError):
+    try:  # the project's checks first (size, no DOCTYPE/ENTITY, depth): a file is read once checked
+        root = ET.fromstring(validate_urdf_file(path))
+    except (InvalidURDFError, ET.ParseError):
         return None
     element = root.find(PROFILE_ELEMENT)
     return None if element is None else element.get("profile")
