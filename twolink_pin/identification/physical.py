@@ -419,7 +419,10 @@ def write_identified_urdf(
         robot.urdf_path.read_text(encoding="utf-8"), robot.model, standard, coefficients
     )
     name = catalog_profile_name(robot.profile)
-    if name is not None:  # given back with --urdf, it runs with the catalog robot's profile
+    # given back with --urdf, it runs with the catalog robot's profile; not a profile whose own
+    # parameter map constrains the inertias (the twolink's lumped p1..p3 need c_y = 0 exactly,
+    # which identified numbers meet only to rounding): that file keeps the generic profile
+    if name is not None and robot.profile.parameter_map is None:
         text = declare_profile(text, name)
     validate_urdf_string(text, path)
     with atomic_write(path) as f:
