@@ -46,7 +46,12 @@ COMMANDS = _commands()
 def test_the_page_runs_simulate_compare_and_sweep() -> None:
     verbs = [shlex.split(c)[1] for c, _ in COMMANDS]
     assert verbs.count("simulate") >= 2 and "compare" in verbs and "sweep" in verbs
-    assert all("--robot ur5" in c and "examples/ur5_square_pose.toml" in c for c, _ in COMMANDS)
+    for robot in ("ur5", "panda"):  # each arm runs its own example square
+        assert any(f"--robot {robot}" in c and f"examples/{robot}_square_pose.toml" in c for c, _ in COMMANDS)
+    assert all(
+        any(f"--robot {r}" in c and f"examples/{r}_square_pose.toml" in c for r in ("ur5", "panda"))
+        for c, _ in COMMANDS
+    )
 
 
 @pytest.mark.slow

@@ -12,6 +12,7 @@ from twolink_pin.identification.excitation_check import (
     MAX_EXCITATION_WORK,
     check_excitation_work,
     excitation_problem,
+    excitation_verdict,
     excitation_work,
 )
 
@@ -61,3 +62,76 @@ def test_work_is_the_product_and_is_bounded() -> None:
     with pytest.raises(InvalidParameterError, match=r"1\.1e\+13"):
         check_excitation_work(2, 5, 100_000, 50, 100_000)
     assert excitation_work(2, 5, 100_000, 50, 100_000) > MAX_EXCITATION_WORK
+
+
+def test_a_feasible_excitation_says_so_even_when_the_optimiser_stopped_at_its_limit() -> None:
+    """The issue's case: every peak within limits, SLSQP at its iteration limit: the verdict
+    says feasible (never "NOT converged to a feasible point") and names the closest limit:
+    positions use 1 of their 2-rad half range (50 %), speeds 2 of 5 (40 %), accelerations 3 of
+    10 (30 %), torque 7 of 192 (3.6 %)."""
+    verdict = excitation_verdict(peaks(), LIMITS, False, "Iteration limit reached")
+    assert verdict.startswith("feasible: every peak within its limit")
+    assert "(closest: position of joint 1 at 50.0 % of its half range)" in verdict
+    assert "SLSQP stopped before converging (Iteration limit reached)" in verdict
+    tight = excitation_verdict(
+        peaks(tau_max=[190.08, 1.0]), LIMITS, True, "Optimization terminated successfully"
+    )
+    assert (
+        tight
+        == "feasible: every peak within its limit (closest: torque of joint 1 at 99.0 % of 192 N·m); SLSQP converged"
+    )
+
+
+def test_an_infeasible_excitation_names_the_limit_and_by_how_much() -> None:
+    verdict = excitation_verdict(
+        peaks(v_max=[2.0, 6.0]), LIMITS, True, "Optimization terminated successfully"
+    )
+    assert verdict == (
+        "peak speed of joint 2 is 6 rad/s, beyond its limit 5 rad/s, over by 1 rad/s (20 % of the limit) (infeasible)"
+    )
+    position = excitation_verdict(peaks(q_min=[-2.5, -1.0]), LIMITS, False, "Iteration limit reached")
+    assert (
+        "joint 1 reaches [-2.5, 1] rad, beyond its range [-2, 2] rad, over by 0.5 rad (25 % of the limit)"
+        in position
+    )
+
+
+def test_the_ur5_has_a_stored_excitation_and_identify_uses_it_without_optimising(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """identify --robot ur5's default reads the packaged excitation (the one the docs measure,
+    tests/fixtures/ur5_excitation.json) instead of optimising one for minutes; a loaded UR5
+    (another robot) has none."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from twolink_pin.identification import excitation
+    from twolink_pin.model import load_robot
+    from twolink_pin.trajectory import read_trajectory_file
+
+    def refuse(*_: object, **__: object) -> None:
+        raise AssertionError("optimise_excitation called")
+
+    monkeypatch.setattr(excitation, "optimise_excitation", refuse)
+    ur5 = load_robot("ur5")
+    stored = excitation.excitation_trajectory(ur5)
+    fixture = read_trajectory_file(Path(__file__).parent / "fixtures" / "ur5_excitation.json", ur5)
+    t = np.linspace(0.0, 10.0, 101)
+    np.testing.assert_array_equal(stored.sample(t).q, fixture.sample(t).q)
+    assert excitation.stored_excitation(load_robot("ur5", payload=1.0)) is None
+
+
+def test_identify_robot_ur5_takes_the_stored_excitation_and_says_so(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The CLI's choice of excitation for `identify --robot ur5` (what took 2 min 9 s when it
+    optimised one first): the stored file, named as such, no optimisation."""
+    from twolink_pin.cli.commands import identify as command
+    from twolink_pin.identification import excitation
+    from twolink_pin.model import load_robot
+
+    def refuse(*_: object, **__: object) -> None:
+        raise AssertionError("optimise_excitation called")
+
+    monkeypatch.setattr(excitation, "optimise_excitation", refuse)
+    trajectory, where = command._excitation(load_robot("ur5"))
+    assert where == "stored excitation" and trajectory.period == 10.0

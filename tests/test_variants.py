@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -41,9 +43,20 @@ def test_payload_must_be_positive() -> None:
         payload_urdf(twolink_urdf_path(), -1.0)
 
 
-def test_link_with_mass_is_refused() -> None:
-    with pytest.raises(InvalidURDFError, match="link 'link2' <inertial>: expected a massless link"):
-        payload_urdf(twolink_urdf_path(), 1.0, link="link2")
+def test_a_link_with_mass_carries_the_sum_of_its_body_and_the_payload(tmp_path: Path) -> None:
+    """Issue 28 §5: a link with an <inertial> of its own (the UR5's tool0) is no refusal: the
+    body read back is Pinocchio's sum of the link's body and a point mass at its origin."""
+    import pinocchio as pin
+
+    from twolink_pin.model import load_robot
+
+    out = tmp_path / "heavier_link2.urdf"
+    out.write_text(payload_urdf(twolink_urdf_path(), 1.0, link="link2"))
+    before, after = load_robot(twolink_urdf_path()).model, load_robot(out).model
+    expected = before.inertias[2] + pin.Inertia(1.0, np.zeros(3), np.zeros((3, 3)))
+    np.testing.assert_allclose(
+        after.inertias[2].toDynamicParameters(), expected.toDynamicParameters(), rtol=1e-12, atol=1e-12
+    )
 
 
 def test_unknown_link_is_named() -> None:

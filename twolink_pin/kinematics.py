@@ -203,6 +203,21 @@ def end_effector_position(robot: RobotModel, q: np.ndarray, data: pin.Data | Non
     return data.oMf[robot.ee_frame_id].translation.copy()
 
 
+def end_effector_pose(
+    robot: RobotModel, q: np.ndarray, data: pin.Data | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The end-effector frame at ``q`` [rad]: its origin ``(x, y, z)`` [m], its rotation (its
+    axes in base coordinates, 3 × 3) and that rotation as ``(roll, pitch, yaw)`` [rad] with
+    ``R = Rz(yaw) Ry(pitch) Rx(roll)`` (the URDF's convention, Pinocchio's ``rpy``: what a
+    via-pose file's ``rpy`` rows hold)."""
+    q = _check_q(robot, q)
+    data = data if data is not None else robot.create_data()
+    pin.framesForwardKinematics(robot.model, data, q)
+    frame = data.oMf[robot.ee_frame_id]
+    rotation = frame.rotation.copy()
+    return frame.translation.copy(), rotation, np.asarray(pin.rpy.matrixToRpy(rotation)).copy()
+
+
 def position_jacobian(robot: RobotModel, q: np.ndarray, data: pin.Data | None = None) -> np.ndarray:
     """``∂(x, y, z)/∂q`` of the end effector [m/rad], shape (3, nv), base-frame axes."""
     q = _check_q(robot, q)

@@ -66,7 +66,18 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "Files, errors, arrays, math, threads, version",
         "The one writer, bounded input documents, the stages a command reports, the signals it "
         "received, the exceptions, read-only arrays, LaTeX → MathML, OpenMP threads, the version.",
-        ("files", "documents", "readiness", "interrupts", "errors", "arrays", "mathml", "openmp", "version"),
+        (
+            "files",
+            "documents",
+            "readiness",
+            "interrupts",
+            "errors",
+            "arrays",
+            "mathml",
+            "openmp",
+            "blas",
+            "version",
+        ),
     ),
 )
 """``(page, title, one line, modules under twolink_pin)`` in the navigation's order."""

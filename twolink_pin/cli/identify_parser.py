@@ -11,14 +11,24 @@ from twolink_pin.cli.common_options import add_robot_options, add_trajectory_opt
 
 def add_identification_commands(sub: Any, c: Any) -> None:
     """``identify`` and ``excite``."""
-    from twolink_pin.identification.data import MAX_LOG_BYTES
-    from twolink_pin.identification.filtering import DEFAULT_CUTOFF_HZ, DEFAULT_ORDER
-
     p = sub.add_parser(
         "identify",
         help="identify the base parameters and joint friction from a run: simulated along the robot's "
         "excitation (or --trajectory FILE), or a log of yours (--data FILE)",
     )
+    _identify_data_options(p)
+    _identify_run_options(p)
+    _identify_fit_options(p)
+    _identify_output_options(p)
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_identify)
+    _add_excite(sub, c)
+
+
+def _identify_data_options(p: Any) -> None:
+    """Where the run comes from (--trajectory, --data and a bag's topics) and --physical."""
+    from twolink_pin.identification.data import MAX_LOG_BYTES
+
     source = p.add_mutually_exclusive_group()
     add_trajectory_option(source)
     source.add_argument(
@@ -46,6 +56,10 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         help="physically consistent fit: every link's pseudo-inertia positive semidefinite and friction >= 0 "
         "(cvxpy + Clarabel), compared with the unconstrained fit on the validation period",
     )
+
+
+def _identify_run_options(p: Any) -> None:
+    """What shapes a simulated run and the noise added to any log."""
     p.add_argument(
         "--duration",
         type=bounded(0.0, 3600.0, low_open=True, unit="s"),
@@ -73,6 +87,12 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         help="add white Gaussian noise of this standard deviation to the logged τ [N·m]",
     )
     p.add_argument("--seed", type=whole(0, 2**63 - 1), default=0, help="seed of the noise (default 0)")
+
+
+def _identify_fit_options(p: Any) -> None:
+    """The filter, the validation period, friction, the reference and the estimator."""
+    from twolink_pin.identification.filtering import DEFAULT_CUTOFF_HZ, DEFAULT_ORDER
+
     p.add_argument(
         "--cutoff",
         type=bounded(0.0, 1e5, low_open=True, unit="Hz"),
@@ -112,6 +132,10 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         help="least squares even when the reference is known (a simulated run's excitation, or --reference)",
     )
     p.add_argument("--ols", action="store_true", help="ordinary least squares (default: Gautier's weighted)")
+
+
+def _identify_output_options(p: Any) -> None:
+    """Figures, saved parameters, the log used and the URDF out."""
     p.add_argument("--plot", metavar="DIR", help="write the figures (validation torques, estimates) into DIR")
     p.add_argument("--save", metavar="FILE.json", help="write the identified parameters (for --p0 / --model)")
     p.add_argument("--save-data", metavar="FILE", help="write the log used (.csv or .npz, after any noise)")
@@ -121,9 +145,10 @@ def add_identification_commands(sub: Any, c: Any) -> None:
         help="write the robot's URDF with the identified inertias and friction (<dynamics damping friction>); "
         "the estimates must be physically consistent (--physical makes them so)",
     )
-    add_robot_options(p)
-    p.set_defaults(func=c.cmd_identify)
 
+
+def _add_excite(sub: Any, c: Any) -> None:
+    """``excite``."""
     p = sub.add_parser(
         "excite",
         help="an optimised excitation: a Fourier-series trajectory of minimal condition number (or fastest "

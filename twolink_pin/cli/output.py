@@ -59,6 +59,17 @@ def fmt(values: Sequence[float] | np.ndarray, digits: int = 4) -> str:
     return "(" + ", ".join("none" if not math.isfinite(x) else f"{x:.{digits}f}" for x in values) + ")"
 
 
+def pose_lines(position: np.ndarray, rotation: np.ndarray, rpy: np.ndarray, indent: str) -> list[str]:
+    """An end-effector pose as text: its rotation's rows and its ``rpy`` [rad], with the digits
+    a via-pose file needs (``positions`` and ``rpy`` rows copy from here)."""
+    rows = ", ".join("[" + ", ".join(f"{x:.9f}" for x in row) + "]" for row in rotation)
+    return [
+        f"{indent}position [{', '.join(f'{x:.9f}' for x in position)}] m",
+        f"{indent}rotation [{rows}]",
+        f"{indent}rpy      [{', '.join(f'{x:.9f}' for x in rpy)}] rad (R = Rz(yaw) Ry(pitch) Rx(roll), as via-pose files)",
+    ]
+
+
 def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any:
     """A tqdm bar on stderr (the one progress display): done, rate and ETA."""
     from tqdm import tqdm

@@ -22,9 +22,14 @@ choose the coefficients by constrained optimisation. Here (:func:`optimise_excit
   ``numpy.random.default_rng(seed)`` and scaled to half the limits; the best feasible result
   is kept. Its time, iterations and evaluations are reported.
 
-Robots may ship a stored result of the default design (:func:`register_excitation`; the
-twolink does, :mod:`twolink_pin.twolink.excitation`), which :func:`excitation_trajectory`
-returns without optimising.
+Robots may ship a stored excitation, which :func:`excitation_trajectory` returns without
+optimising (:func:`stored_excitation`): registered with :func:`register_excitation` (the
+twolink's default-design results, :mod:`twolink_pin.twolink.excitation`), or a trajectory
+file ``excitations/<robot>.json`` beside this module (the UR5's, written by
+``twolink-pin excite --robot ur5 --starts 1 --max-iterations 100``).
+
+The optimisation runs BLAS on one thread (:func:`~twolink_pin.blas.one_blas_thread`: its
+matrices are small, and OpenBLAS's threads made it six times slower on a busy machine).
 """
 
 from __future__ import annotations
@@ -33,11 +38,13 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import one_row
 from twolink_pin.errors import InvalidParameterError
@@ -53,6 +60,8 @@ DEFAULT_VELOCITY = 2.0
 """Velocity limit [rad/s] of a joint whose URDF gives none (velocity 0)."""
 FEASIBILITY_TOLERANCE = 1e-6
 """A start whose constraints are violated by more than this (relative) is not feasible."""
+STORED_FOLDER = Path(__file__).with_name("excitations")
+"""Stored excitations as trajectory files, ``<robot name>.json``."""
 
 
 def _finite_positive(name: str, value: Any, what: str) -> float:
@@ -183,6 +192,9 @@ class Excitation(NamedTuple):
     """Random starts tried."""
     success: bool
     """Whether the best start converged (SLSQP's own test) to a feasible point."""
+    converged: bool
+    """Whether SLSQP's own convergence test passed for the best start (it may stop at its
+    iteration limit at a feasible point: then ``success`` is False but the excitation usable)."""
     message: str
     """SLSQP's message for the best start."""
     limits: dict[str, list[float]]
@@ -322,8 +334,6 @@ def optimise_excitation(
     Raises:
         InvalidParameterError: the controller estimates nothing or lacks ``k``/``gamma``.
     """
-    from scipy.optimize import minimize
-
     design = design if design is not None else ExcitationDesign()
     if design.criterion == "adaptation":
         if controller is None:
@@ -335,6 +345,40 @@ def optimise_excitation(
     problem = _Problem(robot, design, controller if design.criterion == "adaptation" else None)
     rng = np.random.default_rng(design.seed)
     started = time.perf_counter()
+    with one_blas_thread():
+        best, iterations = _run_starts(problem, design, rng, progress)
+    seconds = time.perf_counter() - started
+    (_, objective), result, feasible = best
+    a, b, q0 = _unpack(result.x, robot.nv, design.harmonics)
+    trajectory = FourierTrajectory(design.period, a, b, q0)
+    with one_blas_thread():
+        measures = excitation_measures(robot, trajectory, friction=design.friction)
+        peaks = motion_peaks(robot, trajectory)
+    value = math.exp(objective)  # cond(W), or 1 / λ_min(Γ G_K): the slowest time constant
+    return Excitation(
+        trajectory=trajectory,
+        criterion=design.criterion,
+        objective=value,
+        measures=measures,
+        seconds=seconds,
+        iterations=iterations,
+        evaluations=problem.evaluations,
+        starts=design.starts,
+        success=bool(result.success) and feasible,
+        converged=bool(result.success),
+        message=str(result.message),
+        limits={k: v.tolist() for k, v in problem.limits.items()},
+        peaks=peaks,
+    )
+
+
+def _run_starts(
+    problem: _Problem, design: ExcitationDesign, rng: np.random.Generator, progress: Any
+) -> tuple[Any, int]:
+    """SLSQP from each random start; the best (feasible first, then lowest criterion) and the
+    iterations over all starts."""
+    from scipy.optimize import minimize
+
     best: Any = None
     iterations = 0
     at_most = design.starts * design.max_iterations
@@ -362,26 +406,7 @@ def optimise_excitation(
         key = (not feasible, float(result.fun))
         if best is None or key < best[0]:
             best = (key, result, feasible)
-    seconds = time.perf_counter() - started
-    (_, objective), result, feasible = best
-    a, b, q0 = _unpack(result.x, robot.nv, design.harmonics)
-    trajectory = FourierTrajectory(design.period, a, b, q0)
-    measures = excitation_measures(robot, trajectory, friction=design.friction)
-    value = math.exp(objective)  # cond(W), or 1 / λ_min(Γ G_K): the slowest time constant
-    return Excitation(
-        trajectory=trajectory,
-        criterion=design.criterion,
-        objective=value,
-        measures=measures,
-        seconds=seconds,
-        iterations=iterations,
-        evaluations=problem.evaluations,
-        starts=design.starts,
-        success=bool(result.success) and feasible,
-        message=str(result.message),
-        limits={k: v.tolist() for k, v in problem.limits.items()},
-        peaks=motion_peaks(robot, trajectory),
-    )
+    return best, iterations
 
 
 def motion_peaks(robot: RobotModel, trajectory: Any, samples: int = 2000) -> dict[str, list[float]]:
@@ -420,10 +445,26 @@ def _is_catalog_robot(robot: RobotModel) -> bool:
     return catalog.resolve(robot.name)[0].resolve() == robot.urdf_path.resolve()
 
 
-def excitation_trajectory(robot: RobotModel) -> FourierTrajectory:
-    """The robot's excitation: its stored one (:func:`register_excitation`) for an unloaded
-    robot of the catalog that has one, else :func:`optimise_excitation` with the defaults."""
-    factory = _STORED.get(robot.name) if robot.payload == 0 else None
-    if factory is not None and _is_catalog_robot(robot):
+def stored_excitation(robot: RobotModel) -> FourierTrajectory | None:
+    """The stored excitation of an unloaded robot of the catalog (registered with
+    :func:`register_excitation`, else the file ``STORED_FOLDER/<name>.json``), or None."""
+    if robot.payload != 0 or not _is_catalog_robot(robot):
+        return None
+    factory = _STORED.get(robot.name)
+    if factory is not None:
         return factory()
-    return optimise_excitation(robot).trajectory
+    path = STORED_FOLDER / f"{robot.name}.json"
+    if not path.is_file():
+        return None
+    from twolink_pin.trajectory.file import read_trajectory_file
+
+    trajectory = read_trajectory_file(path, robot)
+    assert isinstance(trajectory, FourierTrajectory)  # the folder holds Fourier excitations only
+    return trajectory
+
+
+def excitation_trajectory(robot: RobotModel) -> FourierTrajectory:
+    """The robot's excitation: its stored one (:func:`stored_excitation`), else
+    :func:`optimise_excitation` with the defaults."""
+    stored = stored_excitation(robot)
+    return stored if stored is not None else optimise_excitation(robot).trajectory

@@ -41,6 +41,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.blas import one_blas_thread
 from twolink_pin.errors import InputFileError, InvalidParameterError
 from twolink_pin.identification.data import MIN_SAMPLES, RunLog, check_sample_count
 from twolink_pin.identification.filtering import FilteredLog, ZeroPhaseFilter, filter_log
@@ -309,6 +310,11 @@ def identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | No
             high for its sampling rate, or the motion does not excite every parameter (the
             message names the worst-excited combination).
     """
+    with one_blas_thread():  # small dense algebra: OpenBLAS's threads only slow it (twolink_pin/blas.py)
+        return _identify(log, robot, options)
+
+
+def _identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | None) -> Identification:
     opts = options if options is not None else IdentificationOptions()
     if log.nv != robot.nv:
         raise InvalidParameterError("log", f"{log.nv} joints", f"a log of {robot.name}'s {robot.nv} joints")

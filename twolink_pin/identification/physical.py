@@ -41,7 +41,9 @@ import numpy as np
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.model.base_parameters import BaseParameterMap, body_name
+from twolink_pin.model.catalog import catalog_profile_name
 from twolink_pin.model.parameters import N_BODY_PARAMETERS
+from twolink_pin.model.urdf_profile import declare_profile
 
 MARGIN = 1e-6
 """The constrained fit asks ``J_i ⪰ MARGIN 𝟙`` [kg·m²], not just ``⪰ 0``: a body strictly inside
@@ -416,6 +418,12 @@ def write_identified_urdf(
     text = urdf_with_inertias(
         robot.urdf_path.read_text(encoding="utf-8"), robot.model, standard, coefficients
     )
+    name = catalog_profile_name(robot.profile)
+    # given back with --urdf, it runs with the catalog robot's profile; not a profile whose own
+    # parameter map constrains the inertias (the twolink's lumped p1..p3 need c_y = 0 exactly,
+    # which identified numbers meet only to rounding): that file keeps the generic profile
+    if name is not None and robot.profile.parameter_map is None:
+        text = declare_profile(text, name)
     validate_urdf_string(text, path)
     with atomic_write(path) as f:
         f.write(text)

@@ -8,6 +8,7 @@ module names no robot's code. :func:`resolve` turns what a user typed
 
 from __future__ import annotations
 
+import dataclasses
 import importlib.metadata
 import os
 from collections.abc import Callable
@@ -15,6 +16,7 @@ from pathlib import Path
 
 from twolink_pin.errors import InvalidURDFError
 from twolink_pin.model.profile import RobotProfile, generic_profile
+from twolink_pin.model.urdf_profile import declared_profile
 
 
 def example_robot_urdf(relative: str) -> Path:
@@ -61,8 +63,10 @@ def names() -> tuple[str, ...]:
 def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
     """The URDF path and profile of ``robot``: a catalog name, or a path to a URDF file.
 
-    A path to a catalog robot's own URDF gets that robot's profile; any other file the
-    generic profile (:func:`~twolink_pin.model.profile.generic_profile`).
+    A path to a catalog robot's own URDF gets that robot's profile, and so does a file that
+    declares it (``<twolink_pin profile="NAME"/>``, written by ``--write-urdf``:
+    :mod:`twolink_pin.model.urdf_profile`); any other file the generic profile
+    (:func:`~twolink_pin.model.profile.generic_profile`).
 
     Raises:
         InvalidURDFError: an unknown name (the message lists the valid ones).
@@ -89,4 +93,17 @@ def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
                 return path, profile
         except OSError:
             continue
+    declared = declared_profile(path)
+    if declared in CATALOG:
+        profile = CATALOG[declared]()[1]
+        return path, dataclasses.replace(profile, source=f"{path} (declares the profile of {declared})")
     return path, generic_profile(path)
+
+
+def catalog_profile_name(profile: RobotProfile) -> str | None:
+    """The catalog name whose profile ``profile`` is (a catalog robot, or a file declaring one),
+    else None (a URDF of yours with the generic profile)."""
+    entry = CATALOG.get(profile.name)
+    if entry is None or entry()[1].description != profile.description:
+        return None
+    return profile.name

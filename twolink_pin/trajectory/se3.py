@@ -219,9 +219,10 @@ def pose_trajectory(
             f"{gap:.3g} m or rad from the first",
             "the first via pose again (the reference repeats)",
         )
-    q = robot.home if seed is None else np.asarray(seed, dtype=float)
+    posture = robot.home if seed is None else np.asarray(seed, dtype=float)
+    q = posture
     try:
-        q = solve_pose(robot, P[0], R[0], q)
+        q = solve_pose(robot, P[0], R[0], q, posture=posture)
     except InverseKinematicsError as err:
         raise InverseKinematicsError(err.target, f"via pose 0: {err.reason}", err.q) from None
     grid = np.linspace(0.0, 1.0, IK_SAMPLES + 1)
@@ -234,7 +235,9 @@ def pose_trajectory(
         qs = []
         for s in grid:
             try:
-                q = solve_pose(robot, P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q)
+                q = solve_pose(
+                    robot, P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q, posture=posture
+                )
             except InverseKinematicsError as err:
                 raise InverseKinematicsError(
                     err.target, f"segment {k} (via pose {k} → {k + 1}) at s = {s:.3g}: {err.reason}", err.q
@@ -247,7 +250,7 @@ def pose_trajectory(
                     f"via poses[{n - 1}]",
                     f"reached at a configuration {closing:.3g} rad from the first",
                     f"the first configuration again (to {JOINT_CLOSURE_TOLERANCE:g} rad): the joint path must "
-                    "repeat too (a redundant arm drifted in its null space; add via poses or a seed)",
+                    "repeat too (the path crossed to another inverse-kinematics branch; add via poses or a seed)",
                 )
             qs[-1] = via_q[0]
         path = make_interp_spline(grid, np.array(qs), k=5)

@@ -13,100 +13,97 @@ from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
+    from twolink_pin.identification import RunLog
     from twolink_pin.model import RobotModel
     from twolink_pin.trajectory import Trajectory
 
 
 def _excitation(robot: RobotModel) -> tuple[Trajectory, str]:
     """The robot's excitation and where it came from (stored, or optimised now)."""
-    from twolink_pin.identification.excitation import _STORED, _is_catalog_robot, excitation_trajectory
+    from twolink_pin.identification.excitation import optimise_excitation, stored_excitation
 
-    stored = robot.name in _STORED and robot.payload == 0 and _is_catalog_robot(robot)
-    if not stored:
-        print(
-            f"twolink-pin: optimising an excitation for {robot.name} (none is stored): this can take minutes; "
-            "save one with twolink-pin excite --out FILE and pass --trajectory FILE",
-            file=sys.stderr,
-            flush=True,
-        )
-    return excitation_trajectory(robot), "stored excitation" if stored else "excitation optimised now"
-
-
-def cmd_identify(args: argparse.Namespace) -> int:
-    from twolink_pin.files import write_json
-    from twolink_pin.identification import (
-        IdentificationOptions,
-        ZeroPhaseFilter,
-        add_noise,
-        identification_document,
-        identify,
-        read_log,
-        simulate_log,
-        write_log,
+    stored = stored_excitation(robot)
+    if stored is not None:
+        return stored, "stored excitation"
+    print(
+        f"twolink-pin: optimising an excitation for {robot.name} (none is stored): this can take minutes; "
+        "save one with twolink-pin excite --out FILE and pass --trajectory FILE",
+        file=sys.stderr,
+        flush=True,
     )
-    from twolink_pin.identification.simulated import DEFAULT_DT
+    return optimise_excitation(robot).trajectory, "excitation optimised now"
 
-    robot = _robot(args)
-    if args.data:
-        given = [
-            name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None
-        ]
-        if given:
-            raise InvalidParameterError(
-                given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
-            )
-        from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
 
-        bag_summary = None
-        if is_bag(args.data):
-            joints = [str(n) for n in robot.model.names[1:]]
-            log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
-        else:
-            if args.topic or args.torque_topic:
-                raise InvalidParameterError(
-                    "--topic" if args.topic else "--torque-topic",
-                    args.topic or args.torque_topic,
-                    "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
-                )
-            log = read_log(args.data, robot.nv)
-        from twolink_pin.identification.diagnostics import check_log
+def _data_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog, str, Any]:
+    """``--data``: the user's log (CSV/NPZ, or a ROS bag with its summary), checked; the
+    refusals of options that only shape a simulated run."""
+    from twolink_pin.identification import read_log
 
-        check_log(log, robot)
-        reference = f"data {args.data}"
-        if args.reference:
-            from dataclasses import replace
+    given = [name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None]
+    if given:
+        raise InvalidParameterError(
+            given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
+        )
+    from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
 
-            from twolink_pin.trajectory import read_trajectory_file
-
-            log = replace(log, reference=read_trajectory_file(args.reference, robot))
-            reference += f", reference {args.reference}"
+    bag_summary = None
+    if is_bag(args.data):
+        joints = [str(n) for n in robot.model.names[1:]]
+        log, bag_summary = read_bag(args.data, joints, args.topic or DEFAULT_TOPIC, args.torque_topic)
     else:
+        if args.topic or args.torque_topic:
+            raise InvalidParameterError(
+                "--topic" if args.topic else "--torque-topic",
+                args.topic or args.torque_topic,
+                "no topic with a CSV/NPZ log (topics are for ROS bags: a folder, .db3, .mcap or .bag)",
+            )
+        log = read_log(args.data, robot.nv)
+    from twolink_pin.identification.diagnostics import check_log
+
+    check_log(log, robot)
+    reference = f"data {args.data}"
+    if args.reference:
+        from dataclasses import replace
+
         from twolink_pin.trajectory import read_trajectory_file
 
-        bag_summary = None
-        if args.reference or args.topic or args.torque_topic:
-            flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
-            raise InvalidParameterError(
-                flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
-            )
-        if args.trajectory:
-            trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
-            reference = f"trajectory {args.trajectory}"
-        else:
-            trajectory, reference = _excitation(robot)
-        log = simulate_log(
-            robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
+        log = replace(log, reference=read_trajectory_file(args.reference, robot))
+        reference += f", reference {args.reference}"
+    return log, reference, bag_summary
+
+
+def _simulated_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog, str]:
+    """No ``--data``: a simulated run along ``--trajectory`` or the robot's excitation; the
+    refusals of options that only apply to a log."""
+    from twolink_pin.identification import simulate_log
+    from twolink_pin.identification.simulated import DEFAULT_DT
+    from twolink_pin.trajectory import read_trajectory_file
+
+    if args.reference or args.topic or args.torque_topic:
+        flag = "--reference" if args.reference else "--topic" if args.topic else "--torque-topic"
+        raise InvalidParameterError(
+            flag, getattr(args, flag[2:].replace("-", "_")), "a value only with --data (a log of yours)"
         )
-    log = add_noise(log, args.noise_q, args.noise_tau, args.seed)
-    options = IdentificationOptions(
-        zero_phase=ZeroPhaseFilter(args.cutoff, args.order, reversal_guard=args.reversal_guard),
-        friction=not args.no_friction,
-        validation=args.validation,
-        weighted=not args.ols,
-        instruments=not args.no_instruments,
+    if args.trajectory:
+        trajectory: Trajectory = read_trajectory_file(args.trajectory, robot)
+        reference = f"trajectory {args.trajectory}"
+    else:
+        trajectory, reference = _excitation(robot)
+    log = simulate_log(
+        robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
     )
-    result = identify(log, robot, options)
-    document = identification_document(result, robot)
+    return log, reference
+
+
+def _physical_and_urdf(
+    args: argparse.Namespace,
+    log: RunLog,
+    robot: RobotModel,
+    options: Any,
+    result: Any,
+    document: dict[str, Any],
+) -> list[str]:
+    """``--physical`` (the constrained fit, into ``document``) and ``--write-urdf``; their lines."""
     physical_lines: list[str] = []
     fit = None
     if args.physical:
@@ -124,28 +121,14 @@ def cmd_identify(args: argparse.Namespace) -> int:
             f"  URDF with the identified inertias{' and friction (<dynamics>)' if options.friction else ''} "
             f"written to {args.write_urdf} (use with --robot/--urdf)"
         )
-    figures: list[str] = []
-    if args.plot:
-        from twolink_pin.files import removed_on_failure
-        from twolink_pin.plotting.identification import save_identification_figures
+    return physical_lines
 
-        with removed_on_failure(args.plot) as folder:
-            figures = [str(p) for p in save_identification_figures(result, folder)]
-    if args.save:
-        write_json(args.save, document)
-    if args.save_data:
-        write_log(args.save_data, log)
-    within = result.within(3.0)
-    document |= {
-        "reference": reference,
-        "noise": {"q_rad": args.noise_q, "tau_Nm": args.noise_tau, "seed": args.seed},
-        "within_3_sigma": None if within is None else within.tolist(),
-        "figures": figures,
-        "saved": args.save,
-        "data_saved": args.save_data,
-    }
-    lines = [] if bag_summary is None else bag_summary.lines()
-    lines += [
+
+def _result_lines(
+    args: argparse.Namespace, robot: RobotModel, log: RunLog, result: Any, reference: str, within: Any
+) -> list[str]:
+    """The fit as text: source, method, filter, one row per parameter, conditioning, ±3σ."""
+    lines = [
         f"identified {result.size} parameters of {robot.name} from {log.source}",
         f"  {reference}; {result.fit_samples} samples fitted (every {result.stride}th valid one of {result.samples}, "
         f"{result.fit_interval[0]:.3g}–{result.fit_interval[1]:.3g} s)"
@@ -183,6 +166,59 @@ def cmd_identify(args: argparse.Namespace) -> int:
                 else ""
             )
         )
+    return lines
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    from twolink_pin.files import write_json
+    from twolink_pin.identification import (
+        IdentificationOptions,
+        ZeroPhaseFilter,
+        add_noise,
+        identification_document,
+        identify,
+        write_log,
+    )
+
+    robot = _robot(args)
+    if args.data:
+        log, reference, bag_summary = _data_log(args, robot)
+    else:
+        bag_summary = None
+        log, reference = _simulated_log(args, robot)
+    log = add_noise(log, args.noise_q, args.noise_tau, args.seed)
+    options = IdentificationOptions(
+        zero_phase=ZeroPhaseFilter(args.cutoff, args.order, reversal_guard=args.reversal_guard),
+        friction=not args.no_friction,
+        validation=args.validation,
+        weighted=not args.ols,
+        instruments=not args.no_instruments,
+    )
+    result = identify(log, robot, options)
+    document = identification_document(result, robot)
+    physical_lines = _physical_and_urdf(args, log, robot, options, result, document)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_identification_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [str(p) for p in save_identification_figures(result, folder)]
+    if args.save:
+        write_json(args.save, document)
+    if args.save_data:
+        write_log(args.save_data, log)
+    within = result.within(3.0)
+    document |= {
+        "reference": reference,
+        "noise": {"q_rad": args.noise_q, "tau_Nm": args.noise_tau, "seed": args.seed},
+        "within_3_sigma": None if within is None else within.tolist(),
+        "figures": figures,
+        "saved": args.save,
+        "data_saved": args.save_data,
+    }
+    lines = [] if bag_summary is None else bag_summary.lines()
+    lines += _result_lines(args, robot, log, result, reference, within)
     from twolink_pin.identification.diagnostics import fit_warnings
 
     warnings = fit_warnings(result)
@@ -222,7 +258,11 @@ def cmd_excite(args: argparse.Namespace) -> int:
         seed=args.seed,
         limits=limits,
     )
-    from twolink_pin.identification.excitation_check import check_excitation_work, excitation_problem
+    from twolink_pin.identification.excitation_check import (
+        check_excitation_work,
+        excitation_problem,
+        excitation_verdict,
+    )
 
     check_excitation_work(robot.nv, args.harmonics, args.samples, args.starts, args.max_iterations)
     bar = progress_bar(args.starts * args.max_iterations, "it", f"excite {robot.name}")
@@ -250,6 +290,10 @@ def cmd_excite(args: argparse.Namespace) -> int:
         "starts": excitation.starts,
         "seed": design.seed,
         "success": excitation.success,
+        "converged": excitation.converged,
+        "verdict": excitation_verdict(
+            excitation.peaks, excitation.limits, excitation.converged, excitation.message
+        ),
         "message": excitation.message,
         "design": {"harmonics": design.harmonics, "period_s": design.period, "samples": design.samples},
         "limits": excitation.limits,
@@ -288,12 +332,9 @@ def cmd_excite(args: argparse.Namespace) -> int:
         f"excitation for {robot.name} ({design.criterion}): {design.harmonics} harmonics, period {design.period:g} s "
         f"-> {written}",
         f"  optimiser: SLSQP from {design.starts} seeded starts (seed {design.seed}), {excitation.iterations} iterations, "
-        f"{excitation.evaluations} evaluations, {excitation.seconds:.1f} s; {excitation.message}"
-        + (
-            ""
-            if excitation.success
-            else " (NOT converged to a feasible point: more --max-iterations or --starts)"
-        ),
+        f"{excitation.evaluations} evaluations, {excitation.seconds:.1f} s; {excitation.message}",
+        "  "
+        + excitation_verdict(excitation.peaks, excitation.limits, excitation.converged, excitation.message),
         f"  cond(W) of {len(excitation.measures.names)} parameters (base + friction) over a period: "
         f"{excitation.measures.condition_number:.4g}; {which}: {default.condition_number:.4g}",
         f"  smallest Gram eigenvalue per second {excitation.measures.gram_min_eigenvalue_per_s:.4g}; {which}: "

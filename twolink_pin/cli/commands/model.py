@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from twolink_pin.cli.commands.common import _robot, _trajectory
-from twolink_pin.cli.output import emit, fmt
+from twolink_pin.cli.output import emit, fmt, pose_lines
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -27,6 +27,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         if isinstance(robot.parameter_map, BaseParameterMap)
         else BaseParameterMap(robot.model)
     )
+    home_pose, home_lines = _pose_payload(robot, robot.home)
     payload: dict[str, Any] = {
         "robot": robot.name,
         "urdf": str(robot.urdf_path),
@@ -35,6 +36,8 @@ def cmd_info(args: argparse.Namespace) -> int:
         "gravity": robot.model.gravity.linear.tolist(),
         "link_lengths": robot.link_lengths.tolist(),
         "torque_limits": robot.torque_limits.tolist(),
+        "home": robot.home.tolist(),
+        "home_pose": home_pose,
         "parameter_names": list(robot.parameter_map.names),
         "p": robot.p.tolist(),
         "base_parameters": {
@@ -63,6 +66,8 @@ def cmd_info(args: argparse.Namespace) -> int:
             f"gravity    {fmt(robot.model.gravity.linear, 3)} m/s²",
             f"links      {fmt(robot.link_lengths, 3)} m",
             f"limits     ({limits}) N·m",
+            f"home       q = [{', '.join(f'{x:.9g}' for x in robot.home)}] rad, end effector at",
+            *home_lines,
             f"payload    {robot.payload:g} kg",
             f"parameters {p_text}",
             f"base       {base.size} identifiable base parameters (twolink-pin info --json lists them)"
@@ -83,7 +88,15 @@ def cmd_info(args: argparse.Namespace) -> int:
                 args.write_urdf,
                 "a file other than the robot's own URDF (it would be replaced)",
             )
-        written = write_payload_urdf(robot.urdf_path, robot.payload, args.write_urdf, robot.ee_frame)
+        from twolink_pin.model.catalog import catalog_profile_name
+
+        written = write_payload_urdf(
+            robot.urdf_path,
+            robot.payload,
+            args.write_urdf,
+            robot.ee_frame,
+            catalog_profile_name(robot.profile),
+        )
         payload["urdf_written"] = str(written)
         text += f"\nwrote      {written}"
     emit(args, payload, text)
@@ -174,6 +187,15 @@ def cmd_controllers(args: argparse.Namespace) -> int:
     return 0
 
 
+def _pose_payload(robot: RobotModel, q: np.ndarray) -> tuple[dict[str, Any], list[str]]:
+    """The end effector's pose at ``q`` [rad] as JSON fields and as text lines."""
+    from twolink_pin.kinematics import end_effector_pose
+
+    position, rotation, rpy = end_effector_pose(robot, q)
+    fields = {"position": position.tolist(), "rotation": rotation.tolist(), "rpy": rpy.tolist()}
+    return fields, pose_lines(position, rotation, rpy, "  ")
+
+
 def cmd_fk(args: argparse.Namespace) -> int:
     from twolink_pin.kinematics import joint_positions
 
@@ -184,10 +206,16 @@ def cmd_fk(args: argparse.Namespace) -> int:
             "Q", args.q, f"{robot.nq} joint angles [rad] for {robot.name} (nq = {robot.nq})"
         )
     position = joint_positions(robot, q)[-1]
+    pose, lines = _pose_payload(robot, q)
     emit(
         args,
-        {"position": position.tolist(), "xy": position[:2].tolist()},
-        f"end effector at {fmt(position)} m for q = {fmt(q)} rad",
+        {
+            "position": position.tolist(),
+            "xy": position[:2].tolist(),
+            "rotation": pose["rotation"],
+            "rpy": pose["rpy"],
+        },
+        "\n".join([f"end effector at {fmt(position)} m for q = {fmt(q)} rad", *lines]),
     )
     return 0
 
