@@ -85,6 +85,9 @@ class BatchResult:
     """Name of each state entry."""
     state_units: tuple[str, ...] = ()
     """SI unit of each state entry."""
+    trajectory: Trajectory | None = field(repr=False, default=None)
+    """The reference every run tracked (``trajectory.sample(t)`` gives ``q_d``, ``q̇_d``,
+    ``q̈_d`` at the output times ``t``)."""
 
     @property
     def n_runs(self) -> int:
@@ -247,4 +250,5 @@ def simulate_batch(
         state=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and nz else None,
         state_names=names,
         state_units=units,
+        trajectory=trajectory,
     )
