@@ -44,6 +44,27 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
     }
 
 
+PARAMETER_NOTES = {
+    "model": "--model: the law's model believes these parameters; the plant stays the robot's",
+    "p0": "--p0: the law's estimates start at these parameters",
+}
+"""What the summary says of each use of a parameter file (:data:`~twolink_pin.run_spec.PARAMETER_USES`)."""
+
+
+def _parameters_used(spec: RunSpec) -> dict[str, str] | None:
+    """The parameter file of ``--model`` / ``--p0`` and its use (JSON), or None without one."""
+    if spec.parameters is None:
+        return None
+    return {"option": f"--{spec.parameters_use}", "file": str(spec.parameters), "use": spec.parameters_use}
+
+
+def _parameters_line(used: dict[str, str] | None) -> list[str]:
+    """The summary's line naming the parameter file a run used (none without one)."""
+    if used is None:
+        return []
+    return [f"  parameters from {used['file']} ({PARAMETER_NOTES[used['use']]})"]
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     from twolink_pin.metrics import compute_metrics
     from twolink_pin.run_spec import plant_description
@@ -65,6 +86,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         "gains": gains,
         "plant": plant_description(scenario),
         "q0_offset": q0_offset.tolist(),
+        "parameters_file": _parameters_used(spec),
         "run": spec.as_dict(),
     }
     figures: list[str] = []
@@ -85,6 +107,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
         f"  gains {gains_text}",
         f"  plant {payload['plant']}; start q(0) − q_des(0) {fmt(q0_offset, 4)} rad",
+        *_parameters_line(payload["parameters_file"]),
         f"  RMS  e {fmt(metrics.rms.e, 5)} rad   edot {fmt(metrics.rms.edot, 5)} rad/s   tau {fmt(metrics.rms.tau, 3)} N·m",
         f"  max  e {fmt(metrics.max.e, 5)} rad   edot {fmt(metrics.max.edot, 5)} rad/s   tau {fmt(metrics.max.tau, 3)} N·m",
         f"  last period max |e| ({', '.join(f'{x:.4g}' for x in metrics.final_period_max_abs_e)}) rad"
