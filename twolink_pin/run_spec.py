@@ -331,19 +331,11 @@ def _with_events(scenario: Scenario, options: PlantOptions) -> Scenario:
 
 def gains_used(controller: Controller) -> dict[str, Any]:
     """The gains a law ran with (the robot's presets and derived values resolved), JSON-ready:
-    a number, a list per joint or per parameter, or None."""
-    import numpy as np
+    a number, a list per joint or per parameter, a matrix as its rows, or None
+    (:func:`~twolink_pin.controllers.gains.gain_as_json`)."""
+    from twolink_pin.controllers.gains import gain_as_json
 
-    used: dict[str, Any] = {}
-    for name, value in controller.gains.values().items():
-        if value is None or isinstance(value, (bool, str)):
-            used[name] = value
-            continue
-        array = np.asarray(value, dtype=float)
-        if array.ndim == 2 and array.shape[0] == 1:
-            array = array[0]
-        used[name] = float(array) if array.ndim == 0 else array.tolist()
-    return used
+    return {name: gain_as_json(value) for name, value in controller.gains.values().items()}
 
 
 def plant_description(scenario: Scenario) -> str:
