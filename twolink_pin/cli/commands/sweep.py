@@ -86,7 +86,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         f"  gains {gains_text}"
         + "".join(f"; {name} drawn per run from U({lo:g}, {hi:g})" for name, (lo, hi) in drawn.items()),
     ]
-    width = max([28, *map(len, summary["metrics"])])
+    width = max([28, *(len(name) for name in summary["metrics"] if len(name) <= 40)])  # long names overflow
     lines.append(f"  {'metric':{width}s} {'p5':>12s} {'median':>12s} {'p95':>12s}")
     for name, stat in summary["metrics"].items():
         cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
