@@ -19,10 +19,15 @@ law's arithmetic broadcasts, it never sees N.
 
 A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size k:
 ``"joint"`` nv, ``"estimate"`` the estimates, ``"axis"`` the 3 world axes): a number s
-(``s I``), k numbers (a diagonal), a symmetric positive-definite ``(k, k)`` matrix, or one
-such matrix per run ``(N, k, k)`` (or one number per run, ``(N, 1)``: a sweep's draws) — checked (symmetry to 1e-12 relative, Cholesky), and
-stored as ``(1, k, k)`` or ``(N, k, k)`` once the law knows k: the law applies it with
-``np.matvec(K, e)``.
+(``s I``), k numbers (a diagonal), k² numbers (a ``(k, k)`` matrix row by row, as the CLI's
+``--gain kp=1500,0,0,0,1500,0,0,0,800`` gives them), a symmetric positive-definite
+``(k, k)`` matrix, or one such matrix per run ``(N, k, k)`` (or one number per run,
+``(N, 1)``: a sweep's draws) — checked (shape, symmetry to 1e-12 relative, Cholesky; a
+refusal names the check and the numbers), and stored as ``(1, k, k)`` or ``(N, k, k)`` once
+the law knows k (k or k² numbers of a per-joint or per-estimate gain wait for it: 4 numbers
+are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one): the law applies it with
+``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
+:func:`gain_as_json`).
 
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
 from the robot (its ``scaled_gains``), or the robot's profile supplies one
