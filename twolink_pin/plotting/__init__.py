@@ -36,7 +36,7 @@ tests can check what is drawn. Units: time [s], angles [rad], rates [rad/s], pos
 
 from twolink_pin.plotting.cartesian import save_end_effector_figure
 from twolink_pin.plotting.distribution import save_distribution_figure
-from twolink_pin.plotting.run import save_simulation_figures, wrench_spans
+from twolink_pin.plotting.run import save_simulation_figures
 from twolink_pin.plotting.task import save_task_error_figure
 from twolink_pin.plotting.trajectory import save_trajectory_figures
 
@@ -46,5 +46,4 @@ __all__ = [
     "save_simulation_figures",
     "save_task_error_figure",
     "save_trajectory_figures",
-    "wrench_spans",
 ]

@@ -41,7 +41,8 @@ def _run(
     figure_numbers: dict[str, int] | None,
 ) -> tuple[SimulationResult, Metrics, list[str], float]:
     """Worker: one law's run, metrics and figures (picklable arguments only)."""
-    from twolink_pin.plotting import save_simulation_figures, wrench_spans
+    from twolink_pin.plotting import save_simulation_figures
+    from twolink_pin.plotting.run import wrench_spans
 
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)

@@ -92,7 +92,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure
-        from twolink_pin.plotting import save_simulation_figures, wrench_spans
+        from twolink_pin.plotting import save_simulation_figures
+        from twolink_pin.plotting.run import wrench_spans
 
         spans = wrench_spans(spec.plant.wrench)  # a push shaded where it acts
         with removed_on_failure(args.plot) as folder:
@@ -167,7 +168,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
         def on_result(name: str, result: SimulationResult) -> None:
             if not args.no_plot:
-                from twolink_pin.plotting import save_simulation_figures, wrench_spans
+                from twolink_pin.plotting import save_simulation_figures
+                from twolink_pin.plotting.run import wrench_spans
 
                 spans, title = wrench_spans(shared.plant.wrench), law_class(by_name[name]).title
                 save_simulation_figures(result, stage / "figures", prefix=name, title=title, spans=spans)
