@@ -129,3 +129,15 @@ def test_controllers_says_which_gains_are_matrices(capsys: pytest.CaptureFixture
     assert kp["matrix"] is True and kp["per"] == "axis"
     assert main(["controllers"]) == 0
     assert "kp [1/s²] (3 × 3 matrix)" in capsys.readouterr().out
+
+
+def test_numbers_awaiting_k_survive_a_replace() -> None:
+    """``dataclasses.replace`` validates every field again (as a law does when it fills a
+    derived gain): the k² numbers still wait for k."""
+    from dataclasses import replace
+
+    gains = replace(
+        _JointGains(kp=(300.0, 20.0, 20.0, 250.0)), kp=_JointGains(kp=(300.0, 20.0, 20.0, 250.0)).kp
+    )
+    law = _JointMatrixLaw(load_robot("twolink"), gains)
+    np.testing.assert_array_equal(law.gains.kp, [[[300.0, 20.0], [20.0, 250.0]]])

@@ -212,6 +212,8 @@ def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
         raise InvalidParameterError(name, value, expected) from None
     if array.ndim == 2 and array.shape[1] == 1:  # one number per run (a sweep's draws): s_r I
         array = array[:, :, None]
+    if array.ndim == 2 and array.shape[0] == 1 and spec.per != "axis":  # numbers awaiting k, validated again
+        array = array[0]
     if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
         raise InvalidParameterError(
             name,
