@@ -694,3 +694,9 @@ def test_the_summary_says_which_parameter_file_a_run_used(
     assert used == {"option": "--p0", "file": str(saved), "use": "p0"}
     assert main(["simulate", "adaptive", "--duration", "0.05", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["parameters_file"] is None
+    out = tmp_path / "cmp"
+    argv = ["compare", "pd", "computed-torque", "--model", str(saved), "--duration", "0.05", "--no-plot"]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert line.strip() in capsys.readouterr().out.splitlines()
+    assert main([*argv, "--out", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["parameters_file"]["option"] == "--model"

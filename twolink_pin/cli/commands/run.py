@@ -208,8 +208,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
         _say_failed(table.failed, f"the other laws' results are in {args.out}")
         return 1
-    payload = table.as_dict() | {"files": [str(f) for f in files]}
-    emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
+    used = _parameters_used(shared)
+    payload = table.as_dict() | {"parameters_file": used, "files": [str(f) for f in files]}
+    said = [line.strip() for line in _parameters_line(used)]
+    emit(args, payload, table.markdown() + "\n" + "\n".join([*said, *(f"wrote {f}" for f in files)]))
     return 0
 
 
