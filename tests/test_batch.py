@@ -427,3 +427,23 @@ def test_both_batch_regressors_equal_pinocchios_regressor_on_the_ur5() -> None:
         C = pin.computeCoriolisMatrix(model, data, q[i], v[i])
         g = pin.computeGeneralizedGravity(model, data, q[i])
         assert np.abs(tau[i] - (M @ a[i] + C @ w[i] + g)).max() <= TOL * max(1.0, float(np.abs(tau[i]).max()))
+
+
+def test_a_batch_result_carries_the_reference_it_ran() -> None:
+    """``result.trajectory`` is the reference: the recorded errors ``q − q_d(t)`` from it give
+    the batch's own RMS |e| (trapezoidal rule, as :mod:`twolink_pin.metrics` defines it)."""
+    controller, plant = make_scenario("pd", ROBOT)
+    result = simulate_batch(controller, plant, TRAJECTORY, SHORT, q0_offsets=OFFSETS, record=True)
+    assert result.trajectory is TRAJECTORY
+    assert result.q is not None
+    e = result.q - result.trajectory.sample(result.t).q[None]  # (N, K, nv)
+    duration = result.t[-1] - result.t[0]
+    rms = np.sqrt(np.trapezoid(e**2, result.t, axis=1) / duration)
+    np.testing.assert_allclose(rms, result.metrics.rms.e, rtol=1e-9)
+
+
+def test_state_variable_is_exported_at_the_top_level() -> None:
+    import twolink_pin
+    from twolink_pin.controllers.base import StateVariable
+
+    assert "StateVariable" in twolink_pin.__all__ and twolink_pin.StateVariable is StateVariable

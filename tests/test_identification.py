@@ -679,3 +679,27 @@ def test_the_docs_script_runs(tmp_path: Path) -> None:
         "identification_excitation.png",
         "identification_validation.png",
     ]
+
+
+def test_the_summary_says_which_parameter_file_a_run_used(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``simulate --model`` / ``--p0``: the text names the file and what it did; the JSON too;
+    without one, neither says anything."""
+    saved = tmp_path / "p.json"
+    assert main(["identify", "--duration", "8", "--save", str(saved), "--json"]) == 0
+    capsys.readouterr()
+    assert main(["simulate", "computed-torque", "--model", str(saved), "--duration", "0.05"]) == 0
+    line = f"  law's model believes the parameters of {saved} (--model); the plant is twolink's own"
+    assert line in capsys.readouterr().out.splitlines()
+    assert main(["simulate", "adaptive", "--p0", str(saved), "--duration", "0.05", "--json"]) == 0
+    used = json.loads(capsys.readouterr().out)["believed"]
+    assert used == {"file": str(saved), "use": "p0"}
+    assert main(["simulate", "adaptive", "--duration", "0.05", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["believed"] is None
+    out = tmp_path / "cmp"
+    argv = ["compare", "pd", "computed-torque", "--model", str(saved), "--duration", "0.05", "--no-plot"]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert line.strip() in capsys.readouterr().out.splitlines()
+    assert main([*argv, "--out", str(out), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["believed"]["use"] == "model"

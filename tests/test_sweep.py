@@ -13,6 +13,7 @@ import csv
 import heapq
 import json
 import math
+import sys
 from dataclasses import replace
 from pathlib import Path
 
@@ -354,8 +355,9 @@ def _parser() -> argparse.ArgumentParser:
 
 
 def test_sweep_command_prints_json_and_a_progress_bar(
-    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # the bar shows on a terminal only
     argv = ["sweep", "computed-torque", "--samples", "4", "--duration", "0.05", "--q0-spread", "0.2"]
     argv += ["--gain", "lam=2:8", "--out", str(tmp_path), "--json", "--no-plot"]
     args = _parser().parse_args(argv)

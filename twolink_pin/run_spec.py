@@ -330,17 +330,11 @@ class RunSpec:
 
 def gains_used(controller: Controller) -> dict[str, Any]:
     """The gains a law ran with (the robot's presets and derived values resolved), JSON-ready:
-    a number, a list per joint or per parameter, or None."""
-    used: dict[str, Any] = {}
-    for name, value in controller.gains.values().items():
-        if value is None or isinstance(value, (bool, str)):
-            used[name] = value
-            continue
-        array = np.asarray(value, dtype=float)
-        if array.ndim == 2 and array.shape[0] == 1:
-            array = array[0]
-        used[name] = float(array) if array.ndim == 0 else array.tolist()
-    return used
+    a number, a list per joint or per parameter, a matrix as its rows, or None
+    (:func:`~twolink_pin.controllers.gains.gain_as_json`)."""
+    from twolink_pin.controllers.gains import gain_as_json
+
+    return {name: gain_as_json(value) for name, value in controller.gains.values().items()}
 
 
 def plant_description(scenario: Scenario) -> str:

@@ -71,15 +71,18 @@ def pose_lines(position: np.ndarray, rotation: np.ndarray, rpy: np.ndarray, inde
 
 
 def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any:
-    """A tqdm bar on stderr (the one progress display): done, rate and ETA."""
+    """A tqdm bar on stderr (the one progress display): done, rate and ETA; shown only when
+    stderr is a terminal (a log or a pipe stays clean), and not when ``disable``."""
     from tqdm import tqdm
+
+    from twolink_pin.studies.progress import stderr_is_terminal
 
     return tqdm(
         total=total,
         unit=unit,
         desc=desc,
         file=sys.stderr,
-        disable=disable,
+        disable=disable or not stderr_is_terminal(),
         dynamic_ncols=True,
         mininterval=0.5,
     )

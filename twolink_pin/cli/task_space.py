@@ -6,6 +6,7 @@ RMS, max, last period; :func:`~twolink_pin.task_metrics.task_metrics`) in the su
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -45,13 +46,19 @@ def task_lines(metrics: TaskMetrics | None) -> list[str]:
 
 
 def save_task_figure(
-    robot: RobotModel, result: SimulationResult, folder: Path, prefix: str, title: str | None = None
+    robot: RobotModel,
+    result: SimulationResult,
+    folder: Path,
+    prefix: str,
+    title: str | None = None,
+    spans: Sequence[tuple[float, float]] = (),
 ) -> Path:
-    """``<prefix>_task_error.png`` in ``folder`` (:func:`~twolink_pin.plotting.save_task_error_figure`)."""
+    """``<prefix>_task_error.png`` in ``folder`` (:func:`~twolink_pin.plotting.save_task_error_figure`),
+    ``spans`` (a wrench's window [s]) shaded."""
     from twolink_pin.plotting import save_task_error_figure
 
     name = f"{prefix}_task_error.png" if prefix else "task_error.png"
-    return save_task_error_figure(robot, result, Path(folder) / name, title)
+    return save_task_error_figure(robot, result, Path(folder) / name, title, spans)
 
 
 def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, check: Any) -> int:

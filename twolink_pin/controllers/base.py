@@ -412,7 +412,7 @@ class Controller(abc.ABC, Generic[G]):
                     ),
                     "axis": (3, "per world axis x, y, z"),
                 }[spec.per]
-                value = matrices[f.name] = as_matrix(value, width)
+                value = matrices[f.name] = as_matrix(value, width, f.name, spec.unit)
                 check_width(f.name, value, width, what)
             elif spec.per == "joint":
                 check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")

@@ -19,10 +19,15 @@ law's arithmetic broadcasts, it never sees N.
 
 A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size k:
 ``"joint"`` nv, ``"estimate"`` the estimates, ``"axis"`` the 3 world axes): a number s
-(``s I``), k numbers (a diagonal), a symmetric positive-definite ``(k, k)`` matrix, or one
-such matrix per run ``(N, k, k)`` (or one number per run, ``(N, 1)``: a sweep's draws) — checked (symmetry to 1e-12 relative, Cholesky), and
-stored as ``(1, k, k)`` or ``(N, k, k)`` once the law knows k: the law applies it with
-``np.matvec(K, e)``.
+(``s I``), k numbers (a diagonal), k² numbers (a ``(k, k)`` matrix row by row, as the CLI's
+``--gain kp=1500,0,0,0,1500,0,0,0,800`` gives them), a symmetric positive-definite
+``(k, k)`` matrix, or one such matrix per run ``(N, k, k)`` (or one number per run,
+``(N, 1)``: a sweep's draws) — checked (shape, symmetry to 1e-12 relative, Cholesky; a
+refusal names the check and the numbers), and stored as ``(1, k, k)`` or ``(N, k, k)`` once
+the law knows k (k or k² numbers of a per-joint or per-estimate gain wait for it: 4 numbers
+are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one): the law applies it with
+``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
+:func:`gain_as_json`).
 
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
 from the robot (its ``scaled_gains``), or the robot's profile supplies one
@@ -131,8 +136,70 @@ def _expected(spec: GainSpec) -> str:
 
 MATRIX_EXPECTED = (
     "a symmetric positive-definite matrix gain{unit}: a number s (s I), k numbers (a diagonal), "
-    "a (k, k) matrix, or one (k, k) matrix per run (N, k, k)"
+    "k² numbers (a (k, k) matrix, row by row), a (k, k) matrix, or one (k, k) matrix per run (N, k, k)"
 )
+AXIS_SIZE = 3
+"""k of a matrix gain declared ``per="axis"``: the world axes x, y, z."""
+
+
+def _shown(matrix: np.ndarray) -> Any:
+    """A matrix as its rows (nested lists), or its shape when large."""
+    return matrix.tolist() if matrix.size <= 49 else f"a {matrix.shape} matrix"
+
+
+def _check_matrices(name: str, array: np.ndarray, expected: str) -> np.ndarray:
+    """``array`` (k, k) or (N, k, k) checked symmetric and positive definite, as a read-only
+    (1 or N, k, k) stack; the error names the check that failed and the offending numbers."""
+    stack = array.reshape(-1, *array.shape[-2:])
+    for i, matrix in enumerate(stack):
+        where = f"{name}[{i}]" if array.ndim == 3 else name
+        scale = float(np.abs(matrix).max())
+        skew = np.abs(matrix - matrix.T)
+        if skew.max() > 1e-12 * scale:
+            r, c = (int(x) for x in np.unravel_index(int(np.argmax(skew)), skew.shape))
+            raise InvalidParameterError(
+                where,
+                _shown(matrix),
+                f"{expected}; the symmetry check failed: it is not symmetric "
+                f"(entry [{r}, {c}] = {matrix[r, c]:g} but [{c}, {r}] = {matrix[c, r]:g})",
+            )
+        try:
+            np.linalg.cholesky(matrix)
+        except np.linalg.LinAlgError:
+            eigenvalues = np.linalg.eigvalsh(matrix)
+            raise InvalidParameterError(
+                where,
+                _shown(matrix),
+                f"{expected}; the positive-definite check failed: it is not positive definite "
+                f"(eigenvalues {', '.join(f'{x:.4g}' for x in eigenvalues[:8])}"
+                f"{', …' if eigenvalues.size > 8 else ''}; smallest {eigenvalues.min():.3g})",
+            ) from None
+    stack = np.ascontiguousarray(stack)
+    stack.setflags(write=False)
+    return stack
+
+
+def _from_numbers(name: str, numbers: np.ndarray, k: int, expected: str) -> np.ndarray:
+    """k numbers (a diagonal) or k² numbers (a (k, k) matrix, row by row) as a checked
+    (1, k, k) matrix; any other count fails the shape check."""
+    n = numbers.size
+    if n == k:
+        if not numbers.min() >= GAIN_RANGE[0]:
+            raise InvalidParameterError(
+                name,
+                numbers.tolist(),
+                f"{expected}; the positive-definite check failed: a diagonal entry is not > 0 "
+                f"(smallest {numbers.min():g})",
+            )
+        return _check_matrices(name, np.diag(numbers), expected)
+    if n == k * k:
+        return _check_matrices(name, numbers.reshape(k, k), expected)
+    raise InvalidParameterError(
+        name,
+        numbers.tolist(),
+        f"{expected}; the shape check failed: {n} numbers are neither 1, {k} (a diagonal) nor "
+        f"{k * k} (a {k} × {k} matrix, row by row)",
+    )
 
 
 def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
@@ -145,43 +212,43 @@ def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
         raise InvalidParameterError(name, value, expected) from None
     if array.ndim == 2 and array.shape[1] == 1:  # one number per run (a sweep's draws): s_r I
         array = array[:, :, None]
+    if array.ndim == 2 and array.shape[0] == 1 and spec.per != "axis":  # numbers awaiting k, validated again
+        array = array[0]
     if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
-        raise InvalidParameterError(name, f"array of shape {array.shape}", expected)
+        raise InvalidParameterError(
+            name,
+            f"array of shape {array.shape}",
+            f"{expected}; the shape check failed: the last two axes of a matrix are equal",
+        )
     if not np.all(np.isfinite(array)) or not np.all(np.abs(array) <= GAIN_RANGE[1]):
         raise InvalidParameterError(
             name, array.tolist() if array.size <= 36 else f"shape {array.shape}", expected
         )
-    if array.ndim < 2:
-        low = array.min()
-        if not low >= GAIN_RANGE[0]:
-            raise InvalidParameterError(name, array.tolist(), expected)
-        if array.ndim == 0:
-            return float(array)
-        array = np.diag(array)
-    stack = array.reshape(-1, *array.shape[-2:])
-    for i, matrix in enumerate(stack):
-        where = f"{name}[{i}]" if array.ndim == 3 else name
-        shown = matrix.tolist() if matrix.size <= 36 else f"a {matrix.shape} matrix"
-        scale = float(np.abs(matrix).max())
-        if np.abs(matrix - matrix.T).max() > 1e-12 * scale:
-            raise InvalidParameterError(where, shown, f"{expected}; it is not symmetric")
-        try:
-            np.linalg.cholesky(matrix)
-        except np.linalg.LinAlgError:
-            low = float(np.linalg.eigvalsh(matrix).min())
-            raise InvalidParameterError(
-                where, shown, f"{expected}; it is not positive definite (smallest eigenvalue {low:.3g})"
-            ) from None
-    stack = np.ascontiguousarray(stack)
-    stack.setflags(write=False)
-    return stack
+    if array.ndim == 0:
+        if not array >= GAIN_RANGE[0]:
+            raise InvalidParameterError(name, float(array), expected)
+        return float(array)
+    if array.ndim == 1:
+        if spec.per == "axis":
+            return _from_numbers(name, array, AXIS_SIZE, expected)
+        side = math.isqrt(array.size)
+        if side > 1 and side * side == array.size:  # k numbers or k² numbers: the law's k decides
+            flat = array.reshape(1, -1)
+            flat.setflags(write=False)
+            return flat
+        return _from_numbers(name, array, array.size, expected)
+    return _check_matrices(name, array, expected)
 
 
-def as_matrix(value: Any, k: int) -> np.ndarray:
-    """A validated matrix gain as ``(1, k, k)`` or ``(N, k, k)`` (a number s: ``s I``)."""
+def as_matrix(value: Any, k: int, name: str = "gain", unit: str = "") -> np.ndarray:
+    """A validated matrix gain as ``(1, k, k)`` or ``(N, k, k)`` (a number s: ``s I``; a row
+    of k or k² numbers: a diagonal or a matrix row by row, checked here)."""
     if isinstance(value, float):
         value = np.array(value).reshape(1, 1, 1)
     array = np.asarray(value)
+    if array.ndim == 2:  # numbers whose reading needed k
+        expected = MATRIX_EXPECTED.format(unit=f" [{unit}]" if unit else "")
+        return _from_numbers(name, array[0], k, expected)
     if array.shape[1:] == (1, 1) and k != 1:
         array = array * np.eye(k)
         array.setflags(write=False)
@@ -238,21 +305,12 @@ class Gains:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def describe(self, digits: int = 4) -> str:
-        """``kp = (350, 300) N·m/rad, kd = ...``: every field with its unit."""
+        """``kp = (350, 300) N·m/rad, kd = ...``: every field with its unit; a matrix gain as
+        its rows, ``kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]] 1/s²``."""
         parts = []
         for f in fields(self):
             value, spec = getattr(self, f.name), _spec(f)
-            if value is None:
-                text = "from the robot"
-            elif isinstance(value, float):
-                text = f"{value:.{digits}g}"
-            else:
-                flat = np.asarray(value).ravel()
-                text = (
-                    "("
-                    + ", ".join(f"{x:.{digits}g}" for x in flat[:12])
-                    + (", …)" if flat.size > 12 else ")")
-                )
+            text = "from the robot" if value is None else format_gain(value, digits)
             parts.append(f"{f.name} = {text}{' ' + spec.unit if spec.unit else ''}")
         return ", ".join(parts)
 
@@ -265,6 +323,47 @@ class Gains:
     def defaults(cls) -> dict[str, Any]:
         """Field name → declared default."""
         return {f.name: (None if f.default is MISSING else f.default) for f in fields(cls)}
+
+
+def gain_as_json(value: Any) -> Any:
+    """A gain value JSON-ready: a number, a list (per joint, axis or estimate), a matrix as its
+    rows (a list of lists), one of these per run for per-run values; None stays None."""
+    if value is None or isinstance(value, (bool, str)):
+        return value
+    array = np.asarray(value, dtype=float)
+    if array.ndim in (2, 3) and array.shape[0] == 1:  # one row or matrix for every run
+        array = array[0]
+    return float(array) if array.ndim == 0 else array.tolist()
+
+
+def default_as_json(gains_type: type[Gains], name: str) -> Any:
+    """Field ``name``'s declared default JSON-ready (:func:`gain_as_json` of its validated
+    value: a matrix default as its rows); None when the robot supplies it."""
+    default = {f.name: f.default for f in fields(gains_type)}[name]
+    if default is None or default is MISSING:
+        return None
+    try:
+        return gain_as_json(_validate(name, default, spec_of(gains_type, name)))
+    except InvalidParameterError:  # a user's law with a bad default: shown as declared
+        return repr(default)
+
+
+def format_gain(value: Any, digits: int = 4) -> str:
+    """A gain value as text: ``350``, ``(350, 300)``, a matrix as its rows
+    ``[[1500, 0, 0], [0, 1500, 0], [0, 0, 800]]``; per-run values (N of them) shortened."""
+    shown = gain_as_json(value)
+    if isinstance(shown, float):
+        return f"{shown:.{digits}g}"
+    array = np.asarray(shown, dtype=float)
+
+    def numbers(row: np.ndarray) -> str:
+        return ", ".join(f"{x:.{digits}g}" for x in row)
+
+    if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1:  # one matrix
+        return "[" + ", ".join(f"[{numbers(row)}]" for row in array) + "]"
+    flat = array.ravel()
+    text = "(" + numbers(flat[:12]) + (", …)" if flat.size > 12 else ")")
+    return text if array.ndim <= 1 else f"{array.shape[0]} runs {text}"
 
 
 def runs_of(value: Any) -> int | None:

@@ -23,7 +23,7 @@ from twolink_pin.dynamics import joint_inertia
 from twolink_pin.model import RobotModel
 
 STIFFNESS_FREQUENCY = 10.0
-"""ω [rad/s] of the robot-derived default stiffness ``K = ω² m`` and damping ``D = 2 ω m``,
+"""ω [rad/s] of the robot-derived default stiffness ``k = ω² m`` and damping ``d = 2 ω m``,
 ``m`` the task inertia at ``home`` (mean eigenvalue of the position, resp. orientation,
 block of Λ): the frame alone on its spring is critically damped near ω."""
 POSTURE_FREQUENCY = 5.0
@@ -32,8 +32,11 @@ POSTURE_FREQUENCY = 5.0
 
 @dataclass(frozen=True, eq=False)
 class ImpedanceGains(Gains):
-    r"""Gains of :class:`Impedance`: each a number (times I), 3 numbers (a diagonal) or a
-    symmetric positive-definite 3 × 3 matrix in world axes (or one per run).
+    r"""Gains of :class:`Impedance`: each a number (times I), 3 numbers (a diagonal), 9 numbers
+    (a 3 × 3 matrix, row by row: ``--gain k=2000,0,0,0,2000,0,0,0,500``) or a symmetric
+    positive-definite 3 × 3 matrix in world axes (or one per run). The CLI's names (``k``,
+    ``d``, …) are the fields below; the law writes them $K$, $D$ (position rows: $K_p$,
+    $D_p$; orientation: $K_o$, $D_o$) and $K_n$, $D_n$.
 
     Attributes:
         k: Translational stiffness $K_p$ [N/m]; default from the robot (see

@@ -29,8 +29,10 @@ POSTURE_FREQUENCY = 5.0
 @dataclass(frozen=True, eq=False)
 class OSCGains(Gains):
     r"""Gains of :class:`OperationalSpace`: acceleration-level, so the same on every robot.
-    Each task gain is a number (times I), 3 numbers (a diagonal) or a symmetric
-    positive-definite 3 × 3 matrix in world axes (or one per run).
+    Each task gain is a number (times I), 3 numbers (a diagonal), 9 numbers (a 3 × 3 matrix,
+    row by row: ``--gain kp=1500,0,0,0,1500,0,0,0,800``) or a symmetric positive-definite
+    3 × 3 matrix in world axes (or one per run). The CLI's names (``kp``, ``kd``, …) are the
+    fields below; the law writes them $K_p$, $D_p$, $K_o$, $D_o$, $K_n$, $D_n$.
 
     Attributes:
         kp: Position stiffness $K_p$ [1/s²]; default $\omega^2$, $\omega$ = 10 rad/s.

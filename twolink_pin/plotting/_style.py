@@ -462,3 +462,36 @@ def _limit_lines(ax: Axes, limit: float, peak: float, label: bool = True) -> boo
             bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.85},
         )
     return in_view
+
+
+SPAN_COLOR = "tab:purple"
+"""Colour of a shaded time span (a wrench acting)."""
+
+
+def shade_spans(
+    fig: Figure, spans: Sequence[tuple[float, float]], t: np.ndarray, label: str = "wrench"
+) -> None:
+    """Shade each time span ``(start, stop)`` [s] on every axis of ``fig`` (all time axes), clipped
+    to the run ``t``; ``label`` is written once, at the top of the span on the top axis."""
+    t0, t1 = float(t[0]), float(t[-1])
+    clipped = [(max(a, t0), min(b, t1)) for a, b in spans if min(b, t1) > max(a, t0)]
+    if not clipped or not fig.axes:
+        return
+    top = max(fig.axes, key=lambda ax: ax.get_position().y1)
+    for ax in fig.axes:
+        limits = ax.get_xlim()
+        for a, b in clipped:
+            ax.axvspan(a, b, color=SPAN_COLOR, alpha=0.12, lw=0, zorder=0)
+        ax.set_xlim(limits)  # the span never widens an axis
+    for a, b in clipped:
+        top.text(
+            0.5 * (a + b),
+            0.98,
+            f"{label} {a:g}–{b:g} s",
+            transform=top.get_xaxis_transform(),
+            ha="center",
+            va="top",
+            fontsize=7,
+            color=SPAN_COLOR,
+            clip_on=True,
+        )

@@ -13,8 +13,9 @@ the result's ``parameter_units``.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -45,6 +46,7 @@ from twolink_pin.plotting._style import (
     _save_all,
     _title,
     _unblock_legends,
+    shade_spans,
 )
 from twolink_pin.plotting.parameters import _check_parameters, _parameter_figures
 from twolink_pin.simulation import SimulationResult
@@ -254,12 +256,20 @@ def _simulation_figures(
     return figures
 
 
+def wrench_spans(wrench: Any) -> tuple[tuple[float, float], ...]:
+    """The time window ``(start, stop)`` [s] of a plant's wrench (``start``/``stop`` attributes,
+    as :class:`~twolink_pin.disturbances.Wrench` has them) as the ``spans`` the run figures
+    shade; none without a wrench."""
+    return () if wrench is None else ((float(wrench.start), float(wrench.stop)),)
+
+
 def save_simulation_figures(
     result: SimulationResult,
     out_dir: str | os.PathLike[str],
     prefix: str | None = None,
     figure_numbers: Mapping[str, int] | None = None,
     title: str | None = None,
+    spans: Sequence[tuple[float, float]] = (),
 ) -> list[Path]:
     """Write one run's figures as PNG into ``out_dir``.
 
@@ -292,6 +302,8 @@ def save_simulation_figures(
             the title as "cf. report Fig. N"; keys of no figure are ignored. Default: none.
         title: The law's display title, shown beside its name in every title
             (e.g. ``"PD + model feedforward"``). Default: the name only.
+        spans: Time windows ``(start, stop)`` [s] in which a wrench pushes the arm, shaded
+            on the time axes of the joint and torque figures. Default: none.
 
     Returns:
         The paths written, in figure order.
@@ -301,5 +313,8 @@ def save_simulation_figures(
         OutputError: ``out_dir`` cannot be created or written.
     """
     figures = _simulation_figures(result, figure_numbers, title)
+    for key, fig in figures.items():
+        if key.startswith("theta") or key == "torque":
+            shade_spans(fig, spans, result.t)
     prefix = result.controller if prefix is None else prefix
     return _save_all(figures, out_dir, f"{prefix}_" if prefix else "")

@@ -39,11 +39,12 @@ from twolink_pin.report import facts
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import _pool
 from twolink_pin.report.runs import _reference, _run, _trajectory_figures
-from twolink_pin.run_spec import plant_description
+from twolink_pin.run_spec import gains_used, plant_description
 from twolink_pin.scenario import builtin_laws, law_class
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.comparison import ComparisonTable
+from twolink_pin.task_metrics import task_metrics
 from twolink_pin.trajectory import default_via_points
 
 MARKER = ".twolink-pin-report"
@@ -193,7 +194,15 @@ def _build(
     controllers = {}
     lams: dict[str, float] = {}
     scenarios = {n: options.run.for_law(by_name[n]).build(robot) for n in names}  # what each ran with
-    table = replace(table, plants={n: plant_description(scenarios[n]) for n in names})
+    task = {  # the task-space laws' end-effector errors (their class declares task_space)
+        n: task_metrics(r[0], robot) for n, r in runs.items() if law_class(by_name[n]).task_space
+    }
+    table = replace(
+        table,
+        plants={n: plant_description(scenarios[n]) for n in names},
+        gains={n: gains_used(scenarios[n].controller) for n in names},
+        task=task,
+    )
     for name, (result, metrics, figures, seconds) in runs.items():
         cls = law_class(by_name[name])
         controller = scenarios[name].controller  # the gains it ran with
@@ -204,6 +213,7 @@ def _build(
             "law": inspect.getdoc(cls) or "",
             "gains": controller.gains.describe(),
             "metrics": metrics.as_dict(),
+            "task_metrics": task[name].as_dict() if name in task else None,
             "figures": figures,
             "seconds": seconds,
             "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),

@@ -21,6 +21,7 @@ from twolink_pin.files import atomic_write, write_json
 from twolink_pin.mathml import docstring_html
 from twolink_pin.metrics import NORMS, SIGNALS
 from twolink_pin.studies.comparison import headers
+from twolink_pin.task_metrics import TASK_TITLES, TASK_UNITS
 
 DIGITS = 4
 """Significant digits of the numbers on the page (tables of coefficients: 6)."""
@@ -110,8 +111,23 @@ def html(r: dict[str, Any]) -> str:
     return (
         _environment()
         .get_template("report.html")
-        .render(r=r, tables=tables, discussion=_discussion(r), nv=nv)
+        .render(r=r, tables=tables, task_table=_task_table(r), discussion=_discussion(r), nv=nv)
     )
+
+
+def _task_table(r: dict[str, Any]) -> dict[str, Any] | None:
+    """The task-space laws' end-effector errors, one row per law (None without such a law)."""
+    rows = [
+        [name, *(fmt(entry["task_metrics"][key]) for key in TASK_UNITS)]
+        for name, entry in r["controllers"].items()
+        if entry.get("task_metrics")
+    ]
+    if not rows:
+        return None
+    return {
+        "headers": ["controller", *(f"{TASK_TITLES[k]} [{u}]" for k, u in TASK_UNITS.items())],
+        "rows": rows,
+    }
 
 
 def markdown(r: dict[str, Any]) -> str:

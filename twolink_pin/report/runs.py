@@ -42,6 +42,7 @@ def _run(
 ) -> tuple[SimulationResult, Metrics, list[str], float]:
     """Worker: one law's run, metrics and figures (picklable arguments only)."""
     from twolink_pin.plotting import save_simulation_figures
+    from twolink_pin.plotting.run import wrench_spans
 
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
@@ -49,9 +50,15 @@ def _run(
     controller, plant = options.run.for_law(spec).build(robot)
     result = simulate(controller, plant, _reference(robot, options), options.run.simulation)
     metrics = compute_metrics(result)
+    spans = wrench_spans(options.run.plant.wrench)  # a push shaded where it acts
     paths = save_simulation_figures(
-        result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title
+        result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title, spans=spans
     )
+    if cls.task_space:  # the law's class declares it: its task errors beside the joint figures
+        from twolink_pin.plotting import save_task_error_figure
+
+        path = Path(fig_dir) / f"{cls.name}_task_error.png"
+        paths.append(save_task_error_figure(robot, result, path, cls.title, spans))
     return result, metrics, [Path(p).name for p in paths], time.perf_counter() - start
 
 

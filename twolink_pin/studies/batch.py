@@ -27,6 +27,7 @@ from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state, state_labels
 from twolink_pin.simulation.terms import check_parallel, threads_for
 from twolink_pin.studies.progress import Progress, progress_callback
+from twolink_pin.task_metrics import RunningTaskMetrics, TaskMetrics
 from twolink_pin.trajectory import Trajectory
 
 
@@ -85,6 +86,12 @@ class BatchResult:
     """Name of each state entry."""
     state_units: tuple[str, ...] = ()
     """SI unit of each state entry."""
+    task_metrics: TaskMetrics | None = field(repr=False, default=None)
+    """Each run's task-space metrics (position error [mm], angle [deg]; arrays (N,), NaN for
+    diverged runs) for a law whose class declares ``task_space = True``, else None."""
+    trajectory: Trajectory | None = field(repr=False, default=None)
+    """The reference every run tracked (``trajectory.sample(t)`` gives ``q_d``, ``q̇_d``,
+    ``q̈_d`` at the output times ``t``)."""
 
     @property
     def n_runs(self) -> int:
@@ -193,6 +200,9 @@ def simulate_batch(
     steps = config.steps
     dt = config.duration / steps
     observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
+    task = None
+    if controller.task_space:  # the law's class declares it: its rows carry the task errors
+        task = RunningTaskMetrics(plant.robot, n, dt, steps + 1, trajectory.period)
     with progress_callback(progress, n) as shown:
         run = integrate(
             controller,
@@ -203,7 +213,7 @@ def simulate_batch(
             ref0.v + v0_off,
             z0,
             record=record,
-            observer=observer,
+            observer=observer if task is None else _Both(observer, task),
             threads=used,
             progress=shown,
         )
@@ -247,4 +257,17 @@ def simulate_batch(
         state=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and nz else None,
         state_names=names,
         state_units=units,
+        task_metrics=None if task is None else task.result(dead),
+        trajectory=trajectory,
     )
+
+
+class _Both:
+    """Two engine observers fed the same blocks (the joint and the task metrics)."""
+
+    def __init__(self, first: Any, second: Any) -> None:
+        self.first, self.second = first, second
+
+    def add(self, samples: Any) -> None:
+        self.first.add(samples)
+        self.second.add(samples)

@@ -17,23 +17,31 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from twolink_pin.controllers.gains import format_gain
 from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
 from twolink_pin.metrics import NORMS, SIGNALS, Metrics, compute_metrics
 from twolink_pin.simulation import SimulationResult
-from twolink_pin.task_metrics import TaskMetrics
+from twolink_pin.task_metrics import TASK_TITLES, TASK_UNITS, TaskMetrics
 
 TASK_COLUMNS = TaskMetrics._fields
 """Columns of the task-space rows (CSV), in :class:`~twolink_pin.task_metrics.TaskMetrics` order."""
-TASK_HEADERS = (
-    "RMS ‖Δp‖ [mm]",
-    "max ‖Δp‖ [mm]",
-    "last period max ‖Δp‖ [mm]",
-    "RMS angle [deg]",
-    "max angle [deg]",
-    "last period max angle [deg]",
-)
+TASK_HEADERS = tuple(f"{TASK_TITLES[name]} [{TASK_UNITS[name]}]" for name in TASK_COLUMNS)
 """Markdown headers of the task-space table (no "|" inside a cell: ‖·‖ for the norm)."""
+
+
+def gains_text(gains: dict[str, Any]) -> str:
+    """The gains a law ran with (:func:`~twolink_pin.run_spec.gains_used`) as one line:
+    ``kp = (350, 300), kd = (40, 50)``, a matrix as its rows."""
+    import numpy as np
+
+    def shown(value: Any) -> str:
+        if value is None:
+            return "from the robot"
+        array = np.asarray(value, dtype=float)
+        return format_gain(array[None] if array.ndim == 2 and array.shape[0] == array.shape[1] else array)
+
+    return ", ".join(f"{name} = {shown(value)}" for name, value in gains.items())
 
 
 def columns(nv: int) -> list[str]:
@@ -104,6 +112,10 @@ class ComparisonTable:
             writer.writerow([name, "last_period_max_abs_e", *e_last, *([""] * (len(cols) - len(e_last)))])
         for name, what in self.failed.items():
             writer.writerow([name, "failed", what, *([""] * (len(cols) - 1))])
+        if self.gains:
+            writer.writerow(["controller", "gains"])
+            for name, used in self.gains.items():
+                writer.writerow([name, gains_text(used)])
         if self.task:
             writer.writerow(["controller", "task_metric", *TASK_COLUMNS])
             for name, t in self.task.items():
@@ -132,13 +144,14 @@ class ComparisonTable:
             out.append("|---|" + "---:|" * len(TASK_HEADERS))
             for name, t in self.task.items():
                 out.append(f"| {name} | " + " | ".join(f"{x:.4g}" for x in t) + " |")
-        if self.plants or self.failed:
+        if self.plants or self.failed or self.gains:
             out.append("\n### the runs\n")
-            out.append("| controller | plant | outcome |")
-            out.append("|---|---|---|")
+            out.append("| controller | gains | plant | outcome |")
+            out.append("|---|---|---|---|")
             for name in [*self.metrics, *(n for n in self.failed if n not in self.metrics)]:
                 outcome = f"FAILED: {self.failed[name]}" if name in self.failed else "finished"
-                out.append(f"| {name} | {self.plants.get(name, '')} | {outcome} |")
+                gains = gains_text(self.gains[name]) if name in self.gains else ""
+                out.append(f"| {name} | {gains} | {self.plants.get(name, '')} | {outcome} |")
         return "\n".join(out) + "\n"
 
     def write(self, out_dir: Path) -> list[Path]:

@@ -22,6 +22,16 @@ Progress = Callable[[int, int], None] | bool | None
 """What ``simulate_batch`` accepts as ``progress``."""
 
 
+def stderr_is_terminal() -> bool:
+    """Whether ``sys.stderr`` is a terminal: where a progress bar is shown by default (a log
+    file, a pipe or a notebook stays clean)."""
+    stream = sys.stderr
+    try:
+        return bool(stream is not None and stream.isatty())
+    except (AttributeError, ValueError):  # no isatty, or a closed stream
+        return False
+
+
 @contextmanager
 def progress_callback(progress: Progress, runs: int) -> Iterator[Callable[[int, int], None] | None]:
     """The engine's ``progress(steps_done, steps_total)`` for ``progress`` (see the module);
@@ -30,7 +40,7 @@ def progress_callback(progress: Progress, runs: int) -> Iterator[Callable[[int, 
         yield progress or None
         return
     stream = sys.stderr
-    if progress is None and not (stream is not None and hasattr(stream, "isatty") and stream.isatty()):
+    if progress is None and not stderr_is_terminal():
         yield None
         return
     from tqdm import tqdm

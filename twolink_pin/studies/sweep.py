@@ -296,7 +296,7 @@ def run_sweep(
                 summary["note"] = f"every one of the {summary['runs']} runs diverged: no distributions.png"
                 write_json(stage / "summary.json", summary)
             elif plot:
-                files.append(_figure(stage, config.samples, robot.nv, cls.name))
+                files.append(_figure(stage, config.samples, robot.nv, cls.name, prepared.task))
         description = "in-process" if engine is None else engine.description
     out = Path(out_dir)
     return SweepOutput(summary, tuple(out / f.name for f in files), seconds, description, chunk)

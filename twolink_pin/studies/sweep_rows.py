@@ -18,6 +18,7 @@ from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.studies.sweep_cases import Cases, SweepConfig, _chunk_law, gain_target
+from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
 
 PERCENTILES = (5.0, 50.0, 95.0)
@@ -39,11 +40,19 @@ METRIC_UNITS = metric_units()
 :func:`twolink_pin.metrics.metric_units`, the one definition."""
 
 
-def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
-    """Names of the metric columns of a row, in order."""
+TASK_COLUMNS = {f"task_{name}": unit for name, unit in TASK_UNITS.items()}
+"""The task-space metric columns of a task-space law's row (:data:`twolink_pin.task_metrics.TASK_UNITS`,
+the one definition), with their units."""
+
+
+def metric_columns(nv: int, parameter_names: Sequence[str] = (), task: bool = False) -> list[str]:
+    """Names of the metric columns of a row, in order: the per-joint metrics, the task metrics
+    of a task-space law (``task``), the final estimates."""
     columns: list[str] = []
     for stem in METRIC_UNITS:
         columns += _joint_columns(stem, nv)
+    if task:
+        columns += list(TASK_COLUMNS)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
     return columns
 
@@ -75,6 +84,8 @@ def _chunk_rows(
     exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & ~result.diverged
     flags = np.column_stack([exceeded, result.diverged, result.diverged_at]).astype(float)
     parts = [metric_array(m, stem) for stem in METRIC_UNITS]
+    if result.task_metrics is not None:
+        parts.append(np.column_stack(list(result.task_metrics)))
     if result.p_hat_final is not None:
         parts.append(result.p_hat_final)
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
@@ -177,7 +188,8 @@ class _Prepared:
         law = self.base.controller
         estimated = law.parameter_names if law.estimates else ()
         self.input_columns = input_columns(config, nv, self.parameter_names)
-        self.metric_columns = metric_columns(nv, estimated)
+        self.task = bool(cls.task_space)  # the law's class declares it
+        self.metric_columns = metric_columns(nv, estimated, self.task)
         self.header = [*self.input_columns, *FLAG_COLUMNS, *self.metric_columns]
         units = {"run": "", **{c: "rad" for c in _joint_columns("q0_offset", nv)}}
         units.update({f"param_factor_{n}": "" for n in self.parameter_names})
@@ -189,6 +201,8 @@ class _Prepared:
         units.update(limit_exceeded="", diverged="", diverged_at="s")
         for stem, unit in METRIC_UNITS.items():
             units.update({c: unit for c in _joint_columns(stem, nv)})
+        if self.task:
+            units.update(TASK_COLUMNS)
         if law.estimates:
             units.update(
                 {f"p_hat_final_{n}": u for n, u in zip(law.parameter_names, law.parameter_units, strict=True)}

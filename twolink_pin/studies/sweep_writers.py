@@ -26,7 +26,14 @@ from twolink_pin.studies.parquet import (
     write_part,
 )
 from twolink_pin.studies.sweep_cases import SweepConfig, law_reference
-from twolink_pin.studies.sweep_rows import METRIC_UNITS, ChunkRows, _joint_columns, _Prepared, _stats
+from twolink_pin.studies.sweep_rows import (
+    METRIC_UNITS,
+    TASK_COLUMNS,
+    ChunkRows,
+    _joint_columns,
+    _Prepared,
+    _stats,
+)
 from twolink_pin.trajectory import Trajectory
 
 # -- the table -----------------------------------------------------------------------------------------
@@ -197,10 +204,11 @@ def _json_rows(path: Path) -> Iterator[Callable[[list[str]], None]]:
         f.write("\n]\n")
 
 
-def _figure(stage: Path, samples: int, nv: int, controller: str) -> Path:
-    """``distributions.png`` from the dataset: only the plotted columns, of at most
-    :data:`FIGURE_MAX_RUNS` runs (every k-th beyond)."""
-    names = [name for stem in FIGURE_METRICS for name in _joint_columns(stem, nv)]
+def _figure(stage: Path, samples: int, nv: int, controller: str, task: bool = False) -> Path:
+    """``distributions.png`` from the dataset: only the plotted columns (the task metrics
+    first for a task-space law, ``task``), of at most :data:`FIGURE_MAX_RUNS` runs (every
+    k-th beyond)."""
+    names = _figure_columns(nv, task)
     every = math.ceil(samples / FIGURE_MAX_RUNS)
     columns = read_columns(stage / RUNS_FOLDER, [*names, "diverged"], every)
     metrics = np.column_stack([columns.pop(n) for n in names])
@@ -210,7 +218,14 @@ def _figure(stage: Path, samples: int, nv: int, controller: str) -> Path:
 
 
 FIGURE_METRICS = ("rms_e", "final_period_max_abs_e", "peak_command")
-"""The per-joint metrics whose histograms ``distributions.png`` shows."""
+"""The per-joint metrics whose histograms ``distributions.png`` shows (after every task metric
+of a task-space law: :data:`~twolink_pin.studies.sweep_rows.TASK_COLUMNS`)."""
+
+
+def _figure_columns(nv: int, task: bool) -> list[str]:
+    """The columns ``distributions.png`` shows, in order."""
+    joints = [name for stem in FIGURE_METRICS for name in _joint_columns(stem, nv)]
+    return [*TASK_COLUMNS, *joints] if task else joints
 
 
 def save_distribution_figure(
@@ -227,10 +242,12 @@ def save_distribution_figure(
     from twolink_pin.plotting import save_distribution_figure as plot_distributions
 
     keep = ~diverged
+    task = TASK_COLUMNS.keys() <= set(names)
+    units = {name: METRIC_UNITS[stem] for stem in FIGURE_METRICS for name in _joint_columns(stem, nv)}
+    units |= TASK_COLUMNS
     rows = {
-        f"{name} [{METRIC_UNITS[stem]}]": metrics[keep, list(names).index(name)]
-        for stem in FIGURE_METRICS
-        for name in _joint_columns(stem, nv)
+        f"{name} [{units[name]}]": metrics[keep, list(names).index(name)]
+        for name in _figure_columns(nv, task)
     }
     title = f"{controller}: {int(keep.sum())} of {keep.size} runs ({int(diverged.sum())} diverged)"
     if every > 1:

@@ -148,11 +148,15 @@ def cmd_robots(args: argparse.Namespace) -> int:
     return 0
 
 
+MATRIX_SIZE = {"axis": "3 × 3", "joint": "nv × nv", "estimate": "estimates × estimates"}
+"""What ``controllers`` says of a matrix gain's size, by its ``per``."""
+
+
 def cmd_controllers(args: argparse.Namespace) -> int:
     from dataclasses import fields
 
     from twolink_pin.controllers import available_controllers
-    from twolink_pin.controllers.gains import _spec
+    from twolink_pin.controllers.gains import _spec, default_as_json
     from twolink_pin.controllers.loading import broken_plugins
 
     rows: list[dict[str, Any]] = []
@@ -161,8 +165,9 @@ def cmd_controllers(args: argparse.Namespace) -> int:
             {
                 "name": f.name,
                 "per": _spec(f).per,
+                "matrix": _spec(f).matrix,
                 "unit": _spec(f).unit,
-                "default": f.default,
+                "default": default_as_json(cls.Gains, f.name),
                 "doc": _spec(f).doc,
             }
             for f in fields(cls.Gains)
@@ -178,7 +183,12 @@ def cmd_controllers(args: argparse.Namespace) -> int:
         )
     lines = []
     for row in rows:
-        listed = ", ".join(f"{g['name']}" + (f" [{g['unit']}]" if g["unit"] else "") for g in row["gains"])
+        listed = ", ".join(
+            f"{g['name']}"
+            + (f" [{g['unit']}]" if g["unit"] else "")
+            + (f" ({MATRIX_SIZE[g['per']]} matrix)" if g["matrix"] else "")
+            for g in row["gains"]
+        )
         lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {listed}")
     broken = broken_plugins()
     for problem in broken.values():  # a plug-in that failed to load is not silently missing

@@ -74,11 +74,13 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.plot:
         from twolink_pin.files import removed_on_failure
         from twolink_pin.plotting import save_simulation_figures
+        from twolink_pin.plotting.run import wrench_spans
 
+        spans = wrench_spans(spec.plant.wrench)  # a push shaded where it acts
         with removed_on_failure(args.plot) as folder:
-            figures = [str(p) for p in save_simulation_figures(result, folder)]
+            figures = [str(p) for p in save_simulation_figures(result, folder, spans=spans)]
             if task is not None:
-                figures.append(str(save_task_figure(robot, result, folder, result.controller)))
+                figures.append(str(save_task_figure(robot, result, folder, result.controller, spans=spans)))
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
@@ -165,12 +167,12 @@ def cmd_compare(args: argparse.Namespace) -> int:
         def on_result(name: str, result: SimulationResult) -> None:
             if not args.no_plot:
                 from twolink_pin.plotting import save_simulation_figures
+                from twolink_pin.plotting.run import wrench_spans
 
-                save_simulation_figures(
-                    result, stage / "figures", prefix=name, title=law_class(by_name[name]).title
-                )
+                spans, title = wrench_spans(shared.plant.wrench), law_class(by_name[name]).title
+                save_simulation_figures(result, stage / "figures", prefix=name, title=title, spans=spans)
                 if is_task_space(law_class(by_name[name])):
-                    save_task_figure(robot, result, stage / "figures", name, law_class(by_name[name]).title)
+                    save_task_figure(robot, result, stage / "figures", name, title, spans)
 
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
@@ -204,8 +206,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
         _say_failed(table.failed, f"the other laws' results are in {args.out}")
         return 1
-    payload = table.as_dict() | {"files": [str(f) for f in files]}
-    emit(args, payload, table.markdown() + "\n" + "\n".join(f"wrote {f}" for f in files))
+    payload = table.as_dict() | {"believed": _believed(shared), "files": [str(f) for f in files]}
+    said = [] if shared.parameters is None else [_believed_text(shared, robot.name)]
+    emit(args, payload, table.markdown() + "\n" + "\n".join([*said, *(f"wrote {f}" for f in files)]))
     return 0
 
 

@@ -86,11 +86,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         f"  ran {'' if output.engine == 'in-process' else 'on '}{output.engine}, in chunks of {output.chunk} runs",
         f"  gains {gains_text}"
         + "".join(f"; {name} drawn per run from U({lo:g}, {hi:g})" for name, (lo, hi) in drawn.items()),
-        f"  {'metric':28s} {'p5':>12s} {'median':>12s} {'p95':>12s}",
     ]
+    width = max([28, *(len(name) for name in summary["metrics"] if len(name) <= 40)])  # long names overflow
+    lines.append(f"  {'metric':{width}s} {'p5':>12s} {'median':>12s} {'p95':>12s}")
     for name, stat in summary["metrics"].items():
         cells = ["—" if stat[k] is None else f"{stat[k]:.5g}" for k in ("p5", "median", "p95")]
-        lines.append(f"  {name:28s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
+        lines.append(f"  {name:{width}s} {cells[0]:>12s} {cells[1]:>12s} {cells[2]:>12s}")
     if "note" in summary:
         lines.append(f"  {summary['note']}")
     lines += [f"  wrote {f}" for f in output.files]
