@@ -1,8 +1,10 @@
 """How the suite is spread over pytest-xdist's workers (``make test``: ``-n 2``, and
 ``--dist loadgroup`` from pyproject.toml): which tests share a worker, and which start first.
 
-Nothing here selects, skips or changes a test; it only sets the order of the collection and
-which tests xdist hands out together (without ``-n``, only the order applies).
+Nothing here skips or changes a test; it sets the order of the collection, which tests xdist
+hands out together (without ``-n``, only the order applies), and the markers that let
+``make check`` leave out what needs a Dask cluster, a docs, tutorial or report build
+(:data:`MARKS`; ``browser`` and ``slow`` are marked on the tests themselves).
 
 - **Shared setup stays on one worker.** A module-scoped fixture or a ``functools.cache`` is
   made once per worker process; where it is expensive (a Dask scheduler and its workers, a
@@ -39,6 +41,21 @@ GROUPS: dict[str, str] = {
 }
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 
+MARKS: dict[str, tuple[str, ...]] = {
+    "test_cluster.py": ("cluster",),  # a dask scheduler and workers
+    "test_interrupt_workers.py": ("cluster", "report"),  # Ctrl-C while a report or a LocalCluster forks
+    "test_docs.py": ("docs",),  # the strict site build on the executed tutorial
+    "test_tutorial.py": ("docs",),  # the tutorial on a fresh kernel
+    "test_docs_task_space.py": ("docs",),  # the page's commands: four 16-s UR5 runs and a sweep
+    "test_docs_images.py": ("docs",),  # an image maker of scripts/docs_images.py
+    "test_report.py": ("report",),  # report builds
+    "test_benchmark_script.py": ("slow",),  # scripts/benchmark.py --quick: minutes
+}
+"""Test file → markers added to each of its tests (``make check`` deselects them: pyproject's markers)."""
+
+CLUSTER_OPTIONS = ("--workers", "--scheduler")
+"""A corpus case whose command has one of these starts Dask workers: marked ``cluster``."""
+
 FIRST: tuple[str, ...] = (
     "test_identification.py",  # the "identification" group: 724 s of test time at load ~6
     "test_report.py",  # 624 s: report builds, Chromium
@@ -62,8 +79,26 @@ def _file(item: pytest.Item) -> str:
     return item.nodeid.split("::", 1)[0].rsplit("/", 1)[-1]
 
 
+def _mark(item: pytest.Item) -> None:
+    for name in MARKS.get(_file(item), ()):
+        item.add_marker(name)
+    case = item.callspec.params.get("case") if hasattr(item, "callspec") else None
+    if _file(item) != "test_corpus.py" or not hasattr(case, "argv"):
+        return
+    commands = [case.argv, *(step.arg for step in case.setup if step.kind == "cli")]
+    if any(argv[:1] == ("sweep",) and any(o in argv for o in CLUSTER_OPTIONS) for argv in commands):
+        item.add_marker("cluster")  # workers start before the options are all checked
+    if any(argv[:1] == ("report",) for argv in commands[1:]) or (
+        case.argv[:1] == ("report",) and (0 in case.exits or case.run == "signal")
+    ):
+        item.add_marker("report")  # a report is built (a refusal is not)
+
+
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """The files of :data:`FIRST` first, longest first (xdist schedules in this order)."""
+    """The markers of :data:`MARKS`; the files of :data:`FIRST` first, longest first (xdist
+    schedules in this order)."""
+    for item in items:
+        _mark(item)
     rank = {name: i for i, name in enumerate(FIRST)}
     items.sort(key=lambda item: rank.get(_file(item), len(FIRST)))  # stable: the rest keep their order
 
