@@ -27,6 +27,27 @@ LIMITS: list[Case] = [
     C("hang-compare-adaptive-lambda-1e5", "compare computed-torque --method adaptive --lambda 1e5 --no-plot --out c", 1, err=("computed-torque", "collapsed to about", "steps per dt"), changed=("c",), timeout=60),
 ]
 
+RUN = "tp.simulate(controller, plant, trajectory, SimulationConfig(duration=0.01))"
+"""A 10-step run of pd on the twolink."""
+NAN_Q = f"__import__('dataclasses').replace({RUN}, q=np.where(np.arange(11)[:, None] >= 5, np.nan, {RUN}.q))"
+"""That run with q NaN from its sample 5 (t = 0.005 s) on."""
+
 LIMITS_LIBRARY: list[LibCase] = [
+    # a wrong type names the parameter and what was expected, not an AttributeError inside
+    LibCase("library-compute_metrics-none", "tp.compute_metrics(None)", ("result", "SimulationResult")),
+    LibCase("library-compute_metrics-string", "tp.compute_metrics('run.npz')", ("result", "SimulationResult", "str")),
+    LibCase("library-compute_metrics-nan-result", f"tp.compute_metrics({NAN_Q})", ("result", "non-finite q", "t = 0.005 s")),
+    LibCase("library-inertial_parameters-robot", "__import__('twolink_pin.model.parameters').model.parameters.inertial_parameters(robot)", ("model", "pinocchio.Model", "RobotModel")),
+    LibCase("library-inertial_parameters-none", "__import__('twolink_pin.model.parameters').model.parameters.inertial_parameters(None)", ("model", "pinocchio.Model")),
+    LibCase("library-default_trajectory-string", "tp.default_trajectory('twolink')", ("robot", "RobotModel", "str")),
+    LibCase("library-build_trajectory-model", "tp.build_trajectory(model)", ("robot", "RobotModel")),
+    LibCase("library-excitation_trajectory-none", "tp.excitation_trajectory(None)", ("robot", "RobotModel")),
+    LibCase("library-optimise_excitation-string", "tp.optimise_excitation('ur5')", ("robot", "RobotModel")),
+    LibCase("library-simulate_log-string", "tp.simulate_log('twolink', trajectory)", ("robot", "RobotModel")),
+    LibCase("library-identify-log-string", "tp.identify('log.npz', robot)", ("log", "RunLog")),
+    LibCase("library-identify-robot-model", "tp.identify(tp.simulate_log(robot, trajectory, duration=0.5), model)", ("robot", "RobotModel")),
+    LibCase("library-read_log-none", "tp.read_log(None, 2)", ("path", "file path")),
+    LibCase("library-read_trajectory_file-int", "tp.read_trajectory_file(3, robot)", ("path", "file path")),
+    LibCase("library-example_robot_urdf-int", "tp.example_robot_urdf(3)", ("relative", "str")),
 ]
 # fmt: on

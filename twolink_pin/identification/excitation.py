@@ -40,7 +40,7 @@ import pinocchio as pin
 
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import one_row
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.identification.measures import ExcitationMeasures, excitation_measures
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.identification.simulated import plant_friction
@@ -322,6 +322,7 @@ def optimise_excitation(
     Raises:
         InvalidParameterError: the controller estimates nothing or lacks ``k``/``gamma``.
     """
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     from scipy.optimize import minimize
 
     design = design if design is not None else ExcitationDesign()
@@ -423,6 +424,7 @@ def _is_catalog_robot(robot: RobotModel) -> bool:
 def excitation_trajectory(robot: RobotModel) -> FourierTrajectory:
     """The robot's excitation: its stored one (:func:`register_excitation`) for an unloaded
     robot of the catalog that has one, else :func:`optimise_excitation` with the defaults."""
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     factory = _STORED.get(robot.name) if robot.payload == 0 else None
     if factory is not None and _is_catalog_robot(robot):
         return factory()
