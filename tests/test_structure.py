@@ -13,8 +13,8 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parents[1] / "twolink_pin"
 LONG = 80
 """A function longer than this many lines (decorators excluded, docstring included) is long."""
-MAX_LONG_FUNCTIONS = 21
-"""Functions over :data:`LONG` lines (21 at 934c0e3; lower it when one is split)."""
+MAX_LONG_FUNCTIONS = 20
+"""Functions over :data:`LONG` lines (21 at 934c0e3; 20 since integrate_adaptive; lower it when one is split)."""
 MAX_PRIVATE_IMPORTS = 70
 """Private names imported from another module of the package (80 at 934c0e3, in 33 module
 pairs; 70 after camera, motion and cluster_startup made theirs public). Lower it when one is."""

@@ -42,6 +42,37 @@ def projected_evaluations(calls: int, time: float, start: float, end: float) -> 
     return calls * (end - start) / elapsed if elapsed > 0 else float("inf")
 
 
+def check_progress(
+    name: str, calls: int, budget: int, time: float, span: tuple[float, float], dt: float, x: np.ndarray
+) -> None:
+    """Raise :class:`SimulationDivergedError` naming ``time`` [s] when the run has used its
+    ``budget`` of evaluations, when its pace so far projected to the end of ``span`` [s] would
+    exceed it (checked every :data:`PROGRESS_WINDOW` evaluations), or when the state ``x``
+    left the bounds."""
+    if calls > budget:  # a collapsing step size: stiff or diverging, never a hang
+        raise SimulationDivergedError(
+            name,
+            time,
+            f"the adaptive step collapsed ({budget} evaluations); the problem is too stiff for DOP853",
+        )
+    if calls % PROGRESS_WINDOW == 0 and projected_evaluations(calls, time, *span) > budget:
+        step = EVALUATIONS_PER_STEP * (time - span[0]) / calls
+        raise SimulationDivergedError(
+            name,
+            time,
+            f"the adaptive step collapsed to about {step:.2g} s ({dt / max(step, 1e-300):.3g} steps per "
+            f"dt = {dt:g} s): at this pace the run needs more than the {budget} evaluations allowed "
+            f"({MAX_EVALUATIONS_PER_STEP} per dt); the problem is too stiff for DOP853 (use --method "
+            "rk4 with a smaller --dt, or smaller gains)",
+        )
+    if not np.all(np.abs(x) < DIVERGENCE_LIMIT):
+        raise SimulationDivergedError(
+            name,
+            time,
+            "non-finite state" if not np.all(np.isfinite(x)) else f"|state| > {DIVERGENCE_LIMIT:g}",
+        )
+
+
 def integrate_adaptive(
     controller: Controller,
     plant: Plant,
@@ -94,28 +125,7 @@ def integrate_adaptive(
     def rhs(time: float, x: np.ndarray) -> np.ndarray:
         nonlocal calls
         calls += 1
-        if calls > budget:  # a collapsing step size: stiff or diverging, never a hang
-            raise SimulationDivergedError(
-                name,
-                time,
-                f"the adaptive step collapsed ({budget} evaluations); the problem is too stiff for DOP853",
-            )
-        if calls % PROGRESS_WINDOW == 0 and projected_evaluations(calls, time, t[0], t[-1]) > budget:
-            step = EVALUATIONS_PER_STEP * (time - t[0]) / calls
-            raise SimulationDivergedError(
-                name,
-                time,
-                f"the adaptive step collapsed to about {step:.2g} s ({dt / max(step, 1e-300):.3g} steps per "
-                f"dt = {dt:g} s): at this pace the run needs more than the {budget} evaluations allowed "
-                f"({MAX_EVALUATIONS_PER_STEP} per dt); the problem is too stiff for DOP853 (use --method "
-                "rk4 with a smaller --dt, or smaller gains)",
-            )
-        if not np.all(np.abs(x) < DIVERGENCE_LIMIT):
-            raise SimulationDivergedError(
-                name,
-                time,
-                "non-finite state" if not np.all(np.isfinite(x)) else f"|state| > {DIVERGENCE_LIMIT:g}",
-            )
+        check_progress(name, calls, budget, time, (t[0], t[-1]), dt, x)
         q, v, z = x[None, :nv], x[None, nv : 2 * nv], x[None, 2 * nv :]
         tau, dz = law(time, q, v, z)
         if not np.all(np.isfinite(tau)):
