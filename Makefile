@@ -1,15 +1,18 @@
 # twolink-pin: the two commands of the quick start.
 #   make demo   creates .venv, installs the package, runs the main job into out/
-#   make test   installs the test extras (and headless Chromium), runs ruff and the whole suite,
-#               which builds the documentation site in strict mode and executes the tutorial
+#   make check  the edit-test loop: ruff, the format check, mypy and every test that needs no
+#               browser, Dask cluster, docs/tutorial/report build and is not marked slow
+#   make test   installs the test extras (and headless Chromium), runs the same checks and the whole
+#               suite, which builds the documentation site in strict mode and executes the tutorial
 #   make docs   installs the docs extra, builds the site into site/ (strict: any warning fails)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 OUT ?= out
 TEST_WORKERS ?= 2
+CHECK_MARKERS ?= not browser and not slow and not cluster and not docs and not report
 
-.PHONY: demo test docs lint bench clean
+.PHONY: demo check test docs lint static bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,18 +38,23 @@ demo: $(VENV)/.installed
 # on the tutorial that tests/test_tutorial.py has just executed on a fresh kernel.
 # Which tests share a worker and which start first: pyproject.toml's addopts
 # (--dist loadgroup --no-loadscope-reorder) and tests/conftest.py.
-test: $(VENV)/.installed-test
+# ruff, the format check and mypy: the first step of check, test and lint
+static: $(VENV)/.installed-test
 	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/mypy twolink_pin
+
+test: static
 	$(BIN)/python -m pytest -n $(TEST_WORKERS)
+
+# the markers: pyproject.toml; which files carry cluster, docs, report: tests/conftest.py (MARKS)
+check: static
+	$(BIN)/python -m pytest -n $(TEST_WORKERS) -m "$(CHECK_MARKERS)"
 
 docs: $(VENV)/.installed-docs
 	NO_MKDOCS_2_WARNING=1 $(BIN)/python -m mkdocs build --strict -d site
 
-lint: $(VENV)/.installed-test
-	$(BIN)/python -m pip install -q -e '.[dev]'
-	$(BIN)/ruff check .
-	$(BIN)/ruff format --check .
-	$(BIN)/mypy twolink_pin
+lint: static
 
 bench: $(VENV)/.installed
 	$(BIN)/python scripts/benchmark.py

@@ -9,6 +9,7 @@ forward kinematics of the IK's answers, and the Lyapunov function of Slotine–L
 
 from __future__ import annotations
 
+import functools
 import json
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from twolink_pin import (
     InvalidParameterError,
     InvalidURDFError,
     InverseKinematicsError,
+    RobotModel,
     SimulationConfig,
     load_robot,
     make_scenario,
@@ -194,7 +196,7 @@ def test_info_json_lists_the_base_parameters_and_friction_on_request(
 @given(st.sampled_from(("ur5", "panda", "z1", "twolink")), st.integers(0, 2**31 - 1))
 def test_ik_round_trip_to_1e_9_m(name: str, seed: int) -> None:
     """A point the arm reaches (FK of a configuration near home) is found again from home to 1e-9 m."""
-    robot = _robots[name]
+    robot = _robot(name)
     rng = np.random.default_rng(seed)
     q = np.clip(
         robot.home + rng.uniform(-0.5, 0.5, robot.nv),
@@ -213,14 +215,17 @@ def test_ik_round_trip_to_1e_9_m(name: str, seed: int) -> None:
     )
 
 
-_robots = {name: load_robot(name) for name in ("ur5", "panda", "z1", "twolink")}
+@functools.cache
+def _robot(name: str) -> RobotModel:
+    """The catalog's robot, loaded once per worker when a test first needs it (not at collection)."""
+    return load_robot(name)
 
 
 def test_ik_reports_unreachable_and_singular_targets() -> None:
-    ur5 = _robots["ur5"]
+    ur5 = _robot("ur5")
     with pytest.raises(InverseKinematicsError, match=r"not reached: the closest .* m away"):
         solve_position(ur5, (2.0, 0.0, 0.0), ur5.home)
-    twolink = _robots["twolink"]
+    twolink = _robot("twolink")
     reach = float(np.sum(twolink.link_lengths))
     with pytest.raises(InverseKinematicsError, match="singular configuration"):
         solve_position(twolink, (reach, 0.0), np.array([0.1, 0.2]))
@@ -235,7 +240,7 @@ def _write(path: Path, document: dict) -> Path:
 
 
 def test_a_joint_via_file_is_the_trajectory_it_describes(tmp_path: Path) -> None:
-    robot = _robots["ur5"]
+    robot = _robot("ur5")
     via = [list(robot.home + d) for d in (0.0, 0.2, 0.0, -0.2, 0.0)]
     trajectory = read_trajectory_file(
         _write(tmp_path / "v.json", {"times": [0, 1, 2, 3, 4], "joints": via}), robot
@@ -247,7 +252,7 @@ def test_a_joint_via_file_is_the_trajectory_it_describes(tmp_path: Path) -> None
 
 
 def test_a_cartesian_via_file_passes_through_its_points(tmp_path: Path) -> None:
-    robot = _robots["ur5"]
+    robot = _robot("ur5")
     square = [[0.45, 0.1, 0.4], [0.45, -0.1, 0.4], [0.45, -0.1, 0.25], [0.45, 0.1, 0.25], [0.45, 0.1, 0.4]]
     path = _write(tmp_path / "square.json", {"times": [0, 1, 2, 3, 4], "positions": square})
     trajectory = read_trajectory_file(path, robot)
@@ -281,14 +286,14 @@ def test_bad_via_files_are_refused_with_the_value_and_the_limit(
     tmp_path: Path, document: dict, message: str
 ) -> None:
     with pytest.raises((InvalidParameterError, InverseKinematicsError), match=message):
-        read_trajectory_file(_write(tmp_path / "bad.json", document), _robots["twolink"])
+        read_trajectory_file(_write(tmp_path / "bad.json", document), _robot("twolink"))
 
 
 def test_a_via_file_whose_motion_leaves_the_limits_between_points_is_refused(tmp_path: Path) -> None:
     """Via points inside the limits, but the polynomial through them overshoots a limit."""
     path = _write(tmp_path / "o.json", {"times": [0, 0.4, 1], "joints": [[0, 0], [3.0, 0], [0, 0]]})
     with pytest.raises(InvalidParameterError, match=r"q1\(.* s\) = 3\.\d+ rad.* between the via points"):
-        read_trajectory_file(path, _robots["twolink"])
+        read_trajectory_file(path, _robot("twolink"))
 
 
 # ------------------------------------------------------------- adaptive on arms in gravity
@@ -342,7 +347,7 @@ def test_the_end_effector_figure_draws_the_distance_pinocchio_gives(tmp_path: Pa
     sample; the left panel draws the plane the desired path spans most (y-z for the square)."""
     from twolink_pin.plotting.cartesian import _end_effector_figure, save_end_effector_figure
 
-    robot = _robots["ur5"]
+    robot = _robot("ur5")
     trajectory = read_trajectory_file(Path(__file__).parents[1] / "examples" / "ur5_square.toml", robot)
     controller, plant = make_scenario("adaptive", robot)
     result = simulate(controller, plant, trajectory, SimulationConfig(duration=0.5))

@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("distributed")
 
 from twolink_pin.errors import TwolinkPinError
-from twolink_pin.studies.cluster import _handshake
+from twolink_pin.studies.cluster import handshake
 
 
 def test_a_non_dask_listener_is_named_not_a_memory_error() -> None:
@@ -31,7 +31,7 @@ def test_a_non_dask_listener_is_named_not_a_memory_error() -> None:
     threading.Thread(target=greet, daemon=True).start()
     try:
         with pytest.raises(TwolinkPinError) as caught:
-            _handshake(f"tcp://127.0.0.1:{port}", 10.0)
+            handshake(f"tcp://127.0.0.1:{port}", 10.0)
     finally:
         server.close()
     message = str(caught.value)

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 from corpus import runner
 from corpus.cases import CASES, LIBRARY
+from corpus.cases_limits import LIMITS, LIMITS_LIBRARY
 from corpus.spec import URDF, Case, LibCase
 
 
@@ -60,7 +61,11 @@ def _registry() -> Any:
             del sys.modules[name]
 
 
-@pytest.mark.parametrize("case", CASES, ids=[c.id for c in CASES])
+ALL_CASES = [*CASES, *LIMITS]
+ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY]
+
+
+@pytest.mark.parametrize("case", ALL_CASES, ids=[c.id for c in ALL_CASES])
 def test_command_line(case: Case, tmp_path: Path, capfd: pytest.CaptureFixture[str]) -> None:
     """The case's expected outcome, and every invariant (see tests/corpus/runner.py)."""
     reason = runner.unavailable(case.run)
@@ -129,7 +134,7 @@ def _summary(value: Any) -> str:
     return f"{type(value).__name__} {str(value)[:80]!r}"
 
 
-@pytest.mark.parametrize("case", LIBRARY, ids=[c.id for c in LIBRARY])
+@pytest.mark.parametrize("case", ALL_LIBRARY, ids=[c.id for c in ALL_LIBRARY])
 def test_library(case: LibCase, scope: dict[str, Any]) -> None:
     """The call raises the error named (InvalidParameterError by default), naming the argument."""
     import twolink_pin.errors as errors

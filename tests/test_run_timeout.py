@@ -107,3 +107,17 @@ def test_a_sweep_on_dask_workers_stops_the_chunk_that_never_returns(
     assert "corpus-sleeper" in err[0] and "Sleeper" in err[0] and "--timeout 2 s" in err[0]
     assert "runs 0–3" in err[0] and "Dask worker" in err[0] and "workers were stopped" in err[0]
     assert not out.exists()
+
+
+@pytest.mark.parametrize("seconds", [1e-9, 1e-6, 1e-4])
+def test_a_bound_that_fires_while_it_is_armed_gives_the_same_error(seconds: float) -> None:
+    """A bound of 1e-9 s fires before the guarded block starts (inside ``setitimer``): the same
+    ControllerError naming the law and the bound as a large one, never a bare RunTimeout, and
+    SIGALRM's handler is restored afterwards."""
+    handler = signal.getsignal(signal.SIGALRM)
+    controller, plant = make_scenario("pd", ROBOT)
+    for _ in range(20):
+        with per_run_limit(seconds), pytest.raises(ControllerError, match=r"within --timeout .* s"):
+            simulate(controller, plant, TRAJECTORY, SimulationConfig(duration=60.0))
+        assert signal.getsignal(signal.SIGALRM) is handler
+        assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)

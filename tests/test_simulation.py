@@ -351,3 +351,15 @@ def test_saturated_and_unsaturated_runs_differ_only_once_a_limit_is_hit() -> Non
     plain, clipped = run("pd", duration=1.0), run("pd", duration=1.0, saturate=True)
     np.testing.assert_array_equal(plain.q, clipped.q)
     np.testing.assert_array_equal(plain.tau, clipped.tau)
+
+
+def test_a_stiff_law_with_the_adaptive_method_is_recognised_from_its_pace() -> None:
+    """λ = 1e5 holds DOP853's step at a fraction of dt by stability: the run's pace, projected to
+    its end, exceeds the evaluation budget, so it ends early in simulated time (not after the
+    whole budget, at t ≈ 22 s of 30) naming the step it is down to."""
+    from twolink_pin import make_scenario
+
+    controller, plant = make_scenario("computed-torque", ROBOT, lam=1e5)
+    with pytest.raises(SimulationDivergedError, match=r"collapsed to about .* s \(.* steps per dt") as info:
+        simulate(controller, plant, TRAJECTORY, SimulationConfig(duration=30.0, method="adaptive"))
+    assert 0 < info.value.time < 1.0

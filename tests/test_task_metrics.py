@@ -12,7 +12,7 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import load_robot
 from twolink_pin.plant import Plant
 from twolink_pin.simulation import SimulationConfig, simulate
-from twolink_pin.task_metrics import task_errors, task_metrics
+from twolink_pin.task_metrics import TaskMetrics, bounded, task_errors, task_metrics
 from twolink_pin.twolink import closed_form
 
 
@@ -50,3 +50,14 @@ def test_orientation_error_is_pinocchios_log3_on_the_panda() -> None:
         np.testing.assert_allclose(errors.orientation[k], pin.log3(R @ Rd.T), atol=1e-9)
     with pytest.raises(InvalidParameterError, match="frame"):
         task_errors(panda, q, qd, frame="nope")
+
+
+def test_errors_below_the_integrators_accuracy_are_printed_as_bounds() -> None:
+    """A value below 1 nm or 1e-6 deg is printed ``< 1e-6`` (its digits are rounding that moves
+    with the machine's BLAS kernels); above it, 4 significant digits. The numbers keep every digit."""
+    m = TaskMetrics(3.068, 34.65, 7.663e-09, 0.6265, 1e-6, 1.274e-09)
+    assert m.text() == ("3.068", "34.65", "< 1e-6", "0.6265", "1e-06", "< 1e-6")
+    assert m.as_dict()["position_last_period_max_mm"] == 7.663e-09
+    assert (
+        bounded(-2e-7, 1e-6) == "< 1e-6" and bounded(5e-3, 1e-2) == "< 1e-2" and bounded(0.02, 1e-2) == "0.02"
+    )

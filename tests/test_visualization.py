@@ -35,7 +35,7 @@ from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.trajectory import default_trajectory
 from twolink_pin.twolink.reference import REPORT_VIA_XY
 from twolink_pin.visualization import LiveViewer, ghost_visual_model, serve, visual_model, write_html
-from twolink_pin.visualization.motion import _prepare
+from twolink_pin.visualization.motion import prepare_motion
 from twolink_pin.visualization.scene import scene_commands
 
 ROBOT: RobotModel = load_robot()
@@ -304,7 +304,7 @@ def test_scaled_mesh_is_drawn_once_scaled_where_pinocchio_puts_it(tmp_path: Path
     (tmp_path / "meshes" / "tet.stl").write_text(TETRAHEDRON)
     robot = load_robot(mesh_arm(tmp_path, "meshes/tet.stl", scale="2 3 0.5"))
     q = np.array([[0.4], [0.4]])
-    scene = scene_commands(robot, _prepare(robot, [0.0, 1.0], q, None, None, 1.0))
+    scene = scene_commands(robot, prepare_motion(robot, [0.0, 1.0], q, None, None, 1.0))
     node = "/meshcat/arm/visuals/arm_0"
     mesh = next(c for c in scene.commands if c["type"] == "set_object" and c["path"] == node)
     transform = next(c for c in scene.commands if c["type"] == "set_transform" and c["path"] == node)
@@ -331,7 +331,7 @@ def test_camera_looks_down_on_planar_motion_and_obliquely_on_3d_motion() -> None
     """The twolink (all joints at z = 0) is seen from nearly straight above; the UR5 (whose
     motion spans z) from 25° above the horizontal; via points given as (x, y) lie at z = 0."""
     t, q, q_des = sample_run()
-    twolink = scene_commands(ROBOT, _prepare(ROBOT, t, q, q_des, REPORT_VIA_XY, FPS)).commands
+    twolink = scene_commands(ROBOT, prepare_motion(ROBOT, t, q, q_des, REPORT_VIA_XY, FPS)).commands
     _, offset = _camera(twolink)
     assert np.degrees(np.arccos(offset[2] / np.linalg.norm(offset))) < 5.0
     vias = [c for c in twolink if c["path"].startswith("/meshcat/via/") and c["type"] == "set_transform"]
@@ -341,7 +341,7 @@ def test_camera_looks_down_on_planar_motion_and_obliquely_on_3d_motion() -> None
     robot = ur5()
     t, q, q_des = sample_run(robot)
     via = joint_positions(robot, q[[0, -1]])[:, -1]  # (2, 3): three-column via points
-    commands = scene_commands(robot, _prepare(robot, t, q, q_des, via, FPS)).commands
+    commands = scene_commands(robot, prepare_motion(robot, t, q, q_des, via, FPS)).commands
     _, offset = _camera(commands)
     assert np.degrees(np.arcsin(offset[2] / np.linalg.norm(offset))) == pytest.approx(25.0, abs=1e-6)
     vias = [c for c in commands if c["path"].startswith("/meshcat/via/") and c["type"] == "set_transform"]
@@ -358,7 +358,7 @@ def test_camera_faces_a_vertical_end_effector_path_from_the_far_side_of_the_base
     trajectory = read_trajectory_file(Path(__file__).parents[1] / "examples" / "ur5_square.toml", robot)
     t = np.linspace(0.0, 8.0, 201)
     q_des = trajectory.sample(t).q
-    commands = scene_commands(robot, _prepare(robot, t, q_des, q_des, None, FPS)).commands
+    commands = scene_commands(robot, prepare_motion(robot, t, q_des, q_des, None, FPS)).commands
     _, offset = _camera(commands)
     direction = offset / np.linalg.norm(offset)
     assert np.degrees(np.arcsin(direction[2])) == pytest.approx(25.0, abs=1e-6)

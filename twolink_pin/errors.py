@@ -213,3 +213,11 @@ def raised_at(exc: BaseException, law: object = None) -> str:
         mine = [f for f in frames if source and f.filename == source]
         frame = mine[-1] if mine else frame
     return f" (raised at {frame.filename}:{frame.lineno} in {frame.name})"
+
+
+def require_type(value: Any, kind: type | tuple[type, ...], name: str, expected: str) -> None:
+    """Raise :class:`InvalidParameterError` naming ``name`` unless ``value`` is a ``kind``:
+    ``robot = 'str' is invalid: expected a RobotModel (twolink_pin.load_robot)``. For the
+    public functions' arguments, so a wrong type is named, not an ``AttributeError`` deep inside."""
+    if not isinstance(value, kind):
+        raise InvalidParameterError(name, type(value).__name__, expected)

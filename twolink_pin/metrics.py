@@ -25,6 +25,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.errors import InvalidParameterError, require_type
+
 if TYPE_CHECKING:
     from twolink_pin.simulation import Samples, SimulationResult
 
@@ -201,9 +203,31 @@ class RunningMetrics:
         )
 
 
+def _require_finite(result: SimulationResult) -> None:
+    """Refuse a result with a non-finite sample, naming the signal and the first such time [s]."""
+    for name in ("q", "v", "tau", "q_des", "v_des"):
+        values = np.asarray(getattr(result, name))
+        bad = ~np.all(np.isfinite(values), axis=tuple(range(1, values.ndim)))
+        if bad.any():
+            k = int(np.argmax(bad))
+            raise InvalidParameterError(
+                "result",
+                f"non-finite {name} from t = {float(result.t[k]):.6g} s (sample {k})",
+                "finite samples: the metrics of a run holding NaN or inf would be NaN",
+            )
+
+
 def compute_metrics(result: SimulationResult) -> Metrics:
-    """RMS, L2 and max of ``e``, ``ė``, ``τ`` and the last-period max ``|e|`` of ``result``."""
-    from twolink_pin.simulation import Samples
+    """RMS, L2 and max of ``e``, ``ė``, ``τ`` and the last-period max ``|e|`` of ``result``.
+
+    Raises:
+        InvalidParameterError: ``result`` is not a :class:`SimulationResult`, or holds a
+            non-finite sample (named with its time): its metrics would be NaN.
+    """
+    from twolink_pin.simulation import Samples, SimulationResult
+
+    require_type(result, SimulationResult, "result", "a SimulationResult (twolink_pin.simulate)")
+    _require_finite(result)
 
     nv = result.q.shape[1]
     running = RunningMetrics(1, nv, result.dt, len(result.t), result.reference_period, result.torque_limits)

@@ -14,6 +14,12 @@ RMS here is over the output samples, ``sqrt(mean_k x_k²)``. One implementation,
 joint metrics: :class:`RunningTaskMetrics` takes blocks of N runs' samples (the engine's
 observer in :func:`~twolink_pin.studies.batch.simulate_batch`, so a sweep's rows carry
 them), :func:`task_metrics` feeds it a recorded run in one block.
+
+Printed (:meth:`TaskMetrics.text`), a value below :data:`POSITION_RESOLUTION_MM` or
+:data:`ORIENTATION_RESOLUTION_DEG` is a bound, ``< 1e-6``: the run's joint angles carry the
+integrator's error (RK4: about 1e-11 rad at the default step), so digits below a nanometre or
+a micro-degree are rounding, and they differ between machines (BLAS kernels). The numbers
+themselves (``--json``, CSV) keep every digit.
 """
 
 from __future__ import annotations
@@ -60,6 +66,20 @@ class TaskErrors(NamedTuple):
     """``log(R R_dᵀ)`` [rad] in world axes, shape (K, 3)."""
 
 
+POSITION_RESOLUTION_MM = 1e-6
+"""Position errors below this [mm] (1 nm) are printed as ``< 1e-6``: below the integrator's accuracy."""
+ORIENTATION_RESOLUTION_DEG = 1e-6
+"""Angle errors below this [deg] are printed as ``< 1e-6``: below the integrator's accuracy."""
+
+
+def bounded(value: float, resolution: float, digits: int = 4) -> str:
+    """``value`` to ``digits`` significant digits, or ``< resolution`` (``< 1e-6``) below it."""
+    if abs(value) < resolution:
+        mantissa, exponent = f"{resolution:.0e}".split("e")
+        return f"< {mantissa}e{int(exponent)}"
+    return f"{value:.{digits}g}"
+
+
 class TaskMetrics(NamedTuple):
     """Norms of a run's task-space error (see the module docstring): floats for one run,
     arrays of shape (N,) for a batch (NaN for diverged runs; :meth:`run` takes one)."""
@@ -84,6 +104,16 @@ class TaskMetrics(NamedTuple):
     def run(self, i: int) -> TaskMetrics:
         """Run ``i``'s metrics of a batch, as floats."""
         return TaskMetrics(*(float(np.asarray(v)[i]) for v in self))
+
+    def text(self) -> tuple[str, ...]:
+        """Each metric as printed: 4 significant digits, or a bound below the resolution
+        (:data:`POSITION_RESOLUTION_MM`, :data:`ORIENTATION_RESOLUTION_DEG`)."""
+        return tuple(
+            bounded(
+                value, POSITION_RESOLUTION_MM if name.startswith("position") else ORIENTATION_RESOLUTION_DEG
+            )
+            for name, value in self._asdict().items()
+        )
 
 
 def _poses(robot: RobotModel, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray]:

@@ -36,12 +36,10 @@ def task_lines(metrics: TaskMetrics | None) -> list[str]:
     """The summary's lines for ``metrics`` (none for None)."""
     if metrics is None:
         return []
-    m = metrics
+    p_rms, p_max, p_last, a_rms, a_max, a_last = metrics.text()
     return [
-        f"  task |p − p_d| RMS {m.position_rms_mm:.4g} mm   max {m.position_max_mm:.4g} mm   "
-        f"last period max {m.position_last_period_max_mm:.4g} mm",
-        f"  task angle     RMS {m.orientation_rms_deg:.4g} deg  max {m.orientation_max_deg:.4g} deg  "
-        f"last period max {m.orientation_last_period_max_deg:.4g} deg",
+        f"  task |p − p_d| RMS {p_rms} mm   max {p_max} mm   last period max {p_last} mm",
+        f"  task angle     RMS {a_rms} deg  max {a_max} deg  last period max {a_last} deg",
     ]
 
 

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.arrays import readonly, readonly_or_none
-from twolink_pin.errors import InputFileError, InvalidParameterError
+from twolink_pin.errors import InputFileError, InvalidParameterError, require_type
 from twolink_pin.files import atomic_write, read_input_file
 
 MAX_LOG_BYTES = 512 << 20
@@ -292,6 +292,7 @@ def read_log(path: str | os.PathLike[str], nv: int) -> RunLog:
         InputFileError: the file cannot be read, or a column or value is missing or wrong
             (the message names the row and the column).
     """
+    require_type(path, (str, os.PathLike), "path", "a file path (str or pathlib.Path)")
     file = Path(os.fspath(path))
     suffix = file.suffix.lower()
     if suffix == ".csv":

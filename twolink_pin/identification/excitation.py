@@ -47,7 +47,7 @@ import pinocchio as pin
 from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import one_row
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.identification.measures import ExcitationMeasures, excitation_measures
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.identification.simulated import plant_friction
@@ -334,6 +334,7 @@ def optimise_excitation(
     Raises:
         InvalidParameterError: the controller estimates nothing or lacks ``k``/``gamma``.
     """
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     design = design if design is not None else ExcitationDesign()
     if design.criterion == "adaptation":
         if controller is None:
@@ -466,5 +467,6 @@ def stored_excitation(robot: RobotModel) -> FourierTrajectory | None:
 def excitation_trajectory(robot: RobotModel) -> FourierTrajectory:
     """The robot's excitation: its stored one (:func:`stored_excitation`), else
     :func:`optimise_excitation` with the defaults."""
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     stored = stored_excitation(robot)
     return stored if stored is not None else optimise_excitation(robot).trajectory

@@ -42,7 +42,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from twolink_pin.blas import one_blas_thread
-from twolink_pin.errors import InputFileError, InvalidParameterError
+from twolink_pin.errors import InputFileError, InvalidParameterError, require_type
 from twolink_pin.identification.data import MIN_SAMPLES, RunLog, check_sample_count
 from twolink_pin.identification.filtering import FilteredLog, ZeroPhaseFilter, filter_log
 from twolink_pin.identification.observation import ParameterSet
@@ -310,6 +310,8 @@ def identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | No
             high for its sampling rate, or the motion does not excite every parameter (the
             message names the worst-excited combination).
     """
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
+    require_type(log, RunLog, "log", "a RunLog (twolink_pin.read_log, simulate_log)")
     with one_blas_thread():  # small dense algebra: OpenBLAS's threads only slow it (twolink_pin/blas.py)
         return _identify(log, robot, options)
 

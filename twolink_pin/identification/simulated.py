@@ -22,7 +22,7 @@ import numpy as np
 
 from twolink_pin.controllers import ComputedTorque, LawInput, LawOutput, Terms
 from twolink_pin.dynamics import Friction
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.identification.data import RunLog
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.model import RobotModel
@@ -90,6 +90,7 @@ def simulate_log(
         InvalidParameterError: a bad duration or step, friction for another number of
             joints; SimulationDivergedError if the run diverges.
     """
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     from twolink_pin.plant import Plant
     from twolink_pin.simulation import SimulationConfig, simulate
 

@@ -14,7 +14,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
-from twolink_pin.errors import InvalidURDFError
+from twolink_pin.errors import InvalidURDFError, require_type
 from twolink_pin.model.profile import RobotProfile, generic_profile
 from twolink_pin.model.urdf_profile import declared_profile
 
@@ -29,6 +29,7 @@ def example_robot_urdf(relative: str) -> Path:
     Raises:
         InvalidURDFError: the distribution is not installed or has no such file.
     """
+    require_type(relative, str, "relative", "a path inside example-robot-data's robots folder (str)")
     try:
         files = importlib.metadata.files("example-robot-data") or []
     except importlib.metadata.PackageNotFoundError:

@@ -19,6 +19,8 @@ import abc
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.errors import require_type
+
 N_BODY_PARAMETERS = 10
 """Inertial parameters per body in Pinocchio's ordering."""
 
@@ -34,6 +36,7 @@ def inertial_parameters(model: pin.Model) -> np.ndarray:
     Returns:
         π, shape ``(10 (njoints - 1),)``: per body ``[kg, kg·m (×3), kg·m² (×6)]``.
     """
+    require_type(model, pin.Model, "model", "a pinocchio.Model (RobotModel.model)")
     return np.concatenate([model.inertias[j].toDynamicParameters() for j in range(1, model.njoints)])
 
 

@@ -5,9 +5,11 @@ as the fixed-step engine, with N = 1) and the plant's ABA; output on the fixed g
 ``t_k = k dt``. Coulomb friction must use a smooth sign (``Friction.smoothing > 0``): an
 exact ``sgn`` makes the step size collapse when a joint sticks. A collapsing step is
 bounded (:data:`~twolink_pin.simulation.config.MAX_EVALUATIONS_PER_STEP` evaluations per
-output interval) and, sooner, by the progress it makes: 20 000 evaluations that advance the
-run by less than 20 output steps end it (:data:`PROGRESS_WINDOW`, :data:`MIN_PROGRESS`) —
-a divergence report within seconds, never a hang.
+output interval) and, sooner, by the progress it makes: every :data:`PROGRESS_WINDOW`
+evaluations the run's pace so far (evaluations per simulated second) is projected to its end,
+and a run that would exceed the budget ends there, naming the time and the step it is down to
+(a stiff law, e.g. ``--lambda 1e5``, whose step is held at a fraction of ``dt`` by stability,
+not accuracy) — a divergence report within seconds, never minutes of work that must fail.
 """
 
 from __future__ import annotations
@@ -29,9 +31,46 @@ from twolink_pin.trajectory import Trajectory
 
 PROGRESS_WINDOW = 20_000
 """Evaluations between two checks that the adaptive step still makes progress."""
-MIN_PROGRESS = 1e-3
-"""Least progress per evaluation, in output steps dt, before the step is declared collapsed
-(DOP853 takes 12 evaluations per step: a step below 1 % of dt over 20 000 evaluations)."""
+EVALUATIONS_PER_STEP = 12
+"""Right-hand-side evaluations of one DOP853 step (to name the step size a pace implies)."""
+
+
+def projected_evaluations(calls: int, time: float, start: float, end: float) -> float:
+    """Evaluations the whole run ``[start, end]`` [s] needs at the pace so far (``calls`` to reach
+    ``time``); infinite when no time has passed."""
+    elapsed = time - start
+    return calls * (end - start) / elapsed if elapsed > 0 else float("inf")
+
+
+def check_progress(
+    name: str, calls: int, budget: int, time: float, span: tuple[float, float], dt: float, x: np.ndarray
+) -> None:
+    """Raise :class:`SimulationDivergedError` naming ``time`` [s] when the run has used its
+    ``budget`` of evaluations, when its pace so far projected to the end of ``span`` [s] would
+    exceed it (checked every :data:`PROGRESS_WINDOW` evaluations), or when the state ``x``
+    left the bounds."""
+    if calls > budget:  # a collapsing step size: stiff or diverging, never a hang
+        raise SimulationDivergedError(
+            name,
+            time,
+            f"the adaptive step collapsed ({budget} evaluations); the problem is too stiff for DOP853",
+        )
+    if calls % PROGRESS_WINDOW == 0 and projected_evaluations(calls, time, *span) > budget:
+        step = EVALUATIONS_PER_STEP * (time - span[0]) / calls
+        raise SimulationDivergedError(
+            name,
+            time,
+            f"the adaptive step collapsed to about {step:.2g} s ({dt / max(step, 1e-300):.3g} steps per "
+            f"dt = {dt:g} s): at this pace the run needs more than the {budget} evaluations allowed "
+            f"({MAX_EVALUATIONS_PER_STEP} per dt); the problem is too stiff for DOP853 (use --method "
+            "rk4 with a smaller --dt, or smaller gains)",
+        )
+    if not np.all(np.abs(x) < DIVERGENCE_LIMIT):
+        raise SimulationDivergedError(
+            name,
+            time,
+            "non-finite state" if not np.all(np.isfinite(x)) else f"|state| > {DIVERGENCE_LIMIT:g}",
+        )
 
 
 def integrate_adaptive(
@@ -58,7 +97,6 @@ def integrate_adaptive(
     accel = SingleRunDynamics(plant)
     budget = MAX_EVALUATIONS_PER_STEP * n + 10_000
     calls = 0
-    checkpoint = [0.0]  # simulated time at the last progress check
 
     compute = contained(controller)  # read-only inputs; sys.exit and MemoryError name the law
 
@@ -87,28 +125,7 @@ def integrate_adaptive(
     def rhs(time: float, x: np.ndarray) -> np.ndarray:
         nonlocal calls
         calls += 1
-        if calls > budget:  # a collapsing step size: stiff or diverging, never a hang
-            raise SimulationDivergedError(
-                name,
-                time,
-                f"the adaptive step collapsed ({budget} evaluations); the problem is too stiff for DOP853",
-            )
-        if calls % PROGRESS_WINDOW == 0:  # progress per evaluation far below the output step
-            if time - checkpoint[0] < PROGRESS_WINDOW * dt * MIN_PROGRESS:
-                raise SimulationDivergedError(
-                    name,
-                    time,
-                    f"the adaptive step collapsed: {PROGRESS_WINDOW} evaluations advanced the run by "
-                    f"{time - checkpoint[0]:.3g} s (less than {MIN_PROGRESS:g} dt each); the problem is too "
-                    "stiff for DOP853",
-                )
-            checkpoint[0] = time
-        if not np.all(np.abs(x) < DIVERGENCE_LIMIT):
-            raise SimulationDivergedError(
-                name,
-                time,
-                "non-finite state" if not np.all(np.isfinite(x)) else f"|state| > {DIVERGENCE_LIMIT:g}",
-            )
+        check_progress(name, calls, budget, time, (t[0], t[-1]), dt, x)
         q, v, z = x[None, :nv], x[None, nv : 2 * nv], x[None, 2 * nv :]
         tau, dz = law(time, q, v, z)
         if not np.all(np.isfinite(tau)):

@@ -25,7 +25,7 @@ import contextvars
 import signal
 import threading
 from collections.abc import Callable, Iterator
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from twolink_pin.errors import ControllerError
 
@@ -59,36 +59,70 @@ def run_limit() -> float | None:
     return _LIMIT.get()
 
 
-@contextlib.contextmanager
-def bounded(error: Callable[[float], BaseException] | None = None) -> Iterator[float | None]:
+class bounded:
     """Raise :class:`RunTimeout` inside the block once it has run for the bound in force
     (:func:`per_run_limit`) — or ``error(seconds)`` in its place, e.g. :func:`timed_out`
-    naming the law; yields the bound. No bound outside the main thread, without
-    ``setitimer``, or when a bound is already armed (an enclosing simulation)."""
-    seconds = _LIMIT.get()
-    if (
-        not seconds
-        or threading.current_thread() is not threading.main_thread()
-        or not hasattr(signal, "setitimer")
-        or signal.getitimer(signal.ITIMER_REAL)[0] > 0
-    ):
-        yield None
-        return
+    naming the law; ``with`` gives the bound. No bound outside the main thread, without
+    ``setitimer``, or when a bound is already armed (an enclosing simulation).
 
-    def expire(signum: int, frame: object) -> None:
-        raise RunTimeout(seconds)
+    Exact at every size: a bound so small (1e-9 s) that the alarm fires while it is being
+    armed raises the same error from ``__enter__``, and once the block has ended the alarm
+    raises nothing (the handler only raises while armed). A class, not a generator: a
+    generator-based context manager has a gap between its ``yield`` and the block where an
+    exception would escape both."""
 
-    previous = signal.signal(signal.SIGALRM, expire)
-    signal.setitimer(signal.ITIMER_REAL, seconds)
-    try:
-        yield seconds
-    except RunTimeout as exc:
-        if error is None:
-            raise
-        raise error(exc.seconds) from None
-    finally:
+    def __init__(self, error: Callable[[float], BaseException] | None = None) -> None:
+        self.error = error
+        self.seconds: float | None = None
+        self.armed = False
+        self.previous: Any = None
+
+    def _expire(self, signum: int, frame: object) -> None:
+        if self.armed:
+            self.armed = False
+            raise RunTimeout(self.seconds or 0.0)
+
+    def _disarm(self) -> None:
+        self.armed = False
         signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, previous)
+        signal.signal(signal.SIGALRM, self.previous)
+
+    def _raise(self, exc: RunTimeout) -> BaseException:
+        return exc if self.error is None else self.error(exc.seconds)
+
+    def __enter__(self) -> float | None:
+        seconds = _LIMIT.get()
+        if (
+            not seconds
+            or threading.current_thread() is not threading.main_thread()
+            or not hasattr(signal, "setitimer")
+            or signal.getitimer(signal.ITIMER_REAL)[0] > 0
+        ):
+            return None
+        self.seconds = seconds
+        self.previous = signal.signal(signal.SIGALRM, self._expire)
+        try:
+            self.armed = True
+            signal.setitimer(signal.ITIMER_REAL, seconds)
+        except RunTimeout as exc:  # fired while being armed
+            self._disarm()
+            raise self._raise(exc) from None
+        return seconds
+
+    def __exit__(self, kind: type[BaseException] | None, exc: BaseException | None, tb: Any) -> None:
+        if self.seconds is None:
+            return
+        try:
+            self._disarm()
+        except RunTimeout as late:  # fired as the block ended, before the disarm took
+            self._disarm()
+            if kind is None:
+                exc = late
+        if isinstance(exc, RunTimeout):
+            if self.error is not None:
+                raise self.error(exc.seconds) from None
+            if kind is None:
+                raise exc
 
 
 def timed_out(controller: Controller, t: float, seconds: float) -> ControllerError:

@@ -34,7 +34,7 @@ from urllib.parse import urlsplit
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
-from twolink_pin.studies.cluster_startup import _handshake, _kill_workers, _probe, _start_local
+from twolink_pin.studies.cluster_startup import handshake, kill_workers, probe, start_local
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -308,7 +308,7 @@ class DaskEngine:
         """
         if kill and self.cluster is not None:
             self._pending.clear()  # the tasks die with the workers
-            _kill_workers(self.cluster)
+            kill_workers(self.cluster)
         self.cancel()
         with contextlib.suppress(Exception):
             self.client.close(timeout=5)
@@ -368,8 +368,8 @@ def open_cluster(
     from distributed import Client
 
     if scheduler is not None:
-        _probe(address, timeout)
-        _handshake(address, timeout)
+        probe(address, timeout)
+        handshake(address, timeout)
         try:
             client = Client(address, timeout=timeout, set_as_default=False)
         except (OSError, TimeoutError) as exc:
@@ -379,7 +379,7 @@ def open_cluster(
         )
     else:
         assert workers is not None
-        cluster, client = _start_local(
+        cluster, client = start_local(
             address,
             dict(
                 n_workers=workers,

@@ -1,10 +1,10 @@
 """Reaching a scheduler and starting a LocalCluster (used by
 :func:`~twolink_pin.studies.cluster.open_cluster`): a scheduler address that nothing answers,
-or that answers with no Dask message, fails fast and says so (:func:`_probe`,
-:func:`_handshake`); what Dask logs while a LocalCluster starts is kept rather than printed: a nanny that cannot spawn its worker (a
+or that answers with no Dask message, fails fast and says so (:func:`probe`,
+:func:`handshake`); what Dask logs while a LocalCluster starts is kept rather than printed: a nanny that cannot spawn its worker (a
 bad ``multiprocessing-method`` in the user's Dask configuration) or a temporary folder that
 cannot be made is then one line naming the cause, not distributed's own tracebacks and
-warnings on stderr (:func:`_start_local`). Imports no Dask until called."""
+warnings on stderr (:func:`start_local`). Imports no Dask until called."""
 
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ def _startup_cause(exc: BaseException, records: list[logging.LogRecord]) -> str:
     return f"{type(exc).__name__}: {str(exc)[:300]}"
 
 
-def _start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
+def start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
     """A LocalCluster of ``options`` and a client of it, or :class:`ClusterError` naming
     the cause. Ctrl-C and SIGTERM are held while it starts: Dask cannot close a cluster that
     is half started (its exit hook then fails on a worker still starting, with a traceback),
@@ -80,7 +80,7 @@ def _start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
         if cluster is not None:
             with interrupts.deferred():  # a second Ctrl-C does not stop the clean-up half-way
                 if not isinstance(exc, Exception):
-                    _kill_workers(cluster)
+                    kill_workers(cluster)
                 if client is not None:
                     with contextlib.suppress(Exception):
                         client.close(timeout=5)
@@ -93,7 +93,7 @@ def _start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
         ) from None
 
 
-def _kill_workers(cluster: Any) -> None:
+def kill_workers(cluster: Any) -> None:
     """Kill a LocalCluster's worker processes at once, their nannies' complaints silenced
     (a task they are in can take minutes)."""
     import os
@@ -107,7 +107,7 @@ def _kill_workers(cluster: Any) -> None:
                 os.kill(pid, signal.SIGKILL)
 
 
-def _probe(address: str, timeout: float) -> None:
+def probe(address: str, timeout: float) -> None:
     """Fail fast if nothing listens at ``address`` (Dask itself would retry until its timeout)."""
     parts = urlsplit(address)
     assert parts.hostname is not None and parts.port is not None
@@ -126,7 +126,7 @@ def _probe(address: str, timeout: float) -> None:
         ) from None
 
 
-def _handshake(address: str, timeout: float) -> None:
+def handshake(address: str, timeout: float) -> None:
     """Fail within ``timeout`` if what listens at ``address`` is no Dask scheduler: Dask's
     own connect waits for the peer's handshake without a time limit."""
     import asyncio

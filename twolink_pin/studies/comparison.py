@@ -143,7 +143,7 @@ class ComparisonTable:
             out.append("| controller | " + " | ".join(TASK_HEADERS) + " |")
             out.append("|---|" + "---:|" * len(TASK_HEADERS))
             for name, t in self.task.items():
-                out.append(f"| {name} | " + " | ".join(f"{x:.4g}" for x in t) + " |")
+                out.append(f"| {name} | " + " | ".join(t.text()) + " |")
         if self.plants or self.failed or self.gains:
             out.append("\n### the runs\n")
             out.append("| controller | gains | plant | outcome |")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from twolink_pin.errors import require_type
 from twolink_pin.kinematics import inverse_kinematics
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.cartesian import ViaPoints, cartesian_trajectory
@@ -32,6 +33,7 @@ def default_via_points(robot: RobotModel) -> ViaPoints | None:
 def default_trajectory(robot: RobotModel) -> JointTrajectory:
     """The robot's default reference: its profile's via points (joint, planar end-effector
     with the analytic IK, or 3-D end-effector), else :func:`neutral_motion`."""
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     spec = robot.profile.trajectory
     if spec is None:
         return neutral_motion(robot)
@@ -87,6 +89,7 @@ def build_trajectory(robot: RobotModel, via: ViaPoints | None = None) -> JointTr
     Raises:
         UnreachableTargetError: a via point is outside the reachable annulus.
     """
+    require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
     if via is None:
         return default_trajectory(robot)
     via_q = np.array([inverse_kinematics(robot, xy)[via.branch] for xy in via.xy])

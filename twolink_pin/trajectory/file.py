@@ -58,7 +58,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.documents import load_json, load_toml
-from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError
+from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError, require_type
 from twolink_pin.files import read_input_file
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
@@ -168,6 +168,7 @@ def read_trajectory_file(
             was expected).
         InverseKinematicsError: an end-effector point is out of reach or singular.
     """
+    require_type(path, (str, os.PathLike), "path", "a file path (str or pathlib.Path)")
     file = Path(os.fspath(path))
     document = _load(file)
     if "fourier" in document:

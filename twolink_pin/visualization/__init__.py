@@ -10,7 +10,7 @@ Three ways to look at a run, all built from the same scene:
   (an ``<iframe srcdoc>``: it plays in the saved notebook, without a server).
 
 =======================  ======================================================================
-``motion.py``            the caller's arrays checked and resampled to frames (``_prepare``)
+``motion.py``            the caller's arrays checked and resampled to frames (``prepare_motion``)
 ``scene.py``             the scene from Pinocchio geometry: arm, ghost, trail, desired path,
                          via markers, floor grid, camera; :func:`visual_model`,
                          :func:`ghost_visual_model`, the node names; the recorded commands

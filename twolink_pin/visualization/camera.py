@@ -1,9 +1,9 @@
 """Where the camera of a scene looks from, and the floor grid under the motion.
 
-:func:`_camera` places the camera (from above for planar motion, facing a vertical
+:func:`frame_camera` places the camera (from above for planar motion, facing a vertical
 end-effector path, obliquely otherwise) at the least distance that keeps everything in
-view; :func:`_grid` sizes a floor grid to the motion and clips it to what lies in front of
-the camera. Both work in our axes ``(x, y, z)`` [m]; :func:`_threejs` converts a vector to
+view; :func:`floor_grid` sizes a floor grid to the motion and clips it to what lies in front of
+the camera. Both work in our axes ``(x, y, z)`` [m]; :func:`threejs_vector` converts a vector to
 three.js axes ``(x, z, −y)``. Used by :mod:`.scene`.
 """
 
@@ -109,7 +109,7 @@ def _view_direction(joints: np.ndarray, path: np.ndarray | None = None) -> np.nd
     )
 
 
-def _camera(
+def frame_camera(
     joints: np.ndarray, points: np.ndarray, path: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """View centre and camera position (both in our axes [m]) framing ``points``.
@@ -165,7 +165,7 @@ def _clip(
     return a, b
 
 
-def _grid(points: np.ndarray, centre: np.ndarray, camera: np.ndarray) -> tuple[float, list[np.ndarray]]:
+def floor_grid(points: np.ndarray, centre: np.ndarray, camera: np.ndarray) -> tuple[float, list[np.ndarray]]:
     """A floor grid in z = 0 under ``points`` [m]: its spacing [m] and its segments.
 
     meshcat's own grid (20 m, 0.5 m spacing) is hidden: too coarse for an arm under a
@@ -198,6 +198,6 @@ def _grid(points: np.ndarray, centre: np.ndarray, camera: np.ndarray) -> tuple[f
     return spacing, [np.array(minor).reshape(-1, 3), np.array(major).reshape(-1, 3)]
 
 
-def _threejs(v: np.ndarray) -> list[float]:
+def threejs_vector(v: np.ndarray) -> list[float]:
     """Our ``(x, y, z)`` in three.js axes ``(x, z, −y)``."""
     return [float(v[0]), float(v[2]), float(-v[1])]

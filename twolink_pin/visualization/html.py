@@ -21,7 +21,7 @@ import numpy.typing as npt
 from twolink_pin.files import atomic_write
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import import_meshcat
-from twolink_pin.visualization.motion import _prepare
+from twolink_pin.visualization.motion import prepare_motion
 from twolink_pin.visualization.overlays import AXIS_COLORS, WRENCH_COLOR
 from twolink_pin.visualization.scene import (
     DESIRED_PATH_COLOR,
@@ -146,7 +146,7 @@ def scene_page(
     Returns:
         The whole page: the viewer's JavaScript and the scene's commands inlined.
     """
-    motion = _prepare(
+    motion = prepare_motion(
         robot,
         t,
         q,

@@ -1,6 +1,6 @@
 """The motion to show: the caller's arrays checked, then resampled to animation frames.
 
-:func:`_prepare` is the one entry point; every check names the offending entry and the
+:func:`prepare_motion` is the one entry point; every check names the offending entry and the
 valid range (:class:`~twolink_pin.errors.InvalidParameterError`). Times [s], joint
 angles [rad], positions [m].
 """
@@ -18,7 +18,7 @@ from twolink_pin.model import RobotModel
 
 
 @dataclass(frozen=True)
-class _Motion:
+class Motion:
     """A validated motion, resampled to the animation's frames."""
 
     frames: np.ndarray
@@ -149,7 +149,7 @@ def _check_desired(
     return poses
 
 
-def _prepare(
+def prepare_motion(
     robot: RobotModel,
     t: npt.ArrayLike,
     q: npt.ArrayLike,
@@ -160,7 +160,7 @@ def _prepare(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
-) -> _Motion:
+) -> Motion:
     """Check the caller's arrays against ``robot`` and resample them at ``fps`` [1/s].
 
     ``wrench`` (per sample, shape (N, 3) or (N, 6) [N, N·m]) and ``desired_frame`` (poses
@@ -189,7 +189,7 @@ def _prepare(
         desired = frame_poses(robot, q_des_frames, int(robot.ee_frame_id))
     elif poses is not None:
         desired = _held(t_arr, poses, times)
-    return _Motion(
+    return Motion(
         frames=frames,
         fps=fps,
         q=_resample(t_arr, q_arr, times),

@@ -9,8 +9,8 @@ What the scene holds (node paths below ``/meshcat``):
   desired end-effector path (``desired_path``) and the via-point markers (``via/<i>``);
 * when asked, the external force as an arrow (``wrench``) and the desired frame as a triad
   (``desired_frame``): :mod:`.overlays`;
-* a floor grid sized to the motion (``grid``, :func:`.camera._grid`) and a camera framing the
-  whole motion (:func:`.camera._camera`): from above for planar motion, obliquely otherwise.
+* a floor grid sized to the motion (``grid``, :func:`.camera.floor_grid`) and a camera framing the
+  whole motion (:func:`.camera.frame_camera`): from above for planar motion, obliquely otherwise.
 
 Meshes are drawn from the triangles Pinocchio loaded (``coal`` BVH models: mesh scale,
 units and up axis already applied by the loader), so the page shows exactly the geometry
@@ -48,8 +48,8 @@ from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import import_meshcat
-from twolink_pin.visualization.camera import GRID_COLORS, _camera, _grid, _threejs
-from twolink_pin.visualization.motion import _Motion
+from twolink_pin.visualization.camera import GRID_COLORS, floor_grid, frame_camera, threejs_vector
+from twolink_pin.visualization.motion import Motion
 
 ARM_NODE = "arm"
 """Root node of the arm following ``q`` (below ``/meshcat``)."""
@@ -307,7 +307,7 @@ def _add_arm(
     drawables: Sequence[_Drawable | None],
     placements: np.ndarray,
     root: str,
-    motion: _Motion,
+    motion: Motion,
     ghost: bool,
 ) -> None:
     """Load each drawable object of ``geom`` under ``<root>/visuals/<name>``, animate the moving ones."""
@@ -338,7 +338,7 @@ def _line(points: np.ndarray, color: int, lift: float) -> Any:
     return mg.Line(mg.PointsGeometry(lifted.T), mg.LineBasicMaterial(color=color, linewidth=2.0))
 
 
-def _add_trail(vis: Any, animation: Any, motion: _Motion, points: np.ndarray) -> None:
+def _add_trail(vis: Any, animation: Any, motion: Motion, points: np.ndarray) -> None:
     """The end-effector trail: pieces that appear (``visible`` tracks) once the arm drew them."""
     n_frames = len(motion.frames)
     per_piece = max(1, math.ceil((n_frames - 1) / MAX_TRAIL_PIECES))
@@ -387,12 +387,12 @@ class Scene(NamedTuple):
     """Length of the desired frame's axes [m] (None: no triad drawn)."""
 
 
-def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, play: bool = True) -> Scene:
+def scene_commands(robot: RobotModel, motion: Motion, *, loop: bool = False, play: bool = True) -> Scene:
     """Record every meshcat command of the scene of ``motion``.
 
     Args:
         robot: The arm.
-        motion: The frames to animate (:func:`~twolink_pin.visualization.motion._prepare`).
+        motion: The frames to animate (:func:`~twolink_pin.visualization.motion.prepare_motion`).
         loop: Repeat the animation forever.
         play: Start playing as soon as the viewer has the scene.
 
@@ -410,7 +410,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
     vis["/Background"].set_property("top_color", list(BACKGROUND[0]))
     vis["/Background"].set_property("bottom_color", list(BACKGROUND[1]))
     vis["/Axes"].set_property("visible", False)
-    vis["/Grid"].set_property("visible", False)  # replaced by one sized to the motion (_grid)
+    vis["/Grid"].set_property("visible", False)  # replaced by one sized to the motion (floor_grid)
 
     geom = visual_model(robot)
     drawables = _drawables(robot, geom)
@@ -449,8 +449,8 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
     joint_points = np.vstack(joints)
     wrench_scale, axis_length = _add_overlays(vis, animation, robot, motion, joint_points, framing)
     in_view = np.vstack([joint_points, *framing])
-    centre, camera = _camera(joint_points, in_view, desired_path)
-    spacing, (minor, major) = _grid(in_view, centre, camera)
+    centre, camera = frame_camera(joint_points, in_view, desired_path)
+    spacing, (minor, major) = floor_grid(in_view, centre, camera)
     for name, segments, color in (("minor", minor, GRID_COLORS[0]), ("major", major, GRID_COLORS[1])):
         if len(segments):
             material = mg.LineBasicMaterial(color=color)
@@ -460,7 +460,7 @@ def scene_commands(robot: RobotModel, motion: _Motion, *, loop: bool = False, pl
     root_transform[:3, 3] = root_transform[:3, :3] @ -centre
     vis[SCENE_ROOT].set_transform(root_transform)
     vis[CAMERA_TARGET_NODE].set_transform(pin.SE3(np.eye(3), centre).homogeneous)
-    vis[CAMERA_NODE].set_property("position", _threejs(camera - centre))
+    vis[CAMERA_NODE].set_property("position", threejs_vector(camera - centre))
     vis.set_animation(animation, play=play, repetitions=math.inf if loop else 1)
     return Scene(window.commands, spacing, wrench_scale, axis_length)
 
@@ -469,7 +469,7 @@ def _add_overlays(
     vis: Any,
     animation: Any,
     robot: RobotModel,
-    motion: _Motion,
+    motion: Motion,
     joints: np.ndarray,
     framing: list[np.ndarray],
 ) -> tuple[float | None, float | None]:

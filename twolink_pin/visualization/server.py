@@ -19,7 +19,7 @@ from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import Bridge, start_bridge
 from twolink_pin.visualization.html import pack
-from twolink_pin.visualization.motion import _prepare
+from twolink_pin.visualization.motion import prepare_motion
 from twolink_pin.visualization.scene import scene_commands
 
 REPLY_TIMEOUT = 10.0
@@ -148,7 +148,7 @@ def serve(
         raise InvalidParameterError("port", port, "None (any free port) or an integer in 0..65535")
     if not isinstance(host, str) or not host:
         raise InvalidParameterError("host", host, "an address to listen on, e.g. '127.0.0.1'")
-    motion = _prepare(
+    motion = prepare_motion(
         robot,
         t,
         q,
