@@ -75,32 +75,28 @@ def cmd_info(args: argparse.Namespace) -> int:
         ]
     )
     if args.write_urdf:
-        from twolink_pin.model.payload import write_payload_urdf
-
-        if robot.payload <= 0:
-            raise InvalidParameterError(
-                "--payload", robot.payload, "a mass > 0 kg to write a payload variant"
-            )
-        target = Path(args.write_urdf)
-        if target.exists() and target.resolve() == Path(robot.urdf_path).resolve():
-            raise InvalidParameterError(
-                "--write-urdf",
-                args.write_urdf,
-                "a file other than the robot's own URDF (it would be replaced)",
-            )
-        from twolink_pin.model.catalog import catalog_profile_name
-
-        written = write_payload_urdf(
-            robot.urdf_path,
-            robot.payload,
-            args.write_urdf,
-            robot.ee_frame,
-            catalog_profile_name(robot.profile),
-        )
-        payload["urdf_written"] = str(written)
-        text += f"\nwrote      {written}"
+        payload["urdf_written"] = str(_write_payload_variant(robot, args.write_urdf))
+        text += f"\nwrote      {payload['urdf_written']}"
     emit(args, payload, text)
     return 0
+
+
+def _write_payload_variant(robot: RobotModel, target_name: str) -> Path:
+    """``info --write-urdf``: the robot with its payload as a URDF that ``--urdf`` loads back with
+    the catalog robot's profile (:func:`~twolink_pin.model.payload.write_payload_urdf`)."""
+    from twolink_pin.model.catalog import catalog_profile_name
+    from twolink_pin.model.payload import write_payload_urdf
+
+    if robot.payload <= 0:
+        raise InvalidParameterError("--payload", robot.payload, "a mass > 0 kg to write a payload variant")
+    target = Path(target_name)
+    if target.exists() and target.resolve() == Path(robot.urdf_path).resolve():
+        raise InvalidParameterError(
+            "--write-urdf", target_name, "a file other than the robot's own URDF (it would be replaced)"
+        )
+    return write_payload_urdf(
+        robot.urdf_path, robot.payload, target_name, robot.ee_frame, catalog_profile_name(robot.profile)
+    )
 
 
 def cmd_robots(args: argparse.Namespace) -> int:

@@ -101,9 +101,21 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         ),
         *task_lines(task),
     ]
+    lines += _limit_and_estimate_lines(result)
+    lines += [f"  figure {f}" for f in figures]
+    if args.save:
+        lines.append(f"  saved {args.save}")
+    emit(args, payload, "\n".join(lines))
+    return 0
+
+
+def _limit_and_estimate_lines(result: Any) -> list[str]:
+    """The summary's lines on torque limits (exceeded, clipped, absent) and, for an adaptive
+    law, its estimates at the end against the truth."""
+    out: list[str] = []
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
         if over:
-            lines.append(
+            out.append(
                 f"  joint {j + 1}: commanded torque exceeded its {result.torque_limits[j]:g} N·m limit "
                 f"(first at t = {at:.3f} s, by up to {result.limit_excess[j]:.3g} N·m"
                 + (
@@ -113,20 +125,16 @@ def cmd_simulate(args: argparse.Namespace) -> int:
                 )
             )
     if not np.isfinite(result.torque_limits).any():
-        lines.append("  no effort limits in the model: torques are not checked against limits")
+        out.append("  no effort limits in the model: torques are not checked against limits")
     if result.p_hat is not None and result.p_true is not None:
         if len(result.parameter_names) <= 8:
-            lines.append(f"  p_hat(end) {fmt(result.p_hat[-1])}  true {fmt(result.p_true)}")
+            out.append(f"  p_hat(end) {fmt(result.p_hat[-1])}  true {fmt(result.p_true)}")
         else:
             err = np.abs(result.p_hat[-1] - result.p_true)
-            lines.append(
+            out.append(
                 f"  {len(result.parameter_names)} estimates; max |p_hat − p| at the end {err.max():.4g}"
             )
-    lines += [f"  figure {f}" for f in figures]
-    if args.save:
-        lines.append(f"  saved {args.save}")
-    emit(args, payload, "\n".join(lines))
-    return 0
+    return out
 
 
 def _believed(spec: RunSpec) -> dict[str, str] | None:
