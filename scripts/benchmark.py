@@ -33,6 +33,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --ur5-only [--quick]     # the UR5 against the baseline
     .venv/bin/python scripts/benchmark.py --single-only [--quick]  # every law's single run, back to back; osc on the Panda
     .venv/bin/python scripts/benchmark.py --shared-only [--quick]  # two batches at once; 200-run sweep, 2 workers
+    .venv/bin/python scripts/benchmark.py --big-arms-only [--quick]  # issue 31: Panda osc/impedance, batches, floor
 
 A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
 processes, at the default thread count, at 1 and at 2 threads, per simulation against the
@@ -728,6 +729,119 @@ def osc_panda_section(baseline: Callable[[], Any], scale: float, quick: bool, re
     }
 
 
+BIG_ARM_TARGETS = {"osc batch": 8.0, "adaptive batch": 5.0}
+"""Issue 31's batch targets per run (× the baseline): osc on the Panda, adaptive on the UR5."""
+
+
+def _floor_stage(robot: Any, law: str, n: int) -> Callable[[], None]:
+    """One RK4 stage of a batch of ``n`` runs reduced to its bare Pinocchio calls in a plain
+    loop over the runs (the floor of issue 31): what the Terms call per run for ``law``
+    (``osc``: one computeAllTerms + the frame's placement, Jacobian and J̇q̇; ``adaptive``:
+    one joint-torque regressor on the polarisation pair) and the plant's one abaInParallel."""
+    import pinocchio as pin
+
+    from twolink_pin.dynamics import polarisation_pair
+
+    rng = np.random.default_rng(0)
+    model = robot.model
+    Q = robot.home + rng.uniform(-0.05, 0.05, (n, robot.nv))
+    V = rng.uniform(-0.5, 0.5, (n, robot.nv))
+    pool = pin.ModelPool(model, 1)
+    out = np.empty((robot.nv, n))
+    Qt, Vt = np.ascontiguousarray(Q.T), np.ascontiguousarray(V.T)
+    if law == "osc":
+        data, fid, frame = model.createData(), robot.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+
+        def stage() -> None:
+            for q, v in zip(Q, V, strict=True):
+                pin.computeAllTerms(model, data, q, v)
+                pin.updateFramePlacement(model, data, fid)
+                pin.getFrameJacobian(model, data, fid, frame)
+                pin.getFrameClassicalAcceleration(model, data, fid, frame)
+            pin.abaInParallel(1, pool, Qt, Vt, Vt, out)
+
+        return stage
+    pair = polarisation_pair(model)
+    pdata = pair.createData()
+    Q2, V2 = np.concatenate((Q, Q), axis=1), np.concatenate((V, V), axis=1)
+    A2 = np.zeros_like(V2)
+
+    def stage_regressor() -> None:
+        for q, v, a in zip(Q2, V2, A2, strict=True):
+            pin.computeJointTorqueRegressor(pair, pdata, q, v, a)
+        pin.abaInParallel(1, pool, Qt, Vt, Vt, out)
+
+    return stage_regressor
+
+
+def big_arms_section(baseline: Callable[[], Any], scale: float, quick: bool, repeats: int) -> dict[str, Any]:
+    """Issue 31: ``osc`` and ``impedance`` on the Panda (single run, law at every stage and held
+    over the step), the ``osc`` batch on the Panda (N = 100 and 1000) and the UR5's ``adaptive``
+    batch (N = 1000), per run against the baseline timed back to back; and the floor — the bare
+    per-run Pinocchio calls of a batch stage in a plain loop (:func:`_floor_stage`) — with the
+    batch's distance to it. Batches and floor on one thread."""
+    panda, ur5 = load_robot("panda"), load_robot("ur5")
+    single_duration = 0.05 if quick else 0.5
+    rows: dict[str, dict[str, float]] = {}
+
+    def pair(label: str, run: Callable[[], Any], per_run_scale: float) -> None:
+        base, times = [], []
+        for _ in range(repeats):
+            base.append(_timed(baseline) * scale)
+            times.append(_timed(run) * per_run_scale)
+        rows[label] = {"seconds": min(times), "baseline": min(base), "ratio": min(times) / min(base)}
+
+    for law in ("osc", "impedance"):
+        reference = default_trajectory(panda)
+        for tag, period in (("per stage", None), ("held", DT)):
+            config = SimulationConfig(duration=single_duration, dt=DT, q0_offset=0.05, control_period=period)
+
+            def one(law: str = law, config: SimulationConfig = config, reference: Any = reference) -> None:
+                c, p = make_scenario(law, panda)
+                simulate(c, p, reference, config)
+
+            pair(f"panda {law} single, {tag}", one, FULL / single_duration)
+    floors: dict[str, float] = {}
+    cases = [("panda", panda, "osc", 100), ("panda", panda, "osc", 1000), ("ur5", ur5, "adaptive", 1000)]
+    for name, robot, law, n in cases[:1] + cases[2:] if quick else cases:
+        n = min(n, 100) if quick else n
+        duration = 0.005 if quick else (0.02 if n >= 1000 else 0.1)
+        reference = default_trajectory(robot)
+        offsets = np.random.default_rng(0).uniform(-0.05, 0.05, (n, robot.nv))
+        config = SimulationConfig(duration=duration, dt=DT)
+
+        def batch(
+            robot: Any = robot,
+            law: str = law,
+            offsets: np.ndarray = offsets,
+            config: Any = config,
+            ref: Any = reference,
+        ) -> None:
+            c, p = make_scenario(law, robot)
+            simulate_batch(c, p, ref, config, q0_offsets=offsets, threads=1, progress=False)
+
+        label = f"{name} {law} batch N={n}, per run"
+        pair(label, batch, FULL / duration / n)
+        stage = _floor_stage(robot, law, n)
+        stage()
+        floor = min(_timed(stage) for _ in range(max(3, repeats))) * 4 * round(FULL / DT) / n
+        floors[label] = floor
+        rows[label]["floor"] = floor
+    print(
+        f"\nissue 31, the big arms: seconds per 30-s run, each timed back to back with the baseline {repeats} times "
+        f"(ratio of minima); single runs {single_duration:g} s simulated; batches 1 thread, per run; floor: the bare "
+        f"per-run Pinocchio calls of a batch stage in a plain loop; load average {[round(x, 2) for x in os.getloadavg()]}"
+    )
+    print(f"  {'case':44s} {'s per 30 s':>10s} {'ratio':>8s} {'floor s':>9s} {'x floor':>8s}")
+    for label, row in rows.items():
+        target = next((t for k, t in BIG_ARM_TARGETS.items() if label.split(" ", 1)[1].startswith(k)), None)
+        floor_cells = f" {row['floor']:9.3f} {row['seconds'] / row['floor']:7.2f}x" if "floor" in row else ""
+        print(
+            f"  {label:44s} {row['seconds']:10.3f} {row['ratio']:7.2f}x{floor_cells}{_verdict(row['ratio'], target)}"
+        )
+    return {"big_arms": rows}
+
+
 def _verdict(ratio: float, target: float | None) -> str:
     if target is None:
         return ""
@@ -854,6 +968,11 @@ def main(argv: list[str] | None = None) -> int:
         help="only every law's single run (twolink, UR5) back to back with the baseline, and osc on the Panda",
     )
     parser.add_argument(
+        "--big-arms-only",
+        action="store_true",
+        help="only issue 31's rows: osc/impedance on the Panda, osc and UR5 adaptive batches, their floor",
+    )
+    parser.add_argument(
         "--shared-only",
         action="store_true",
         help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
@@ -914,6 +1033,11 @@ def main(argv: list[str] | None = None) -> int:
         results.update(contention_section(baseline, scale, repeats))
         if not quick and not args.contention_only:
             results.update(sweep_200_section())
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.big_arms_only:
+        results.update(big_arms_section(baseline, scale, quick, repeats))
         if args.json:
             print(json.dumps(results))
         return 0
@@ -1018,6 +1142,8 @@ def main(argv: list[str] | None = None) -> int:
     results.update(ur5_section(baseline, scale, quick, repeats))
     results.update(single_runs_section(baseline, scale, quick, repeats))
     results.update(osc_panda_section(baseline, scale, quick, repeats))
+    if not quick:  # the smoke test runs --big-arms-only --quick on its own
+        results.update(big_arms_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))
 
     # -- batch scaling ------------------------------------------------------------------------------

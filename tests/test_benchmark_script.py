@@ -58,3 +58,27 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
     assert set(contention["alone_seconds_per_sim"]) == {"default", "1"}  # one copy alone: default vs 1
     assert all(x > 0 for x in contention["alone_seconds_per_sim"].values())
     assert contention["alone_default_threads"] >= 1
+
+
+def test_big_arms_rows_give_ratios_and_the_floor() -> None:
+    """``--big-arms-only --quick`` (issue 31): the Panda's single runs and the batches, each with a
+    positive ratio to the baseline, and each batch with its floor below it (the bare Pinocchio
+    calls cannot cost more than the batch that makes them)."""
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), "--big-arms-only", "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=300,
+    )
+    rows = json.loads(done.stdout.splitlines()[-1])["big_arms"]
+    assert {label.rsplit(",", 1)[0] for label in rows if "single" in label} == {
+        "panda osc single",
+        "panda impedance single",
+    }
+    batches = [label for label in rows if "batch" in label]
+    assert [label.split(" batch")[0] for label in batches] == ["panda osc", "ur5 adaptive"]
+    for label, row in rows.items():
+        assert row["seconds"] > 0 and row["ratio"] > 0, label
+    for label in batches:
+        assert 0 < rows[label]["floor"] < rows[label]["seconds"], label

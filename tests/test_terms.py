@@ -180,3 +180,48 @@ def test_batch_equals_single_runs(name: str) -> None:
     g = batch.gravity(q[:1])
     assert g.shape == (n, r.nv)
     assert batch.frame(q[:1], v[:1]).jacobian.shape == (1, 6, r.nv)
+
+
+@pytest.mark.parametrize("runs", [1, 3])
+def test_one_pass_per_state_gives_the_frame_mass_bias_and_gravity(
+    runs: int, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Once a law has asked for a dynamics term, ``frame`` runs one Pinocchio pass per run that
+    also gives ``M̂``, ``Ĉ q̇ + ĝ`` and ``ĝ`` at that state: asking for them then makes no other
+    Pinocchio call, and they equal ``crba``, ``nonLinearEffects`` and
+    ``computeGeneralizedGravity`` (to rounding: the pass works in the world frame)."""
+    r = robot("panda")
+    rows = np.asarray(r.p) * np.linspace(0.8, 1.2, runs)[:, None]
+    terms = terms_for(Probe(r, model_parameters=rows if runs > 1 else rows[0]), runs=runs, threads=1)
+    q0, _ = _state(r, 40, runs)
+    terms.mass(q0)  # the law has asked for a dynamics term
+    q, v = _state(r, 41, runs)
+    frame = terms.frame(q, v)
+    expected = []
+    for i in range(runs):
+        model = model_with_parameters(r.model, r.parameter_map, rows[i])
+        data = model.createData()
+        upper = pin.crba(model, data, q[i])
+        expected.append(
+            (
+                np.triu(upper) + np.triu(upper, 1).T,
+                pin.nonLinearEffects(model, data, q[i], v[i]).copy(),
+                pin.computeGeneralizedGravity(model, data, q[i]).copy(),
+            )
+        )
+
+    def no_second_call(*args: object) -> None:
+        raise AssertionError("a second Pinocchio call for a term the frame's pass gave")
+
+    for name in ("crba", "nonLinearEffects", "computeGeneralizedGravity", "computeAllTerms"):
+        monkeypatch.setattr(pin, name, no_second_call)
+    M, bias, gravity = terms.mass(q), terms.bias(q, v), terms.gravity(q)
+    for i, (M_i, bias_i, gravity_i) in enumerate(expected):
+        np.testing.assert_allclose(M[i], M_i, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(bias[i], bias_i, rtol=0, atol=1e-11)
+        np.testing.assert_allclose(gravity[i], gravity_i, rtol=0, atol=1e-11)
+    assert frame.jacobian.shape == (runs, 6, r.nv)
+    monkeypatch.undo()
+    alone = terms_for(Probe(r, model_parameters=rows[0]))  # the kinematics alone: the same frame, bit for bit
+    for a, b in zip(alone.frame(q[:1], v[:1]), frame, strict=True):
+        np.testing.assert_array_equal(a, b[:1])

@@ -36,10 +36,13 @@ from twolink_pin.model import RobotModel
 SINGULAR_RATIO = 1e-3
 """ε: the task inertia is damped when the smallest eigenvalue of ``J M⁻¹ Jᵀ`` normalised to a
 unit diagonal is below ε (its largest is at most k: a condition number above about 1000 k)."""
-_SKEW_PLUS = np.array([7, 2, 3])
-"""Flat indices (row-major 3 × 3) of E₂₁, E₀₂, E₁₀."""
-_SKEW_MINUS = np.array([5, 6, 1])
-"""Flat indices of E₁₂, E₂₀, E₀₁."""
+_HALF_SKEW = np.zeros((9, 3))
+"""``E.reshape(9) @ _HALF_SKEW = (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2`` (row-major 3 × 3): one
+product whose entries are exactly ``0.5 (a − b)`` (the ±½ products are exact, the zeros add
+nothing)."""
+_HALF_SKEW[[7, 2, 3], [0, 1, 2]] = 0.5
+_HALF_SKEW[[5, 6, 1], [0, 1, 2]] = -0.5
+_HALF_SKEW.setflags(write=False)
 AXES = ("x", "y", "z", "rx", "ry", "rz")
 """Names of the six task rows (world axes; linear first)."""
 
@@ -92,20 +95,18 @@ def task_rows(robot: RobotModel) -> np.ndarray:
 
 def rotation_error(R: np.ndarray, R_des: np.ndarray) -> np.ndarray:
     """``log(R R_dᵀ)`` [rad] in world axes, shape (N, 3), for (N, 3, 3) and (1 or N, 3, 3)."""
-    E = R @ R_des.transpose(0, 2, 1)
+    E = np.matmul(R, R_des.transpose(0, 2, 1))
     # The skew part (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2 from E's rows of 9 (few numpy calls:
     # this runs at every RK4 stage of a task-space law).
-    flat = E.reshape(-1, 9)
-    w = 0.5 * (flat.take(_SKEW_PLUS, axis=1) - flat.take(_SKEW_MINUS, axis=1))
+    w = E.reshape(-1, 9).dot(_HALF_SKEW)
     sin = np.sqrt(np.add.reduce(w * w, axis=1))  # |w|, as numpy.linalg.norm computes it
-    cos = 0.5 * (E[:, 0, 0] + E[:, 1, 1] + E[:, 2, 2] - 1.0)
+    cos = 0.5 * (E.trace(0, 1, 2) - 1.0)  # (E₀₀ + E₁₁) + E₂₂
     angle = np.arctan2(sin, cos)
     factor = 1.0 + angle * angle / 6.0  # θ / sin θ: its series near 0, else the quotient
     np.divide(angle, sin, out=factor, where=sin > 1e-9)
     out = factor[:, None] * w
-    near_pi = angle > np.pi - 1e-6
-    if near_pi.any():  # near π the skew part vanishes
-        for i in np.flatnonzero(near_pi):
+    if np.maximum.reduce(angle) > np.pi - 1e-6:  # near π the skew part vanishes
+        for i in np.flatnonzero(angle > np.pi - 1e-6):
             out[i] = pin.log3(E[i])
     return out
 
@@ -164,10 +165,10 @@ class TaskInertia:
     def __call__(self, A: np.ndarray, t: float) -> np.ndarray:
         """Λ from ``A = J M⁻¹ Jᵀ`` (N, k, k) at time ``t`` [s]."""
         scale = 1.0 / np.sqrt(A.diagonal(0, 1, 2))  # the rows' units (1/kg, 1/(kg·m²)) out
-        rows, cols = scale[:, :, None], scale[:, None, :]
-        s, U = np.linalg.eigh(A * rows * cols)
-        rho2 = np.maximum(SINGULAR_RATIO**2 - s[:, :1] ** 2, 0.0)
-        if rho2.any():
+        S = scale[:, :, None] * scale[:, None, :]  # S_ij = scale_i scale_j
+        s, U = np.linalg.eigh(A * S)
+        if np.minimum.reduce(np.abs(s[:, 0])) < SINGULAR_RATIO:  # ρ² > 0 for some run
+            rho2 = np.maximum(SINGULAR_RATIO**2 - s[:, :1] ** 2, 0.0)
             near = rho2[:, 0] > 0
             self.damped += 1
             if not self._warned:
@@ -179,9 +180,11 @@ class TaskInertia:
                     SingularityWarning,
                     stacklevel=3,
                 )
-        inverse = s / (s * s + rho2)
+            inverse = s / (s * s + rho2)
+        else:  # ρ = 0 for every run: s / (s² + 0), the same bits without the sum
+            inverse = s / (s * s)
         core = np.matmul(U * inverse[:, None, :], U.transpose(0, 2, 1))
-        return core * rows * cols
+        return core * S
 
 
 def null_space_torque(J: np.ndarray, MinvJt: np.ndarray, Lam: np.ndarray, tau0: np.ndarray) -> np.ndarray:

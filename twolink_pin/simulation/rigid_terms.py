@@ -15,9 +15,19 @@ parameters, built the first time a law asks):
 ``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
                 then ``getFrameJacobian`` and ``getFrameClassicalAcceleration`` in
                 ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model); the
-                last few results kept by value (the reference's frame is asked
-                again at the next RK4 stage)
+                last few results kept by value (the same state is asked again
+                within a step)
 ==============  ================================================================
+
+**One pass per state.** Once a law has asked for a dynamics term (``mass``, ``gravity``,
+``bias``, ``solve_mass``), its ``frame`` calls run one ``pin.computeAllTerms`` per run
+instead of the forward kinematics: the same pass gives the frame's pose, Jacobian and
+``J̇ q̇`` (bit for bit as above: the same kinematic recursions) and ``M̂`` (upper triangle),
+``Ĉ q̇ + ĝ`` and ``ĝ`` at that state, read from the ``Data``'s own arrays and kept by value,
+so that the law's ``mass``, ``bias`` and ``gravity`` at the same state cost no second
+Pinocchio call. (``M̂`` and ``ĝ`` of that pass agree with ``crba`` and
+``computeGeneralizedGravity`` to rounding: world-frame recursions.) A law that asks only
+for the frame (or a caller such as the wrench events) keeps the lighter kinematics.
 
 Every array returned is read-only (:func:`frozen`). A batch computes every run with the same calls as a single run, so a batch equals N
 single runs bit for bit. The runs are looped over in Python: these terms cost about
@@ -77,9 +87,12 @@ class RigidBodyTerms:
         self._data: pin.Data | None = None
         self._frames: dict[str | None, int] = {None: robot.ee_frame_id}
         self._zero = np.zeros(robot.nv)
-        self._lower = np.tril_indices(robot.nv, -1)
-        self._last_mass: tuple[tuple[np.dtype, tuple[int, ...], bytes], np.ndarray] | None = None
+        self._lower = np.tril(np.ones((robot.nv, robot.nv), dtype=bool), -1)
+        self._last_mass: tuple[tuple[object, ...], np.ndarray] | None = None
+        self._last_bias: tuple[tuple[object, ...], np.ndarray] | None = None
+        self._last_gravity: tuple[tuple[object, ...], np.ndarray] | None = None
         self._frame_cache: dict[tuple[object, ...], FrameTerms] = {}
+        self._fused = False  # set when the law asks for a dynamics term: frame() then fills them too
 
     # -- models ------------------------------------------------------------------------
 
@@ -126,10 +139,15 @@ class RigidBodyTerms:
 
     # -- terms -------------------------------------------------------------------------
 
+    def _symmetric(self, upper: np.ndarray) -> np.ndarray:
+        """(N, nv, nv) upper triangles (Pinocchio's CRBA) made symmetric, read-only."""
+        return frozen(np.where(self._lower, upper.transpose(0, 2, 1), upper))
+
     def mass(self, q: np.ndarray) -> np.ndarray:
         q = self._matrix(q)
-        # Asked twice per law call (solve_mass, then mass): reused when q has the same shape
-        # and the same bytes (exact values; no copy kept, no array_equal).
+        self._fused = True
+        # Asked twice per law call (solve_mass, then mass), and filled by frame()'s pass:
+        # reused when q has the same shape and the same bytes (exact values; no copy kept).
         key = (q.dtype, q.shape, q.tobytes())
         last = self._last_mass
         if last is not None and last[0] == key:
@@ -139,14 +157,16 @@ class RigidBodyTerms:
         out = np.empty((n, self._nv, self._nv))
         for i in range(n):
             out[i] = pin.crba(models[i % len(models)], data, Q[i])  # the upper triangle
-        lower = self._lower
-        out[:, lower[0], lower[1]] = out[:, lower[1], lower[0]]
-        frozen(out)
+        out = self._symmetric(out)
         self._last_mass = (key, out)
         return out
 
     def gravity(self, q: np.ndarray) -> np.ndarray:
         q = self._matrix(q)
+        self._fused = True
+        last = self._last_gravity  # set by frame()'s pass only (a law without it pays no key)
+        if last is not None and last[0] == (q.dtype, q.shape, q.tobytes()):
+            return last[1]
         n, models, data = self._rows(q)
         Q = self._states(q, n)
         out = np.empty((n, self._nv))
@@ -156,6 +176,10 @@ class RigidBodyTerms:
 
     def bias(self, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         q, v = self._matrix(q), self._matrix(v)
+        self._fused = True
+        last = self._last_bias  # set by frame()'s pass only
+        if last is not None and last[0] == (q.dtype, v.dtype, q.shape, v.shape, q.tobytes(), v.tobytes()):
+            return last[1]
         n, models, data = self._rows(q, v)
         Q, V = self._states(q, n), self._states(v, n)
         out = np.empty((n, self._nv))
@@ -171,7 +195,7 @@ class RigidBodyTerms:
                 f"shape {b.shape}",
                 f"(N, {self._nv}) or (N, {self._nv}, k): one vector or matrix per run",
             )
-        M = self.mass(q)
+        M = self.mass(q)  # (sets _fused)
         n = max(M.shape[0], b.shape[0])
         if M.shape[0] != n:
             M = np.broadcast_to(M, (n, self._nv, self._nv))
@@ -211,6 +235,10 @@ class RigidBodyTerms:
     def _frame(self, fid: int, q: np.ndarray, v: np.ndarray) -> FrameTerms:
         n = max(q.shape[0], v.shape[0])
         Q, V = self._states(q, n), self._states(v, n)
+        if self._fused:
+            models, data = self._dynamics()
+            if len(models) in (1, n):
+                return self._fused_pass(fid, q, v, Q, V, models, data)
         model, data, zero = self._kinematics, self._kinematics_data, self._zero
         position = np.empty((n, 3))
         rotation = np.empty((n, 3, 3))
@@ -224,6 +252,47 @@ class RigidBodyTerms:
             rotation[i] = placement.rotation
             jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
             drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
+        return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
+
+    def _fused_pass(
+        self,
+        fid: int,
+        q: np.ndarray,
+        v: np.ndarray,
+        Q: np.ndarray,
+        V: np.ndarray,
+        models: list[pin.Model],
+        data: pin.Data,
+    ) -> FrameTerms:
+        """The frame by one ``pin.computeAllTerms`` per run, with ``M̂``, ``Ĉ q̇ + ĝ`` and ``ĝ`` of
+        the same pass kept by value for :meth:`mass`, :meth:`bias`, :meth:`gravity`."""
+        n, nv = Q.shape
+        position = np.empty((n, 3))
+        rotation = np.empty((n, 3, 3))
+        jacobian = np.empty((n, 6, nv))
+        drift = np.empty((n, 6))
+        upper = np.empty((n, nv, nv))
+        bias = np.empty((n, nv))
+        gravity = np.empty((n, nv))
+        # The Data's own arrays (views that Pinocchio fills in place at every call)
+        M_data, bias_data, gravity_data = data.M, data.nle, data.g
+        runs_models = models if len(models) == n else [models[0]] * n
+        for i, (model, qi, vi) in enumerate(zip(runs_models, Q, V, strict=True)):
+            pin.computeAllTerms(model, data, qi, vi)
+            placement = pin.updateFramePlacement(model, data, fid)
+            position[i] = placement.translation
+            rotation[i] = placement.rotation
+            jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
+            drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
+            upper[i] = M_data
+            bias[i] = bias_data
+            gravity[i] = gravity_data
+        if q.shape[0] == n:
+            self._last_mass = ((q.dtype, q.shape, q.tobytes()), self._symmetric(upper))
+            self._last_gravity = ((q.dtype, q.shape, q.tobytes()), frozen(gravity))
+            if v.shape[0] == n:
+                key = (q.dtype, v.dtype, q.shape, v.shape, q.tobytes(), v.tobytes())
+                self._last_bias = (key, frozen(bias))
         return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
 
 

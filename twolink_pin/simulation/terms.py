@@ -300,19 +300,28 @@ class _RegressorByRun:
         self.n_pi = N_BODY_PARAMETERS * (model.njoints - 1)
         self.P = np.ascontiguousarray(parameter_map.matrix)
         self.size = self.P.shape[1]
+        self._buffer: np.ndarray | None = None  # the runs' pair regressors, (N, 2 nv, 2 n_pi)
 
     def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
-        nv, n_pi, P = self.nv, self.n_pi, self.P
+        Y = self.matrix(q, v, w, a)
+        return [Y[:, :, j] for j in range(self.size)]
+
+    def matrix(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
+        """``Y_p`` of every run, shape (N, nv, n_p): the loop over the runs only copies each
+        pair regressor; the blocks' difference and the map are one product for all runs
+        (per run the same BLAS product as a single run's)."""
+        nv, n_pi = self.nv, self.n_pi
         n = q.shape[0]
         Q = np.concatenate((q, q), axis=1)
         V = np.concatenate((0.5 * (v + w), 0.5 * (v - w)), axis=1)
         A = np.concatenate((np.broadcast_to(a, (n, nv)), np.zeros((n, nv))), axis=1)
-        Y = np.empty((n, nv, self.size))
+        R = self._buffer
+        if R is None or R.shape[0] != n:
+            R = self._buffer = np.empty((n, 2 * nv, 2 * n_pi))
         regressor, pair, data = pin.computeJointTorqueRegressor, self.pair, self.data
-        for i in range(n):
-            R = regressor(pair, data, Q[i], V[i], A[i])
-            np.matmul(R[:nv, :n_pi] - R[nv:, n_pi:], P, out=Y[i])
-        return [Y[:, :, j] for j in range(self.size)]
+        for i, (qi, vi, ai) in enumerate(zip(Q, V, A, strict=True)):
+            R[i] = regressor(pair, data, qi, vi, ai)
+        return np.matmul(R[:, :nv, :n_pi] - R[:, nv:, n_pi:], self.P)
 
 
 REGRESSOR_BY_RUN_COLUMNS = 12
@@ -391,7 +400,10 @@ class BatchTerms(RigidBodyTermsMixin):
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
-        return frozen(np.stack(self._columns()(q, v, w, a), axis=2))
+        columns = self._columns()
+        if isinstance(columns, _RegressorByRun):
+            return frozen(columns.matrix(q, v, w, a))
+        return frozen(np.stack(columns(q, v, w, a), axis=2))
 
     def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
         return frozen(friction_regressor(np.broadcast_to(v, (self._runs, self._nv)), smoothing))
