@@ -20,6 +20,7 @@ from collections import Counter
 
 import numpy as np
 
+from corpus.cases_outside import OUTSIDE
 from corpus.spec import (
     SIGINT,
     SIGTERM,
@@ -921,6 +922,7 @@ CASES: list[Case] = [
     *INTERRUPT,
     *USERCODE,
     *READERS,
+    *OUTSIDE,
 ]
 """Every command-line case."""
 
