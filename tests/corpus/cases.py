@@ -20,7 +20,7 @@ from collections import Counter
 
 import numpy as np
 
-from corpus.cases_outside import OUTSIDE
+from corpus.cases_outside import OUTSIDE, OUTSIDE_LIBRARY
 from corpus.spec import (
     SIGINT,
     SIGTERM,
@@ -906,7 +906,8 @@ LIBRARY = [
     LibCase("library-make_scenario-gain-nan", "tp.make_scenario('pd', robot, gains={'kp': float('nan')})", ("kp",)),
     LibCase("library-make_scenario-gain-three-values", "tp.make_scenario('pd', robot, gains={'kp': (1.0, 2.0, 3.0)})", ("kp",)),
     LibCase("library-plant-saturate-string", "tp.Plant(robot, saturate='yes')", ("saturate",)),
-    LibCase("library-plant-pin-model", "tp.Plant(model)", ("robot",))
+    LibCase("library-plant-pin-model", "tp.Plant(model)", ("robot",)),
+    *OUTSIDE_LIBRARY,
 ]
 
 # fmt: on

@@ -8,7 +8,7 @@ from __future__ import annotations
 import shlex
 
 from corpus.bags import bag_file, log_file, ros2_bag
-from corpus.spec import Case, blob, text
+from corpus.spec import Case, LibCase, blob, text, urdf
 
 LAW = "{corpus}/laws"
 SIM = "--duration 0.5"
@@ -53,7 +53,37 @@ LOGS = [
     C("unclear-identify-ros2-bag-metadata-binary", "identify --data run", 2, err=("metadata.yaml", "not UTF-8"), setup=(*folder_bag("none"), blob("run/metadata.yaml", b"\x00\xff\xfe")), not_err=("codec",)),
     C("hang-identify-bag-larger-than-memory", "identify --data run.bag", 2, err=("run.bag", "MiB on disk", "3 ×", "0.09537 MiB of memory are available"), setup=bag("none"), env=(("TWOLINK_PIN_MEMORY", "100000"),), run="proc", note="refused by its size before it is read; the limit is the machine's available memory unless TWOLINK_PIN_MEMORY says"),
 ]
+
+# == Via-pose files: a number that is not finite or absurd is refused naming its row and column ======
+POSES = "times = [0.0, 2.0, 4.0, 6.0, 8.0]\npositions = [{}]\nrpy = [{}]\n"
+P_ROWS = ["[0.45, 0.10, 0.40]", "[0.45, -0.10, 0.40]", "[0.45, -0.10, 0.20]", "[0.45, 0.10, 0.20]", "[0.45, 0.10, 0.40]"]
+R_ROWS = ["[3.141592653589793, 0.0, -1.5707963267948966]", "[3.141592653589793, 0.2, -1.5707963267948966]", "[3.141592653589793, 0.2, -1.2707963267948966]", "[2.941592653589793, 0.0, -1.2707963267948966]", "[3.141592653589793, 0.0, -1.5707963267948966]"]
+
+
+def poses(name: str, positions: dict[int, str] | None = None, rpy: dict[int, str] | None = None) -> tuple:
+    """Setup: the task-space tutorial's square of via poses for the UR5 with rows replaced."""
+    p = [(positions or {}).get(i, row) for i, row in enumerate(P_ROWS)]
+    r = [(rpy or {}).get(i, row) for i, row in enumerate(R_ROWS)]
+    return (text(name, POSES.format(", ".join(p), ", ".join(r))),)
+
+
+UR5 = f"--robot ur5 {SIM}"
+VIA_POSES = [
+    C("nonfinite-simulate-poses-rpy-1e300", f"simulate pd {UR5} --trajectory p.toml", 2, err=("p.toml", "rpy[1][2]", "1e+300", "±100 rad"), setup=poses("p.toml", rpy={1: "[3.14, 0.2, 1e300]"}), note="sin(1e300) is no angle: the run succeeded with a garbage orientation"),
+    C("nonfinite-simulate-poses-rpy-1e6", f"simulate pd {UR5} --trajectory p.toml", 2, err=("rpy[2][0]", "1000000", "±100 rad"), setup=poses("p.toml", rpy={2: "[1e6, 0.2, -1.27]"})),
+    C("nonfinite-simulate-poses-rpy-nan", f"simulate pd {UR5} --trajectory p.toml", 2, err=("rpy[3][1]", "nan"), setup=poses("p.toml", rpy={3: "[2.94, nan, -1.27]"})),
+    C("nonfinite-simulate-poses-position-1e300", f"simulate pd {UR5} --trajectory p.toml", 2, err=("positions[2][1]", "1e+300", "±100 m"), setup=poses("p.toml", positions={2: "[0.45, 1e300, 0.2]"}), note="was an overflow warning and an IK error at 'inf m'"),
+    C("nonfinite-simulate-poses-position-inf", f"simulate pd {UR5} --trajectory p.toml", 2, err=("positions[3][2]", "-inf"), setup=poses("p.toml", positions={3: "[0.45, 0.1, -inf]"})),
+    C("nonfinite-simulate-poses-seed-1e300", f"simulate pd {UR5} --trajectory p.toml", 2, err=("seed[4]", "1e+300", "±100 rad"), setup=(text("p.toml", POSES.format(", ".join(P_ROWS), ", ".join(R_ROWS)) + "seed = [0, -1.5, 1.5, -1.5, 1e300, 0]\n"),)),
+    C("nonfinite-simulate-joints-continuous-1e300", "simulate pd --robot continuous.urdf --duration 0.5 --trajectory j.toml", 2, err=("joints[1][0]", "1e+300", "±100 rad"), setup=(urdf("continuous"), text("j.toml", "times = [0, 1, 2]\njoints = [[0, 0], [1e300, 0.3], [0, 0]]\n")), note="a joint without limits (continuous) has no other bound"),
+]
+
+EYE3 = "np.stack([np.eye(3)] * 3)"
+OUTSIDE_LIBRARY = [
+    LibCase("library-pose_trajectory-position-1e300", f"tp.trajectory.pose_trajectory(robot, (0, 1, 2), np.array([[0.3, 0, 0], [0.3, 1e300, 0], [0.3, 0, 0]]), {EYE3})", ("positions[1][1]", "1e+300", "±100 m")),
+    LibCase("library-pose_trajectory-rotation-nan", "tp.trajectory.pose_trajectory(robot, (0, 1, 2), np.array([[0.3, 0, 0]] * 3), np.array([np.eye(3), np.full((3, 3), np.nan), np.eye(3)]))", ("rotations[1][0][0]", "nan")),
+]
 # fmt: on
 
-OUTSIDE: list[Case] = [*LOGS]
+OUTSIDE: list[Case] = [*LOGS, *VIA_POSES]
 """Every case of this file."""
