@@ -8,7 +8,7 @@ from __future__ import annotations
 import shlex
 
 from corpus.bags import bag_file, log_file, ros2_bag
-from corpus.spec import Case, LibCase, blob, text, urdf
+from corpus.spec import Case, LibCase, blob, folder, text, urdf
 
 LAW = "{corpus}/laws"
 SIM = "--duration 0.5"
@@ -78,6 +78,30 @@ VIA_POSES = [
     C("nonfinite-simulate-joints-continuous-1e300", "simulate pd --robot continuous.urdf --duration 0.5 --trajectory j.toml", 2, err=("joints[1][0]", "1e+300", "±100 rad"), setup=(urdf("continuous"), text("j.toml", "times = [0, 1, 2]\njoints = [[0, 0], [1e300, 0.3], [0, 0]]\n")), note="a joint without limits (continuous) has no other bound"),
 ]
 
+# == User code everywhere it runs (laws/hostile.py, sleeps_on_import.py, import_raises_line.py) =========
+H = f"{LAW}/hostile.py"
+NOT_OURS = ("twolink_pin_user_", "internal error")
+"""Never a module name of ours, never a bug of ours."""
+USER_LAWS = [
+    C("usercode-simulate-law-init-raises-file-line", f"simulate {H}:InitRaises {SIM}", 2, err=("corpus-hostile-init-raises", "RuntimeError", "hostile.py:52"), not_err=NOT_OURS, note="was the module name twolink_pin_user_hostile_<hash>"),
+    C("usercode-simulate-law-scaled-gains-raises-file-line", f"simulate {H}:ScaledGainsRaises {SIM}", 2, err=("KeyError", "hostile.py:93"), not_err=NOT_OURS),
+    C("usercode-simulate-law-init-exits", f"simulate {H}:InitExits {SIM} --save run.npz", 2, err=("sys.exit(0)", "hostile.py:72"), absent=("run.npz",), note="sys.exit(0) while the law is built ended the command silently with exit 0"),
+    C("usercode-simulate-law-init-sleeps-timeout", f"simulate {H}:InitSleeps {SIM} --timeout 2", 2, err=("--timeout 2 s", "hostile.py:62", "corpus-hostile-init-sleeps"), run="proc", timeout=30),
+    C("usercode-simulate-law-scaled-gains-spins-timeout", f"simulate {H}:ScaledGainsSpins {SIM} --timeout 2", 2, err=("--timeout 2 s", "hostile.py:82"), run="proc", timeout=30),
+    C("usercode-simulate-law-file-sleeps-on-import-timeout", f"simulate {LAW}/sleeps_on_import.py:Law {SIM} --timeout 2", 2, err=("--timeout 2 s", "sleeps_on_import.py:5"), run="proc", timeout=30),
+    C("usercode-simulate-law-file-import-raises-line", f"simulate {LAW}/import_raises_line.py:Law {SIM}", 2, err=("ImportError", "import_raises_line.py:5"), not_err=NOT_OURS),
+    C("usercode-simulate-law-complex-torque", f"simulate {H}:ComplexTorque {SIM}", 1, err=("corpus-hostile-complex-torque", "complex128", "real numbers", "tau.real"), not_err=NOT_OURS),
+    C("usercode-simulate-law-string-torque", f"simulate {H}:StringTorque {SIM}", 1, err=("corpus-hostile-string-torque", "<U", "real numbers"), not_err=NOT_OURS),
+    C("usercode-simulate-law-object-torque-adaptive", f"simulate {H}:ObjectTorque {SIM} --method adaptive", 1, err=("corpus-hostile-object-torque", "object", "real numbers"), not_err=NOT_OURS),
+    C("usercode-simulate-law-chdir-save", f"simulate {H}:Chdir {SIM} --save run.npz", 0, setup=(folder("elsewhere"),), exists=("run.npz",), absent=("elsewhere/run.npz",), note="the output goes where the command was started, not where the law moved"),
+    C("usercode-compare-law-chdir-out", f"compare {H}:Chdir pd {SIM} --no-plot --out c", 0, setup=(folder("elsewhere"),), exists=("c/comparison.json",), absent=("elsewhere/c",)),
+    C("usercode-simulate-law-starts-process", f"simulate {H}:StartsProcess {SIM}", 0, run="proc", note="the law's 'sleep 600' is ended with the command (the runner finds every process that inherited the case's marker)"),
+    C("usercode-simulate-law-starts-multiprocessing", f"simulate {H}:StartsMultiprocessing {SIM}", 0, run="proc", timeout=20, note="Python's exit waited 600 s for the law's non-daemon child"),
+    C("usercode-simulate-law-state-named-twice", f"simulate {H}:StateNamedTwice {SIM}", 2, err=("corpus-hostile-state-named-twice", "'s' at entries [0, 1]", "named once")),
+    C("usercode-simulate-law-state-name-empty", f"simulate {H}:StateNameEmpty {SIM}", 2, err=("state_variables()[0].name", "''", "non-empty")),
+    C("usercode-simulate-law-initial-state-wrong-size", f"simulate {H}:StateWrongSize {SIM}", 2, err=("initial_state()", "(3,)", "nz = 2", "(a, b)")),
+]
+
 EYE3 = "np.stack([np.eye(3)] * 3)"
 OUTSIDE_LIBRARY = [
     LibCase("library-pose_trajectory-position-1e300", f"tp.trajectory.pose_trajectory(robot, (0, 1, 2), np.array([[0.3, 0, 0], [0.3, 1e300, 0], [0.3, 0, 0]]), {EYE3})", ("positions[1][1]", "1e+300", "±100 m")),
@@ -85,5 +109,5 @@ OUTSIDE_LIBRARY = [
 ]
 # fmt: on
 
-OUTSIDE: list[Case] = [*LOGS, *VIA_POSES]
+OUTSIDE: list[Case] = [*LOGS, *VIA_POSES, *USER_LAWS]
 """Every case of this file."""
