@@ -247,8 +247,9 @@ def read_trajectory_file(
                     row,
                     f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
                 )
-        via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
-        check_within_limits(robot, via_q, f"{file}: joints")
+        via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
+        check_within_limits(robot, via_q, f"{file}: joints")  # the URDF's limits first: the better message
+        _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
     else:
         width = {len(row) if isinstance(row, list) else -1 for row in rows}
         if len(width) != 1 or width.pop() not in (2, 3):
