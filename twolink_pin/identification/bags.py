@@ -82,7 +82,7 @@ MIN_MESSAGE_BYTES = 16
 to its size on disk divided by this."""
 READ_MEMORY_FACTOR = 3.0
 """Memory reading a bag may take, as a multiple of its size on disk (measured: below 2 for
-joint states; see ``scripts/bag_memory.py``); a bag larger than the memory available divided
+joint states: ``tests/test_bags.py``, tracemalloc); a bag larger than the memory available divided
 by this is refused before it is read."""
 MAX_METADATA_BYTES = 1 << 20
 """Largest ``metadata.yaml`` of a ROS 2 bag read (1 MiB)."""
