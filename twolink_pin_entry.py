@@ -70,6 +70,65 @@ def _ready(stage: str) -> None:
             pass
 
 
+def _adopt_orphans() -> None:
+    """Become the reaper of this command's orphaned descendants (Linux ``PR_SET_CHILD_SUBREAPER``):
+    a process a law started and detached (``sleep 600 &`` in a shell it ran) is re-parented to
+    this process instead of init, so that :func:`_end_children` finds it."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(36, 1, 0, 0, 0)  # PR_SET_CHILD_SUBREAPER = 36
+    except (OSError, AttributeError):  # not Linux: children are still ended, orphans are not found
+        pass
+
+
+def _children() -> list[int]:
+    """This process's living children (from /proc; empty where there is none)."""
+    me = os.getpid()
+    found = []
+    try:
+        entries = os.listdir("/proc")
+    except OSError:
+        return []
+    for entry in entries:
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as f:
+                fields = f.read().rpartition(b")")[2].split()
+        except OSError:
+            continue
+        if len(fields) > 1 and int(fields[1]) == me and fields[0] != b"Z":
+            found.append(int(entry))
+    return found
+
+
+def _end_children() -> None:
+    """Kill every process this command started that is still running (a law's subprocess or
+    ``multiprocessing`` child; the command's own workers are stopped by then), and their
+    children as they are re-parented here, so that none keeps the command alive (Python's
+    exit waits for ``multiprocessing`` children) or outlives it."""
+    for _ in range(100):  # each round ends one generation (their orphans come back to us)
+        children = _children()
+        if not children:
+            break
+        for pid in children:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+        for pid in children:
+            try:
+                os.waitpid(pid, 0)
+            except OSError:  # not our child after all (a race), or reaped by its owner
+                pass
+    try:  # zombies of processes reaped by nobody
+        while os.waitpid(-1, os.WNOHANG)[0] > 0:
+            pass
+    except OSError:
+        pass
+
+
 def _finish(code: int) -> None:
     """End the process with ``code``, the command's outcome: exit handlers run (with a
     signal then ending the process at once with ``code``), streams flushed, and no
@@ -83,6 +142,7 @@ def _finish(code: int) -> None:
         if signal.getsignal(s) is not signal.SIG_IGN:
             signal.signal(s, done)
     try:
+        _end_children()  # before the exit handlers: multiprocessing's would wait for a law's child
         import atexit
 
         atexit._run_exitfuncs()
@@ -97,6 +157,7 @@ def main() -> int:
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job ignores Ctrl-C
         signal.signal(signal.SIGINT, _leave_at_once)
     code = 1
+    _adopt_orphans()
     try:
         _ready("started")
         from twolink_pin.cli import main as cli_main

@@ -24,7 +24,7 @@ import pytest
 
 from twolink_pin import load_robot
 from twolink_pin.cli import main
-from twolink_pin.errors import InputFileError
+from twolink_pin.errors import InputFileError, InvalidParameterError
 from twolink_pin.identification import IdentificationOptions, RunLog, identify, read_log, write_log
 from twolink_pin.identification.bags import read_bag
 from twolink_pin.identification.observation import ParameterSet
@@ -290,3 +290,55 @@ def test_broken_bags_and_pipes_are_refused_before_reading(tmp_path: Path) -> Non
         read_bag(pipe, ["joint1"])
     with pytest.raises(InputFileError, match=r"folder without metadata.yaml"):
         read_bag(tmp_path, ["joint1"])
+
+
+def test_reading_a_bag_takes_at_most_three_times_its_size(twolink, tmp_path: Path) -> None:
+    """Messages are streamed into preallocated arrays: the peak of the memory Python and NumPy
+    allocate while reading (tracemalloc: deterministic, not timed) stays under
+    READ_MEMORY_FACTOR = 3 × the bag's size on disk (measured 1.7; the reader that kept every
+    message as an object took 8.8 ×)."""
+    import tracemalloc
+
+    from twolink_pin.identification.bags import READ_MEMORY_FACTOR
+
+    bag = write_bag(
+        tmp_path / "run", twolink, twolink_excitation.identification_excitation(), 10.0, 1e-3, "sqlite3"
+    )
+    disk = sum(p.stat().st_size for p in bag.glob("*.db3"))
+    read_bag(bag, joint_names(twolink))  # imports and the type store, outside the measurement
+    tracemalloc.start()
+    try:
+        log, _ = read_bag(bag, joint_names(twolink))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert log.samples > 9_000
+    assert READ_MEMORY_FACTOR == 3.0
+    assert peak < READ_MEMORY_FACTOR * disk, f"peak {peak / disk:.2f} × the bag's {disk} bytes"
+
+
+def test_a_bag_too_large_for_the_memory_available_is_refused_by_its_size(
+    twolink, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """With TWOLINK_PIN_MEMORY below 3 × the bag's size the bag is refused before it is opened
+    (a bag whose content is garbage is refused for its size, not its bytes); at 3 × it is read."""
+    bag = write_bag(
+        tmp_path / "run.bag", twolink, twolink_excitation.identification_excitation(), 0.3, 1e-3, "ros1"
+    )
+    disk = bag.stat().st_size
+    monkeypatch.setenv("TWOLINK_PIN_MEMORY", str(3 * disk - 1))
+    with pytest.raises(
+        InputFileError, match=r"MiB on disk; reading it needs up to 3 × that .* MiB of memory are available"
+    ):
+        read_bag(bag, joint_names(twolink))
+    garbage = tmp_path / "garbage.bag"
+    garbage.write_bytes(b"x" * disk)
+    with pytest.raises(InputFileError, match="MiB of memory are available"):
+        read_bag(garbage, joint_names(twolink))
+    monkeypatch.setenv("TWOLINK_PIN_MEMORY", str(3 * disk))
+    assert read_bag(bag, joint_names(twolink))[0].samples > 250
+    monkeypatch.setenv("TWOLINK_PIN_MEMORY", "lots")
+    with pytest.raises(
+        InvalidParameterError, match=r"TWOLINK_PIN_MEMORY.*'lots'.*positive whole number of bytes"
+    ):
+        read_bag(bag, joint_names(twolink))

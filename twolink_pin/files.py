@@ -30,6 +30,7 @@ from typing import IO, Any
 
 from twolink_pin.errors import InputFileError, OutputError
 from twolink_pin.readiness import ready
+from twolink_pin.user_code import restore_baseline
 
 
 def _reason(exc: OSError) -> str:
@@ -86,6 +87,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
     """
     if mode not in ("w", "wb"):
         raise ValueError(f"mode must be 'w' or 'wb', got {mode!r}")
+    restore_baseline()  # a law that changed the working directory cannot move the output
     target = check_replaceable(path)
     _make_parent(target)
     try:
@@ -248,6 +250,7 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
         OutputError: ``path`` is someone else's folder, a file, or its parent cannot be
             written.
     """
+    restore_baseline()  # a law that changed the working directory cannot move the output
     out = check_output_directory(path, marker)
     _make_parent(out)
     try:

@@ -11,14 +11,17 @@ estimates and which gains it has, its class declares.
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Mapping
 from typing import Any, NamedTuple
 
 from twolink_pin.controllers import Controller, load_controller
+from twolink_pin.controllers.base import check_state_declaration
 from twolink_pin.dynamics import Friction
-from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError
+from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.plant import Plant
+from twolink_pin.user_code import guarded
 
 
 class Scenario(NamedTuple):
@@ -47,6 +50,20 @@ def builtin_laws() -> tuple[str, ...]:
     from twolink_pin.controllers import CONTROLLERS
 
     return tuple(n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers."))
+
+
+def _reference(cls: type[Controller]) -> str:
+    """How a law is named in an error about its code: its name, and its class in the user's
+    file (never the module name a law file is imported under)."""
+    try:
+        where = inspect.getsourcefile(cls) or ""
+    except TypeError:
+        where = ""
+    return (
+        f"{getattr(cls, 'name', cls.__qualname__)} ({cls.__qualname__} in {where})"
+        if where
+        else str(cls.name)
+    )
 
 
 def make_controller(
@@ -90,24 +107,13 @@ def make_controller(
             "gain", unknown[0], f"one of the gains of '{cls.name}': {', '.join(cls.Gains.field_names())}"
         )
     presets = {k: v for k, v in robot.gain_presets.get(cls.name, {}).items() if k in cls.Gains.field_names()}
-    try:
+    reference = _reference(cls)
+    with guarded(reference, f"building its gains {cls.Gains.__name__}"):  # a user's gains class's checks
         gains_obj = cls.Gains(**{**presets, **changes})
-    except TwolinkPinError:
-        raise
-    except Exception as exc:  # a user's gains class whose checks raised
-        raise ControllerSpecError(
-            f"{cls.__module__}:{cls.__qualname__}",
-            f"its gains {cls.Gains.__name__} could not be built: {type(exc).__name__}: {str(exc)[:300]}",
-        ) from exc
     kwargs: dict[str, Any] = {}
     if "friction" in cls.estimates:
         kwargs["friction"] = friction
-    try:
-        return cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
-    except TwolinkPinError:
-        raise
-    except Exception as exc:  # a user's law whose constructor (or scaled_gains) raised
-        raise ControllerSpecError(
-            f"{cls.__module__}:{cls.__qualname__}",
-            f"could not be built on {robot.name}: {type(exc).__name__}: {str(exc)[:300]}",
-        ) from exc
+    with guarded(reference, f"building it on {robot.name}"):  # its __init__, scaled_gains, state
+        controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
+        check_state_declaration(controller)
+    return controller

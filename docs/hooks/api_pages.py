@@ -65,12 +65,15 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "files",
         "Files, errors, arrays, math, threads, version",
         "The one writer, bounded input documents, the stages a command reports, the signals it "
-        "received, the exceptions, read-only arrays, LaTeX → MathML, OpenMP threads, the version.",
+        "received, user code outside compute, the memory available, the exceptions, read-only "
+        "arrays, LaTeX → MathML, OpenMP and BLAS threads, the version.",
         (
             "files",
             "documents",
             "readiness",
             "interrupts",
+            "user_code",
+            "memory",
             "errors",
             "arrays",
             "mathml",

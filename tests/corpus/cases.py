@@ -20,6 +20,7 @@ from collections import Counter
 
 import numpy as np
 
+from corpus.cases_outside import OUTSIDE, OUTSIDE_LIBRARY
 from corpus.spec import (
     SIGINT,
     SIGTERM,
@@ -921,7 +922,8 @@ LIBRARY = [
     LibCase("library-make_scenario-gain-nan", "tp.make_scenario('pd', robot, gains={'kp': float('nan')})", ("kp",)),
     LibCase("library-make_scenario-gain-three-values", "tp.make_scenario('pd', robot, gains={'kp': (1.0, 2.0, 3.0)})", ("kp",)),
     LibCase("library-plant-saturate-string", "tp.Plant(robot, saturate='yes')", ("saturate",)),
-    LibCase("library-plant-pin-model", "tp.Plant(model)", ("robot",))
+    LibCase("library-plant-pin-model", "tp.Plant(model)", ("robot",)),
+    *OUTSIDE_LIBRARY,
 ]
 
 # fmt: on
@@ -937,6 +939,7 @@ CASES: list[Case] = [
     *INTERRUPT,
     *USERCODE,
     *READERS,
+    *OUTSIDE,
 ]
 """Every command-line case."""
 

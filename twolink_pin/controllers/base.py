@@ -61,6 +61,39 @@ class StateVariable(NamedTuple):
     own word (e.g. ``"integral"``, ``"filter"``)."""
 
 
+def check_state_declaration(controller: Any) -> None:
+    """Refuse a law whose state declaration is wrong, when it is built: a name empty or given
+    twice in :meth:`Controller.state_variables`, or an :meth:`Controller.initial_state` whose
+    size is not the number of entries declared.
+
+    Raises:
+        InvalidParameterError: naming the law, the entry and what was expected.
+    """
+    law = f"law {getattr(controller, 'name', type(controller).__name__)!r}"
+    variables = tuple(controller.state_variables())
+    names = [getattr(v, "name", None) for v in variables]
+    for i, name in enumerate(names):
+        if not isinstance(name, str) or not name.strip():
+            raise InvalidParameterError(
+                f"{law}: state_variables()[{i}].name", name, "a non-empty name (each entry of z is named)"
+            )
+    twice = [n for n in dict.fromkeys(names) if names.count(n) > 1]
+    if twice:
+        raise InvalidParameterError(
+            f"{law}: state_variables()",
+            f"{twice[0]!r} at entries {[i for i, n in enumerate(names) if n == twice[0]]}",
+            "each state entry named once",
+        )
+    z0 = np.asarray(controller.initial_state())
+    if z0.ndim not in (1, 2) or z0.shape[-1] != len(variables):
+        raise InvalidParameterError(
+            f"{law}: initial_state()",
+            f"shape {z0.shape}",
+            f"(nz,) or (N, nz) with nz = {len(variables)}, the entries state_variables() declares "
+            f"({', '.join(map(str, names)) or 'none'})",
+        )
+
+
 class LawInput(NamedTuple):
     """What a law sees at one evaluation, for N runs (arrays batch-first)."""
 

@@ -23,6 +23,7 @@ from pathlib import Path
 
 from twolink_pin.controllers.base import CONTROLLERS, Controller
 from twolink_pin.errors import ControllerSpecError
+from twolink_pin.user_code import guarded
 
 ENTRY_POINT_GROUP = "twolink_pin.controllers"
 """Entry-point group through which installed packages add control laws."""
@@ -95,15 +96,11 @@ def _from_file(spec: str, file_part: str, class_name: str) -> type:
         module = importlib.util.module_from_spec(loader_spec)
         sys.modules[module_name] = module
         try:
-            loader_spec.loader.exec_module(module)
-        except ControllerSpecError:
+            with guarded(spec, f"importing {path}"):
+                loader_spec.loader.exec_module(module)
+        except BaseException:
             sys.modules.pop(module_name, None)
             raise
-        except BaseException as exc:
-            sys.modules.pop(module_name, None)
-            if isinstance(exc, KeyboardInterrupt):
-                raise
-            raise ControllerSpecError(spec, f"importing {path} {_raised(exc)}") from None
     if not hasattr(module, class_name):
         found = sorted(
             n
@@ -117,14 +114,10 @@ def _from_file(spec: str, file_part: str, class_name: str) -> type:
 
 
 def _from_module(spec: str, module_name: str, class_name: str) -> type:
-    try:
+    if importlib.util.find_spec(module_name.partition(".")[0]) is None:
+        raise ControllerSpecError(spec, f"cannot import module {module_name!r} (no module of that name)")
+    with guarded(spec, f"importing {module_name!r}"):  # its own failure, sys.exit and MemoryError included
         module = importlib.import_module(module_name)
-    except ImportError as exc:
-        raise ControllerSpecError(spec, f"cannot import module {module_name!r} ({exc})") from exc
-    except KeyboardInterrupt:
-        raise
-    except BaseException as exc:  # the module's own failure, sys.exit and MemoryError included
-        raise ControllerSpecError(spec, f"importing {module_name!r} {_raised(exc)}") from None
     if not hasattr(module, class_name):
         raise ControllerSpecError(spec, f"module {module_name!r} has no class {class_name!r}")
     return getattr(module, class_name)

@@ -20,7 +20,11 @@ A real arm's data come as ROS 2 bags (a bag folder with ``metadata.yaml``, or it
 1. each message's time is its ``header.stamp`` — the acquisition time the driver stamped —
    or, when that is zero, the time the bag recorded it (receive time: it includes transport
    delay, so the stamp is preferred); messages are sorted by that time (a bag stores them in
-   arrival order) and a repeated stamp is dropped (counted);
+   arrival order: out of order by a few steps); time that repeats (two stamps at most half a
+   step apart), runs backwards (a stamp :data:`MAX_GAP_STEPS` steps before one already read:
+   a clock reset) or jumps (below) is refused, naming the messages and the time, as is a
+   value that is not finite (the message, field and joint) or a joint named twice in one
+   message;
 2. the grid ``t_0 + k T`` is the stamps' own: each stamp gets its sample index (a step of
    ``n`` median steps counts ``n``: dropped messages keep their place) and ``t_0``, ``T`` are
    fitted to the stamps by least squares (zero-mean jitter averages out; the median step
@@ -41,6 +45,12 @@ A real arm's data come as ROS 2 bags (a bag folder with ``metadata.yaml``, or it
    and length); a longer gap is refused, naming where it is (interpolating 10 steps of a
    2-kHz log spans 5 ms, under a tenth of the 20-Hz filter's period).
 
+**Memory**: messages are streamed into arrays preallocated for the count the bag declares
+(believed up to its size on disk), never kept as message objects: reading takes at most
+:data:`READ_MEMORY_FACTOR` × the bag's size on disk, and a bag larger than the memory
+available (:func:`~twolink_pin.memory.available_memory`) divided by that is refused by its
+size before it is opened.
+
 :class:`BagSummary` says all of it, and :func:`read_bag` returns it with the
 :class:`~twolink_pin.identification.data.RunLog`.
 """
@@ -49,6 +59,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -56,7 +67,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.errors import InputFileError
-from twolink_pin.identification.data import MIN_SAMPLES, RunLog
+from twolink_pin.identification.data import MAX_GAP_STEPS, MIN_SAMPLES, RunLog
 
 DEFAULT_TOPIC = "/joint_states"
 """Topic of the joint states when none is given."""
@@ -66,8 +77,15 @@ MAX_BAG_BYTES = 16 << 30
 """Largest bag file read (16 GiB)."""
 GAP_STEPS = 1.5
 """A step between stamps longer than this many grid steps is a gap (messages dropped)."""
-MAX_GAP_STEPS = 10.0
-"""Longest gap interpolated across, in grid steps; a longer one is refused."""
+MIN_MESSAGE_BYTES = 16
+"""Fewest bytes a stored message takes on disk: a bag's claimed message count is believed up
+to its size on disk divided by this."""
+READ_MEMORY_FACTOR = 3.0
+"""Memory reading a bag may take, as a multiple of its size on disk (measured: below 2 for
+joint states: ``tests/test_bags.py``, tracemalloc); a bag larger than the memory available divided
+by this is refused before it is read."""
+MAX_METADATA_BYTES = 1 << 20
+"""Largest ``metadata.yaml`` of a ROS 2 bag read (1 MiB)."""
 JOINT_STATE = ("sensor_msgs/msg/JointState", "sensor_msgs/JointState")
 MULTI_ARRAY = ("std_msgs/msg/Float64MultiArray", "std_msgs/Float64MultiArray")
 
@@ -86,8 +104,6 @@ class BagSummary:
     """Where the torques came from: ``"effort of /joint_states"`` or the torque topic."""
     messages: int
     """Joint-state messages read."""
-    repeated: int
-    """Messages dropped because their stamp repeated an earlier one."""
     stamps: str
     """``"header.stamp"`` or ``"bag receive time"``."""
     period: float
@@ -119,8 +135,6 @@ class BagSummary:
                 f"  {self.dropped} messages dropped in {len(self.gaps)} gaps (interpolated across); longest "
                 f"{longest[1] * 1e3:.3g} ms at t = {longest[0]:.6g} s"
             )
-        if self.repeated:
-            out.append(f"  {self.repeated} messages with a repeated stamp ignored")
         if self.ignored_joints:
             out.append(f"  joints not in the model, ignored: {', '.join(self.ignored_joints)}")
         return out
@@ -164,8 +178,8 @@ def _stamp(msg: Any) -> int:
     return int(header.stamp.sec) * 1_000_000_000 + int(header.stamp.nanosec)
 
 
-def _read_topic(reader: Any, path: str, topic: str, types: tuple[str, ...]) -> list[tuple[int, int, Any]]:
-    """``(stamp ns, receive ns, message)`` of every message on ``topic``."""
+def _connections(reader: Any, path: str, topic: str, types: tuple[str, ...]) -> list[Any]:
+    """The connections of ``topic``, which must carry one of ``types``."""
     connections = [c for c in reader.connections if c.topic == topic]
     if not connections:
         topics = sorted({f"{c.topic} ({c.msgtype})" for c in reader.connections})
@@ -173,17 +187,109 @@ def _read_topic(reader: Any, path: str, topic: str, types: tuple[str, ...]) -> l
     wrong = [c.msgtype for c in connections if c.msgtype not in types]
     if wrong:
         raise InputFileError(path, f"topic {topic!r} carries {wrong[0]}; expected {' or '.join(types[::2])}")
-    out = []
-    for connection, received, raw in reader.messages(connections=connections):
+    return connections
+
+
+class _Table:
+    """A topic's messages as arrays, in the order read: times [ns] and one (rows, n) float64
+    array per field, preallocated for the count the bag declares (bounded by its size on disk:
+    a count is the bag's claim) and doubled if more come."""
+
+    def __init__(self, capacity: int, width: int, fields: tuple[str, ...]) -> None:
+        self.size = 0
+        self.stamp = np.empty(capacity, dtype=np.int64)
+        self.received = np.empty(capacity, dtype=np.int64)
+        self.values = {name: np.empty((capacity, width)) for name in fields}
+
+    def add(self, stamp: int, received: int) -> int:
+        """A new row (its index), with its two times."""
+        if self.size == self.stamp.size:
+            grow = max(16, self.size)
+            self.stamp = np.concatenate([self.stamp, np.empty(grow, dtype=np.int64)])
+            self.received = np.concatenate([self.received, np.empty(grow, dtype=np.int64)])
+            self.values = {
+                k: np.concatenate([v, np.empty((grow, v.shape[1]))]) for k, v in self.values.items()
+            }
+        self.stamp[self.size], self.received[self.size] = stamp, received
+        self.size += 1
+        return self.size - 1
+
+    def trimmed(self) -> _Table:
+        """The table with its unused rows dropped (views, no copy)."""
+        self.stamp, self.received = self.stamp[: self.size], self.received[: self.size]
+        self.values = {k: v[: self.size] for k, v in self.values.items()}
+        return self
+
+
+def _capacity(connections: list[Any], disk_bytes: int) -> int:
+    claimed = sum(int(getattr(c, "msgcount", 0) or 0) for c in connections)
+    return max(16, min(claimed, disk_bytes // MIN_MESSAGE_BYTES + 1))
+
+
+def _read_states(
+    reader: Any, path: str, topic: str, names: list[str], efforts: bool, disk_bytes: int
+) -> tuple[_Table, bool, tuple[str, ...]]:
+    """The joint states on ``topic`` streamed into a :class:`_Table` (``position``,
+    ``velocity`` and, with ``efforts``, ``effort`` of the model's joints), whether every
+    message logs velocities, and the joints not in the model."""
+    connections = _connections(reader, path, topic, JOINT_STATE)
+    fields = ("position", "velocity", "effort") if efforts else ("position", "velocity")
+    table = _Table(_capacity(connections, disk_bytes), len(names), fields)
+    has_v = True
+    ignored: dict[str, None] = {}
+    cache: dict[tuple[str, ...], tuple[np.ndarray, tuple[str, ...]]] = {}
+    for k, (connection, received, raw) in enumerate(reader.messages(connections=connections)):
         msg = reader.deserialize(raw, connection.msgtype)
-        out.append((_stamp(msg), int(received), msg))
-    return out
+        row = table.add(_stamp(msg), int(received))
+        key = tuple(msg.name)
+        if key not in cache:
+            cache[key] = _columns(path, topic, names, list(key), k)
+            ignored |= dict.fromkeys(cache[key][1])
+        index = cache[key][0]
+        table.values["position"][row] = _field(path, topic, msg, "position", index, len(key), k)
+        if has_v and len(msg.velocity) == len(key):
+            table.values["velocity"][row] = np.asarray(msg.velocity, dtype=float)[index]
+        else:
+            has_v = False
+        if efforts:
+            table.values["effort"][row] = _field(path, topic, msg, "effort", index, len(key), k)
+    return table.trimmed(), has_v, tuple(ignored)
+
+
+def _read_commands(reader: Any, path: str, topic: str, names: list[str], disk_bytes: int) -> _Table:
+    """The commanded torques on ``topic`` streamed into a :class:`_Table` (field ``effort``):
+    ``sensor_msgs/JointState`` matched by name, or ``std_msgs/Float64MultiArray`` in the
+    model's joint order."""
+    connections = _connections(reader, path, topic, JOINT_STATE + MULTI_ARRAY)
+    table = _Table(_capacity(connections, disk_bytes), len(names), ("effort",))
+    for k, (connection, received, raw) in enumerate(reader.messages(connections=connections)):
+        msg = reader.deserialize(raw, connection.msgtype)
+        row = table.add(_stamp(msg), int(received))
+        if hasattr(msg, "name"):
+            index, _ = _columns(path, topic, names, list(msg.name), k)
+            table.values["effort"][row] = _field(path, topic, msg, "effort", index, len(msg.name), k)
+        else:
+            data = np.asarray(msg.data, dtype=float)
+            if data.size != len(names):
+                raise InputFileError(
+                    path,
+                    f"{topic} message {k}: {data.size} values; expected {len(names)} (the model's joints in order)",
+                )
+            table.values["effort"][row] = data
+    return table.trimmed()
 
 
 def _columns(
     path: str, topic: str, names: list[str], message_names: list[str], k: int
 ) -> tuple[np.ndarray, tuple[str, ...]]:
     """Index of each model joint in a message's ``name`` list, and the message's other joints."""
+    twice = [n for n, count in Counter(message_names).items() if count > 1]
+    if twice:
+        raise InputFileError(
+            path,
+            f"{topic} message {k}: joint {twice[0]!r} is named twice in one message "
+            f"(the message names {', '.join(repr(n) for n in message_names)}); expected each joint once",
+        )
     where = {n: i for i, n in enumerate(message_names)}
     missing = [n for n in names if n not in where]
     if missing:
@@ -211,8 +317,65 @@ def _field(path: str, topic: str, msg: Any, name: str, index: np.ndarray, size: 
     return values[index]
 
 
-def _grid(path: str, t: np.ndarray) -> tuple[np.ndarray, float, int, tuple[tuple[float, float], ...]]:
-    """The uniform grid of stamped times ``t`` [s] (sorted, distinct): grid, step, dropped, gaps."""
+def _check_finite(path: str, topic: str, table: _Table, times: np.ndarray, names: list[str]) -> None:
+    """Every value read is a finite number; else the message, its time, the field and the joint."""
+    for field_name, values in table.values.items():
+        bad = ~np.isfinite(values)
+        if bad.any():
+            k, j = (int(i) for i in np.argwhere(bad)[0])
+            raise InputFileError(
+                path,
+                f"{topic} message {k} (t = {(times[k] - times.min()) * 1e-9:.9g} s): {field_name} of joint "
+                f"{names[j]!r} is {float(values[k, j])!r}; expected a finite number",
+            )
+
+
+def _check_time(path: str, topic: str, times: np.ndarray, what: str) -> np.ndarray:
+    """The order that sorts ``times`` [ns] (message order), after refusing time that runs
+    backwards by more than a reordering in transport (:data:`MAX_GAP_STEPS` steps), repeats,
+    or comes twice for one step (two stamps at most half a step apart)."""
+    order = np.argsort(times, kind="stable")
+    sorted_times = times[order]
+    steps = np.diff(sorted_times)
+    positive = steps[steps > 0]
+    if positive.size == 0:
+        raise InputFileError(path, f"{topic}: every message has the same {what} t = {times[0] * 1e-9:.9g} s")
+    period = float(np.median(positive))
+    latest = np.maximum.accumulate(times)
+    back = latest[:-1] - times[1:]
+    if np.any(back > MAX_GAP_STEPS * period):
+        k = int(np.flatnonzero(back > MAX_GAP_STEPS * period)[0]) + 1
+        j = int(np.argmax(times[:k]))
+        raise InputFileError(
+            path,
+            f"{topic} message {k}: time goes backwards: its {what} is {(times[j] - times[k]) * 1e-9:.6g} s before "
+            f"that of message {j} (t = {(times[j] - sorted_times[0]) * 1e-9:.9g} s); messages may arrive out of "
+            f"order by at most {MAX_GAP_STEPS:g} steps of {period * 1e-6:.6g} ms",
+        )
+    close = np.flatnonzero(steps <= 0.5 * period)
+    if close.size:
+        i = int(close[0])
+        a, b = sorted(int(m) for m in order[i : i + 2])
+        at = f"t = {(sorted_times[i] - sorted_times[0]) * 1e-9:.9g} s"
+        raise InputFileError(
+            path,
+            f"{topic} messages {a} and {b}: time {'repeats' if b == a + 1 and steps[i] == 0 else 'repeats or goes backwards'}: "
+            + (
+                f"both have the {what} {at}"
+                if steps[i] == 0
+                else f"their {what}s are {steps[i] * 1e-6:.6g} ms apart at {at}, at most half the "
+                f"{period * 1e-6:.6g}-ms step"
+            )
+            + "; expected one message per step",
+        )
+    return order
+
+
+def _grid(
+    path: str, topic: str, t: np.ndarray, messages: np.ndarray
+) -> tuple[np.ndarray, float, int, tuple[tuple[float, float], ...]]:
+    """The uniform grid of stamped times ``t`` [s] (sorted, distinct; ``messages[i]`` is the
+    index of the message at ``t[i]``): grid, step, dropped, gaps."""
     steps = np.diff(t)
     period = float(np.median(steps))
     index = np.concatenate([[0], np.cumsum(np.maximum(np.round(steps / period), 1))])
@@ -225,7 +388,8 @@ def _grid(path: str, t: np.ndarray) -> tuple[np.ndarray, float, int, tuple[tuple
         i = int(too_long[0])
         raise InputFileError(
             path,
-            f"has a gap of {steps[i] * 1e3:.6g} ms ({steps[i] / period:.1f} steps of {period * 1e3:.6g} ms) after "
+            f"{topic} messages {int(messages[i])} and {int(messages[i + 1])}: time jumps: a gap of "
+            f"{steps[i] * 1e3:.6g} ms ({steps[i] / period:.1f} steps of {period * 1e3:.6g} ms) after "
             f"t = {t[i] - t[0]:.6g} s: more than {MAX_GAP_STEPS:g} steps cannot be interpolated honestly "
             "(cut the bag into the parts without such gaps)",
         )
@@ -261,6 +425,81 @@ def _torques_on_grid(
     return out
 
 
+def _size_checked(root: Path, file: Path) -> int:
+    """The bag's size on disk [bytes], after refusing what
+    would block the reader (a FIFO or device named like a bag), a bag too large for the memory
+    available, and a ``metadata.yaml`` that is no YAML (in one line: where and why)."""
+    from twolink_pin.files import check_input_file
+    from twolink_pin.memory import available_memory
+
+    stored = [p for p in root.iterdir() if p.suffix.lower() in BAG_SUFFIXES] if root.is_dir() else [root]
+    disk = sum(check_input_file(part, MAX_BAG_BYTES, "a ROS bag").stat().st_size for part in stored)
+    available = available_memory()
+    if available is not None and READ_MEMORY_FACTOR * disk > available:
+        raise InputFileError(
+            str(file),
+            f"is {disk / 2**20:.4g} MiB on disk; reading it needs up to {READ_MEMORY_FACTOR:g} × that "
+            f"({READ_MEMORY_FACTOR * disk / 2**20:.4g} MiB) and {available / 2**20:.4g} MiB of memory are "
+            "available: cut the bag (ros2 bag convert / rosbag filter), or free memory",
+        )
+    if root.is_dir():
+        _check_metadata(root / "metadata.yaml")
+    return disk
+
+
+def _check_metadata(path: Path) -> None:
+    """Refuse a ``metadata.yaml`` that is not a bounded regular UTF-8 YAML file, in one line."""
+    from ruamel.yaml import YAML
+    from ruamel.yaml.error import MarkedYAMLError, YAMLError
+
+    from twolink_pin.files import read_input_file
+
+    raw = read_input_file(path, MAX_METADATA_BYTES, "a ROS 2 bag's metadata.yaml")
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        raise InputFileError(str(path), f"is not UTF-8 text (byte {err.start})") from None
+    try:
+        document = YAML(typ="safe").load(text)
+    except MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark is not None else ""
+        raise InputFileError(str(path), f"is not valid YAML ({where}{err.problem or err.context})") from None
+    except YAMLError as err:
+        raise InputFileError(str(path), f"is not valid YAML ({_one_line(err)})") from None
+    if not isinstance(document, dict) or "rosbag2_bagfile_information" not in document:
+        raise InputFileError(
+            str(path), "has no rosbag2_bagfile_information mapping: not a ROS 2 bag's metadata"
+        )
+
+
+def _one_line(exc: BaseException) -> str:
+    """An exception as one short line (a reader's message may span many)."""
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text[:300]}{'…' if len(text) > 300 else ''}"
+
+
+def _read(
+    root: Path, file: Path, topic: str, names: list[str], torque_topic: str | None
+) -> tuple[_Table, bool, tuple[str, ...], _Table | None]:
+    """The joint states (and commanded torques) of the bag, streamed into arrays."""
+    where = str(file)
+    disk = _size_checked(root, file)
+    try:
+        reader = _open(root)
+        reader.open()
+        try:
+            states, has_v, ignored = _read_states(reader, where, topic, names, torque_topic is None, disk)
+            commands = _read_commands(reader, where, torque_topic, names, disk) if torque_topic else None
+        finally:
+            reader.close()
+    except InputFileError:
+        raise
+    except Exception as exc:  # rosbags raises its own errors (and sqlite3's, struct's) for broken bags
+        raise InputFileError(where, f"is not a readable ROS bag ({_one_line(exc)})") from None
+    return states, has_v, ignored, commands
+
+
 def read_bag(
     path: str | os.PathLike[str],
     joint_names: list[str] | tuple[str, ...],
@@ -271,86 +510,48 @@ def read_bag(
     docstring), and what was done to it.
 
     Raises:
-        InputFileError: not a readable bag, no such topic or the wrong message type, a model
-            joint missing from the messages (named), no efforts and no torque topic, too few
-            messages, or a gap too long to interpolate across (where it is).
+        InputFileError: not a readable bag, too large for the memory available, no such topic
+            or the wrong message type, a model joint missing from the messages or named twice
+            (the message), a value that is not finite (the message, its time, the field and the
+            joint), time that repeats or runs backwards (the messages), no efforts and no
+            torque topic, too few messages, or a gap too long to interpolate across (where it is).
     """
     from scipy.interpolate import CubicSpline
-
-    from twolink_pin.files import check_input_file
 
     file = Path(os.fspath(path))
     root, storage = _bag_root(file)
     where = str(file)
     names = list(joint_names)
-    stored = [p for p in root.iterdir() if p.suffix.lower() in BAG_SUFFIXES] if root.is_dir() else [root]
-    for part in stored:  # a FIFO or a device named *.bag would block the reader: refused before it opens
-        check_input_file(part, MAX_BAG_BYTES, "a ROS bag")
-    try:
-        reader = _open(root)
-        reader.open()
-        try:
-            states = _read_topic(reader, where, topic, JOINT_STATE)
-            commands = (
-                _read_topic(reader, where, torque_topic, JOINT_STATE + MULTI_ARRAY) if torque_topic else []
-            )
-        finally:
-            reader.close()
-    except InputFileError:
-        raise
-    except Exception as exc:  # rosbags raises its own errors (and sqlite3's, struct's) for broken bags
-        raise InputFileError(where, f"is not a readable ROS bag ({type(exc).__name__}: {exc})") from None
-    if len(states) < MIN_SAMPLES:
+    states, has_v, ignored, commands = _read(root, file, topic, names, torque_topic)
+    if states.size < MIN_SAMPLES:
         raise InputFileError(
-            where, f"has {len(states)} messages on {topic}; identification needs at least {MIN_SAMPLES}"
+            where, f"has {states.size} messages on {topic}; identification needs at least {MIN_SAMPLES}"
         )
-    use_stamp = all(s != 0 for s, _, _ in states)
-    times = np.array([(s if use_stamp else r) for s, r, _ in states], dtype=np.int64)
-    order = np.argsort(times, kind="stable")
-    keep = order[np.concatenate([[True], np.diff(times[order]) > 0])]
-    repeated = len(states) - keep.size
-    n = len(names)
-    q, v, tau = np.empty((keep.size, n)), np.empty((keep.size, n)), np.empty((keep.size, n))
-    has_v = True
-    ignored: dict[str, None] = {}
-    cache: dict[tuple[str, ...], tuple[np.ndarray, tuple[str, ...]]] = {}
-    for row, k in enumerate(keep):
-        msg = states[k][2]
-        key = tuple(msg.name)
-        if key not in cache:
-            cache[key] = _columns(where, topic, names, list(key), int(k))
-        index, extra = cache[key]
-        ignored |= dict.fromkeys(extra)
-        q[row] = _field(where, topic, msg, "position", index, len(key), int(k))
-        if has_v and len(msg.velocity) == len(key):
-            v[row] = np.asarray(msg.velocity, dtype=float)[index]
-        else:
-            has_v = False
-        if torque_topic is None:
-            tau[row] = _field(where, topic, msg, "effort", index, len(key), int(k))
-    t0 = int(times[keep[0]])
-    t = (times[keep] - t0) * 1e-9
-    grid, period, dropped, gaps = _grid(where, t)
-    if torque_topic is not None:
-        tau = _command_torques(where, torque_topic, commands, names, t0, t)
+    use_stamp = bool(np.all(states.stamp != 0))
+    times = states.stamp if use_stamp else states.received
+    what = "stamp" if use_stamp else "receive time"
+    _check_finite(where, topic, states, times, names)
+    order = _check_time(where, topic, times, what)
+    t0 = int(times[order[0]])
+    t = (times[order] - t0) * 1e-9
+    grid, period, dropped, gaps = _grid(where, topic, t, order)
+    q = states.values["position"][order]
     spline = CubicSpline(t, q, axis=0)
-    q_grid = spline(grid)
+    del q
+    if commands is None:
+        tau = states.values["effort"][order]
+    else:
+        tau = _command_torques(where, torque_topic or "", commands, names, t0, t)
     tau_grid = _torques_on_grid(t, tau, grid, spline(t, 1), spline(grid, 1))
-    v_grid = _interpolate(t, v, grid) if has_v else None
-    log = RunLog(
-        t=grid,
-        q=q_grid,
-        tau=tau_grid,
-        v=v_grid,
-        source=f"{where} ({topic})",
-    )
+    del tau
+    v_grid = _interpolate(t, states.values["velocity"][order], grid) if has_v else None
+    log = RunLog(t=grid, q=spline(grid), tau=tau_grid, v=v_grid, source=f"{where} ({topic})")
     summary = BagSummary(
         path=where,
         storage=storage,
         topic=topic,
         torque=f"effort of {topic}" if torque_topic is None else f"commanded, {torque_topic}",
-        messages=len(states),
-        repeated=repeated,
+        messages=states.size,
         stamps="header.stamp" if use_stamp else "bag receive time",
         period=period,
         samples=int(grid.size),
@@ -364,38 +565,21 @@ def read_bag(
 
 
 def _command_torques(
-    where: str,
-    topic: str,
-    commands: list[tuple[int, int, Any]],
-    names: list[str],
-    t0: int,
-    t: np.ndarray,
+    where: str, topic: str, commands: _Table, names: list[str], t0: int, t: np.ndarray
 ) -> np.ndarray:
-    """The commanded torques at the joint states' times ``t`` [s from ``t0`` ns], linearly."""
-    rows, times = [], []
-    for k, (stamp, received, msg) in enumerate(commands):
-        if hasattr(msg, "name"):
-            index, _ = _columns(where, topic, names, list(msg.name), k)
-            rows.append(_field(where, topic, msg, "effort", index, len(msg.name), k))
-        else:
-            data = np.asarray(msg.data, dtype=float)
-            if data.size != len(names):
-                raise InputFileError(
-                    where,
-                    f"{topic} message {k}: {data.size} values; expected {len(names)} (the model's joints in order)",
-                )
-            rows.append(data)
-        times.append(stamp if stamp else received)
-    if len(rows) < 2:
+    """The commanded torques at the joint states' times ``t`` [s from ``t0`` ns], linearly
+    (each command at its stamp, or the bag's receive time where it has none)."""
+    if commands.size < 2:
         raise InputFileError(
-            where, f"has {len(rows)} messages on {topic}; expected commanded torques over the run"
+            where, f"has {commands.size} messages on {topic}; expected commanded torques over the run"
         )
-    order = np.argsort(np.array(times), kind="stable")
-    tc = (np.array(times, dtype=np.int64)[order] - t0) * 1e-9
-    tau = np.array(rows)[order]
+    times = np.where(commands.stamp != 0, commands.stamp, commands.received)
+    _check_finite(where, topic, commands, times, names)
+    order = _check_time(where, topic, times, "time")
+    tc = (times[order] - t0) * 1e-9
     if tc[0] > t[0] + 1e-9 or tc[-1] < t[-1] - 1e-9:
         raise InputFileError(
             where,
             f"{topic} covers {tc[0]:.6g}–{tc[-1]:.6g} s of the joint states' 0–{t[-1]:.6g} s: the torques must span the run",
         )
-    return _interpolate(tc, tau, t)
+    return _interpolate(tc, commands.values["effort"][order], t)

@@ -15,8 +15,8 @@ the arm. Files (``--data FILE``):
 
 :func:`read_log` refuses, with what is wrong and where: a missing column or array, a cell
 that is not a finite number (data row and line of the file, column name), time that does
-not increase strictly (the row), and fewer samples than :data:`MIN_SAMPLES` or than the
-caller needs for its number of parameters. Data rows are numbered from 1 (the header is
+not increase strictly or jumps by more than :data:`MAX_GAP_STEPS` median steps (the row), and
+fewer samples than :data:`MIN_SAMPLES` or than the caller needs for its number of parameters. Data rows are numbered from 1 (the header is
 line 1 of the file when there are no comment lines).
 """
 
@@ -43,6 +43,11 @@ MAX_LOG_VALUES = MAX_LOG_BYTES // 8
 allows bytes): a compressed archive that expands past that is refused before it is read."""
 MIN_SAMPLES = 10
 """Fewest samples a log may have whatever the number of parameters."""
+MAX_GAP_STEPS = 10.0
+"""Longest gap between samples, in median steps, that a log may have (a bag's gaps are
+interpolated across up to this); a longer one is refused: time that jumps (a clock reset, two
+runs in one file) would be resampled into a log of a motion that never happened. A bag's
+stamp this many steps before one already read is time that runs backwards."""
 TIME_NAMES = ("t", "time")
 """Accepted names of the time column."""
 
@@ -142,6 +147,17 @@ def _check_values(path: str, log: RunLog, names: dict[str, tuple[str, int | None
             path,
             f"{line_of(k)}, column '{column}': t = {log.t[k]:.9g} s is not after the previous row's "
             f"{log.t[k - 1]:.9g} s (time must increase strictly)",
+        )
+    step = float(np.median(steps))
+    jumps = np.flatnonzero(steps > MAX_GAP_STEPS * step)
+    if jumps.size:
+        k = int(jumps[0]) + 1
+        column = next(c for c, (a, _) in names.items() if a == "t")
+        raise InputFileError(
+            path,
+            f"{line_of(k)}, column '{column}': time jumps from {log.t[k - 1]:.9g} s to {log.t[k]:.9g} s, "
+            f"{steps[k - 1] / step:.3g} times the median step {step:.6g} s: more than {MAX_GAP_STEPS:g} steps "
+            "cannot be interpolated honestly (cut the log into the parts without such gaps)",
         )
 
 

@@ -11,7 +11,11 @@ naming the law, never a changed simulation or a silent exit:
 * ``sys.exit()`` inside ``compute`` (``SystemExit``) is an error naming the law, not an exit
   of the program with a status the law chose;
 * ``MemoryError`` inside ``compute`` names the law (it is the law's allocation, not a bug of
-  twolink-pin).
+  twolink-pin);
+* each run starts from the command's working directory and NumPy global state
+  (:func:`~twolink_pin.user_code.restore_baseline`): a law that changed them in an earlier
+  run cannot change this one. Importing and building a law are contained by
+  :func:`~twolink_pin.user_code.guarded`.
 
 What cannot be contained in-process: ``os._exit()``, a crash in C code, a law that blocks
 signals. The CLI bounds a law that never returns with ``--timeout`` (``cli``), and
@@ -27,6 +31,7 @@ import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
 from twolink_pin.errors import ControllerError
+from twolink_pin.user_code import restore_baseline
 
 READ_ONLY_HINT = (
     "wrote into an array it was given, which is read-only: its inputs (the engine's state and the "
@@ -47,6 +52,7 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
     ``MemoryError`` turned into :class:`ControllerError` naming the law (see module doc).
 
     The returned function has the law's signature ``(x, terms) -> LawOutput``."""
+    restore_baseline()  # each run starts from the command's working directory and NumPy state
     compute = controller.compute
     name = controller.name
 

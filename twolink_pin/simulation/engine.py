@@ -117,6 +117,13 @@ def _validate(controller: Controller, out: object, runs: int, nv: int, nz: int, 
         if not isinstance(value, np.ndarray) or shape != (runs, width):
             got = f"shape {shape}" if shape is not None else type(value).__name__
             raise ControllerError(name, t, f"LawOutput.{label} must have shape ({runs}, {width}), got {got}")
+        if value.dtype.kind not in "fiu":  # complex, bool, str, object: not a torque Pinocchio takes
+            raise ControllerError(
+                name,
+                t,
+                f"LawOutput.{label} holds {value.dtype} values; expected real numbers (float64)"
+                + (f", e.g. {label}.real if the imaginary part is zero" if value.dtype.kind == "c" else ""),
+            )
 
 
 def _bad_rows(x: np.ndarray) -> np.ndarray:

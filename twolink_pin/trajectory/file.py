@@ -65,7 +65,7 @@ from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
-from twolink_pin.trajectory.se3 import PoseTrajectory, pose_trajectory
+from twolink_pin.trajectory.se3 import MAX_POSITION, PoseTrajectory, pose_trajectory
 
 MAX_TRAJECTORY_BYTES = 1 << 20
 """Largest trajectory file read (1 MiB)."""
@@ -80,6 +80,9 @@ MAX_TIME = 1e6
 MIN_TIME_STEP = 1e-3
 """Shortest interval between via points [s]."""
 
+MAX_ANGLE = 100.0
+"""Largest magnitude of an angle in a file (joint positions, seed, roll, pitch, yaw) [rad], as
+of a command-line offset: beyond, a number is a typo or garbage (sin(1e300) is not an angle)."""
 CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
@@ -115,15 +118,26 @@ def _only_numbers(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _numbers(path: Path, key: str, value: Any, shape: str) -> np.ndarray:
+def _numbers(
+    path: Path, key: str, value: Any, shape: str, bound: float | None = None, unit: str = ""
+) -> np.ndarray:
+    """``value`` as a float array; a number that is not finite or beyond ``±bound`` [unit] is
+    refused naming its row and column (``rpy[2][0]``)."""
     if not _only_numbers(value):
         raise InvalidParameterError(f"{path}: {key}", value, f"numbers (not booleans or strings): {shape}")
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
         raise InvalidParameterError(f"{path}: {key}", value, shape) from None
-    if not np.all(np.isfinite(array)):
-        raise InvalidParameterError(f"{path}: {key}", value, f"finite numbers: {shape}")
+    bad = ~np.isfinite(array) | (np.abs(array) > (math.inf if bound is None else bound))
+    if bad.any():
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        within = "" if bound is None else f" within ±{bound:g} {unit}"
+        raise InvalidParameterError(
+            f"{path}: {key}" + "".join(f"[{i}]" for i in index),
+            float(array[index]),
+            f"a finite number{within} ({shape})",
+        )
     return array
 
 
@@ -235,7 +249,8 @@ def read_trajectory_file(
                     f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
                 )
         via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
-        check_within_limits(robot, via_q, f"{file}: joints")
+        check_within_limits(robot, via_q, f"{file}: joints")  # the URDF's limits first: the better message
+        _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
     else:
         width = {len(row) if isinstance(row, list) else -1 for row in rows}
         if len(width) != 1 or width.pop() not in (2, 3):
@@ -244,10 +259,12 @@ def read_trajectory_file(
                 rows,
                 "rows of 3 coordinates (x, y, z) [m], or 2 (x, y) for a planar arm, all alike",
             )
-        points = _numbers(file, "positions", rows, "end-effector positions [m]")
+        points = _numbers(file, "positions", rows, "end-effector positions [m]", MAX_POSITION, "m")
         seed = None
         if "seed" in document:
-            seed = _numbers(file, "seed", document["seed"], f"{robot.nv} joint positions [rad]")
+            seed = _numbers(
+                file, "seed", document["seed"], f"{robot.nv} joint positions [rad]", MAX_ANGLE, "rad"
+            )
             if seed.shape != (robot.nv,):
                 raise InvalidParameterError(
                     f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
@@ -296,7 +313,7 @@ def _pose_file(
         raise InvalidParameterError(
             f"{file}: rpy", rows, f"one row (roll, pitch, yaw) [rad] per time ({times.size})"
         )
-    rpy = _numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]")
+    rpy = _numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]", MAX_ANGLE, "rad")
     if points.shape[1] != 3:
         raise InvalidParameterError(
             f"{file}: positions", document["positions"], "3 coordinates (x, y, z) [m] per row beside 'rpy'"
@@ -357,7 +374,9 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
     b = _numbers(file, "fourier.b", table["b"], f"{robot.nv} rows of N cosine coefficients [rad/s]")
     if b.shape != a.shape:
         raise InvalidParameterError(f"{file}: fourier.b", f"shape {b.shape}", f"shape {a.shape} like a")
-    offset = _numbers(file, "fourier.offset", table["offset"], f"{robot.nv} mean positions [rad]")
+    offset = _numbers(
+        file, "fourier.offset", table["offset"], f"{robot.nv} mean positions [rad]", MAX_ANGLE, "rad"
+    )
     if offset.shape != (robot.nv,):
         raise InvalidParameterError(
             f"{file}: fourier.offset", table["offset"], f"{robot.nv} mean joint positions [rad]"

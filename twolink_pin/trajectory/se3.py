@@ -50,6 +50,9 @@ from twolink_pin.trajectory.pose_ik import solve_pose
 
 IK_SAMPLES = 32
 """Intervals of ``s`` per segment at which the joint path is solved by inverse kinematics."""
+MAX_POSITION = 100.0
+"""Largest coordinate of a via position [m]: no arm reaches further (a number beyond is a
+typo or garbage; refused before the IK, naming the row and column)."""
 CLOSURE_TOLERANCE = 1e-9
 """How far [m, rad] the last via pose may be from the first."""
 JOINT_CLOSURE_TOLERANCE = 1e-6
@@ -181,6 +184,18 @@ class PoseTrajectory(Trajectory):
         return TrajectorySample(*out)
 
 
+def _check_finite(name: str, values: np.ndarray, bound: float, unit: str) -> None:
+    """Raise naming the first entry (row, column) of ``values`` that is not finite or beyond ``±bound``."""
+    bad = ~np.isfinite(values) | (np.abs(values) > bound)
+    if bad.any():
+        index = tuple(int(i) for i in np.argwhere(bad)[0])
+        raise InvalidParameterError(
+            name + "".join(f"[{i}]" for i in index),
+            float(values[index]),
+            f"a finite number within ±{bound:g}{' ' + unit if unit else ''}",
+        )
+
+
 def pose_trajectory(
     robot: RobotModel,
     times: Sequence[float],
@@ -209,6 +224,8 @@ def pose_trajectory(
         raise InvalidParameterError(
             "via poses", f"{P.shape}, {R.shape}", f"positions ({n}, 3) and rotations ({n}, 3, 3)"
         )
+    _check_finite("positions", P, MAX_POSITION, "m")
+    _check_finite("rotations", R, 1.0 + 1e-9, "")
     for i, Ri in enumerate(R):
         if not np.allclose(Ri @ Ri.T, np.eye(3), atol=1e-9) or np.linalg.det(Ri) < 0:
             raise InvalidParameterError(f"rotations[{i}]", Ri.tolist(), "a rotation matrix")
