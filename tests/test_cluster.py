@@ -177,7 +177,11 @@ def assert_identical(a: Path, b: Path) -> None:
 
 
 def test_in_process_a_local_cluster_and_a_scheduler_give_identical_tables(
-    scheduler: DaskProcesses, reference: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+    scheduler: DaskProcesses,
+    reference: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """In-process (one chunk of 300), LocalCluster of 2 (chunks of 40), the scheduler through
     the command with --json (chunks of 7 and auto): the same table, and --json's stdout is
@@ -187,6 +191,7 @@ def test_in_process_a_local_cluster_and_a_scheduler_give_identical_tables(
     assert local.engine.startswith("LocalCluster of 2 workers at tcp://127.0.0.1:") and local.chunk == 40
     assert len(list((tmp_path / "local" / "runs").glob("part-*.parquet"))) == 8
     assert_identical(reference, tmp_path / "local")
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)  # the bar shows on a terminal only
     for chunk in ("7", "auto"):
         argv = [
             "sweep",

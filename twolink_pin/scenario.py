@@ -108,12 +108,15 @@ def make_controller(
         )
     presets = {k: v for k, v in robot.gain_presets.get(cls.name, {}).items() if k in cls.Gains.field_names()}
     reference = _reference(cls)
-    with guarded(reference, f"building its gains {cls.Gains.__name__}"):  # a user's gains class's checks
+    timed = not cls.__module__.startswith("twolink_pin.")  # user code: under --timeout too
+    with guarded(
+        reference, f"building its gains {cls.Gains.__name__}", timed=timed
+    ):  # a user's gains class's checks
         gains_obj = cls.Gains(**{**presets, **changes})
     kwargs: dict[str, Any] = {}
     if "friction" in cls.estimates:
         kwargs["friction"] = friction
-    with guarded(reference, f"building it on {robot.name}"):  # its __init__, scaled_gains, state
+    with guarded(reference, f"building it on {robot.name}", timed=timed):  # its __init__, scaled_gains, state
         controller = cls(robot, gains_obj, model_parameters=model_parameters, **kwargs)
         check_state_declaration(controller)
     return controller

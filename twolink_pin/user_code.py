@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.errors import ControllerSpecError, TwolinkPinError
+from twolink_pin.errors import ControllerError, ControllerSpecError, TwolinkPinError
 
 PACKAGE = Path(__file__).resolve().parent
 """This package's folder: frames in it are ours, not the user's."""
@@ -118,21 +118,26 @@ def _raised(exc: BaseException) -> str:
 
 
 @contextlib.contextmanager
-def guarded(reference: str, what: str) -> Iterator[None]:
+def guarded(reference: str, what: str, *, timed: bool = True) -> Iterator[None]:
     """Run user code (``what``: ``"importing path/to/law.py"``, ``"building it on twolink"``):
     its failures are a :class:`ControllerSpecError` naming ``reference``, what it did and
-    where (file and line); the process state is put back afterwards (module docstring).
+    where (file and line) — except running past the command's bound, a
+    :class:`~twolink_pin.errors.ControllerError` as when ``compute`` does (a failed run, exit
+    status 1); the process state is put back afterwards (module docstring).
 
-    Ctrl-C and SIGTERM pass through; so do the package's own errors (a gain out of bounds)."""
-    bound = _BOUND.get()
+    Ctrl-C and SIGTERM pass through; so do the package's own errors (a gain out of bounds).
+    ``timed=False``: not under the command's bound (a law of this package: its build is ours,
+    not user code, and ``--timeout`` bounds its runs only)."""
+    bound = _BOUND.get() if timed else None
     with process_state():
         try:
             with bound(_TimedOut) if bound is not None else contextlib.nullcontext():
                 yield
-        except _TimedOut as exc:
+        except _TimedOut as exc:  # a run stopped by its bound, as in compute: exit 1, not bad input
             where = location(exc.__context__) if exc.__context__ is not None else ""
-            raise ControllerSpecError(
+            raise ControllerError(
                 reference,
+                float("nan"),
                 f"{what} did not finish within --timeout {exc.seconds:g} s"
                 + (f" (it was at {where})" if where else ""),
             ) from None
