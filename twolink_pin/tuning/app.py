@@ -4,6 +4,8 @@ with ``watch``, the law's file is saved."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import threading
 from collections.abc import Callable
@@ -122,7 +124,8 @@ class Tuner:
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         knobs = knobs_of(type(controller).Gains, gains_used(controller))
-        self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        with contextlib.redirect_stdout(io.StringIO()):  # its banner: the command prints the URL itself
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
         if port and self.server.get_port() != port:
             self.server.stop()
             raise InvalidParameterError("--port", port, "a free port (it is in use)")

@@ -1,0 +1,178 @@
+"""``tune`` without a browser: the latest-wins session, the controls read from a law's
+``Gains`` declaration, and the ``simulate`` line that reproduces a run."""
+
+from __future__ import annotations
+
+import math
+import threading
+
+import pytest
+
+from twolink_pin.cli.commands.common import run_spec
+from twolink_pin.cli.parser import build_parser
+from twolink_pin.cli.simulate_line import command_line, simulate_argv
+from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench
+from twolink_pin.run_spec import PlantOptions, RunSpec
+from twolink_pin.simulation import SimulationConfig
+from twolink_pin.tuning import LatestWins, gains_from, knobs_of
+
+WAIT = 60.0
+"""Bound on every wait [s]: a failure, never a pass, when it runs out."""
+
+
+def test_a_burst_of_requests_runs_the_first_and_the_last_and_delivers_the_last_only() -> None:
+    """Requests 2, 3, 4 arrive while 1 runs: 2 and 3 never start (superseded while waiting),
+    1's outcome is stale (4 is newer) and dropped, 4's is delivered."""
+    started, release = threading.Event(), threading.Event()
+    delivered: list[tuple[int, int, object]] = []
+    done = threading.Event()
+
+    def work(x: int) -> int:
+        if x == 1:
+            started.set()
+            assert release.wait(WAIT)
+        return 10 * x
+
+    def deliver(generation: int, request: int, outcome: object) -> None:
+        delivered.append((generation, request, outcome))
+        done.set()
+
+    session: LatestWins[int, int] = LatestWins(work, deliver)
+    try:
+        session.submit(1)
+        assert started.wait(WAIT)
+        for x in (2, 3, 4):
+            session.submit(x)
+        release.set()
+        assert done.wait(WAIT)
+        assert session.idle(WAIT)
+        assert delivered == [(4, 4, 40)]
+        assert session.runs == 2
+    finally:
+        session.close()
+
+
+def test_a_failed_run_is_delivered_as_its_exception_and_the_next_run_still_runs() -> None:
+    outcomes: list[object] = []
+    ready = threading.Semaphore(0)
+
+    def work(x: int) -> float:
+        return 1.0 / x
+
+    def deliver(generation: int, request: int, outcome: object) -> None:
+        outcomes.append(outcome)
+        ready.release()
+
+    session: LatestWins[int, float] = LatestWins(work, deliver)
+    try:
+        session.submit(0)
+        assert ready.acquire(timeout=WAIT)
+        session.submit(4)
+        assert ready.acquire(timeout=WAIT)
+        assert isinstance(outcomes[0], ZeroDivisionError)
+        assert outcomes[1] == 0.25
+    finally:
+        session.close()
+
+
+def _parsed(argv: list[str]) -> RunSpec:
+    args = build_parser().parse_args(argv)
+    return run_spec(args, args.controller)
+
+
+@pytest.mark.parametrize(
+    "spec",
+    [
+        RunSpec(law="pd", gains=(("kp", (0.1 + 0.2, 1 / 3)), ("kd", 7e-5)), simulation=SimulationConfig(4.0)),
+        RunSpec(
+            law="computed-torque",
+            gains=(("k", (math.pi, math.e)),),
+            lam=2 / 3,
+            plant=PlantOptions(
+                friction="on",
+                saturate=True,
+                friction_smoothing=1e-3,
+                wrench=Wrench((-20.0, 0.1, 0.0), 1.0, 1.25),
+                payload_step=PayloadStep(0.3, 2.0),
+                sensor_noise=SensorNoise(1e-4, 1e-3, seed=7),
+                delay=2,
+            ),
+            simulation=SimulationConfig(
+                duration=2.5, dt=5e-4, q0_offset=(-0.1, 1 / 7), control_period=1e-3, method="rk4"
+            ),
+        ),
+        RunSpec(
+            law="pd",
+            plant=PlantOptions(wrench=Wrench((0.0, -5.0, 0.0, 0.0, 0.0, 0.5), 0.5)),  # until the end
+            simulation=SimulationConfig(duration=1.0, method="adaptive", q0_offset=-0.05),
+        ),
+    ],
+)
+def test_the_simulate_line_parses_back_to_the_same_run(spec: RunSpec) -> None:
+    """Every number as repr prints it: the parsed run equals the run, float for float."""
+    argv = simulate_argv(spec)
+    assert _parsed(argv) == spec
+    assert command_line(argv).startswith("twolink-pin simulate ")
+
+
+def test_the_simulate_line_carries_the_robot_payload_and_trajectory() -> None:
+    argv = simulate_argv(
+        RunSpec(law="pd"), robot="ur5", payload=0.1 + 0.2, trajectory="examples/ur5_square.toml"
+    )
+    args = build_parser().parse_args(argv)
+    assert (args.robot, args.payload, args.trajectory) == ("ur5", 0.1 + 0.2, "examples/ur5_square.toml")
+
+
+def test_a_quoted_line_keeps_a_path_with_spaces() -> None:
+    import shlex
+
+    line = command_line(simulate_argv(RunSpec(law="my laws/law.py:Law")))
+    assert shlex.split(line)[2] == "my laws/law.py:Law"
+
+
+def test_controls_follow_the_gains_declaration() -> None:
+    """pd on the twolink: kp and kd per joint (the report's values), each with a scale; the
+    labels carry the names ``twolink-pin controllers`` prints and the units; the defaults
+    give back the gains exactly and a scale multiplies every joint's value."""
+    from twolink_pin.controllers import CONTROLLERS
+
+    gains = {"kp": [350.0, 300.0], "kd": [40.0, 50.0]}
+    knobs = knobs_of(CONTROLLERS["pd"].Gains, gains)
+    assert [k.label for k in knobs] == [
+        "kp joint 1 [N·m/rad]",
+        "kp joint 2 [N·m/rad]",
+        "kp × (all)",
+        "kd joint 1 [N·m·s/rad]",
+        "kd joint 2 [N·m·s/rad]",
+        "kd × (all)",
+    ]
+    assert [(k.low, k.high, k.step) for k in knobs[:2]] == [(0.0, 1400.0, 1.0), (0.0, 1200.0, 1.0)]
+    assert gains_from(knobs, {}) == {"kp": (350.0, 300.0), "kd": (40.0, 50.0)}
+    assert gains_from(knobs, {2: 0.5, 3: 41.0}) == {"kp": (175.0, 150.0), "kd": (41.0, 50.0)}
+
+
+def test_a_scalar_gain_is_one_control_and_a_signed_one_ranges_both_ways() -> None:
+    from dataclasses import dataclass
+    from typing import Any
+
+    from twolink_pin import Gains, gain
+
+    @dataclass(frozen=True, eq=False)
+    class G(Gains):
+        lam: Any = gain(5.0, unit="1/s")
+        bias: Any = gain(-2.0, bound="any", unit="N·m")
+
+    knobs = knobs_of(G, {"lam": 5.0, "bias": -2.0})
+    assert [(k.label, k.low, k.high, k.step) for k in knobs] == [
+        ("lam [1/s]", 0.0, 20.0, 0.01),
+        ("bias [N·m]", -8.0, 8.0, 0.01),
+    ]
+
+
+def test_a_matrix_gain_is_its_diagonal_and_a_scale() -> None:
+    from twolink_pin.controllers import CONTROLLERS
+
+    k = [[[300.0, 0.0, 0.0], [0.0, 200.0, 0.0], [0.0, 0.0, 100.0]]]
+    knobs = knobs_of(CONTROLLERS["impedance"].Gains, {"k": k})
+    assert [kn.label for kn in knobs] == ["k axis x [N/m]", "k axis y [N/m]", "k axis z [N/m]", "k × (all)"]
+    assert gains_from(knobs, {3: 2.0}) == {"k": (600.0, 400.0, 200.0)}
