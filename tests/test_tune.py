@@ -176,3 +176,31 @@ def test_a_matrix_gain_is_its_diagonal_and_a_scale() -> None:
     knobs = knobs_of(CONTROLLERS["impedance"].Gains, {"k": k})
     assert [kn.label for kn in knobs] == ["k axis x [N/m]", "k axis y [N/m]", "k axis z [N/m]", "k × (all)"]
     assert gains_from(knobs, {3: 2.0}) == {"k": (600.0, 400.0, 200.0)}
+
+
+def test_a_refused_gain_on_the_command_line_is_one_line_and_exit_2_before_serving() -> None:
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "twolink_pin_entry",
+            "tune",
+            "pd",
+            "--gain",
+            "kp=-1",
+            "--no-browser",
+            "--json",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+    )
+    assert done.returncode == 2
+    assert done.stdout == ""  # no URL: nothing was served
+    assert done.stderr.strip().splitlines() == [
+        "twolink-pin: error: kp = -1.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) "
+        "[N·m/rad]: one for every joint or one per joint (or a row per run)"
+    ]
