@@ -204,3 +204,43 @@ def test_a_refused_gain_on_the_command_line_is_one_line_and_exit_2_before_servin
         "twolink-pin: error: kp = -1.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) "
         "[N·m/rad]: one for every joint or one per joint (or a row per run)"
     ]
+
+
+def test_the_tuner_runs_a_changed_gain_and_its_line_reproduces_the_run() -> None:
+    """In-process, no browser: the tuner's first run, then kd × 1.5; the second line carries
+    the new gains, and the run its command line describes (parsed as the CLI does) has the
+    same metrics, float for float."""
+    import queue
+    import shlex
+
+    from twolink_pin.cli.output import jsonable
+    from twolink_pin.metrics import compute_metrics
+    from twolink_pin.model import load_robot
+    from twolink_pin.simulation import simulate
+    from twolink_pin.trajectory import default_trajectory
+    from twolink_pin.tuning import Tuner
+
+    robot = load_robot("twolink")
+    reference = default_trajectory(robot)
+    lines: queue.Queue[dict[str, object]] = queue.Queue()
+    tuner = Tuner(
+        RunSpec(law="pd", simulation=SimulationConfig(duration=0.3)),
+        0.0,
+        lambda payload: (robot, reference),
+        lambda spec, payload: command_line(simulate_argv(spec, None, payload)),
+        lambda spec, payload: {},
+        lines.put,
+    )
+    try:
+        first = lines.get(timeout=WAIT)
+        assert first["gains"] == {"kp": [350.0, 300.0], "kd": [40.0, 50.0]}
+        tuner.panel.sliders[-1].value = 1.5  # kd × (all)
+        tuner.changed()
+        line = lines.get(timeout=WAIT)
+    finally:
+        tuner.close()
+    assert line["gains"] == {"kp": [350.0, 300.0], "kd": [60.0, 75.0]}
+    spec = _parsed(shlex.split(str(line["command"]))[1:])
+    result = simulate(*spec.build(robot), reference, spec.simulation)
+    assert jsonable(compute_metrics(result).as_dict()) == jsonable(line["metrics"])
+    assert line["metrics"] != first["metrics"]

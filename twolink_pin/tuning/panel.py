@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 
 MAX_PUSH = 1000.0
 """Largest push force on a control [N]."""
+MAX_DURATION = 60.0
+"""Longest run the duration control offers [s] (more when the command line asks for more)."""
 
 
 class Panel:
@@ -48,7 +50,9 @@ class Panel:
         plant, sim = base.plant, base.simulation
         wrench = plant.wrench
         with gui.add_folder("run", expand_by_default=False):
-            self.duration = gui.add_number("duration [s]", sim.duration, min=sim.dt, max=1e4, step=0.1)
+            self.duration = gui.add_number(  # bounded: a run in flight is not interrupted
+                "duration [s]", sim.duration, min=sim.dt, max=max(MAX_DURATION, sim.duration), step=0.1
+            )
             self.friction = gui.add_dropdown("plant friction", FRICTION_CHOICES, initial_value=plant.friction)
             self.saturate = gui.add_checkbox("saturate at the effort limits", plant.saturate)
             self.payload = gui.add_number("payload [kg]", payload, min=0.0, max=1e4, step=0.1)
