@@ -10,6 +10,7 @@ is delivered only while g is the newest.
 
 from __future__ import annotations
 
+import sys
 import threading
 from collections.abc import Callable
 from typing import Generic, TypeVar
@@ -92,6 +93,8 @@ class LatestWins(Generic[In, Out]):
                     current = generation == self._generation and not self._closed
                 if current:
                     self._deliver(generation, request, outcome)
+            except Exception as exc:  # showing a run failed (stdout closed): say so, keep serving
+                print(f"twolink-pin: run {generation} could not be shown: {exc}", file=sys.stderr, flush=True)
             finally:
                 with self._lock:
                     self._busy = False
