@@ -244,3 +244,24 @@ def test_the_tuner_runs_a_changed_gain_and_its_line_reproduces_the_run() -> None
     result = simulate(*spec.build(robot), reference, spec.simulation)
     assert jsonable(compute_metrics(result).as_dict()) == jsonable(line["metrics"])
     assert line["metrics"] != first["metrics"]
+
+
+def test_reload_controller_reads_the_saved_file_again(tmp_path: object) -> None:
+    """``--watch``'s reload: the class after an edit is the edited one (load_controller alone
+    keeps the module it imported first)."""
+    from pathlib import Path
+
+    from twolink_pin.controllers.loading import load_controller, reload_controller
+
+    law = Path(str(tmp_path)) / "edited_law.py"
+    source = (Path(__file__).resolve().parents[1] / "examples" / "sliding_mode.py").read_text()
+    law.write_text(source.replace('name = "sliding-mode"', 'name = "sliding-mode-watched"'))
+    first = load_controller(f"{law}:SlidingMode")
+    law.write_text(
+        source.replace('name = "sliding-mode"', 'name = "sliding-mode-watched"').replace(
+            'title = "sliding mode with a boundary layer"', 'title = "edited"'
+        )
+    )
+    assert load_controller(f"{law}:SlidingMode") is first
+    again = reload_controller(f"{law}:SlidingMode")
+    assert again.title == "edited" and first.title == "sliding mode with a boundary layer"
