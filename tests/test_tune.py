@@ -265,3 +265,101 @@ def test_reload_controller_reads_the_saved_file_again(tmp_path: object) -> None:
     assert load_controller(f"{law}:SlidingMode") is first
     again = reload_controller(f"{law}:SlidingMode")
     assert again.title == "edited" and first.title == "sliding mode with a boundary layer"
+
+
+def _blocking_pd(at: float, blocked: threading.Event, release: threading.Event, seen: list[float]) -> type:
+    """PD + feedforward whose first run stops at t ≥ ``at`` [s] until ``release`` is set
+    (``seen``: the times that first run evaluated)."""
+    from twolink_pin.controllers.pd import PDFeedforward
+
+    class BlockingPD(PDFeedforward):
+        def compute(self, x, terms):  # type: ignore[no-untyped-def]
+            if not hasattr(self, "first"):
+                self.first = not blocked.is_set()
+            if self.first:
+                seen.append(float(x.t))
+            if x.t >= at and not blocked.is_set():
+                blocked.set()
+                assert release.wait(WAIT)
+            return super().compute(x, terms)
+
+    return BlockingPD
+
+
+def test_a_change_cancels_the_run_in_flight_and_only_the_newer_run_is_shown() -> None:
+    """Run 1's law blocks at t = 0.2 s until run 2 (kd × 1.5) has been asked for: run 1 then
+    stops at its next block of samples (cancelled, its last law time well before the end),
+    never reaches the JSON lines or the page; run 2's result is the one shown."""
+    import queue
+
+    from twolink_pin.model import load_robot
+    from twolink_pin.trajectory import default_trajectory
+    from twolink_pin.tuning import Tuner
+
+    blocked, release, seen = threading.Event(), threading.Event(), []
+    robot = load_robot("twolink")
+    reference = default_trajectory(robot)
+    lines: queue.Queue[dict[str, object]] = queue.Queue()
+    law = _blocking_pd(0.2, blocked, release, seen)
+    tuner = Tuner(
+        RunSpec(law=law, simulation=SimulationConfig(duration=1.0)),
+        0.0,
+        lambda payload: (robot, reference),
+        lambda spec, payload: "twolink-pin simulate …",
+        lambda spec, payload: {},
+        lines.put,
+    )
+    try:
+        assert blocked.wait(WAIT)
+        tuner.panel.sliders[-1].value = 1.5  # kd × (all)
+        tuner.changed()
+        release.set()
+        line = lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        status = tuner.status.content
+    finally:
+        tuner.close()
+    assert line["run"] == 2 and line["gains"] == {"kp": [350.0, 300.0], "kd": [60.0, 75.0]}
+    assert lines.empty()
+    assert tuner.session.cancelled == 1 and tuner.session.runs == 2
+    assert 0.2 <= max(seen) < 0.3  # run 1 stopped at the end of its block (128 steps of 1 ms)
+    assert status.startswith("run 2: 1 s simulated")
+
+
+def test_a_long_run_publishes_the_part_simulated_so_far_and_it_is_the_results_prefix() -> None:
+    """The law waits at t = 0.3 s: what was published before that covers t < 0.3 s only and
+    equals the finished run's first samples exactly (q, q_des, τ)."""
+    import numpy as np
+
+    from twolink_pin.model import load_robot
+    from twolink_pin.trajectory import default_trajectory
+    from twolink_pin.tuning.runner import Partial, Request, Runner
+
+    blocked, release, seen = threading.Event(), threading.Event(), []
+    robot = load_robot("twolink")
+    reference = default_trajectory(robot)
+    parts: list[Partial] = []
+    runner = Runner(
+        lambda payload: (robot, reference), partial=parts.append, stream_after=0.0, stream_period=0.0
+    )
+    law = _blocking_pd(0.3, blocked, release, seen)
+    request = Request(RunSpec(law=law, simulation=SimulationConfig(duration=0.6)), 0.0)
+    finished: list[object] = []
+    worker = threading.Thread(target=lambda: finished.append(runner(request)))
+    worker.start()
+    try:
+        assert blocked.wait(WAIT)
+        before = list(parts)
+    finally:
+        release.set()
+        worker.join(WAIT)
+    assert before and float(before[-1].t[-1]) < 0.3
+    assert len(before[-1].t) == 256  # two blocks of 128 samples
+    result = finished[0].result  # type: ignore[attr-defined]
+    for part in (before[-1], parts[-1]):
+        k = len(part.t)
+        assert np.array_equal(part.t, result.t[:k])
+        assert np.array_equal(part.q, result.q[:k])
+        assert np.array_equal(part.q_des, result.q_des[:k])
+        assert np.array_equal(part.tau_command, result.tau_command[:k])
+    assert len(parts[-1].t) == len(result.t)

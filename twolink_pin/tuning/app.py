@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.knobs import knobs_of
 from twolink_pin.tuning.latest import LatestWins
-from twolink_pin.tuning.runner import Finished, Request, Runner
+from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
@@ -120,7 +120,7 @@ class Tuner:
         from twolink_pin.run_spec import gains_used
 
         self._command_of, self._record_of, self._report = command_of, record_of, report
-        self._runner = Runner(arm)
+        self._runner = Runner(arm, lambda: self._session.superseded(), self._partial)
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         knobs = knobs_of(type(controller).Gains, gains_used(controller))
@@ -175,6 +175,11 @@ class Tuner:
         """The page's address."""
         return f"http://{self.server.get_host()}:{self.server.get_port()}/"
 
+    @property
+    def session(self) -> LatestWins[Request, Finished]:
+        """The runs (latest wins): how many started, how many were cancelled."""
+        return self._session
+
     def changed(self) -> None:
         """Re-run with the controls' values (superseding a run in flight)."""
         try:
@@ -191,6 +196,14 @@ class Tuner:
         self._session.close()
         self.scene.close()
         self.server.stop()
+
+    def _partial(self, part: Partial) -> None:
+        """Show the part of the run in flight simulated so far (on the worker thread)."""
+        if self._session.superseded():
+            return
+        self.scene.show(part.t, part.q, part.q_des)
+        self.plots.show_partial(part)
+        self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
 
     def _deliver(self, generation: int, request: Request, outcome: Finished | Exception) -> None:
         command = self._command_of(request.spec, request.payload)

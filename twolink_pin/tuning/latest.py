@@ -6,6 +6,11 @@ at most one run in flight and one waiting); when the in-flight run ends, its out
 delivered only if no newer request was made meanwhile, so a stale outcome never overwrites
 a newer one. Every request gets a generation number (1, 2, …); the outcome of generation g
 is delivered only while g is the newest.
+
+The run in flight is cancelled, not waited for: ``work`` may ask :meth:`LatestWins.superseded`
+(the tuner asks it after every block of samples the engine writes,
+:func:`~twolink_pin.simulation.deadline.watched`) and stop by raising
+:class:`~twolink_pin.simulation.deadline.RunCancelled`; a cancelled run is never delivered.
 """
 
 from __future__ import annotations
@@ -14,6 +19,8 @@ import sys
 import threading
 from collections.abc import Callable
 from typing import Generic, TypeVar
+
+from twolink_pin.simulation.deadline import RunCancelled
 
 In = TypeVar("In")
 Out = TypeVar("Out")
@@ -39,8 +46,11 @@ class LatestWins(Generic[In, Out]):
         self._waiting: tuple[int, In] | None = None
         self._generation = 0
         self._closed = False
+        self._running = 0
         self.runs = 0
         """Runs started (a superseded request never starts)."""
+        self.cancelled = 0
+        """Runs that stopped with :class:`RunCancelled` (superseded while in flight)."""
         self._thread = threading.Thread(target=self._loop, name="twolink-pin-tune-runs", daemon=True)
         self._thread.start()
 
@@ -58,8 +68,12 @@ class LatestWins(Generic[In, Out]):
             self._lock.notify()
             return self._generation
 
+    def superseded(self) -> bool:
+        """Whether the run in flight is no longer wanted (a newer request, or closed)."""
+        return self._closed or self._running != self._generation
+
     def close(self) -> None:
-        """Stop after the run in flight (no further request starts)."""
+        """Stop: no further request starts, and the run in flight is superseded."""
         with self._lock:
             self._closed = True
             self._waiting = None
@@ -82,10 +96,17 @@ class LatestWins(Generic[In, Out]):
                 generation, request = self._waiting
                 self._waiting = None
                 self._busy = True
+                self._running = generation
                 self.runs += 1
             outcome: Out | Exception
             try:
                 outcome = self._work(request)
+            except RunCancelled:
+                with self._lock:
+                    self.cancelled += 1
+                    self._busy = False
+                    self._lock.notify_all()
+                continue
             except Exception as exc:  # the run's failure is its outcome (shown, the server stays up)
                 outcome = exc
             try:

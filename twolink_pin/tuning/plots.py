@@ -1,7 +1,7 @@
 """The tuner's plots (uPlot panels in Viser's GUI), redrawn after every run: the joint
 errors [rad], the torques as a fraction of their limits (N·m where the model has none),
 the task errors [mm, deg] of a task-space law, and the law's state (estimates,
-integrators)."""
+integrators); while a long run is in flight, its joint errors and torques so far."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 if TYPE_CHECKING:
-    from twolink_pin.tuning.runner import Finished
+    from twolink_pin.tuning.runner import Finished, Partial
 
 POINTS = 600
 """Largest number of samples drawn per curve."""
@@ -38,25 +38,32 @@ def _curves(
     return data, series
 
 
-def panels(done: Finished) -> dict[str, tuple[tuple[np.ndarray, ...], tuple[Any, ...]]]:
-    """Title → (data, series) of every panel for the run ``done``."""
-    result = done.result
-    t = result.t
-    nv = result.q.shape[1]
-    out = {
-        "joint errors e = q − q_des [rad]": _curves(
-            t, result.q - result.q_des, [f"e{j + 1}" for j in range(nv)]
-        )
-    }
-    limits = np.asarray(result.torque_limits, dtype=float)
+Panels = dict[str, tuple[tuple[np.ndarray, ...], tuple[Any, ...]]]
+
+
+def joint_panels(
+    t: np.ndarray, q: np.ndarray, q_des: np.ndarray, tau: np.ndarray, limits: np.ndarray
+) -> Panels:
+    """The joint-error [rad] and torque panels (what a run in flight shows too)."""
+    nv = q.shape[1]
+    out = {"joint errors e = q − q_des [rad]": _curves(t, q - q_des, [f"e{j + 1}" for j in range(nv)])}
+    limits = np.asarray(limits, dtype=float)
     if np.isfinite(limits).all():
         out["torque / limit (±1 = the URDF effort limit)"] = _curves(
-            t, result.tau_command / limits, [f"τ{j + 1}/limit" for j in range(nv)]
+            t, tau / limits, [f"τ{j + 1}/limit" for j in range(nv)]
         )
     else:
         out["torque τ [N·m] (no effort limits in the model)"] = _curves(
-            t, result.tau_command, [f"τ{j + 1}" for j in range(nv)]
+            t, tau, [f"τ{j + 1}" for j in range(nv)]
         )
+    return out
+
+
+def panels(done: Finished) -> Panels:
+    """Title → (data, series) of every panel for the run ``done``."""
+    result = done.result
+    t = result.t
+    out = joint_panels(t, result.q, result.q_des, result.tau_command, result.torque_limits)
     if done.task is not None:
         from twolink_pin.task_metrics import task_errors
 
@@ -88,9 +95,16 @@ class Plots:
 
     def show(self, done: Finished) -> None:
         """Redraw every panel for ``done`` (a panel this run has no data for is hidden)."""
-        wanted = panels(done)
-        for title, handle in self._handles.items():
-            handle.visible = title in wanted
+        self._draw(panels(done), hide_others=True)
+
+    def show_partial(self, part: Partial) -> None:
+        """Redraw the joint-error and torque panels for the part of a run simulated so far."""
+        self._draw(joint_panels(part.t, part.q, part.q_des, part.tau_command, part.torque_limits), False)
+
+    def _draw(self, wanted: Panels, hide_others: bool) -> None:
+        if hide_others:
+            for title, handle in self._handles.items():
+                handle.visible = title in wanted
         for title, (data, series) in wanted.items():
             handle = self._handles.get(title)
             if handle is not None and len(handle.series) == len(series):
@@ -102,4 +116,4 @@ class Plots:
             self._handles[title] = self._server.gui.add_uplot(data, series, title=title, aspect=1.6)
 
 
-__all__ = ["Plots", "panels"]
+__all__ = ["Plots", "joint_panels", "panels"]
