@@ -1,7 +1,8 @@
 """``tune`` in a real Chromium, driven by the keyboard: the page draws the arm, a gain's
 slider re-runs the law, the latest setting wins, the reproducing ``simulate`` line gives the
 same metrics, a user's law gets its own controls, ``--watch`` reloads it, refused values,
-a law that raises and a diverging run leave the server up, and Ctrl-C ends it cleanly.
+a law that raises and a diverging run leave the server up, Ctrl-C ends it cleanly, and two
+tabs (one closed and reopened) show the same latest run.
 
 The runs are observed through ``tune --json``'s lines on stdout (one per finished run);
 every wait is on a condition, bounded by :data:`WAIT` (a failure when it runs out)."""
@@ -209,6 +210,54 @@ def test_ctrl_c_ends_the_server_cleanly(pd: Tune) -> None:
     assert code == 0, err
     assert "Traceback" not in err
     assert "stopping the tuner" in err
+
+
+def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_controls(driver: Any) -> None:
+    """Two tabs on one tuner: a gain moved in the first is the second's control value and
+    both show that run; the second closed and opened again draws the arm and has the controls
+    and the latest run."""
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    tune = Tune("pd")
+    first_tab = driver.current_window_handle
+    try:
+        tune.next(ran)
+        driver.get(tune.url)
+        thumb = slider(driver, "kp joint 1 [N·m/rad]")
+        driver.switch_to.new_window("tab")
+        second_tab = driver.current_window_handle
+        driver.get(tune.url)
+        slider(driver, "kp joint 1 [N·m/rad]")
+        driver.switch_to.window(first_tab)
+        press(thumb, Keys.ARROW_RIGHT)
+        line = tune.next(ran)
+        assert line["gains"]["kp"] == [351.0, 300.0]
+        shown = f"run {line['run']}: "
+
+        def latest(d: Any) -> bool:
+            value = slider(d, "kp joint 1 [N·m/rad]").get_attribute("aria-valuenow")
+            return float(value) == 351.0 and shown in page_text(d)
+
+        WebDriverWait(driver, WAIT).until(latest)
+        driver.switch_to.window(second_tab)
+        WebDriverWait(driver, WAIT).until(latest)
+        driver.close()
+        driver.switch_to.window(first_tab)
+        driver.switch_to.new_window("tab")
+        driver.get(tune.url)
+        WebDriverWait(driver, WAIT).until(latest)
+        assert {"kp joint 1 [N·m/rad]", "kd joint 2 [N·m·s/rad]"} <= set(labels(driver))
+        WebDriverWait(driver, WAIT).until(
+            lambda d: bool((screenshot(d)[150:850, 300:950, :3].min(axis=2) < 0.8).mean() > 0.01)
+        )
+    finally:
+        for handle in driver.window_handles:
+            if handle != first_tab:
+                driver.switch_to.window(handle)
+                driver.close()
+        driver.switch_to.window(first_tab)
+        tune.stop()
 
 
 @pytest.fixture(scope="module")
