@@ -201,7 +201,8 @@ class Tuner:
         """Show the part of the run in flight simulated so far (on the worker thread)."""
         if self._session.superseded():
             return
-        self.scene.show(part.t, part.q, part.q_des)
+        step = max(1, len(part.t) // 600)  # the final run redraws at full resolution
+        self.scene.show(part.t[::step], part.q[::step], part.q_des[::step])
         self.plots.show_partial(part)
         self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
 

@@ -119,7 +119,7 @@ class Runner:
         cancelled: Callable[[], bool] = lambda: False,
         partial: Callable[[Partial], None] | None = None,
         stream_after: float = 1.0,
-        stream_period: float = 0.25,
+        stream_period: float = 0.5,
     ) -> None:
         self._arm = arm
         self.cancelled, self.partial = cancelled, partial
