@@ -34,6 +34,12 @@ Usage::
     .venv/bin/python scripts/benchmark.py --single-only [--quick]  # every law's single run, back to back; osc on the Panda
     .venv/bin/python scripts/benchmark.py --shared-only [--quick]  # two batches at once; 200-run sweep, 2 workers
     .venv/bin/python scripts/benchmark.py --big-arms-only [--quick]  # issue 31: Panda osc/impedance, batches, floor
+    .venv/bin/python scripts/benchmark.py --tune-only [--quick]    # tune: from a change to updated results
+
+``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
+measured, the scene, plots and metrics table updated, its JSON line reported) for one period
+of the reference: pd on the twolink (4 s; goal 0.5 s), pd on the UR5, osc on the Panda; the
+median and the largest of several changes, through the tuner's own server (no browser).
 
 A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
 processes, at the default thread count, at 1 and at 2 threads, per simulation against the
@@ -842,6 +848,72 @@ def big_arms_section(baseline: Callable[[], Any], scale: float, quick: bool, rep
     return {"big_arms": rows}
 
 
+TUNE_GOAL = 0.5
+"""From a change to updated results for the twolink's one-period pd run [s] (issue 29)."""
+
+
+def _tune_latency(robot_name: str, law: str, changes: int) -> list[float]:
+    """Seconds from each of ``changes`` gain changes to the tuner's report of the new run."""
+    import threading
+
+    from twolink_pin.cli.simulate_line import command_line, simulate_argv
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.tuning import Tuner
+
+    robot = load_robot(robot_name)
+    reference = default_trajectory(robot)
+    base = RunSpec(law=law, simulation=SimulationConfig(duration=float(reference.period), dt=DT))
+    finished = threading.Semaphore(0)
+    tuner = Tuner(
+        base,
+        0.0,
+        lambda payload: (robot, reference),
+        lambda spec, payload: command_line(simulate_argv(spec, robot_name, payload)),
+        lambda spec, payload: {},
+        lambda line: finished.release(),
+        port=0,
+    )
+    try:
+        assert finished.acquire(timeout=600)  # the first run
+        seconds = []
+        for k in range(changes):
+            slider = tuner.panel.sliders[-1]  # the last gain's scale: × 1.01, 1.02, …
+            slider.value = 1.0 + 0.01 * (k + 1)
+            start = time.perf_counter()
+            tuner.changed()
+            assert finished.acquire(timeout=600)
+            seconds.append(time.perf_counter() - start)
+        return seconds
+    finally:
+        tuner.close()
+
+
+def tune_section(quick: bool) -> dict[str, Any]:
+    """``tune``: the latency from a change to updated results (see the module docstring)."""
+    changes = 2 if quick else 5
+    cases = [("twolink", "pd"), ("ur5", "pd"), ("panda", "osc")]
+    print(
+        f"\ntune: from a change of a gain to updated results, one period of the reference, median and max of "
+        f"{changes} changes (goal for pd on the twolink {TUNE_GOAL:g} s); load average "
+        f"{[round(x, 2) for x in os.getloadavg()]}"
+    )
+    out: dict[str, Any] = {}
+    for robot_name, law in cases[:1] if quick else cases:
+        seconds = _tune_latency(robot_name, law, changes)
+        period = float(default_trajectory(load_robot(robot_name)).period)
+        median = statistics.median(seconds)
+        goal = (
+            f"  (goal {TUNE_GOAL:g} s: {'met' if median <= TUNE_GOAL else 'NOT met'})"
+            if robot_name == "twolink"
+            else ""
+        )
+        print(
+            f"  {law + ' on the ' + robot_name:22s} {period:5.1f} s run   {median:6.3f} s   max {max(seconds):6.3f} s{goal}"
+        )
+        out[f"{law}_{robot_name}"] = {"period": period, "median_seconds": median, "max_seconds": max(seconds)}
+    return {"tune_latency": out}
+
+
 def _verdict(ratio: float, target: float | None) -> str:
     if target is None:
         return ""
@@ -978,6 +1050,9 @@ def main(argv: list[str] | None = None) -> int:
         help="only the contention row (two batches at once) and the 200-run sweep in-process against 2 workers",
     )
     parser.add_argument(
+        "--tune-only", action="store_true", help="only tune's latency from a change to updated results"
+    )
+    parser.add_argument(
         "--contention-only",
         action="store_true",
         help="only the contention row: two batches at once, and one alone (default threads against 1)",
@@ -1006,6 +1081,11 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.tune_only:
+        results.update(tune_section(quick))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.identify_only:
         results.update(identification_section(quick))
         if args.json:
@@ -1222,6 +1302,7 @@ def main(argv: list[str] | None = None) -> int:
     else:
         results.update(sweep_200_section())
         results.update(sweep_section(quick))
+        results.update(tune_section(quick))
     results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
     print(f"\nload average at the end {results['machine']['load_average_end']}")
     if args.json:

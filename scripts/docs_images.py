@@ -19,6 +19,7 @@ animation      animation.png: the exported meshcat animation (adaptive, 8 s)    
 live           live.png: the same run served live (``twolink-pin animate``)     10 s
 figures        trajectory_workspace.png, adaptive_theta1.png                    10 s
 ur5_square     ur5_square_end_effector.png, ur5_square_meshcat.png              40 s
+tune           tune.png: ``twolink-pin tune pd`` in the browser, after one run  30 s
 =============  ==============================================================  =========
 """
 
@@ -190,12 +191,38 @@ def ur5_square() -> list[Path]:
     return [figure, shot]
 
 
+TUNE_READY = (  # the first run shown, the scene faded in, the WebGL notice closed
+    "document.querySelectorAll('.mantine-Notification-root').forEach(function (e) { e.remove(); });"
+    "return performance.now() > 8000 && document.body.innerText.includes('run 1:')"  # the scene has faded in
+    " && document.body.innerText.includes('this run');"
+)
+
+
+def tune() -> list[Path]:
+    """``twolink-pin tune pd`` as a user starts it, photographed after its first run."""
+    import json
+    import signal
+    import subprocess
+
+    command = [sys.executable, "-m", "twolink_pin_entry", "tune", "pd", "--json", "--no-browser"]
+    proc = subprocess.Popen(command, cwd=ROOT, stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        url = json.loads(proc.stdout.readline())["url"]
+        proc.stdout.readline()  # the first run
+        return [_photograph(url, IMAGES / "tune.png", 1280, 800, TUNE_READY)]
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.wait(timeout=60)
+
+
 MAKERS: dict[str, Callable[[], list[Path]]] = {
     "report": report,
     "animation": animation,
     "live": live,
     "figures": figures,
     "ur5_square": ur5_square,
+    "tune": tune,
 }
 
 

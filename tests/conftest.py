@@ -38,6 +38,7 @@ GROUPS: dict[str, str] = {
     "test_physical.py": "physical",  # identify --physical (cvxpy + Clarabel)
     "test_plotting.py": "plotting",  # closed-loop runs and their figures
     "test_controllers.py": "controllers",  # two 8-s adaptive runs (Lyapunov checks)
+    "test_tune_browser.py": "tune",  # Chromium on two live tune servers
 }
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 

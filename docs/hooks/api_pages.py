@@ -58,6 +58,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "The 3-D view with meshcat (the only meshcat user).",
         ("visualization",),
     ),
+    (
+        "tuning",
+        "Tuning",
+        "`twolink-pin tune`: a law tuned live in the browser (the only viser user).",
+        ("tuning",),
+    ),
     ("report", "Report", "The one-command HTML report.", ("report",)),
     ("cli", "Command line", "`twolink-pin`, a thin shell over the library.", ("cli",)),
     ("twolink", "The twolink", "Everything specific to the course report's arm.", ("twolink",)),

@@ -7,6 +7,7 @@
 ``commands/``          one module per family of commands, each command a thin shell over the library
 ``output.py``          text or JSON on stdout, the progress display on stderr
 ``guard.py``           around a command: ``--json`` stdout kept for the JSON, outputs ≠ inputs
+``simulate_line.py``   the ``twolink-pin simulate …`` line that reproduces a run, bit for bit (``tune``)
 =====================  ====================================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged

@@ -305,6 +305,28 @@ def _add_run_commands(sub: Any, c: Any) -> None:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_animate, run_options=run_option_strings(p))
 
+    p = sub.add_parser(
+        "tune", help="tune a law live in the browser: move a gain, the run is simulated again and shown"
+    )
+    p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
+    add_sim_options(p)
+    p.set_defaults(duration=None)  # one period of the reference: a run to tune is short
+    add_gain_option(p)
+    add_identified_options(p)
+    p.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1: this machine only)"
+    )
+    p.add_argument("--port", type=port, default=None, help="port of the page (default: a free one)")
+    p.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    p.add_argument(
+        "--watch",
+        action="store_true",
+        help="reload a law file (file.py:Class) when it is saved and run again",
+    )
+    add_disturbance_options(p)
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_tune)
+
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
     add_sim_options(p)

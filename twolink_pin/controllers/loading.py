@@ -78,6 +78,13 @@ def available_controllers() -> dict[str, type[Controller]]:
     return dict(CONTROLLERS)
 
 
+def _file_module_name(path: Path) -> str:
+    """The module name a law file is imported under (one per resolved path)."""
+    resolved = path.expanduser().resolve()
+    digest = hashlib.sha1(str(resolved).encode()).hexdigest()[:10]
+    return f"twolink_pin_user_{resolved.stem}_{digest}"
+
+
 def _from_file(spec: str, file_part: str, class_name: str) -> type:
     path = Path(file_part).expanduser()
     if not path.is_file():
@@ -85,9 +92,8 @@ def _from_file(spec: str, file_part: str, class_name: str) -> type:
         raise ControllerSpecError(spec, f"{reason}: {path}")
     if path.suffix != ".py":
         raise ControllerSpecError(spec, f"expected a Python file ending in .py, got {path.name}")
+    module_name = _file_module_name(path)
     resolved = path.resolve()
-    digest = hashlib.sha1(str(resolved).encode()).hexdigest()[:10]
-    module_name = f"twolink_pin_user_{resolved.stem}_{digest}"
     module = sys.modules.get(module_name)
     if module is None:
         loader_spec = importlib.util.spec_from_file_location(module_name, resolved)
@@ -154,3 +160,16 @@ def load_controller(spec: str) -> type[Controller]:
     if "name" not in cls.__dict__:
         raise ControllerSpecError(spec, f"{class_name} must declare its own name = '...'")
     return cls
+
+
+def reload_controller(spec: str) -> type[Controller]:
+    """The law of ``spec`` read again from its file (``tune --watch``: the file was saved);
+    a registered name or a module: as :func:`load_controller`.
+
+    Raises:
+        ControllerSpecError: as :func:`load_controller` (the file raised: its message).
+    """
+    location, sep, _ = spec.rpartition(":") if isinstance(spec, str) else ("", "", "")
+    if sep and (location.endswith(".py") or "/" in location or "\\" in location):
+        sys.modules.pop(_file_module_name(Path(location)), None)
+    return load_controller(spec)

@@ -16,6 +16,11 @@ thread only) — a Dask worker runs its tasks in worker threads, so a sweep on D
 is not bounded per run (an in-process sweep is, per chunk of runs: one chunk is one
 simulation of N runs); on a platform without ``setitimer`` (Windows); and code that blocks
 signals or loops inside C without returning to Python.
+
+A second, cooperative hook: :func:`watched` hands every block of samples the fixed-step
+engine writes to a callable (in the thread that runs the simulation), which may raise
+:class:`RunCancelled` to stop the run there — the tuner (:mod:`twolink_pin.tuning`) cancels a
+superseded run this way and streams the part already simulated.
 """
 
 from __future__ import annotations
@@ -33,6 +38,30 @@ if TYPE_CHECKING:
     from twolink_pin.controllers import Controller
 
 _LIMIT: contextvars.ContextVar[float | None] = contextvars.ContextVar("twolink_pin_run_limit", default=None)
+_WATCHER: contextvars.ContextVar[Callable[[Any], None] | None] = contextvars.ContextVar(
+    "twolink_pin_run_watcher", default=None
+)
+
+
+class RunCancelled(Exception):
+    """A run stopped by its watcher (:func:`watched`): its result is no longer wanted."""
+
+
+@contextlib.contextmanager
+def watched(hook: Callable[[Any], None] | None) -> Iterator[None]:
+    """Call ``hook(block)`` with each block of samples (:class:`~twolink_pin.simulation.engine.Samples`,
+    views: copy to keep) of the fixed-step simulations started inside the block; the hook
+    may raise :class:`RunCancelled` to stop the run."""
+    token = _WATCHER.set(hook)
+    try:
+        yield
+    finally:
+        _WATCHER.reset(token)
+
+
+def run_watcher() -> Callable[[Any], None] | None:
+    """The hook in force (:func:`watched`; None: none)."""
+    return _WATCHER.get()
 
 
 class RunTimeout(BaseException):
@@ -135,4 +164,13 @@ def timed_out(controller: Controller, t: float, seconds: float) -> ControllerErr
     )
 
 
-__all__ = ["RunTimeout", "bounded", "per_run_limit", "run_limit", "timed_out"]
+__all__ = [
+    "RunCancelled",
+    "RunTimeout",
+    "bounded",
+    "per_run_limit",
+    "run_limit",
+    "run_watcher",
+    "timed_out",
+    "watched",
+]

@@ -44,7 +44,7 @@ from twolink_pin.errors import ControllerError, SimulationDivergedError, Twolink
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
 from twolink_pin.simulation.containment import contained, read_only
-from twolink_pin.simulation.deadline import bounded, timed_out
+from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.task_reference import reference_rows
@@ -211,6 +211,7 @@ def integrate(
     dz1: Any = None
     first = True
     clock = _Clock()  # time of the law evaluation under way (for error messages)
+    watcher = run_watcher()
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
     # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
     with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, clock.now, seconds)):
@@ -291,12 +292,14 @@ def integrate(
                     j = 2 * (k1 - k0)
                     q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
                     q[newly], v[newly], z[newly] = rq[j][0], rv[j][0], z_start[newly]
-            if observer is not None:
-                observer.add(
-                    Samples(
-                        k0, times[k0:k1], Q[rows], V[rows], Z[rows], T[rows], RQ[rows], RV[rows], RA[rows]
-                    )
+            if observer is not None or watcher is not None:
+                block = Samples(
+                    k0, times[k0:k1], Q[rows], V[rows], Z[rows], T[rows], RQ[rows], RV[rows], RA[rows]
                 )
+                if observer is not None:
+                    observer.add(block)
+                if watcher is not None:  # simulation.deadline.watched: may raise RunCancelled
+                    watcher(block)
             if progress is not None:
                 progress(min(k1, n), n)
     recorded = Samples(0, times, Q, V, Z, T, RQ, RV, RA, MQ, MV) if record else None

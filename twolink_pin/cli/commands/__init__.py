@@ -6,6 +6,7 @@
 ``identify.py``   ``identify``, ``excite``
 ``run.py``        ``simulate``, ``compare``, ``animate``, ``report``
 ``sweep.py``      ``sweep``
+``tune.py``       ``tune``
 ================  =====================================================================
 
 Every command prints a readable summary, or JSON with ``--json``. The library is imported
@@ -25,6 +26,7 @@ from twolink_pin.cli.commands.model import (
 )
 from twolink_pin.cli.commands.run import cmd_animate, cmd_compare, cmd_report, cmd_simulate
 from twolink_pin.cli.commands.sweep import cmd_sweep
+from twolink_pin.cli.commands.tune import cmd_tune
 
 __all__ = [
     "cmd_animate",
@@ -40,4 +42,5 @@ __all__ = [
     "cmd_simulate",
     "cmd_sweep",
     "cmd_trajectory",
+    "cmd_tune",
 ]

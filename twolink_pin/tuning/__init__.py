@@ -1,0 +1,25 @@
+"""``twolink-pin tune``: tune a law live in the browser, on a Viser page.
+
+Every change of a control re-simulates the run in the background (latest wins: a change
+supersedes the run waiting, and a run that ends after a newer change is dropped) and the
+page shows the new run: the arm, its ghost and trail, the plots, the metrics beside the
+previous run and the defaults, and the ``twolink-pin simulate …`` line that reproduces it.
+
+================  ===================================================================
+``latest.py``     :class:`LatestWins`: one worker thread, one waiting request
+``knobs.py``      the controls of a law's gains, from its ``Gains`` declaration
+``runner.py``     one run: simulated, measured, its gains and plant
+``panel.py``      the controls in the page and the ``RunSpec`` they describe
+``scene.py``      the arm (Pinocchio's ``ViserVisualizer``), ghost, trail, playback
+``plots.py``      joint errors, torques against limits, task errors, the law's state
+``app.py``        :class:`Tuner`: the server, the metrics table, save and export, watch
+================  ===================================================================
+
+The only part of twolink-pin that imports viser (in :mod:`.app`, :mod:`.scene`, lazily).
+"""
+
+from twolink_pin.tuning.app import Tuner
+from twolink_pin.tuning.knobs import Knob, gains_from, knobs_of
+from twolink_pin.tuning.latest import LatestWins
+
+__all__ = ["Knob", "LatestWins", "Tuner", "gains_from", "knobs_of"]

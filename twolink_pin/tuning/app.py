@@ -1,0 +1,292 @@
+"""The tuner: a Viser server whose page shows the arm, the controls, the plots and the
+metrics of the latest run, and re-simulates (latest wins) whenever a control moves or,
+with ``watch``, the law's file is saved."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import os
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from twolink_pin.errors import InvalidParameterError, TwolinkPinError, raised_at
+from twolink_pin.tuning.knobs import knobs_of
+from twolink_pin.tuning.latest import LatestWins
+from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
+
+if TYPE_CHECKING:
+    from twolink_pin.model import RobotModel
+    from twolink_pin.run_spec import RunSpec
+    from twolink_pin.trajectory import Trajectory
+
+WATCH_PERIOD = 0.25
+"""How often the law's file is looked at [s] (``watch``)."""
+
+
+def metrics_table(this: Finished, previous: Finished | None, defaults: Finished) -> str:
+    """The metrics of this run beside the previous one and the defaults, as Markdown."""
+
+    def cells(done: Finished | None, pick: Callable[[Finished], Any]) -> str:
+        if done is None:
+            return "–"
+        value = pick(done)
+        return ", ".join(f"{x:.4g}" for x in value) if hasattr(value, "__len__") else f"{value:.4g}"
+
+    def m(kind: str, name: str) -> Callable[[Finished], Any]:
+        return lambda d: getattr(getattr(d.metrics, kind), name)
+
+    rows = [
+        ("RMS e [rad]", m("rms", "e")),
+        ("max \\|e\\| [rad]", m("max", "e")),
+        ("last period max \\|e\\| [rad]", lambda d: d.metrics.final_period_max_abs_e),
+        ("RMS τ [N·m]", m("rms", "tau")),
+        ("max \\|τ\\| [N·m]", m("max", "tau")),
+    ]
+    if this.task is not None:
+        rows += [
+            ("task RMS \\|p − p_d\\| [mm]", lambda d: d.task.position_rms_mm if d.task else float("nan")),
+            ("task RMS angle [deg]", lambda d: d.task.orientation_rms_deg if d.task else float("nan")),
+        ]
+    lines = ["| | this run | previous | defaults |", "|---|---|---|---|"]
+    lines += [
+        f"| {name} | {cells(this, f)} | {cells(previous, f)} | {cells(defaults, f)} |" for name, f in rows
+    ]
+    return "\n".join(lines)
+
+
+def run_line(done: Finished, command: str, generation: int) -> dict[str, Any]:
+    """What the tuner reports of a finished run (``tune --json`` prints it as one line):
+    ``gains`` and ``metrics`` as ``simulate --json`` prints them, the reproducing
+    ``command``, the plant and its settings."""
+    line: dict[str, Any] = {
+        "run": generation,
+        "controller": done.result.controller,
+        "gains": done.gains,
+        "metrics": done.metrics.as_dict(),
+        "command": command,
+        "plant": done.plant,
+        "payload": done.request.payload,
+        "spec": done.request.spec.as_dict(),
+        "seconds": done.seconds,
+    }
+    if done.task is not None:
+        line["task_metrics"] = done.task.as_dict()
+    return line
+
+
+def error_text(exc: BaseException) -> str:
+    """A failed run in one line; a law file that did not load: with the file and line."""
+    text = str(exc)
+    cause = exc.__context__ or exc.__cause__
+    if cause is not None and not isinstance(exc, InvalidParameterError):
+        where = raised_at(cause)
+        if where and where.strip(" ()") not in text:
+            text += where
+    return text
+
+
+class Tuner:
+    """The tuner's server and its state.
+
+    Args:
+        base: The run the command line describes (the controls start there).
+        payload: Its payload [kg].
+        arm: ``payload`` → the robot and the reference (loaded as the command line says).
+        command_of: ``(spec, payload)`` → the ``twolink-pin simulate …`` line of that run.
+        record_of: ``(spec, payload)`` → what a saved run records (``simulate --save``).
+        report: Called with each run's line (:func:`run_line`) or a failure's
+            (``{"error": ..., "command": ...}``), on the worker thread.
+        host, port: Where the page is served (port 0: a free one).
+        watch: Re-read the law's file when it changes.
+    """
+
+    def __init__(
+        self,
+        base: RunSpec,
+        payload: float,
+        arm: Callable[[float], tuple[RobotModel, Trajectory]],
+        command_of: Callable[[RunSpec, float], str],
+        record_of: Callable[[RunSpec, float], dict[str, Any]],
+        report: Callable[[dict[str, Any]], None],
+        host: str = "127.0.0.1",
+        port: int = 0,
+        watch: bool = False,
+    ) -> None:
+        import viser
+
+        from twolink_pin.run_spec import gains_used
+
+        self._command_of, self._record_of, self._report = command_of, record_of, report
+        self._runner = Runner(arm, lambda: self._session.superseded(), self._partial)
+        robot, _ = self._runner.arm(payload)
+        controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
+        knobs = knobs_of(type(controller).Gains, gains_used(controller))
+        with contextlib.redirect_stdout(io.StringIO()):  # its banner: the command prints the URL itself
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        if port and self.server.get_port() != port:
+            self.server.stop()
+            raise InvalidParameterError("--port", port, "a free port (it is in use)")
+        self.server.gui.configure_theme(control_width="large")
+        gui = self.server.gui
+        gui.add_markdown(f"**twolink-pin tune** · {controller.title} (`{controller.name}`) on {robot.name}")
+        self.status = gui.add_markdown("starting…")
+        from twolink_pin.tuning.panel import Panel
+        from twolink_pin.tuning.plots import Plots
+        from twolink_pin.tuning.scene import ArmScene
+
+        self.panel = Panel(self.server, knobs, base, payload, self.changed)
+        with gui.add_folder("playback"):
+            self.scene = ArmScene(self.server, robot)
+        with gui.add_folder("metrics"):
+            self.metrics = gui.add_markdown("")
+        with gui.add_folder("plots"):
+            self.plots = Plots(self.server)
+        with gui.add_folder("as a command"):
+            self.command = gui.add_markdown("")
+            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz")
+            gui.add_button("save run").on_click(lambda _: self._save())
+            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html")
+            gui.add_button("export animation").on_click(lambda _: self._export())
+            self.saved = gui.add_markdown("")
+        self._lock = threading.Lock()
+        self._latest: Finished | None = None
+        self._previous: Finished | None = None
+        self._defaults: Finished | None = None
+        self._law_version = 0
+        self._closed = threading.Event()
+        self._session: LatestWins[Request, Finished] = LatestWins(self._runner, self._deliver)
+        self._watcher = None
+        law = base.law if isinstance(base.law, str) else ""
+        if watch and ".py:" in law:
+            self._watcher = threading.Thread(
+                target=self._watch,
+                args=(Path(law.rpartition(":")[0]),),
+                name="twolink-pin-tune-watch",
+                daemon=True,
+            )
+            self._watcher.start()
+        self.changed()
+
+    @property
+    def url(self) -> str:
+        """The page's address."""
+        return f"http://{self.server.get_host()}:{self.server.get_port()}/"
+
+    @property
+    def session(self) -> LatestWins[Request, Finished]:
+        """The runs (latest wins): how many started, how many were cancelled."""
+        return self._session
+
+    def changed(self) -> None:
+        """Re-run with the controls' values (superseding a run in flight)."""
+        try:
+            spec, payload = self.panel.spec()
+        except TwolinkPinError as exc:
+            self.panel.show_error(None, str(exc))
+            return
+        self.status.content = "running…"
+        self._session.submit(Request(spec, payload, self._law_version))
+
+    def close(self) -> None:
+        """Stop the runs, the playback and the server."""
+        self._closed.set()
+        self._session.close()
+        self.scene.close()
+        self.server.stop()
+
+    def _partial(self, part: Partial) -> None:
+        """Show the part of the run in flight simulated so far (on the worker thread)."""
+        if self._session.superseded():
+            return
+        step = max(1, len(part.t) // 600)  # the final run redraws at full resolution
+        self.scene.show(part.t[::step], part.q[::step], part.q_des[::step])
+        self.plots.show_partial(part)
+        self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+
+    def _deliver(self, generation: int, request: Request, outcome: Finished | Exception) -> None:
+        command = self._command_of(request.spec, request.payload)
+        if isinstance(outcome, Exception):
+            text = error_text(outcome)
+            gain = getattr(outcome, "name", None)
+            gain = gain.partition("[")[0] if isinstance(gain, str) else None
+            if isinstance(outcome, InvalidParameterError) and gain in self.panel.gain_errors:
+                self.panel.show_error(gain, text)
+            else:
+                self.panel.show_error(None, "")
+            self.status.content = f"**run {generation} failed** (the last good run stays on screen): {text}"
+            self._report({"run": generation, "error": text, "command": command})
+            return
+        self.panel.show_error(None, "")
+        with self._lock:
+            self._previous, self._latest = self._latest, outcome
+            if self._defaults is None:
+                self._defaults = outcome
+            previous, defaults = self._previous, self._defaults
+        result = outcome.result
+        self.scene.show(result.t, result.q, result.q_des)
+        self.plots.show(outcome)
+        self.metrics.content = metrics_table(outcome, previous, defaults)
+        self.command.content = f"```\n{command}\n```"
+        self.status.content = f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s"
+        self._report(run_line(outcome, command, generation))
+
+    def _save(self) -> None:
+        from twolink_pin.simulation.storage import save_result
+
+        done = self._latest
+        if done is None:
+            return
+        try:
+            path = save_result(done.result, self.save_path.value, record=self._record_of(*done.request[:2]))
+            self.saved.content = f"saved `{path}`"
+        except (TwolinkPinError, OSError) as exc:
+            self.saved.content = f"**not saved**: {exc}"
+
+    def _export(self) -> None:
+        from twolink_pin.kinematics import joint_positions
+        from twolink_pin.visualization import write_html
+        from twolink_pin.visualization.overlays import run_overlays
+
+        done = self._latest
+        if done is None:
+            return
+        result = done.result
+        _, reference = self._runner.arm(done.request.payload)
+        via_q = getattr(reference, "via_q", None)
+        points = None if via_q is None else joint_positions(done.robot, via_q)[:, -1, :]
+        try:
+            path = write_html(
+                done.robot,
+                result.t,
+                result.q,
+                result.q_des,
+                path=self.html_path.value,
+                via_points=points,
+                **run_overlays(done.request.spec.plant.wrench, result.t),
+            )
+            self.saved.content = f"animation written to `{path}`"
+        except (TwolinkPinError, OSError) as exc:
+            self.saved.content = f"**not written**: {exc}"
+
+    def _watch(self, path: Path) -> None:
+        def stamp() -> tuple[int, int] | None:
+            try:
+                info = os.stat(path)
+            except OSError:
+                return None
+            return info.st_mtime_ns, info.st_size
+
+        seen = stamp()
+        while not self._closed.wait(WATCH_PERIOD):
+            now = stamp()
+            if now != seen and now is not None:
+                seen = now
+                self._law_version += 1
+                self.status.content = f"`{path}` changed: reloading the law"
+                self.changed()
+
+
+__all__ = ["Tuner", "error_text", "metrics_table", "run_line"]

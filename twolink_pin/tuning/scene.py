@@ -1,0 +1,141 @@
+"""The tuner's 3-D scene in Viser: the arm (its URDF meshes, through Pinocchio's
+``ViserVisualizer``), its translucent ghost following the reference, the end effector's
+trail and desired path, and the playback (play/pause, a time scrubber, a speed)."""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from twolink_pin.kinematics import joint_positions
+from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visual_model
+
+if TYPE_CHECKING:
+    from twolink_pin.model import RobotModel
+
+FPS = 30.0
+"""Playback frames per second."""
+TRAIL_POINTS = 400
+"""Largest number of points of the trail and the desired path."""
+TRAIL_RGB = (194, 37, 92)
+DESIRED_RGB = (43, 138, 62)
+
+
+def _segments(points: np.ndarray) -> np.ndarray:
+    """A polyline ``(P, 3)`` as line segments ``(P − 1, 2, 3)``."""
+    step = max(1, len(points) // TRAIL_POINTS)
+    p = points[::step]
+    return np.stack([p[:-1], p[1:]], axis=1).astype(np.float32)
+
+
+def view_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where the camera looks (the motion's centre [m]) and where it is: along the normal of
+    a planar motion, obliquely otherwise, far enough to see it all."""
+    centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
+    spread = points - points.mean(axis=0)
+    _, sigma, axes = np.linalg.svd(spread, full_matrices=False)
+    radius = float(max(np.linalg.norm(points - centre, axis=1).max(), 0.2))
+    if sigma[-1] < 1e-6 * max(sigma[0], 1e-12):  # planar: look along its normal, from the side of +z
+        direction = axes[-1] * (1.0 if axes[-1][2] >= 0 else -1.0) + np.array([0.0, -0.15, 0.0])
+    else:
+        direction = np.array([1.0, -1.2, 0.8])
+    direction /= np.linalg.norm(direction)
+    return centre, centre + 2.2 * radius * direction
+
+
+class ArmScene:
+    """The arm, its ghost and trail in ``server``'s scene, with the playback controls in its
+    GUI (created in the folder open when this is built)."""
+
+    def __init__(self, server: Any, robot: RobotModel) -> None:
+        import pinocchio as pin
+        from pinocchio.visualize import ViserVisualizer
+
+        self._server = server
+        self._robot = robot
+        visual = visual_model(robot)
+        self.arm = ViserVisualizer(robot.model, pin.GeometryModel(), visual)
+        self.arm.initViewer(viewer=server)
+        self.arm.loadViewerModel("arm")
+        self.ghost = ViserVisualizer(
+            robot.model, pin.GeometryModel(), ghost_visual_model(visual, rgb=GHOST_RGB)
+        )
+        self.ghost.initViewer(viewer=server)
+        self.ghost.loadViewerModel("ghost")
+        self.playing = server.gui.add_checkbox("play", True, hint="play or pause the run")
+        self.time = server.gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0, hint="the instant shown")
+        self.speed = server.gui.add_slider("speed", 0.1, 4.0, 0.1, 1.0, hint="× real time")
+        self.time.on_update(self._on_scrub)
+        self._lock = threading.Lock()
+        self._t = np.zeros(1)
+        self._q = np.array([robot.home])
+        self._q_des = self._q
+        self._now = 0.0
+        self._stop = threading.Event()
+        self._framed = False
+        self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
+        self._thread.start()
+
+    def show(self, t: np.ndarray, q: np.ndarray, q_des: np.ndarray) -> None:
+        """Play the run ``q`` [rad] against ``q_des`` [rad] at the times ``t`` [s]."""
+        ee = joint_positions(self._robot, q)[:, -1, :]
+        ee_des = joint_positions(self._robot, q_des)[:, -1, :]
+        scene = self._server.scene
+        scene.add_line_segments("trail", _segments(ee), TRAIL_RGB, thickness=3.0, thickness_units="screen")
+        scene.add_line_segments(
+            "desired_path", _segments(ee_des), DESIRED_RGB, thickness=2.0, thickness_units="screen"
+        )
+        if not self._framed:  # the first run frames the view; later ones keep the user's
+            self._framed = True
+            joints = joint_positions(self._robot, q_des[:: max(1, len(q_des) // 50)]).reshape(-1, 3)
+            centre, eye = view_of(np.vstack([joints, ee, ee_des]))
+            self._server.initial_camera.look_at = centre
+            self._server.initial_camera.position = eye
+            self._server.initial_camera.up = (0.0, 0.0, 1.0)
+        with self._lock:
+            self._t, self._q, self._q_des = t, q, q_des
+            self._now = min(self._now, float(t[-1]))
+        self.time.max = float(t[-1])
+        self._draw()
+
+    def close(self) -> None:
+        """Stop the playback thread."""
+        self._stop.set()
+
+    def _on_scrub(self, event: Any) -> None:
+        if event.client is not None:  # the user moved it (the playback sets it too)
+            self._seek(float(self.time.value))
+
+    def _seek(self, now: float) -> None:
+        with self._lock:
+            self._now = now
+        if not self.playing.value:
+            self._draw()
+
+    def _draw(self) -> None:
+        with self._lock:
+            i = int(np.searchsorted(self._t, self._now).clip(0, len(self._t) - 1))
+            q, q_des = self._q[i], self._q_des[i]
+        with self._server.atomic():
+            self.arm.display(q)
+            self.ghost.display(q_des)
+
+    def _play(self) -> None:
+        last = time.monotonic()
+        while not self._stop.wait(1.0 / FPS):
+            now = time.monotonic()
+            elapsed, last = now - last, now
+            if not self.playing.value:
+                continue
+            with self._lock:
+                end = float(self._t[-1])
+                self._now = (self._now + elapsed * float(self.speed.value)) % end if end > 0 else 0.0
+                shown = self._now
+            self.time.value = round(shown, 2)
+            self._draw()
+
+
+__all__ = ["ArmScene", "view_of"]
