@@ -190,6 +190,8 @@ inline_animation(robot, adaptive.t, adaptive.q, adaptive.q_des, via_points=via_x
 # ## Where next
 #
 # - Write your own law: one class in one file ([writing a controller](../docs/writing_a_controller.md)).
+# - Tune a law live in the browser: move a gain and watch the arm, its errors and torques change,
+#   `twolink-pin tune pd` ([tuning a law live](../docs/tune.md)).
 # - Compare every built-in law over 30 s, as the report's Table 2: `twolink-pin compare`
 #   ([comparison with the report](../docs/report_comparison.md)).
 # - Any other arm from URDF, e.g. `load_robot("ur5")` ([any robot](../docs/any_robot.md)).
