@@ -299,7 +299,7 @@ def test_reading_a_bag_takes_at_most_three_times_its_size(twolink, tmp_path: Pat
     message as an object took 8.8 ×)."""
     import tracemalloc
 
-    from twolink_pin.identification.bags import READ_MEMORY_FACTOR
+    from twolink_pin.identification.bag_checks import READ_MEMORY_FACTOR
 
     bag = write_bag(
         tmp_path / "run", twolink, twolink_excitation.identification_excitation(), 10.0, 1e-3, "sqlite3"

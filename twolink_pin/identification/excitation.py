@@ -338,9 +338,9 @@ def optimise_excitation(
     design = design if design is not None else ExcitationDesign()
     if design.criterion == "adaptation":
         if controller is None:
-            from twolink_pin.run_spec import make_scenario
+            from twolink_pin.scenario import make_controller  # the law alone: no plant, no run
 
-            controller = make_scenario("adaptive", robot).controller
+            controller = make_controller("adaptive", robot)
         if not controller.estimates or not hasattr(controller.gains, "gamma"):
             raise InvalidParameterError("controller", controller.name, "an adaptive law (gains k and gamma)")
     problem = _Problem(robot, design, controller if design.criterion == "adaptation" else None)
