@@ -132,6 +132,27 @@ def start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
         raise _failed_start(address, options.get("n_workers"), exc, records) from None
 
 
+class _SlowExit(logging.Filter):
+    """Drops a nanny's "Worker process still alive after 4.0 seconds, killing"."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("Worker process still alive after")
+
+
+@contextlib.contextmanager
+def quiet_worker_exit() -> Iterator[None]:
+    """While a LocalCluster closes after its work: a worker process that is slow to exit (a
+    loaded machine; a teardown that does not return) is killed by its nanny after 4 s, and
+    the nanny's warning that says so is dropped: the results are complete, and a success
+    prints nothing on stderr."""
+    logger, quiet = logging.getLogger("distributed.nanny"), _SlowExit()
+    logger.addFilter(quiet)
+    try:
+        yield
+    finally:
+        logger.removeFilter(quiet)
+
+
 def kill_workers(cluster: Any) -> None:
     """Kill a LocalCluster's worker processes at once, their nannies' complaints silenced
     (a task they are in can take minutes)."""
