@@ -161,7 +161,8 @@ def _quiet_worker_start() -> None:
     """In a process that ``multiprocessing`` spawned from this command (a Dask worker, which
     imports this module as its ``__main__``): if it cannot create a thread or process (the
     limit on processes reached), it ends with status ``EX_TEMPFAIL`` instead of printing a
-    traceback; the command names the cause in one line (:mod:`twolink_pin.studies.cluster_startup`)."""
+    traceback, and a worker that fails while it starts (its imports) does not log its
+    traceback: the command names the cause in one line (:mod:`twolink_pin.studies.cluster_startup`)."""
     process = sys.modules.get("multiprocessing.process")
     if process is None or not getattr(process.current_process(), "_inheriting", False):
         return
@@ -178,6 +179,11 @@ def _quiet_worker_start() -> None:
             raise
 
     process.BaseProcess.run = run_or_leave
+    import logging  # the worker's failed start (an import that fails) is the command's one line
+
+    logging.getLogger("distributed.nanny").addFilter(
+        lambda record: record.getMessage() != "Failed to initialize worker"
+    )
 
 
 _quiet_worker_start()

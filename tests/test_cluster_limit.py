@@ -46,6 +46,8 @@ HOOK = textwrap.dedent(
             f.write("1")
     if WHEN == "worker" and getattr(multiprocessing.process.current_process(), "_inheriting", False):
         limit()  # a spawned worker process, before its first thread
+    if WHEN == "import" and getattr(multiprocessing.process.current_process(), "_inheriting", False):
+        sys.modules["pinocchio"] = None  # the worker dies in its imports
     import twolink_pin_entry
     if __name__ == "__main__":
         if CGROUP:
@@ -183,3 +185,15 @@ def test_closing_a_local_cluster_whose_worker_is_slow_to_exit_prints_no_warning(
     said = [(r.levelno, r.getMessage()) for r in caplog.records if r.name == "distributed.nanny"]
     assert any(m.endswith("was killed by signal 9") for _, m in said), said
     assert [m for level, m in said if level >= logging.WARNING] == []
+
+
+def test_a_worker_that_dies_in_its_imports_is_one_line_naming_the_error(tmp_path: Path) -> None:
+    """Before: each worker logged "Failed to initialize worker" with its traceback."""
+    done, left = _run(tmp_path, "", "import")
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1, done.stderr[-3000:]
+    assert lines[0].startswith(
+        "twolink-pin: error: Dask cluster 127.0.0.1 (LocalCluster): the LocalCluster did not start "
+        "(ModuleNotFoundError: import of pinocchio halted"
+    ), lines[0]
+    assert done.returncode == 2 and left == []
