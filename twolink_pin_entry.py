@@ -21,6 +21,7 @@ module's first line ends the process as the operating system does (exit âˆ’2 / â
 
 from __future__ import annotations
 
+import errno
 import os
 import signal
 import sys
@@ -108,8 +109,13 @@ def _end_children() -> None:
     ``multiprocessing`` child; the command's own workers are stopped by then), and their
     children as they are re-parented here, so that none keeps the command alive (Python's
     exit waits for ``multiprocessing`` children) or outlives it."""
+    tracker = sys.modules.get("multiprocessing.resource_tracker")
+    # multiprocessing's resource tracker ends by itself when this process's end of its pipe
+    # closes; killed here, the exit handlers' unregistering (a LocalCluster that did not
+    # start leaves semaphores) starts a new one that prints a KeyError traceback per name.
+    spared = getattr(getattr(tracker, "_resource_tracker", None), "_pid", None)
     for _ in range(100):  # each round ends one generation (their orphans come back to us)
-        children = _children()
+        children = [pid for pid in _children() if pid != spared]
         if not children:
             break
         for pid in children:
@@ -149,6 +155,38 @@ def _finish(code: int) -> None:
     finally:
         _flush()
         os._exit(code)
+
+
+def _quiet_worker_start() -> None:
+    """In a process that ``multiprocessing`` spawned from this command (a Dask worker, which
+    imports this module as its ``__main__``): if it cannot create a thread or process (the
+    limit on processes reached), it ends with status ``EX_TEMPFAIL`` instead of printing a
+    traceback, and a worker that fails while it starts (its imports) does not log its
+    traceback: the command names the cause in one line (:mod:`twolink_pin.studies.cluster_startup`)."""
+    process = sys.modules.get("multiprocessing.process")
+    if process is None or not getattr(process.current_process(), "_inheriting", False):
+        return
+    run = process.BaseProcess.run
+
+    def run_or_leave(self: object) -> None:
+        try:
+            run(self)
+        except (OSError, RuntimeError) as exc:
+            if isinstance(exc, OSError) and exc.errno in (errno.EAGAIN, errno.ENOMEM):
+                raise SystemExit(os.EX_TEMPFAIL) from None
+            if isinstance(exc, RuntimeError) and "can't start new thread" in str(exc):
+                raise SystemExit(os.EX_TEMPFAIL) from None
+            raise
+
+    process.BaseProcess.run = run_or_leave
+    import logging  # the worker's failed start (an import that fails) is the command's one line
+
+    logging.getLogger("distributed.nanny").addFilter(
+        lambda record: record.getMessage() != "Failed to initialize worker"
+    )
+
+
+_quiet_worker_start()
 
 
 def main() -> int:

@@ -8,10 +8,22 @@ are; ``tests/test_corpus.py`` runs both.
 from __future__ import annotations
 
 from corpus.cases import REP, SIM, C
-from corpus.spec import Case, LibCase
+from corpus.spec import Case, LibCase, text
 
 TIMEOUT = ("did not finish within --timeout", "pd")
 """What every --timeout message says: the bound and the law."""
+
+CANNOT_FORK = """import errno, os, multiprocessing.process
+start = multiprocessing.process.BaseProcess.start
+def start_at_the_limit(self):  # a Dask worker process: refused as fork is at the process limit
+    if "Dask Worker" in self.name:
+        raise OSError(errno.EAGAIN, os.strerror(errno.EAGAIN))
+    start(self)
+multiprocessing.process.BaseProcess.start = start_at_the_limit
+"""
+"""A ``sitecustomize`` (on ``PYTHONPATH``) that fails every start of a Dask worker process as
+fork fails at the limit on processes; tests/test_cluster_limit.py reaches the kernel's limit
+itself (a pids cgroup)."""
 
 # fmt: off
 LIMITS: list[Case] = [
@@ -24,6 +36,8 @@ LIMITS: list[Case] = [
     C("traceback-report-timeout-1e-9", f"report {REP} --out r --timeout 1e-9", 1, err=(*TIMEOUT, "1e-09"), run="proc", note="the report keeps the other laws: here none, an index that says so"),
     # stiff: the adaptive step held at a fraction of dt is recognised from its pace, not after its whole budget
     C("hang-simulate-adaptive-lambda-1e5", "simulate computed-torque --method adaptive --lambda 1e5", 1, err=("computed-torque", "t = 0.", "collapsed to about", "steps per dt"), timeout=60, note="73 s of work before the budget ran out; the pace is projected after 20 000 evaluations"),
+    # Dask at the process limit: one line naming the reason and what to do, exit 2 as every cluster error
+    C("traceback-sweep-dask-workers-cannot-fork", f"sweep pd --samples 4 {SIM} --no-plot --workers 2 --out s", 2, err=("the 2 Dask worker processes could not start", "Resource temporarily unavailable", "fewer workers"), setup=(text("hook/sitecustomize.py", CANNOT_FORK),), env=(("PYTHONPATH", "{dir}/hook"),), run="proc", absent=("s",), timeout=120, note="before: after the error, multiprocessing's resource tracker 'died unexpectedly' (killed by the reaping) and KeyError tracebacks"),
     C("hang-compare-adaptive-lambda-1e5", "compare computed-torque --method adaptive --lambda 1e5 --no-plot --out c", 1, err=("computed-torque", "collapsed to about", "steps per dt"), changed=("c",), timeout=60),
 ]
 

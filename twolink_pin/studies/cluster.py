@@ -34,7 +34,7 @@ from urllib.parse import urlsplit
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
-from twolink_pin.studies.cluster_startup import handshake, kill_workers, probe, start_local
+from twolink_pin.studies.cluster_startup import handshake, kill_workers, probe, quiet_worker_exit, start_local
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -313,7 +313,7 @@ class DaskEngine:
         with contextlib.suppress(Exception):
             self.client.close(timeout=5)
         if self.cluster is not None:
-            with contextlib.suppress(Exception):
+            with contextlib.suppress(Exception), quiet_worker_exit():
                 self.cluster.close(timeout=10)
 
 

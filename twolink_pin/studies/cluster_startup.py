@@ -2,14 +2,17 @@
 :func:`~twolink_pin.studies.cluster.open_cluster`): a scheduler address that nothing answers,
 or that answers with no Dask message, fails fast and says so (:func:`probe`,
 :func:`handshake`); what Dask logs while a LocalCluster starts is kept rather than printed: a nanny that cannot spawn its worker (a
-bad ``multiprocessing-method`` in the user's Dask configuration) or a temporary folder that
-cannot be made is then one line naming the cause, not distributed's own tracebacks and
-warnings on stderr (:func:`start_local`). Imports no Dask until called."""
+bad ``multiprocessing-method`` in the user's Dask configuration), a temporary folder that
+cannot be made or workers that cannot start at the limit on processes (a fork or a thread
+refused with ``EAGAIN``) is then one line naming the cause, not distributed's own tracebacks
+and warnings on stderr (:func:`start_local`). Imports no Dask until called."""
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import logging
+import os
 import socket
 import threading
 from collections.abc import Iterator
@@ -33,7 +36,7 @@ def _startup_log() -> Iterator[list[logging.LogRecord]]:
             records.append(record)
 
     saved = logger.handlers[:], logger.propagate
-    logger.handlers, logger.propagate = [_Keep(logging.WARNING)], False
+    logger.handlers, logger.propagate = [_Keep(logging.INFO)], False
     started = False
     try:
         yield records
@@ -42,7 +45,8 @@ def _startup_log() -> Iterator[list[logging.LogRecord]]:
         logger.handlers, logger.propagate = saved
         if started:  # a warning of a cluster that did start (a slow start, a deprecation) still shows
             for record in records:
-                logger.handle(record)
+                if record.levelno >= logging.WARNING:
+                    logger.handle(record)
 
 
 def _startup_cause(exc: BaseException, records: list[logging.LogRecord]) -> str:
@@ -53,6 +57,43 @@ def _startup_cause(exc: BaseException, records: list[logging.LogRecord]) -> str:
             inner = record.exc_info[1]
             return f"{type(inner).__name__}: {str(inner)[:300]}; {record.getMessage()[:120]}"
     return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+def _resource_cause(exc: BaseException, records: list[logging.LogRecord]) -> str | None:
+    """The operating system's reason when a worker process or thread could not be created
+    (fork or clone refused at the process limit: ``EAGAIN``, ``ENOMEM``; Python's "can't
+    start new thread"), from ``exc`` or what distributed logged; else None."""
+    seen = [exc] + [r.exc_info[1] for r in records if r.exc_info and r.exc_info[1] is not None]
+    for first in seen:
+        error: BaseException | None = first
+        for _ in range(20):  # along its chain of causes (bounded: a chain can loop)
+            if error is None:
+                break
+            if isinstance(error, OSError) and error.errno in (errno.EAGAIN, errno.ENOMEM):
+                return error.strerror or os.strerror(error.errno)
+            if isinstance(error, RuntimeError) and "can't start new thread" in str(error):
+                return "can't start new thread"
+            error = error.__cause__ or error.__context__
+    for record in records:  # a worker that could not start a thread (twolink_pin_entry) left quietly
+        if record.getMessage().endswith(f"exited with status {os.EX_TEMPFAIL}"):
+            return "a worker process could not start its threads"
+    return None
+
+
+def _failed_start(
+    address: str, workers: Any, exc: BaseException, records: list[logging.LogRecord]
+) -> ClusterError:
+    """The error of a LocalCluster that did not start: at the process limit one line naming
+    the operating system's reason and what to do, else the cause distributed logged."""
+    reason = _resource_cause(exc, records)
+    if reason is None:
+        return ClusterError(address, f"the LocalCluster did not start ({_startup_cause(exc, records)})")
+    return ClusterError(
+        address,
+        f"the {workers} Dask worker process{'es' if workers != 1 else ''} could not start: {reason} "
+        "(the limit on processes and threads reached?); try fewer workers, or run in-process "
+        "(without --workers)",
+    )
 
 
 def start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
@@ -88,9 +129,28 @@ def start_local(address: str, options: dict[str, Any]) -> tuple[Any, Any]:
                     cluster.close(timeout=10)
         if not isinstance(exc, Exception):
             raise
-        raise ClusterError(
-            address, f"the LocalCluster did not start ({_startup_cause(exc, records)})"
-        ) from None
+        raise _failed_start(address, options.get("n_workers"), exc, records) from None
+
+
+class _SlowExit(logging.Filter):
+    """Drops a nanny's "Worker process still alive after 4.0 seconds, killing"."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        return not record.getMessage().startswith("Worker process still alive after")
+
+
+@contextlib.contextmanager
+def quiet_worker_exit() -> Iterator[None]:
+    """While a LocalCluster closes after its work: a worker process that is slow to exit (a
+    loaded machine; a teardown that does not return) is killed by its nanny after 4 s, and
+    the nanny's warning that says so is dropped: the results are complete, and a success
+    prints nothing on stderr."""
+    logger, quiet = logging.getLogger("distributed.nanny"), _SlowExit()
+    logger.addFilter(quiet)
+    try:
+        yield
+    finally:
+        logger.removeFilter(quiet)
 
 
 def kill_workers(cluster: Any) -> None:
