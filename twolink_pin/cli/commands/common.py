@@ -17,13 +17,13 @@ if TYPE_CHECKING:
     from twolink_pin.trajectory import Trajectory
 
 
-def _robot(args: argparse.Namespace) -> RobotModel:
+def robot_from_args(args: argparse.Namespace) -> RobotModel:
     from twolink_pin.model import load_robot
 
     return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
 
 
-def _trajectory(args: argparse.Namespace, robot: RobotModel) -> Trajectory:
+def trajectory_from_args(args: argparse.Namespace, robot: RobotModel) -> Trajectory:
     """The reference of ``--trajectory FILE``, else the robot's default."""
     from twolink_pin.trajectory import default_trajectory, read_trajectory_file
 
@@ -103,7 +103,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
     )
 
 
-def _identified(spec: RunSpec, robot: RobotModel) -> IdentifiedParameters | None:
+def identified_parameters(spec: RunSpec, robot: RobotModel) -> IdentifiedParameters | None:
     """The parameter file of ``--p0`` or ``--model``, read once per command (its notes on stderr)."""
     identified = spec.read_parameters(robot)
     if identified is not None:

@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import _robot
+from twolink_pin.cli.commands.common import robot_from_args
 from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.errors import InvalidParameterError
 
@@ -180,7 +180,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         write_log,
     )
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     if args.data:
         log, reference, bag_summary = _data_log(args, robot)
     else:
@@ -239,7 +239,7 @@ def cmd_excite(args: argparse.Namespace) -> int:
     from twolink_pin.identification.measures import averaged_adaptation, excitation_measures
     from twolink_pin.trajectory import default_trajectory, write_trajectory_file
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     if Path(args.out).suffix.lower() not in (".json", ".toml"):
         raise InvalidParameterError("--out", args.out, "a trajectory file name ending in .json or .toml")
     limits = ExcitationLimits(

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.cli.commands.common import _robot, _trajectory
+from twolink_pin.cli.commands.common import robot_from_args, trajectory_from_args
 from twolink_pin.cli.output import emit, fmt, pose_lines
 from twolink_pin.errors import InvalidParameterError
 
@@ -21,7 +21,7 @@ if TYPE_CHECKING:
 def cmd_info(args: argparse.Namespace) -> int:
     from twolink_pin.model.base_parameters import BaseParameterMap
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     base = (
         robot.parameter_map
         if isinstance(robot.parameter_map, BaseParameterMap)
@@ -205,7 +205,7 @@ def _pose_payload(robot: RobotModel, q: np.ndarray) -> tuple[dict[str, Any], lis
 def cmd_fk(args: argparse.Namespace) -> int:
     from twolink_pin.kinematics import joint_positions
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     q = np.array(args.q, dtype=float)
     if q.shape != (robot.nq,):
         raise InvalidParameterError(
@@ -230,7 +230,7 @@ def cmd_ik(args: argparse.Namespace) -> int:
     from twolink_pin.kinematics import inverse_kinematics, is_planar_2r, solve_position
     from twolink_pin.trajectory import home_configuration
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     if args.z is None and args.seed is None and is_planar_2r(robot):
         sols = inverse_kinematics(robot, (args.x, args.y))
         text = "\n".join(
@@ -255,8 +255,8 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     from twolink_pin.feasibility import check_torques
     from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, PoseTrajectory, default_via_points
 
-    robot = _robot(args)
-    traj = _trajectory(args, robot)
+    robot = robot_from_args(args)
+    traj = trajectory_from_args(args, robot)
     via = default_via_points(robot) if not args.trajectory else None
     check = check_torques(robot, traj)
     if args.save:

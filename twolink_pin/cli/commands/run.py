@@ -12,7 +12,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.cli.commands.common import _gains_echo, _identified, _robot, _trajectory, run_spec
+from twolink_pin.cli.commands.common import (
+    _gains_echo,
+    identified_parameters,
+    robot_from_args,
+    run_spec,
+    trajectory_from_args,
+)
 from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.cli.task_space import is_task_space, save_task_figure, task_lines, task_summary
 from twolink_pin.errors import InvalidParameterError
@@ -50,11 +56,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     from twolink_pin.simulation import simulate
     from twolink_pin.simulation.config import joint_offsets
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     spec = run_spec(args, args.controller)
     spec.check_effective(robot)
-    scenario = spec.build(robot, _identified(spec, robot))
-    result = simulate(*scenario, _trajectory(args, robot), spec.simulation)
+    scenario = spec.build(robot, identified_parameters(spec, robot))
+    result = simulate(*scenario, trajectory_from_args(args, robot), spec.simulation)
     metrics = compute_metrics(result)
     payload = _result_payload(result, metrics)
     task = task_summary(scenario.controller, result, robot)  # None unless a task-space law
@@ -84,7 +90,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
-        save_result(result, args.save, record=_record(args, spec))
+        save_result(result, args.save, record=run_record(args, spec))
     payload["figures"] = figures
     lines = [
         f"controller {result.controller} on {result.robot}: {result.duration:g} s, dt = {result.dt:g} s ({result.method})",
@@ -158,7 +164,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from twolink_pin.scenario import builtin_laws, law_class
     from twolink_pin.studies.comparison import run_comparison
 
-    robot = _robot(args)
+    robot = robot_from_args(args)
     specs = args.controllers or list(builtin_laws())
     names = [law_class(s).name for s in specs]
     if len(set(names)) != len(names):
@@ -167,8 +173,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
     shared = run_spec(args)
     shared.check_law_gains(specs)
     shared.check_effective(robot, specs)
-    identified = _identified(shared, robot)
-    reference = _trajectory(args, robot)
+    identified = identified_parameters(shared, robot)
+    reference = trajectory_from_args(args, robot)
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(names), "run", "compare")
 
@@ -250,11 +256,11 @@ def cmd_animate(args: argparse.Namespace) -> int:
     else:
         from twolink_pin.simulation import simulate
 
-        robot = _robot(args)
-        reference = _trajectory(args, robot)
+        robot = robot_from_args(args)
+        reference = trajectory_from_args(args, robot)
         spec = run_spec(args, args.controller)
         spec.check_effective(robot)
-        scenario = spec.build(robot, _identified(spec, robot))
+        scenario = spec.build(robot, identified_parameters(spec, robot))
         controller = scenario.controller
         result = simulate(*scenario, reference, spec.simulation)
     gains, gains_text = _gains_echo(controller) if controller is not None else (None, "not recorded")
@@ -357,7 +363,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     return 0
 
 
-def _record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
+def run_record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
     """What a saved result records beside its arrays: the robot (as given: a catalog name or a
     URDF path), its payload, the trajectory file and the run's spec."""
     from pathlib import Path as _Path

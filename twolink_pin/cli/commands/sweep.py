@@ -6,7 +6,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import _gains_echo, _robot, _trajectory, run_spec
+from twolink_pin.cli.commands.common import _gains_echo, robot_from_args, run_spec, trajectory_from_args
 from twolink_pin.cli.output import emit, progress_bar
 
 if TYPE_CHECKING:
@@ -24,8 +24,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 1
-    robot = _robot(args)
-    trajectory = _trajectory(args, robot)
+    robot = robot_from_args(args)
+    trajectory = trajectory_from_args(args, robot)
     config = SweepConfig(
         run=run_spec(args, args.controller, fixed_gains=False),
         samples=args.samples,

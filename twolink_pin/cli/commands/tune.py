@@ -7,7 +7,12 @@ import sys
 import threading
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import _identified, _robot, _trajectory, run_spec
+from twolink_pin.cli.commands.common import (
+    identified_parameters,
+    robot_from_args,
+    run_spec,
+    trajectory_from_args,
+)
 from twolink_pin.cli.output import emit
 
 if TYPE_CHECKING:
@@ -19,29 +24,29 @@ if TYPE_CHECKING:
 def _duration(args: argparse.Namespace) -> None:
     """No ``--duration``: one period of the reference (a tuning run is short)."""
     if args.duration is None:
-        robot = _robot(args)
-        args.duration = float(_trajectory(args, robot).period)
+        robot = robot_from_args(args)
+        args.duration = float(trajectory_from_args(args, robot).period)
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
-    from twolink_pin.cli.commands.run import _record
+    from twolink_pin.cli.commands.run import run_record
     from twolink_pin.cli.simulate_line import command_line, simulate_argv
     from twolink_pin.tuning import Tuner
 
     _duration(args)
     spec = run_spec(args, args.controller)
-    _identified(spec, _robot(args))  # the parameter file's notes, once
+    identified_parameters(spec, robot_from_args(args))  # the parameter file's notes, once
 
     def arm(payload: float) -> tuple[RobotModel, Trajectory]:
         at = argparse.Namespace(**(vars(args) | {"payload": payload}))
-        robot = _robot(at)
-        return robot, _trajectory(at, robot)
+        robot = robot_from_args(at)
+        return robot, trajectory_from_args(at, robot)
 
     def command_of(run: RunSpec, payload: float) -> str:
         return command_line(simulate_argv(run, args.robot, payload, args.trajectory))
 
     def record_of(run: RunSpec, payload: float) -> dict[str, Any]:
-        return _record(argparse.Namespace(**(vars(args) | {"payload": payload})), run)
+        return run_record(argparse.Namespace(**(vars(args) | {"payload": payload})), run)
 
     lock = threading.Lock()
 
