@@ -260,6 +260,50 @@ def test_missing_joint_extra_joint_and_a_long_gap_are_named(
         read_bag(gap, ["joint1", "joint2"])
 
 
+def test_a_bag_without_velocities_is_read_whatever_memory_held(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """Velocities are optional: a bag whose messages log none is read, and what its unused
+    velocity rows would have held is never checked (they were uninitialised memory: a NaN
+    there refused a valid bag now and then). The rows are made NaN here to show it."""
+    import twolink_pin.identification.bags as bags
+
+    real = np.empty
+
+    def poisoned(shape, dtype=float, *args, **kwargs):  # np.empty that returns NaN floats
+        out = real(shape, dtype, *args, **kwargs)
+        if np.dtype(dtype).kind == "f":
+            out.fill(np.nan)
+        return out
+
+    twolink = load_robot("twolink")
+    log = grid_log(twolink, twolink_excitation.identification_excitation(), 0.3, 1e-3)
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    JointState, Header, Time = (
+        store.types[n]
+        for n in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time")
+    )
+    path = tmp_path / "no_velocity.bag"
+    with Writer(path) as w:
+        c = w.add_connection("/joint_states", JointState.__msgtype__, typestore=store)
+        for k, t in enumerate(log.t):
+            ns = 10**9 + round(t * 1e9)
+            msg = JointState(
+                header=Header(seq=k, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
+                name=["joint1", "joint2"],
+                position=log.q[k],
+                velocity=np.zeros(0),
+                effort=log.tau[k],
+            )
+            w.write(c, ns, store.serialize_ros1(msg, JointState.__msgtype__))
+    monkeypatch.setattr(bags.np, "empty", poisoned)
+    read, _ = read_bag(path, ["joint1", "joint2"])
+    np.testing.assert_allclose(read.q, log.q, atol=1e-9)
+
+
 def test_ur5_mcap_bag_gives_the_npz_estimates(tmp_path: Path) -> None:
     """The UR5 (48 parameters) along its stored excitation at 2 kHz (the toolkit's log rate):
     bag and NPZ agree to 1e-6 (measured 6.7e-7; at 1 kHz the linear torque interpolation's

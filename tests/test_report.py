@@ -49,7 +49,13 @@ def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> 
     assert plants == {
         n: "friction" if n == "adaptive-friction" else "no friction" for n in REPORT_CONTROLLERS
     }
-    assert "| adaptive-friction | friction | finished |" in (report_dir / "report.md").read_text()
+    # ... and the gains it ran with (the report's λ = 5 1/s among them), as comparison.md lists them
+    row = re.search(
+        r"^\| adaptive-friction \| (?P<gains>[^|]+) \| friction \| finished \|$",
+        (report_dir / "report.md").read_text(),
+        re.MULTILINE,
+    )
+    assert row is not None and "lam = 5," in row["gains"] and "k = (90, 90)" in row["gains"]
 
 
 def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:

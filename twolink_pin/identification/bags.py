@@ -250,6 +250,8 @@ def _read_states(
             has_v = False
         if efforts:
             table.values["effort"][row] = _field(path, topic, msg, "effort", index, len(key), k)
+    if not has_v:  # velocities are optional (a check only): a bag that lacks them in any message
+        del table.values["velocity"]  # has none — its rows were never written, not checked either
     return table.trimmed(), has_v, tuple(ignored)
 
 
