@@ -60,6 +60,35 @@ def joint_names(robot) -> list[str]:
     return [str(n) for n in robot.model.names[1:]]
 
 
+def write_ros1_without_velocities(path: Path, log: RunLog, skip: range = range(0)) -> Path:
+    """A ROS 1 bag of ``log``'s joints ``joint1``, ``joint2`` whose messages log positions and
+    efforts but no velocities (an empty field), written by rosbags' writer; the samples in
+    ``skip`` are left out."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    store = get_typestore(Stores.ROS1_NOETIC)
+    JointState, Header, Time = (
+        store.types[n]
+        for n in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time")
+    )
+    with Writer(path) as w:
+        c = w.add_connection("/joint_states", JointState.__msgtype__, typestore=store)
+        for k, t in enumerate(log.t):
+            if k in skip:
+                continue
+            ns = 10**9 + round(t * 1e9)
+            msg = JointState(
+                header=Header(seq=k, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
+                name=["joint1", "joint2"],
+                position=log.q[k],
+                velocity=np.zeros(0),
+                effort=log.tau[k],
+            )
+            w.write(c, ns, store.serialize_ros1(msg, JointState.__msgtype__))
+    return path
+
+
 def write_bag(
     path: Path,
     robot,
@@ -234,28 +263,9 @@ def test_missing_joint_extra_joint_and_a_long_gap_are_named(
     )
     gap = tmp_path / "gap.bag"
     rng_log = grid_log(twolink, twolink_excitation.identification_excitation(), 0.3, 1e-3)
-    from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
-
-    store = get_typestore(Stores.ROS1_NOETIC)
-    JointState, Header, Time = (
-        store.types[n]
-        for n in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time")
-    )
-    with Writer(gap) as w:
-        c = w.add_connection("/joint_states", JointState.__msgtype__, typestore=store)
-        for k, t in enumerate(rng_log.t):
-            if 100 <= k < 120:  # 20 messages missing: a 21-ms gap after t = 0.099 s
-                continue
-            ns = 10**9 + round(t * 1e9)
-            msg = JointState(
-                header=Header(seq=k, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
-                name=["joint1", "joint2"],
-                position=rng_log.q[k],
-                velocity=np.zeros(0),
-                effort=rng_log.tau[k],
-            )
-            w.write(c, ns, store.serialize_ros1(msg, JointState.__msgtype__))
+    write_ros1_without_velocities(
+        gap, rng_log, skip=range(100, 120)
+    )  # 20 missing: a 21-ms gap after t = 0.099 s
     with pytest.raises(InputFileError, match=r"gap of 21 ms \(21.0 steps of 1 ms\) after t = 0.099 s"):
         read_bag(gap, ["joint1", "joint2"])
 
@@ -278,27 +288,7 @@ def test_a_bag_without_velocities_is_read_whatever_memory_held(
 
     twolink = load_robot("twolink")
     log = grid_log(twolink, twolink_excitation.identification_excitation(), 0.3, 1e-3)
-    from rosbags.rosbag1 import Writer
-    from rosbags.typesys import Stores, get_typestore
-
-    store = get_typestore(Stores.ROS1_NOETIC)
-    JointState, Header, Time = (
-        store.types[n]
-        for n in ("sensor_msgs/msg/JointState", "std_msgs/msg/Header", "builtin_interfaces/msg/Time")
-    )
-    path = tmp_path / "no_velocity.bag"
-    with Writer(path) as w:
-        c = w.add_connection("/joint_states", JointState.__msgtype__, typestore=store)
-        for k, t in enumerate(log.t):
-            ns = 10**9 + round(t * 1e9)
-            msg = JointState(
-                header=Header(seq=k, stamp=Time(sec=ns // 10**9, nanosec=ns % 10**9), frame_id=""),
-                name=["joint1", "joint2"],
-                position=log.q[k],
-                velocity=np.zeros(0),
-                effort=log.tau[k],
-            )
-            w.write(c, ns, store.serialize_ros1(msg, JointState.__msgtype__))
+    path = write_ros1_without_velocities(tmp_path / "no_velocity.bag", log)
     monkeypatch.setattr(bags.np, "empty", poisoned)
     read, _ = read_bag(path, ["joint1", "joint2"])
     np.testing.assert_allclose(read.q, log.q, atol=1e-9)
