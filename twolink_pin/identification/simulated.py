@@ -11,7 +11,8 @@ the applied ``τ``. The run is integrated by RK4 at ``dt`` (default :data:`DEFAU
 0.5 ms, a 2-kHz log), starting on the trajectory (no initial offset).
 
 The plant's friction is the robot profile's (the twolink: the report's V = (0.4, 0.2)
-N·m·s/rad, C = (0.2, 0.1) N·m), else :data:`DEFAULT_FRICTION` on every joint.
+N·m·s/rad, C = (0.2, 0.1) N·m), else the plant's :data:`~twolink_pin.plant.DEFAULT_FRICTION` on every joint (a URDF's
+``<dynamics>`` is not read here: the identification runs of a catalog arm stay what they were).
 """
 
 from __future__ import annotations
@@ -26,15 +27,13 @@ from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.identification.data import RunLog
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.model import RobotModel
+from twolink_pin.plant import DEFAULT_FRICTION
 from twolink_pin.trajectory import Trajectory
 
 DEFAULT_DT = 5e-4
 """RK4 step and log spacing of simulated identification runs [s]."""
 DEFAULT_PERIODS = 4
 """Default length of a simulated run, in periods of the excitation (3 to fit, 1 to validate)."""
-DEFAULT_FRICTION = (0.4, 0.2)
-"""(V [N·m·s/rad], C [N·m]) on every joint of a robot whose profile gives no friction (the
-report's joint-1 values)."""
 
 
 class FrictionCompensatedTracking(ComputedTorque, register=False):
