@@ -117,6 +117,23 @@ def test_osc_position_error_follows_the_designed_linear_dynamics() -> None:
     assert np.abs(e[-1]).max() < 0.1 * np.abs(e[0]).max()
 
 
+def test_osc_on_the_planar_twolink_controls_x_and_y_by_their_designed_dynamics() -> None:
+    """The twolink's home (stretched along x) moves its tip in y only; the task is still the
+    plane's x and y, each error following ``ë + D ė + K e = 0`` with its own gains (a task
+    chosen at home alone left x to drift)."""
+    r = robot("twolink")
+    K, D = np.diag([100.0, 64.0, 1.0]), np.diag([20.0, 12.0, 1.0])
+    law = OperationalSpace(r, OSCGains(kp=K, kd=D))
+    q_d = np.array([0.6, 1.2])
+    config = SimulationConfig(duration=0.6, q0_offset=(0.08, -0.1))
+    result = simulate(law, Plant(r), Hold(q_d), config)
+    e, de, _, _ = _task_errors(r, result)
+    assert np.abs(e[0, :2]).min() > 0.01  # a real initial error in x and in y
+    expected = _linear_response(K, D, e[0], de[0], result.t)
+    assert np.abs(e[:, :2] - expected[:, :2]).max() < 1e-6
+    assert np.abs(e[:, 2]).max() < 1e-12  # the plane
+
+
 def test_osc_orientation_error_obeys_its_designed_dynamics() -> None:
     r = robot("panda")
     result = _osc_run(25.0, 10.0)

@@ -6,10 +6,12 @@ rows first. The orientation error is ``e_o = log(R R_dᵀ)`` — the rotation ve
 takes the desired orientation to the actual one, in world axes — so that ``e_o ≈ ∫(ω − ω_d)``
 for small errors.
 
-**The task.** A frame that can move in 6 DOF at the robot's ``home`` (its Jacobian has rank 6
-there) is controlled in position and orientation (6 rows). Otherwise (the planar twolink, a
-3-joint arm) the task is the frame's position along the world axes it moves at ``home`` (the
-twolink: x and y); orientation is left to the joints. This is :func:`task_rows`' choice.
+**The task.** A frame that can move in 6 DOF (its Jacobian has rank 6 near the robot's
+``home``) is controlled in position and orientation (6 rows). Otherwise (the planar twolink, a
+3-joint arm) the task is the frame's position along the world axes it moves in (the twolink:
+x and y); orientation is left to the joints. This is :func:`task_rows`' choice; it looks near
+``home``, not at it, because a home can be singular (the twolink's, stretched along x, moves
+its tip in y only).
 
 **Singularities.** ``Λ = (J M⁻¹ Jᵀ)⁻¹`` is formed from the eigen-decomposition of
 ``J M⁻¹ Jᵀ`` normalised to a unit diagonal, ``S J M⁻¹ Jᵀ S = U diag(s) Uᵀ`` with
@@ -78,13 +80,34 @@ def desired_frame(x: LawInput) -> DesiredFrame:
     return DesiredFrame(x.x_des, x.R_des, x.twist_des, x.accel_des)
 
 
+GENERIC_OFFSETS_RAD = (0.0, 0.3, -0.45)
+"""Offsets [rad] added to every joint of ``home`` (alternating in sign along the chain) where
+:func:`task_rows` looks at the Jacobian: a home that is itself singular (the twolink
+stretched along x) would hide a direction the arm moves in everywhere else."""
+
+
 def task_rows(robot: RobotModel) -> np.ndarray:
-    """The rows of the 6-D frame Jacobian the law controls (see the module docstring)."""
+    """The rows of the 6-D frame Jacobian the law controls (see the module docstring): those
+    of the configuration of :data:`GENERIC_OFFSETS_RAD` where the most rows move."""
     data = robot.model.createData()
-    J = pin.computeFrameJacobian(
-        robot.model, data, robot.home, robot.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-    )
-    if robot.nv >= 6 and np.linalg.matrix_rank(J, tol=1e-9 * max(1.0, np.abs(J).max())) == 6:
+    signs = np.where(np.arange(robot.nv) % 2 == 0, 1.0, -1.0)
+    best = np.arange(0)
+    for offset in GENERIC_OFFSETS_RAD:
+        q = pin.integrate(robot.model, robot.home, offset * signs)
+        rows = _moving_rows(
+            pin.computeFrameJacobian(
+                robot.model, data, q, robot.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            ),
+            robot.nv,
+        )
+        if len(rows) > len(best):
+            best = rows
+    return best
+
+
+def _moving_rows(J: np.ndarray, nv: int) -> np.ndarray:
+    """All 6 rows where ``J`` has rank 6, else the independent linear rows that move."""
+    if nv >= 6 and np.linalg.matrix_rank(J, tol=1e-9 * max(1.0, np.abs(J).max())) == 6:
         return np.arange(6)
     linear = J[:3]
     moving = np.flatnonzero(np.linalg.norm(linear, axis=1) > 1e-9 * max(1.0, np.abs(linear).max()))
