@@ -15,7 +15,6 @@ not accuracy) — a divergence report within seconds, never minutes of work that
 from __future__ import annotations
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
@@ -133,6 +132,8 @@ def integrate_adaptive(
                 name, time, f"the controller returned a non-finite torque τ = {tau[0].tolist()}"
             )
         return np.concatenate([v[0], accel(q, v, tau)[0], dz[0]])
+
+    from scipy.integrate import solve_ivp  # with scipy.optimize 0.3 s to import: only for this method
 
     # bounded in wall-clock time (--timeout, simulation.deadline): past it, an error naming the law
     with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, last[0], seconds)):
