@@ -68,7 +68,6 @@ SLOW: tuple[str, ...] = (
     "tests/test_new_laws.py::test_every_new_law_runs_on_every_robot_and_reduces_the_error",
     "tests/test_new_laws.py::test_osc_position_error_follows_the_designed_linear_dynamics",
     "tests/test_new_laws.py::test_batch_equals_single_runs",
-    "tests/test_se3_trajectory.py::test_osc_with_the_exact_model_tracks_the_pose_path",
     "tests/test_batch.py::test_a_run_does_not_depend_on_its_batch_nor_on_threads",
     "tests/test_plant_events.py::test_adaptive_reconverges_after_a_payload_step_computed_torque_does_not",
     "tests/test_controllers.py::test_adaptive_lyapunov_function_never_increases",

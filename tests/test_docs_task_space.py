@@ -2,7 +2,8 @@
 page quotes must be in what it prints; the page's code and trajectory file are the example's;
 the tutorial's laws scale their gains where the built-in laws do (the robot's home).
 
-Slow-ish: four UR5 runs of 16 s and a sweep of 8 (about 2 minutes on a quiet 2-core machine).
+Slow-ish: four UR5 runs of 16 s and a sweep of 8. ``compare`` and ``sweep`` run with ``--no-plot``:
+what is checked here is what they print (the figures are tests/test_plotting.py's).
 """
 
 from __future__ import annotations
@@ -69,6 +70,8 @@ def test_every_command_prints_what_the_page_says(
     if "--out" in argv:  # the page's out/… folder, here in a temporary one
         i = argv.index("--out") + 1
         argv[i] = str(tmp_path / Path(argv[i]).name)
+    if argv[0] in ("compare", "sweep"):  # the printed lines, not the figures (test_plotting's):
+        argv.append("--no-plot")  # compare's 27 figures of two 16-s runs were half of this file's time
     monkeypatch.chdir(ROOT)
     assert main(argv) == 0
     printed = capsys.readouterr().out.splitlines()

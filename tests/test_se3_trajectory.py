@@ -189,22 +189,6 @@ def test_the_engine_passes_the_pose_paths_own_reference(method: str) -> None:
         np.testing.assert_allclose(a[0], pose.accel[i], rtol=1e-12, atol=1e-15)
 
 
-def test_osc_with_the_exact_model_tracks_the_pose_path() -> None:
-    """From the reference's first configuration with the exact model, osc's task error obeys
-    ë + D ė + K e = 0 from e(0) = 0: it stays at the integrator's error (< 1e-6 m, rad)."""
-    osc = load_controller("osc")(UR5)
-    result = simulate(osc, Plant(UR5), SQUARE, SimulationConfig(duration=8.0, q0_offset=(0.0,) * 6))
-    model, data, fid = UR5.model, UR5.model.createData(), UR5.ee_frame_id
-    pose = SQUARE.pose(np.asarray(result.t))
-    worst_p = worst_r = 0.0
-    for i, q in enumerate(np.asarray(result.q)[::10]):
-        pin.framesForwardKinematics(model, data, q)
-        frame = data.oMf[fid]
-        worst_p = max(worst_p, float(np.linalg.norm(frame.translation - pose.position[10 * i])))
-        worst_r = max(worst_r, float(np.linalg.norm(pin.log3(frame.rotation.T @ pose.rotation[10 * i]))))
-    assert worst_p < 1e-6 and worst_r < 1e-6
-
-
 def test_a_joint_reference_still_gives_the_same_osc_torque_as_before() -> None:
     """osc on the twolink's default (joint) reference: the torque equals the law written with the
     desired frame from terms.frame of the joint reference (the path the law took before)."""

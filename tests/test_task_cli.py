@@ -69,7 +69,9 @@ def test_a_joint_space_law_has_no_task_metrics(capsys: pytest.CaptureFixture[str
 def test_compare_tabulates_the_task_space_laws(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
     out = tmp_path / "cmp"
     argv = ["compare", "osc", "pd", "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.2"]
-    assert main([*argv, "--out", str(out), "--json"]) == 0
+    # --no-plot: the 27 figures of two 6-joint runs took 5/6 of this test; tests/test_plotting.py
+    # draws them
+    assert main([*argv, "--out", str(out), "--json", "--no-plot"]) == 0
     payload = json.loads(capsys.readouterr().out)
     assert set(payload["task_metrics"]) == {"osc"}
     saved = tmp_path / "osc.npz"

@@ -33,6 +33,9 @@ ROOT = Path(__file__).resolve().parents[1]
 WAIT = 600.0
 """Bound on every wait [s] (a busy machine): a failure, never a pass, when it runs out."""
 CLI = [sys.executable, "-m", "twolink_pin_entry"]
+SHORT = ("--duration", "4")
+"""The tuner's runs here: 4 s simulated (its default, 30 s, made every run and every redraw
+of the page 7.5 times longer; nothing checked here depends on the length)."""
 
 
 class Tune:
@@ -136,7 +139,7 @@ def simulate_json(command: str) -> dict[str, Any]:
 
 @pytest.fixture(scope="module")
 def pd() -> Iterator[Tune]:
-    tune = Tune("pd")
+    tune = Tune("pd", *SHORT)
     try:
         yield tune
     finally:
@@ -219,7 +222,7 @@ def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_con
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 
-    tune = Tune("pd")
+    tune = Tune("pd", *SHORT)
     first_tab = driver.current_window_handle
     try:
         tune.next(ran)
@@ -265,7 +268,7 @@ def own_law(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Tune, Pa
     folder = tmp_path_factory.mktemp("law")
     law = folder / "sliding_mode.py"
     shutil.copy(ROOT / "examples" / "sliding_mode.py", law)
-    tune = Tune(f"{law}:SlidingMode", "--watch", cwd=folder)
+    tune = Tune(f"{law}:SlidingMode", "--watch", *SHORT, cwd=folder)
     try:
         yield tune, law
     finally:
