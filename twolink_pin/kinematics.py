@@ -268,52 +268,21 @@ def solve_position(
             ``min_singular_value`` [m/rad].
         InvalidParameterError: ``target`` is not 2 or 3 finite numbers, or ``q_seed`` not nq.
     """
-    try:
-        goal = np.asarray(target, dtype=float)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(
-            "target", target, "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
-        ) from None
-    if goal.shape not in ((2,), (3,)) or not np.all(np.isfinite(goal)):
-        raise InvalidParameterError(
-            "target", np.asarray(target).tolist(), "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
-        )
+    goal = _target_point(target)
     rows = goal.size
     q = _check_q(robot, q_seed)
     lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
     q = np.clip(q, lower, upper)
     data = robot.create_data()
-
-    def residual(qk: np.ndarray) -> np.ndarray:
-        return goal - end_effector_position(robot, qk, data)[:rows]
-
-    def descend(qk: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        e = residual(qk)
-        for _ in range(max_iterations):
-            if float(np.linalg.norm(e)) <= tol:
-                break
-            J = position_jacobian(robot, qk, data)[:rows]
-            damping = 0.5 * float(e @ e) + 1e-9
-            step = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(rows), e)
-            for _ in range(30):
-                trial = np.clip(qk + step, lower, upper)
-                e_trial = residual(trial)
-                if float(e_trial @ e_trial) < float(e @ e):
-                    qk, e = trial, e_trial
-                    break
-                step = 0.5 * step
-            else:
-                break  # no descent: a local minimum of the distance (out of reach, a limit, a singular seed)
-        return qk, e
-
     # A seed exactly at a singularity (a straight arm) has no descent direction towards some
     # targets: up to IK_RESTARTS seeded perturbations of the seed are tried, then it gives up.
     rng = np.random.default_rng(0)
-    q, e = descend(q)
+    q, e = _descend(robot, data, goal, q, tol, max_iterations)
     for _ in range(IK_RESTARTS):
         if float(np.linalg.norm(e)) <= tol:
             break
-        q_try, e_try = descend(np.clip(q_seed + rng.uniform(-0.2, 0.2, robot.nq), lower, upper))
+        seed = np.clip(q_seed + rng.uniform(-0.2, 0.2, robot.nq), lower, upper)
+        q_try, e_try = _descend(robot, data, goal, seed, tol, max_iterations)
         if float(e_try @ e_try) < float(e @ e):
             q, e = q_try, e_try
     distance = float(np.linalg.norm(e))
@@ -334,3 +303,48 @@ def solve_position(
             tuple(float(x) for x in q),
         )
     return q
+
+
+def _target_point(target: tuple[float, ...] | np.ndarray) -> np.ndarray:
+    """``target`` as 2 (x, y) or 3 (x, y, z) finite coordinates [m], or an error naming it."""
+    try:
+        goal = np.asarray(target, dtype=float)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(
+            "target", target, "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
+        ) from None
+    if goal.shape not in ((2,), (3,)) or not np.all(np.isfinite(goal)):
+        raise InvalidParameterError(
+            "target", np.asarray(target).tolist(), "2 (x, y) or 3 (x, y, z) finite coordinates [m]"
+        )
+    return goal
+
+
+def _descend(
+    robot: RobotModel, data: pin.Data, goal: np.ndarray, qk: np.ndarray, tol: float, max_iterations: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Damped least squares from ``qk`` [rad] (see :func:`solve_position`) until the error
+    ``goal − x(q)`` [m] is within ``tol`` or no halved step decreases it; ``(q, error)``."""
+    rows = goal.size
+    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+
+    def residual(q: np.ndarray) -> np.ndarray:
+        return goal - end_effector_position(robot, q, data)[:rows]
+
+    e = residual(qk)
+    for _ in range(max_iterations):
+        if float(np.linalg.norm(e)) <= tol:
+            break
+        J = position_jacobian(robot, qk, data)[:rows]
+        damping = 0.5 * float(e @ e) + 1e-9
+        step = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(rows), e)
+        for _ in range(30):
+            trial = np.clip(qk + step, lower, upper)
+            e_trial = residual(trial)
+            if float(e_trial @ e_trial) < float(e @ e):
+                qk, e = trial, e_trial
+                break
+            step = 0.5 * step
+        else:
+            break  # no descent: a local minimum of the distance (out of reach, a limit, a singular seed)
+    return qk, e

@@ -18,9 +18,9 @@ import inspect
 import os
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -37,8 +37,8 @@ from twolink_pin.metrics import Metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
-from twolink_pin.report.pool import _pool
-from twolink_pin.report.runs import _reference, _run, _trajectory_figures
+from twolink_pin.report.pool import worker_pool
+from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
 from twolink_pin.run_spec import gains_used, plant_description
 from twolink_pin.scenario import builtin_laws, law_class
 from twolink_pin.simulation import SimulationResult
@@ -116,30 +116,118 @@ def _build(
     options: ReportOptions,
     tick: Callable[[str], None],
 ) -> dict[str, Any]:
-    fig_dir = stage / "figures"
-    fig_dir.mkdir()
-    trajectory = _reference(robot, options)
+    """The report's runs and figures written into ``stage``; returns ``results.json``'s content."""
+    trajectory = reference_trajectory(robot, options)
     via = default_via_points(robot) if not options.trajectory else None
     check = check_torques(robot, trajectory)
+    sections = robot.profile.report.sections
+    names = [law_class(spec).name for spec in specs]
+    by_name = dict(zip(names, specs))
+    ran = _run_all(stage, robot, trajectory, via, by_name, options, tick)
+    runs = {n: ran.runs[n] for n in names if n in ran.runs}  # the order asked for
+    cfg = options.run.simulation
+    q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
+    scenarios = {n: options.run.for_law(by_name[n]).build(robot) for n in names}  # what each ran with
+    task = {  # the task-space laws' end-effector errors (their class declares task_space)
+        n: task_metrics(r[0], robot) for n, r in runs.items() if law_class(by_name[n]).task_space
+    }
+    table = ComparisonTable(
+        {n: r[1] for n, r in runs.items()},
+        {n: r[3] for n, r in runs.items()},
+        cfg.duration,
+        {n: ran.failed[n] for n in names if n in ran.failed},
+        plants={n: plant_description(scenarios[n]) for n in names},
+        gains={n: gains_used(scenarios[n].controller) for n in names},
+        task=task,
+    )
+    controllers, lams = _law_entries(runs, by_name, scenarios, task)
+    errata: list[dict[str, Any]] = []
+    if sections:
+        done_runs = {n: r[0] for n, r in runs.items()}
+        errata = sections.errata(robot, trajectory, done_runs, by_name, options, q0_offset, lams)
+    tick("errata")
+    return {
+        "robot": ran.model,
+        "twolink": ran.own_facts,
+        "trajectory": _trajectory_facts(trajectory, via, ran.trajectory_figures),
+        "torque_check": facts.torque_facts(check),
+        "simulation": asdict(cfg)
+        | {
+            "q0_offset": q0_offset.tolist(),
+            "lambda": lams,
+            "saturate": options.run.plant.saturate,
+            "friction_smoothing": options.run.friction_smoothing,
+        },
+        "run": options.run.as_dict(),
+        "controllers": controllers,
+        "failed": table.failed,
+        "comparison": table.as_dict(),
+        "comparison_markdown": table.markdown(),
+        "comparison_csv": table.csv(),
+        "animation": ran.animation,
+        "warnings": ran.warnings,
+        "animated": ran.animated,
+        "errata": errata,
+        "identification": ran.identification,
+        "versions": facts.versions(),
+    }
+
+
+class _Ran(NamedTuple):
+    """What the worker pool made: the laws' runs and the figures, animation and sections."""
+
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]]
+    """Each law that ran: its result, metrics, figure names and wall time [s], in run order."""
+    failed: dict[str, str]
+    """Each law whose run failed: the error."""
+    warnings: list[str]
+    """What the report goes without (an animation whose meshes are missing)."""
+    animation: str | None
+    """The animation's file name, None without."""
+    animated: str
+    """The law animated (the profile's, else the first that ran)."""
+    trajectory_figures: list[str]
+    """The desired trajectory's figure names."""
+    identification: Any
+    """The robot's own sections' identification results (None without)."""
+    model: dict[str, Any]
+    """The robot's facts."""
+    own_facts: Any
+    """The robot's own sections' facts (None without)."""
+
+
+def _run_all(
+    stage: Path,
+    robot: Any,
+    trajectory: Any,
+    via: Any,
+    by_name: dict[str, str],
+    options: ReportOptions,
+    tick: Callable[[str], None],
+) -> _Ran:
+    """Every task of the worker pool: the robot's own sections, each law's run and figures,
+    the desired trajectory's figures; the animation of the animated law (or, if it failed,
+    of the first that ran) while the others finish."""
+    fig_dir = stage / "figures"
+    fig_dir.mkdir()
     declared = robot.profile.report
     sections = declared.sections
     numbers = {k: dict(v) for k, v in declared.figure_numbers.items()}
-    names = [law_class(spec).name for spec in specs]
+    names = list(by_name)
     animated = declared.animated_law if declared.animated_law in names else names[0]
     order = [animated, *(n for n in names if n != animated)]
-    by_name = dict(zip(names, specs))
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
     failed: dict[str, str] = {}
     warnings: list[str] = []
     tried, shown = False, animated
     animation = None
     workers = min(options.workers or 1, len(order) + 1)  # None was resolved to the cores
-    with _pool(workers) as pool:
+    with worker_pool(workers) as pool:
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
         pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
-        futures = {n: pool.submit(_run, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
-        traj_future = pool.submit(_trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
+        futures = {n: pool.submit(run_law, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
+        traj_future = pool.submit(trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
         model = facts.model_facts(robot)
         own_facts = sections.facts(robot, via) if sections else None
         tick("model and trajectory")
@@ -150,28 +238,8 @@ def _build(
                 failed[name] = str(exc)
             tick(f"controller {name}")
             if options.animation and not tried and name in runs and (name == animated or animated in failed):
-                from twolink_pin.visualization import write_html
-
                 tried, shown = True, name
-                res = runs[name][0]
-                from twolink_pin.kinematics import joint_positions
-
-                points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
-                try:
-                    from twolink_pin.visualization.overlays import run_overlays
-
-                    write_html(
-                        robot,
-                        res.t,
-                        res.q,
-                        res.q_des,
-                        path=stage / "animation.html",
-                        via_points=points,
-                        **run_overlays(options.run.plant.wrench, res.t),
-                    )
-                    animation = "animation.html"
-                except InvalidURDFError as exc:  # a missing mesh: the report without its animation
-                    warnings.append(f"no animation: {exc}")
+                animation = _write_animation(stage, robot, trajectory, runs[name][0], options, warnings)
                 tick("animation")
         if options.animation and not tried:
             tick("animation")  # every law failed: nothing to animate
@@ -182,27 +250,51 @@ def _build(
             done_runs = {n: r[0] for n, r in runs.items()}
             identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
             tick("identification")
-    runs = {n: runs[n] for n in names if n in runs}  # the order asked for
-    table = ComparisonTable(
-        {n: r[1] for n, r in runs.items()},
-        {n: r[3] for n, r in runs.items()},
-        options.run.simulation.duration,
-        {n: failed[n] for n in names if n in failed},
-    )
-    cfg = options.run.simulation
-    q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
+    return _Ran(runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts)
+
+
+def _write_animation(
+    stage: Path,
+    robot: Any,
+    trajectory: Any,
+    result: SimulationResult,
+    options: ReportOptions,
+    warnings: list[str],
+) -> str | None:
+    """``animation.html`` of ``result`` with the end effector's via points and the push, if
+    any; its name, or None (and a warning) when the robot's meshes are missing."""
+    from twolink_pin.kinematics import joint_positions
+    from twolink_pin.visualization import write_html
+
+    points = joint_positions(robot, trajectory.via_q)[:, -1, :]  # the end effector's via points
+    try:
+        from twolink_pin.visualization.overlays import run_overlays
+
+        write_html(
+            robot,
+            result.t,
+            result.q,
+            result.q_des,
+            path=stage / "animation.html",
+            via_points=points,
+            **run_overlays(options.run.plant.wrench, result.t),
+        )
+    except InvalidURDFError as exc:  # a missing mesh: the report without its animation
+        warnings.append(f"no animation: {exc}")
+        return None
+    return "animation.html"
+
+
+def _law_entries(
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
+    by_name: dict[str, str],
+    scenarios: dict[str, Any],
+    task: dict[str, Any],
+) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
+    """Each law that ran as ``results.json`` shows it (its law, gains, metrics, figures,
+    estimates, limits), and the λ [1/s] of those that have one."""
     controllers = {}
     lams: dict[str, float] = {}
-    scenarios = {n: options.run.for_law(by_name[n]).build(robot) for n in names}  # what each ran with
-    task = {  # the task-space laws' end-effector errors (their class declares task_space)
-        n: task_metrics(r[0], robot) for n, r in runs.items() if law_class(by_name[n]).task_space
-    }
-    table = replace(
-        table,
-        plants={n: plant_description(scenarios[n]) for n in names},
-        gains={n: gains_used(scenarios[n].controller) for n in names},
-        task=task,
-    )
     for name, (result, metrics, figures, seconds) in runs.items():
         cls = law_class(by_name[name])
         controller = scenarios[name].controller  # the gains it ran with
@@ -222,41 +314,17 @@ def _build(
             "limit_exceeded": result.limit_exceeded.tolist(),
             "limit_exceeded_at": result.first_exceeded_at,
         }
-    errata: list[dict[str, Any]] = []
-    if sections:
-        done_runs = {n: r[0] for n, r in runs.items()}
-        errata = sections.errata(robot, trajectory, done_runs, by_name, options, q0_offset, lams)
-    tick("errata")
-    out: dict[str, Any] = {
-        "robot": model,
-        "twolink": own_facts,
-        "trajectory": {
-            "times": trajectory.times.tolist(),
-            "via_q": trajectory.via_q.tolist(),
-            "via_xy": None if via is None else [list(p) for p in via.xy],
-            "period_s": trajectory.period,
-            "coefficients": trajectory.coefficients.tolist(),
-            "figures": traj_figs,
-        },
-        "torque_check": facts.torque_facts(check),
-        "simulation": asdict(cfg)
-        | {
-            "q0_offset": q0_offset.tolist(),
-            "lambda": lams,
-            "saturate": options.run.plant.saturate,
-            "friction_smoothing": options.run.friction_smoothing,
-        },
-        "run": options.run.as_dict(),
-        "controllers": controllers,
-        "failed": table.failed,
-        "comparison": table.as_dict(),
-        "comparison_markdown": table.markdown(),
-        "comparison_csv": table.csv(),
-        "animation": animation,
-        "warnings": warnings,
-        "animated": shown,
-        "errata": errata,
-        "identification": identification,
-        "versions": facts.versions(),
+    return controllers, lams
+
+
+def _trajectory_facts(trajectory: Any, via: Any, figures: list[str]) -> dict[str, Any]:
+    """The reference as ``results.json`` shows it: via times [s] and joints [rad], the
+    end effector's via points [m] (the robot's default reference), period [s], coefficients."""
+    return {
+        "times": trajectory.times.tolist(),
+        "via_q": trajectory.via_q.tolist(),
+        "via_xy": None if via is None else [list(p) for p in via.xy],
+        "period_s": trajectory.period,
+        "coefficients": trajectory.coefficients.tolist(),
+        "figures": figures,
     }
-    return out

@@ -57,7 +57,7 @@ class _Workers:
 
 
 @contextmanager
-def _pool(workers: int) -> Iterator[Any]:
+def worker_pool(workers: int) -> Iterator[Any]:
     """Worker processes that never outlive the report: on an error, Ctrl-C or SIGTERM the
     pending runs are cancelled and the workers killed before the exception goes on."""
     if workers <= 1:

@@ -17,7 +17,7 @@ from twolink_pin.simulation import SimulationResult, simulate
 from twolink_pin.trajectory import default_trajectory
 
 
-def _reference(robot: Any, options: ReportOptions) -> Any:
+def reference_trajectory(robot: Any, options: ReportOptions) -> Any:
     """The trajectory the runs track: the options' file, else the robot's default."""
     from twolink_pin.trajectory import read_trajectory_file
 
@@ -34,7 +34,7 @@ def _reference(robot: Any, options: ReportOptions) -> Any:
     return reference
 
 
-def _run(
+def run_law(
     spec: str,
     options: ReportOptions,
     fig_dir: str,
@@ -48,7 +48,7 @@ def _run(
     robot = load_robot(options.robot, payload=options.payload)
     cls = law_class(spec)
     controller, plant = options.run.for_law(spec).build(robot)
-    result = simulate(controller, plant, _reference(robot, options), options.run.simulation)
+    result = simulate(controller, plant, reference_trajectory(robot, options), options.run.simulation)
     metrics = compute_metrics(result)
     spans = wrench_spans(options.run.plant.wrench)  # a push shaded where it acts
     paths = save_simulation_figures(
@@ -62,14 +62,14 @@ def _run(
     return result, metrics, [Path(p).name for p in paths], time.perf_counter() - start
 
 
-def _trajectory_figures(
+def trajectory_figures(
     options: ReportOptions, fig_dir: str, figure_numbers: dict[str, int] | None
 ) -> list[str]:
     """Worker: the desired trajectory's figures (picklable arguments only)."""
     from twolink_pin.plotting import save_trajectory_figures
 
     robot = load_robot(options.robot, payload=options.payload)
-    trajectory = _reference(robot, options)
+    trajectory = reference_trajectory(robot, options)
     check = check_torques(robot, trajectory)
     paths = save_trajectory_figures(robot, trajectory, check, Path(fig_dir), figure_numbers=figure_numbers)
     return [p.name for p in paths]

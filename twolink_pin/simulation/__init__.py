@@ -6,10 +6,11 @@
 ``rigid_terms.py``     M̂, ĝ, Ĉq̇ + ĝ, M̂⁻¹b and the frame kinematics a law asks for
 ``forward.py``         the plant's accelerations (ABA) for one run or N
 ``engine.py``          :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks, plant events
+``divergence.py``      which runs diverged in a block, when, and what was seen (non-finite or too large)
 ``events.py``          what a plant that pushes back does to a step: wrench, payload step, noise, delay
 ``task_reference.py``  the desired pose, twist and acceleration a task-space law sees (``law_input``)
 ``adaptive_step.py``   DOP853 with error control, one run
-``containment.py``     the one door to a law's ``compute``: read-only inputs, sys.exit / MemoryError named
+``containment.py``     a law's one door: read-only inputs, sys.exit / MemoryError named, its output checked
 ``deadline.py``        the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law
 ``result.py``          :class:`SimulationResult`
 ``run.py``             :func:`simulate` (N = 1, recorded)

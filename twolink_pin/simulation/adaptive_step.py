@@ -20,9 +20,9 @@ from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
-from twolink_pin.simulation.containment import contained
+from twolink_pin.simulation.containment import check_output, contained
 from twolink_pin.simulation.deadline import bounded, timed_out
-from twolink_pin.simulation.engine import Samples, _validate
+from twolink_pin.simulation.engine import Samples
 from twolink_pin.simulation.forward import SingleRunDynamics
 from twolink_pin.simulation.task_reference import task_reference
 from twolink_pin.simulation.terms import SingleRunTerms
@@ -118,7 +118,7 @@ def integrate_adaptive(
                 name, time, f"{type(exc).__name__}: {exc}{raised_at(exc, controller)}"
             ) from exc
         if calls <= 1:
-            _validate(controller, out, 1, nv, nz, time)
+            check_output(controller, out, 1, nv, nz, time)
         return out.tau, (out.dz if out.dz is not None else np.zeros((1, 0)))
 
     def rhs(time: float, x: np.ndarray) -> np.ndarray:

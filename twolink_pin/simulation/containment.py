@@ -17,6 +17,10 @@ naming the law, never a changed simulation or a silent exit:
   run cannot change this one. Importing and building a law are contained by
   :func:`~twolink_pin.user_code.guarded`.
 
+What comes out of the door is checked too (:func:`check_output`, at a law's first
+evaluation): a :class:`~twolink_pin.controllers.LawOutput` of the right shapes and of real
+numbers.
+
 What cannot be contained in-process: ``os._exit()``, a crash in C code, a law that blocks
 signals. The CLI bounds a law that never returns with ``--timeout`` (``cli``), and
 ``docs/reliability.md`` says what it does about ``os._exit``.
@@ -86,4 +90,29 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
     return call
 
 
-__all__ = ["contained", "read_only"]
+def check_output(controller: Controller, out: object, runs: int, nv: int, nz: int, t: float) -> None:
+    """Raise :class:`ControllerError` unless ``out`` (the law's output at ``t`` [s]) is a
+    :class:`LawOutput` with ``tau`` of shape (runs, nv) and ``dz`` of shape (runs, nz) (or
+    None when nz = 0), both of real numbers."""
+    name = controller.name
+    if not isinstance(out, LawOutput):
+        raise ControllerError(
+            name, t, f"compute returned {type(out).__name__}; return LawOutput(tau) or LawOutput(tau, dz)"
+        )
+    for label, value, width in (("tau", out.tau, nv), ("dz", out.dz, nz)):
+        if value is None and label == "dz" and nz == 0:
+            continue
+        shape = getattr(value, "shape", None)
+        if not isinstance(value, np.ndarray) or shape != (runs, width):
+            got = f"shape {shape}" if shape is not None else type(value).__name__
+            raise ControllerError(name, t, f"LawOutput.{label} must have shape ({runs}, {width}), got {got}")
+        if value.dtype.kind not in "fiu":  # complex, bool, str, object: not a torque Pinocchio takes
+            raise ControllerError(
+                name,
+                t,
+                f"LawOutput.{label} holds {value.dtype} values; expected real numbers (float64)"
+                + (f", e.g. {label}.real if the imaginary part is zero" if value.dtype.kind == "c" else ""),
+            )
+
+
+__all__ = ["check_output", "contained", "read_only"]

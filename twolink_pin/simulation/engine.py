@@ -33,18 +33,18 @@ naming the law and the simulated time.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
-from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
+from twolink_pin.errors import ControllerError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
-from twolink_pin.simulation.config import DIVERGENCE_LIMIT, SimulationConfig
-from twolink_pin.simulation.containment import contained, read_only
+from twolink_pin.simulation.config import SimulationConfig
+from twolink_pin.simulation.containment import check_output, contained, read_only
 from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
+from twolink_pin.simulation.divergence import flag_block, late_divergence
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.task_reference import reference_rows
@@ -104,35 +104,6 @@ class EngineRun(NamedTuple):
     """What was detected for each diverged run, None for the others."""
 
 
-def _validate(controller: Controller, out: object, runs: int, nv: int, nz: int, t: float) -> None:
-    name = controller.name
-    if not isinstance(out, LawOutput):
-        raise ControllerError(
-            name, t, f"compute returned {type(out).__name__}; return LawOutput(tau) or LawOutput(tau, dz)"
-        )
-    for label, value, width in (("tau", out.tau, nv), ("dz", out.dz, nz)):
-        if value is None and label == "dz" and nz == 0:
-            continue
-        shape = getattr(value, "shape", None)
-        if not isinstance(value, np.ndarray) or shape != (runs, width):
-            got = f"shape {shape}" if shape is not None else type(value).__name__
-            raise ControllerError(name, t, f"LawOutput.{label} must have shape ({runs}, {width}), got {got}")
-        if value.dtype.kind not in "fiu":  # complex, bool, str, object: not a torque Pinocchio takes
-            raise ControllerError(
-                name,
-                t,
-                f"LawOutput.{label} holds {value.dtype} values; expected real numbers (float64)"
-                + (f", e.g. {label}.real if the imaginary part is zero" if value.dtype.kind == "c" else ""),
-            )
-
-
-def _bad_rows(x: np.ndarray) -> np.ndarray:
-    """(B, N) mask: the sample's entries are non-finite or beyond the divergence limit."""
-    if x.shape[-1] == 0:
-        return np.zeros(x.shape[:2], dtype=bool)
-    return ~(np.abs(x) < DIVERGENCE_LIMIT).all(axis=-1)
-
-
 def integrate(
     controller: Controller,
     plant: Plant,
@@ -165,145 +136,228 @@ def integrate(
             run instead of parking it.
         progress: Called as ``progress(steps_done, steps_total)`` after each block.
     """
-    runs, nv = q0.shape
-    nz = z0.shape[1]
-    name = controller.name
-    n = config.steps
-    dt = config.duration / n
-    hold = config.hold_steps
-    new = tuple.__new__  # LawInput(...) through tuple.__new__ (see below)
-    terms = terms_for(controller, runs, threads)
-    # A plant that pushes back (wrench, payload step, sensor noise, delay): its events
-    # choose the dynamics of each step, offset what the law measures, delay its torque.
-    events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
-    line = DelayLine(plant.delay) if plant.delay > 0 else None
-    accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
-    noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
-    compute = _law_call(controller, noise if events is not None and events.noise is not None else None)
-    sampled = hold is not None or line is not None  # the law evaluated once per step or period
-    every = hold if hold is not None else 1
-    total = n + 1
-    size = total if record else min(total, BLOCK)
-    Q, V, T = (np.empty((size, runs, nv)) for _ in range(3))
-    Z = np.empty((size, runs, nz))
-    RQ, RV, RA = (np.empty((size, 1, nv)) for _ in range(3))
-    measured = record and events is not None and events.noise is not None
-    MQ, MV = (np.empty((size, runs, nv)) for _ in range(2)) if measured else (None, None)
-    times = np.arange(total) * dt
-    diverged_at = np.full(runs, np.nan)
-    detail: list[str | None] = [None] * runs
-    alive = np.ones(runs, dtype=bool)
-    z_start = np.array(z0, dtype=float)
-    q, v, z = np.array(q0, dtype=float), np.array(v0, dtype=float), z_start.copy()
-    # The steps as (1, width) rows: numpy multiplies two 2-D operands on its fast path, while
-    # a Python float (or a 1-D row) against a (1, nv) array costs twice as much at N = 1.
-    steps = _Steps(
-        dt,
-        *(np.full((1, nv), x) for x in (dt, dt / 2, dt / 6, 2.0)),
-        *(np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0)),
-    )
-    no_state = np.zeros((runs, 0))
-
-    # LawInput(...) through tuple.__new__ (``new`` above): the NamedTuple's own __new__ is a
-    # Python function that costs twice as much, four times a step.
-    # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
-    tau1: Any = None
-    dz1: Any = None
-    first = True
-    clock = _Clock()  # time of the law evaluation under way (for error messages)
+    run = _Run(controller, plant, config, q0, v0, z0, record, threads)
+    n, dt, clock, events = run.n, run.dt, run.clock, run.events
     watcher = run_watcher()
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
     # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
     with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, clock.now, seconds)):
-        for k0 in range(0, total, BLOCK):
-            k1 = min(k0 + BLOCK, total)
+        for k0 in range(0, run.total, BLOCK):
+            k1 = min(k0 + BLOCK, run.total)
             rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt)
             if events is not None:
                 events.draw(k0, k1)
-            off = 0 if record else k0
-            filled = k0 - off
-            try:
-                for k in range(k0, k1):
-                    i = 2 * (k - k0)
-                    t = k * dt
-                    if events is not None:
-                        accel = events.accel_at(t)
-                        if events.noise is not None:
-                            noise[:] = events.noise_at(k)
-                    if not sampled or k % every == 0:
-                        clock.now = t
-                        out = compute(new(LawInput, (t, q, v, z, *ref[i])), terms)
-                        if first:
-                            _validate(controller, out, runs, nv, nz, t)
-                            first = False
-                        tau1, dz1 = out.tau, (out.dz if nz else no_state)
-                        if line is not None:
-                            line.push(k, tau1, dz1)
-                    tau_k, dz_k = (tau1, dz1) if line is None else line.at(k)  # the torque applied
-                    b = k - off
-                    Q[b], V[b], T[b] = q, v, tau_k
-                    if MQ is not None and MV is not None:
-                        MQ[b], MV[b] = q + noise[0], v + noise[1]  # as the law measured it
-                    if nz:
-                        Z[b] = z
-                    filled = b + 1
-                    if k == n:
-                        break
-                    if sampled:  # zero-order hold (or delay): τ and ż fixed over the step
-                        q, v, z = _held_step(accel, q, v, z, tau_k, dz_k, steps, nz)
-                    else:
-                        q, v, z = _stage_step(
-                            compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
-                        )
-            except (KeyboardInterrupt, SystemExit, MemoryError):
-                raise
-            except Exception as exc:
-                if not _raised_by(exc, compute):
-                    raise
-                # A law may raise on a state that had already diverged: report the divergence.
-                _flag_block(Q, V, Z, T, k0 - off, filled, times, off, alive, diverged_at, detail, name, True)
-                if isinstance(exc, ControllerError):
-                    raise
-                what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
-                raise ControllerError(name, clock.now, what + raised_at(exc, controller)) from exc
-            rows = slice(k0 - off, k1 - off)
-            RQ[rows], RV[rows], RA[rows] = (x[: 2 * (k1 - k0) : 2] for x in (rq, rv, ra))
-            newly = _flag_block(
-                Q,
-                V,
-                Z,
-                T,
-                k0 - off,
-                k1 - off,
-                times,
-                off,
-                alive,
-                diverged_at,
-                detail,
-                name,
-                stop_on_divergence,
-            )
-            if k1 <= n:  # the state after the block's last step is sample k1
-                late = _late_divergence(
-                    q, v, z, alive, k1 * dt, diverged_at, detail, name, stop_on_divergence
-                )
-                newly |= late
-                if newly.any():  # park them on the reference, keep the batch going
-                    j = 2 * (k1 - k0)
-                    q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
-                    q[newly], v[newly], z[newly] = rq[j][0], rv[j][0], z_start[newly]
+            run.advance(k0, k1, ref)
+            run.out.reference(run.rows(k0, k1), rq, rv, ra)
+            run.check(k0, k1, rq, rv, stop_on_divergence)
             if observer is not None or watcher is not None:
-                block = Samples(
-                    k0, times[k0:k1], Q[rows], V[rows], Z[rows], T[rows], RQ[rows], RV[rows], RA[rows]
-                )
+                block = run.out.block(k0, run.times[k0:k1], run.rows(k0, k1))
                 if observer is not None:
                     observer.add(block)
                 if watcher is not None:  # simulation.deadline.watched: may raise RunCancelled
                     watcher(block)
             if progress is not None:
                 progress(min(k1, n), n)
-    recorded = Samples(0, times, Q, V, Z, T, RQ, RV, RA, MQ, MV) if record else None
-    return EngineRun(times, recorded, z, diverged_at, tuple(detail))
+    recorded = run.out.everything(run.times) if record else None
+    return EngineRun(run.times, recorded, run.z, run.diverged_at, tuple(run.detail))
+
+
+class _Outputs(NamedTuple):
+    """The buffers samples are written into: every sample (``record``) or one block's.
+    Shapes (S, N, ·), the reference's (S, 1, nv); ``MQ``, ``MV`` (what the law measured)
+    only when the full record is kept under sensor noise."""
+
+    Q: np.ndarray
+    V: np.ndarray
+    T: np.ndarray
+    Z: np.ndarray
+    RQ: np.ndarray
+    RV: np.ndarray
+    RA: np.ndarray
+    MQ: np.ndarray | None
+    MV: np.ndarray | None
+
+    @classmethod
+    def empty(cls, size: int, runs: int, nv: int, nz: int, measured: bool) -> _Outputs:
+        """Uninitialised buffers of ``size`` samples."""
+        Q, V, T = (np.empty((size, runs, nv)) for _ in range(3))
+        Z = np.empty((size, runs, nz))
+        RQ, RV, RA = (np.empty((size, 1, nv)) for _ in range(3))
+        MQ, MV = (np.empty((size, runs, nv)) for _ in range(2)) if measured else (None, None)
+        return cls(Q, V, T, Z, RQ, RV, RA, MQ, MV)
+
+    def reference(self, rows: slice, rq: np.ndarray, rv: np.ndarray, ra: np.ndarray) -> None:
+        """Write the block's reference (its half-step rows ``rq``, ``rv``, ``ra``) at its samples."""
+        count = rows.stop - rows.start
+        self.RQ[rows], self.RV[rows], self.RA[rows] = (x[: 2 * count : 2] for x in (rq, rv, ra))
+
+    def block(self, start: int, t: np.ndarray, rows: slice) -> Samples:
+        """The samples of buffer ``rows`` (the first is sample ``start``, at times ``t``)."""
+        Q, V, Z, T, RQ, RV, RA = self.Q, self.V, self.Z, self.T, self.RQ, self.RV, self.RA
+        return Samples(start, t, Q[rows], V[rows], Z[rows], T[rows], RQ[rows], RV[rows], RA[rows])
+
+    def everything(self, times: np.ndarray) -> Samples:
+        """The full record (``record=True``)."""
+        return Samples(0, times, self.Q, self.V, self.Z, self.T, self.RQ, self.RV, self.RA, self.MQ, self.MV)
+
+
+class _Run:
+    """One call of :func:`integrate`: what is fixed for the run (the law as the loop calls it,
+    the plant's events, the step's factors, the output buffers) and what is carried from block
+    to block (the state, the law's held output, the runs still alive and how the others ended)."""
+
+    def __init__(
+        self,
+        controller: Controller,
+        plant: Plant,
+        config: SimulationConfig,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        z0: np.ndarray,
+        record: bool,
+        threads: int | None,
+    ) -> None:
+        self.controller = controller
+        self.runs, self.nv = runs, nv = q0.shape
+        self.nz = nz = z0.shape[1]
+        self.n = n = config.steps
+        self.dt = dt = config.duration / n
+        hold = config.hold_steps
+        self.record = record
+        self.terms = terms_for(controller, runs, threads)
+        # A plant that pushes back (wrench, payload step, sensor noise, delay): its events
+        # choose the dynamics of each step, offset what the law measures, delay its torque.
+        self.events = events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
+        self.line = line = DelayLine(plant.delay) if plant.delay > 0 else None
+        self.accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
+        noisy = events is not None and events.noise is not None
+        self.noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
+        self.compute = _law_call(controller, self.noise if noisy else None)
+        self.sampled = hold is not None or line is not None  # the law evaluated once per step or period
+        self.every = hold if hold is not None else 1
+        self.total = total = n + 1
+        self.out = _Outputs.empty(total if record else min(total, BLOCK), runs, nv, nz, record and noisy)
+        self.times = np.arange(total) * dt
+        self.diverged_at = np.full(runs, np.nan)
+        self.detail: list[str | None] = [None] * runs
+        self.alive = np.ones(runs, dtype=bool)
+        self.z_start = np.array(z0, dtype=float)
+        self.q, self.v, self.z = np.array(q0, dtype=float), np.array(v0, dtype=float), self.z_start.copy()
+        self.steps = _Steps.of(dt, nv, nz)
+        self.no_state = np.zeros((runs, 0))
+        # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
+        self.tau1: Any = None
+        self.dz1: Any = None
+        self.first = True
+        self.clock = _Clock()  # time of the law evaluation under way (for error messages)
+
+    def rows(self, k0: int, k1: int) -> slice:
+        """The buffer rows of samples ``k0 … k1 − 1``."""
+        off = 0 if self.record else k0
+        return slice(k0 - off, k1 - off)
+
+    def advance(self, k0: int, k1: int, ref: Any) -> None:
+        """Steps ``k0 … k1 − 1``: write each sample, evaluate the law where the run samples it
+        (``ref[i]``: the law's reference rows of the block's half-step i), advance the state."""
+        controller, compute, terms, clock, events, line, noise = (
+            self.controller,
+            self.compute,
+            self.terms,
+            self.clock,
+            self.events,
+            self.line,
+            self.noise,
+        )
+        runs, nv, nz, n, dt, every, sampled, steps, no_state = (
+            self.runs,
+            self.nv,
+            self.nz,
+            self.n,
+            self.dt,
+            self.every,
+            self.sampled,
+            self.steps,
+            self.no_state,
+        )
+        Q, V, T, Z, MQ, MV = self.out.Q, self.out.V, self.out.T, self.out.Z, self.out.MQ, self.out.MV
+        q, v, z, accel, tau1, dz1, first = self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first
+        # LawInput(...) through tuple.__new__: the NamedTuple's own __new__ is a Python
+        # function that costs twice as much, four times a step.
+        new = tuple.__new__
+        off = 0 if self.record else k0
+        filled = k0 - off
+        try:
+            for k in range(k0, k1):
+                i = 2 * (k - k0)
+                t = k * dt
+                if events is not None:
+                    accel = events.accel_at(t)
+                    if events.noise is not None:
+                        noise[:] = events.noise_at(k)
+                if not sampled or k % every == 0:
+                    clock.now = t
+                    out = compute(new(LawInput, (t, q, v, z, *ref[i])), terms)
+                    if first:
+                        check_output(controller, out, runs, nv, nz, t)
+                        first = False
+                    tau1, dz1 = out.tau, (out.dz if nz else no_state)
+                    if line is not None:
+                        line.push(k, tau1, dz1)
+                tau_k, dz_k = (tau1, dz1) if line is None else line.at(k)  # the torque applied
+                b = k - off
+                Q[b], V[b], T[b] = q, v, tau_k
+                if MQ is not None and MV is not None:
+                    MQ[b], MV[b] = q + noise[0], v + noise[1]  # as the law measured it
+                if nz:
+                    Z[b] = z
+                filled = b + 1
+                if k == n:
+                    break
+                if sampled:  # zero-order hold (or delay): τ and ż fixed over the step
+                    q, v, z = _held_step(accel, q, v, z, tau_k, dz_k, steps, nz)
+                else:
+                    q, v, z = _stage_step(
+                        compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
+                    )
+        except (KeyboardInterrupt, SystemExit, MemoryError):
+            raise
+        except Exception as exc:
+            if not _raised_by(exc, compute):
+                raise
+            # A law may raise on a state that had already diverged: report the divergence.
+            self.flag(k0 - off, filled, off, True)
+            if isinstance(exc, ControllerError):
+                raise
+            what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
+            raise ControllerError(controller.name, clock.now, what + raised_at(exc, controller)) from exc
+        self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first = q, v, z, accel, tau1, dz1, first
+
+    def flag(self, start: int, stop: int, off: int, raise_now: bool) -> np.ndarray:
+        """Flag the live runs that diverged within buffer rows ``start:stop`` (the first is
+        sample ``start + off``); returns them."""
+        o = self.out
+        return flag_block(
+            o.Q, o.V, o.Z, o.T, start, stop, self.times, off,
+            self.alive, self.diverged_at, self.detail, self.controller.name, raise_now,
+        )  # fmt: skip
+
+    def check(self, k0: int, k1: int, rq: np.ndarray, rv: np.ndarray, stop_on_divergence: bool) -> None:
+        """After steps ``k0 … k1 − 1``: flag the runs that diverged within them or at sample
+        ``k1``, and park those on the reference (``rq``, ``rv``: the block's half-step rows)
+        while the others go on."""
+        rows = self.rows(k0, k1)
+        newly = self.flag(rows.start, rows.stop, k0 - rows.start, stop_on_divergence)
+        if k1 <= self.n:  # the state after the block's last step is sample k1
+            q, v, z = self.q, self.v, self.z
+            name = self.controller.name
+            newly |= late_divergence(
+                q, v, z, self.alive, k1 * self.dt, self.diverged_at, self.detail, name, stop_on_divergence
+            )
+            if newly.any():  # park them on the reference, keep the batch going
+                j = 2 * (k1 - k0)
+                q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
+                q[newly], v[newly], z[newly] = rq[j][0], rv[j][0], self.z_start[newly]
+                self.q, self.v, self.z = q, v, z
 
 
 def _block_reference(
@@ -340,6 +394,15 @@ class _Steps(NamedTuple):
     h2z: np.ndarray
     h6z: np.ndarray
     twoz: np.ndarray
+
+    @classmethod
+    def of(cls, dt: float, nv: int, nz: int) -> _Steps:
+        """The factors of a step of ``dt`` [s] for nv joints and a law state of nz entries."""
+        return cls(
+            dt,
+            *(np.full((1, nv), x) for x in (dt, dt / 2, dt / 6, 2.0)),
+            *(np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0)),
+        )
 
 
 def _stage_step(
@@ -431,86 +494,3 @@ def _raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
             return True
         tb = tb.tb_next
     return isinstance(exc, ControllerError)
-
-
-def _late_divergence(
-    q: np.ndarray,
-    v: np.ndarray,
-    z: np.ndarray,
-    alive: np.ndarray,
-    t: float,
-    diverged_at: np.ndarray,
-    detail: list[str | None],
-    name: str,
-    stop_on_divergence: bool,
-) -> np.ndarray:
-    """Flag the live runs whose state after a block (at ``t`` [s]) has diverged; returns them."""
-    current = _bad_rows(q[None])[0] | _bad_rows(v[None])[0] | _bad_rows(z[None])[0]
-    late = alive & current
-    if late.any():
-        if stop_on_divergence:
-            raise SimulationDivergedError(name, t, _state_detail(q, v, z, late))
-        for r in np.flatnonzero(late):
-            diverged_at[r] = t
-            detail[r] = _state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r])
-        alive &= ~late
-    return late
-
-
-def _state_detail(q: np.ndarray, v: np.ndarray, z: np.ndarray, mask: np.ndarray) -> str:
-    values = np.concatenate([np.abs(q[mask]).ravel(), np.abs(v[mask]).ravel(), np.abs(z[mask]).ravel()])
-    worst = float(np.max(values)) if values.size else math.nan
-    if not math.isfinite(worst) or np.isnan(values).any():
-        return "non-finite state"
-    return f"|state| = {worst:.3g} > {DIVERGENCE_LIMIT:g}"
-
-
-def _flag_block(
-    Q: np.ndarray,
-    V: np.ndarray,
-    Z: np.ndarray,
-    T: np.ndarray,
-    start: int,
-    stop: int,
-    times: np.ndarray,
-    off: int,
-    alive: np.ndarray,
-    diverged_at: np.ndarray,
-    detail: list[str | None],
-    name: str,
-    raise_now: bool,
-) -> np.ndarray:
-    """Flag the runs that diverged within buffer rows ``start:stop``; returns them."""
-    rows = slice(start, stop)
-    state_bad = _bad_rows(Q[rows]) | _bad_rows(V[rows]) | _bad_rows(Z[rows])
-    torque_bad = ~np.isfinite(T[rows]).all(axis=-1)
-    bad = (state_bad | torque_bad) & alive[None, :]
-    newly = bad.any(axis=0)
-    for r in np.flatnonzero(newly):
-        first = int(np.argmax(bad[:, r]))
-        k = start + first + off
-        t = float(times[k])
-        if torque_bad[first, r] and not state_bad[first, r]:
-            what = f"the controller returned a non-finite torque τ = {T[start + first, r].tolist()}"
-            if raise_now:
-                raise ControllerError(name, t, what)
-        else:
-            what = _state_detail(
-                Q[start + first], V[start + first], Z[start + first], np.eye(len(alive), dtype=bool)[r]
-            )
-            row = start + first
-            if (
-                row > 0
-                and what == "non-finite state"
-                and not (_bad_rows(Q[row - 1 : row]) | _bad_rows(V[row - 1 : row]))[0, r]
-            ):
-                what += (
-                    f" one step after a sound state at t = {times[k - 1]:.6g} s: the controller's torque"
-                    " or the plant produced NaN or inf within that step"
-                )
-            if raise_now:
-                raise SimulationDivergedError(name, t, what)
-        diverged_at[r] = t
-        detail[r] = what
-    alive &= ~newly
-    return newly

@@ -10,7 +10,7 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.adaptive_step import integrate_adaptive
 from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, joint_offsets
-from twolink_pin.simulation.engine import integrate
+from twolink_pin.simulation.engine import Samples, integrate
 from twolink_pin.simulation.result import SimulationResult
 from twolink_pin.trajectory import Trajectory
 
@@ -98,6 +98,21 @@ def simulate(
     q0, v0 = initial_state(plant, trajectory, config)
     z0 = np.atleast_2d(np.asarray(controller.initial_state(), dtype=float)).reshape(1, -1)
     check_recorded_size(config.steps, plant.robot.nv, z0.shape[1])
+    samples = _recorded_run(controller, plant, trajectory, config, q0, v0, z0)
+    return _single_result(controller, plant, trajectory, config, samples)
+
+
+def _recorded_run(
+    controller: Controller,
+    plant: Plant,
+    trajectory: Trajectory,
+    config: SimulationConfig,
+    q0: np.ndarray,
+    v0: np.ndarray,
+    z0: np.ndarray,
+) -> Samples:
+    """Every sample of the run from ``q0`` [rad], ``v0`` [rad/s], ``z0`` (shape (nv,), (nv,),
+    (1, nz)) by the config's method: the engine's RK4 (raising at a divergence) or DOP853."""
     if config.method == "rk4":
         samples = integrate(
             controller,
@@ -111,17 +126,24 @@ def simulate(
             stop_on_divergence=True,
         ).record
         assert samples is not None
-    else:
-        if plant.has_events:
-            raise InvalidParameterError(
-                "method", config.method, "'rk4' with a wrench, payload step, sensor noise or delay"
-            )
-        friction = plant.friction
-        if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
-            raise InvalidParameterError(
-                "friction.smoothing", 0.0, "> 0 rad/s with the adaptive-step method (exact sgn stalls it)"
-            )
-        samples = integrate_adaptive(controller, plant, trajectory, config, q0[None], v0[None], z0)
+        return samples
+    if plant.has_events:
+        raise InvalidParameterError(
+            "method", config.method, "'rk4' with a wrench, payload step, sensor noise or delay"
+        )
+    friction = plant.friction
+    if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
+        raise InvalidParameterError(
+            "friction.smoothing", 0.0, "> 0 rad/s with the adaptive-step method (exact sgn stalls it)"
+        )
+    return integrate_adaptive(controller, plant, trajectory, config, q0[None], v0[None], z0)
+
+
+def _single_result(
+    controller: Controller, plant: Plant, trajectory: Trajectory, config: SimulationConfig, samples: Samples
+) -> SimulationResult:
+    """The run's ``samples`` (N = 1) as a :class:`SimulationResult`: the applied torque, the
+    law's estimates picked out of its state, read-only arrays."""
     tau_command = samples.tau_command[:, 0, :]
     z = samples.z[:, 0, :]
     estimates = controller.state_size > 0 and controller.estimates

@@ -22,7 +22,7 @@ from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.metrics import Metrics, RunningMetrics
 from twolink_pin.plant import Plant
-from twolink_pin.simulation import SimulationConfig, estimated_truth, integrate
+from twolink_pin.simulation import EngineRun, SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state, state_labels
 from twolink_pin.simulation.terms import check_parallel, threads_for
@@ -186,12 +186,8 @@ def simulate_batch(
     check_setup(controller, plant, trajectory)
     nv = plant.robot.nv
     n = batch_size(controller, q0_offsets, v0_offsets, runs=runs)
-    q0_nominal, v0_nominal = initial_state(plant, trajectory, config)
+    q0_off, v0_off = _offsets(plant, trajectory, config, n, q0_offsets, v0_offsets)
     ref0 = trajectory.sample(0.0)
-    q0_off = _per_run("q0_offsets", q0_offsets, n, nv)
-    v0_off = _per_run("v0_offsets", v0_offsets, n, nv)
-    q0_off = np.tile(q0_nominal - ref0.q, (n, 1)) if q0_off is None else q0_off
-    v0_off = np.tile(v0_nominal - ref0.v, (n, 1)) if v0_off is None else v0_off
     z0 = np.asarray(controller.initial_state(), dtype=float)
     z0 = np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
     if record:
@@ -200,9 +196,12 @@ def simulate_batch(
     steps = config.steps
     dt = config.duration / steps
     observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
-    task = None
-    if controller.task_space:  # the law's class declares it: its rows carry the task errors
-        task = RunningTaskMetrics(plant.robot, n, dt, steps + 1, trajectory.period)
+    # A task-space law (its class declares it): its rows carry the task errors too.
+    task = (
+        RunningTaskMetrics(plant.robot, n, dt, steps + 1, trajectory.period)
+        if controller.task_space
+        else None
+    )
     with progress_callback(progress, n) as shown:
         run = integrate(
             controller,
@@ -218,6 +217,48 @@ def simulate_batch(
             progress=shown,
         )
     dead = ~np.isnan(run.diverged_at)
+    metrics, task_metrics = observer.result(dead), None if task is None else task.result(dead)
+    return _batch_result(
+        controller, plant, trajectory, config, run, q0_off, v0_off, metrics, task_metrics, used
+    )
+
+
+def _offsets(
+    plant: Plant,
+    trajectory: Trajectory,
+    config: SimulationConfig,
+    n: int,
+    q0_offsets: Any,
+    v0_offsets: Any,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each run's ``q(0) − q_d(0)`` [rad] and ``q̇(0) − q̇_d(0)`` [rad/s], shape (N, nv) each:
+    the ones given, else the configuration's (the robot's default offset) for every run."""
+    nv = plant.robot.nv
+    q0_nominal, v0_nominal = initial_state(plant, trajectory, config)
+    ref0 = trajectory.sample(0.0)
+    q0_off = _per_run("q0_offsets", q0_offsets, n, nv)
+    v0_off = _per_run("v0_offsets", v0_offsets, n, nv)
+    q0_off = np.tile(q0_nominal - ref0.q, (n, 1)) if q0_off is None else q0_off
+    v0_off = np.tile(v0_nominal - ref0.v, (n, 1)) if v0_off is None else v0_off
+    return q0_off, v0_off
+
+
+def _batch_result(
+    controller: Controller,
+    plant: Plant,
+    trajectory: Trajectory,
+    config: SimulationConfig,
+    run: EngineRun,
+    q0_off: np.ndarray,
+    v0_off: np.ndarray,
+    metrics: Metrics,
+    task_metrics: TaskMetrics | None,
+    threads: int,
+) -> BatchResult:
+    """The engine's ``run`` as a :class:`BatchResult`: final states and estimates NaN for the
+    diverged runs, the law's estimates picked out of its state, records run-first (N, K, ·)."""
+    dead = ~np.isnan(run.diverged_at)
+    dt = config.duration / config.steps
     estimates = controller.state_size > 0 and bool(controller.estimates)
     nz = run.z_final.shape[1]
     state_final = run.z_final.copy()
@@ -238,12 +279,12 @@ def simulate_batch(
         t=readonly(run.t),
         q0_offset=readonly(q0_off),
         v0_offset=readonly(v0_off),
-        metrics=observer.result(dead),
+        metrics=metrics,
         diverged_at=readonly(run.diverged_at),
         divergence=run.detail,
         torque_limits=readonly(plant.limits),
         saturate=plant.saturate,
-        threads=used,
+        threads=threads,
         control_period=None if config.hold_steps is None else config.hold_steps * dt,
         p_hat_final=readonly_or_none(p_hat_final),
         p_true=readonly_or_none(estimated_truth(controller, plant)) if estimates else None,
@@ -257,7 +298,7 @@ def simulate_batch(
         state=readonly(rec.z.transpose(1, 0, 2)) if rec is not None and nz else None,
         state_names=names,
         state_units=units,
-        task_metrics=None if task is None else task.result(dead),
+        task_metrics=task_metrics,
         trajectory=trajectory,
     )
 

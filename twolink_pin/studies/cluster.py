@@ -139,6 +139,40 @@ def _call(fn: Callable[..., Any], topic: str, index: int, args: tuple[Any, ...])
     return str(worker.address), fn(*args, progress=progress)
 
 
+class _Reports:
+    """The running tasks' progress reports, which arrive on Dask's thread as events of the
+    run's topic: runs done per task, and when each task's first report came (it is running)."""
+
+    def __init__(self) -> None:
+        self.partial: dict[int, int] = {}
+        self.started: dict[int, float] = {}  # task -> when its first report arrived [monotonic s]
+        self.lock = threading.Lock()
+
+    def on_event(self, event: Any) -> None:
+        """A worker's ``(index, runs done)`` event."""
+        index, runs = event[1]
+        with self.lock:
+            self.partial[int(index)] = max(self.partial.get(int(index), 0), int(runs))
+            self.started.setdefault(int(index), time.monotonic())  # its first report: running
+
+    def snapshot(self) -> dict[int, int]:
+        """``{index: runs done}`` of the running tasks."""
+        with self.lock:
+            return dict(self.partial)
+
+    def forget(self, index: int) -> None:
+        """Task ``index`` has finished."""
+        with self.lock:
+            self.partial.pop(index, None)
+            self.started.pop(index, None)
+
+    def late(self, limit_s: float) -> list[int]:
+        """The tasks running for longer than ``limit_s`` [s]."""
+        now = time.monotonic()
+        with self.lock:
+            return [i for i, t0 in self.started.items() if now - t0 > limit_s]
+
+
 @dataclass
 class DaskEngine:
     """A Dask client (and the LocalCluster it owns, if any); see the module docstring."""
@@ -195,22 +229,11 @@ class DaskEngine:
             TaskTimeout: a task ran past ``limit_s``.
             Exception: what a task raised (a twolink-pin error arrives whole).
         """
-        from distributed import KilledWorker
-
         token = uuid.uuid4().hex[:12]
         topic = f"twolink-pin-{name}-{token}"
         done_queue: queue.Queue[Any] = queue.Queue()
-        partial: dict[int, int] = {}
-        started: dict[int, float] = {}  # task -> when its first report arrived [monotonic s]
-        lock = threading.Lock()
-
-        def on_event(event: Any) -> None:
-            index, runs = event[1]
-            with lock:
-                partial[int(index)] = max(partial.get(int(index), 0), int(runs))
-                started.setdefault(int(index), time.monotonic())  # its first report: running
-
-        self.client.subscribe_topic(topic, on_event)
+        reports = _Reports()
+        self.client.subscribe_topic(topic, reports.on_event)
         index_of: dict[str, int] = {}
         next_item = 0
         finished = 0
@@ -220,12 +243,8 @@ class DaskEngine:
             while finished < len(items):
                 while next_item < len(items) and len(self._pending) < limit:
                     key = f"{name}-{token}-{next_item}"
-                    future = self.client.submit(
-                        _call, fn, topic, next_item, items[next_item], key=key, pure=False, retries=0
-                    )
-                    self._pending[key] = future
+                    self._submit(fn, topic, next_item, items[next_item], key, done_queue)
                     index_of[key] = next_item
-                    future.add_done_callback(done_queue.put)
                     next_item += 1
                 try:
                     future = done_queue.get(timeout=PROGRESS_INTERVAL)
@@ -239,39 +258,16 @@ class DaskEngine:
                         self.address, f"lost the connection to the scheduler during the {name}"
                     )
                 if limit_s is not None:
-                    self._check_bound(started, lock, limit_s, name)
+                    self._check_bound(reports, limit_s, name)
                 if future is None or future.key not in self._pending:
                     if progress is not None:
-                        with lock:
-                            snapshot = dict(partial)
-                        progress(snapshot)
+                        progress(reports.snapshot())
                     continue
                 index = index_of.pop(future.key)
                 del self._pending[future.key]
-                with lock:
-                    partial.pop(index, None)
-                    started.pop(index, None)
-                if future.status == "cancelled":
-                    raise ClusterError(
-                        self.address,
-                        f"the scheduler dropped the {name} tasks (was it restarted, or did another client cancel them?)",
-                    )
-                if future.status == "error":
-                    exc = future.exception()
-                    if isinstance(exc, KilledWorker):
-                        deaths = int(getattr(exc, "allowed_failures", ALLOWED_FAILURES)) + 1
-                        last = getattr(getattr(exc, "last_worker", None), "address", "?")
-                        raise ClusterError(
-                            self.address,
-                            f"{name} {index} killed {deaths} worker{'s' if deaths != 1 else ''} in a row (out of "
-                            f"memory? a crash in the law?); the last was {last}: see its log",
-                        ) from exc
-                    if isinstance(exc, ImportError):
-                        raise ClusterError(
-                            self.address,
-                            f"a worker cannot import the code ({exc}): install the same twolink-pin on every worker",
-                        ) from exc
-                    raise exc
+                reports.forget(index)
+                if future.status in ("cancelled", "error"):
+                    raise self._failure(future, index, name)
                 worker, result = future.result()
                 future.release()
                 finished += 1
@@ -281,13 +277,47 @@ class DaskEngine:
             with contextlib.suppress(Exception):
                 self.client.unsubscribe_topic(topic)
 
-    def _check_bound(
-        self, started: dict[int, float], lock: threading.Lock, limit_s: float, name: str
+    def _submit(
+        self, fn: Callable[..., Any], topic: str, index: int, args: tuple[Any, ...], key: str, done: Any
     ) -> None:
+        """Submit task ``index`` (``fn(*args)``, reporting on ``topic``) under ``key``; its
+        future is pending until it is put on the queue ``done`` when it ends."""
+        future = self.client.submit(_call, fn, topic, index, args, key=key, pure=False, retries=0)
+        self._pending[key] = future
+        future.add_done_callback(done.put)
+
+    def _failure(self, future: Any, index: int, name: str) -> BaseException:
+        """The error of task ``index`` that was cancelled or raised: the scheduler dropped it,
+        it killed too many workers, a worker cannot import the code, or what it raised."""
+        from distributed import KilledWorker
+
+        if future.status == "cancelled":
+            return ClusterError(
+                self.address,
+                f"the scheduler dropped the {name} tasks (was it restarted, or did another client cancel them?)",
+            )
+        exc = future.exception()
+        if isinstance(exc, KilledWorker):
+            deaths = int(getattr(exc, "allowed_failures", ALLOWED_FAILURES)) + 1
+            last = getattr(getattr(exc, "last_worker", None), "address", "?")
+            error = ClusterError(
+                self.address,
+                f"{name} {index} killed {deaths} worker{'s' if deaths != 1 else ''} in a row (out of "
+                f"memory? a crash in the law?); the last was {last}: see its log",
+            )
+        elif isinstance(exc, ImportError):
+            error = ClusterError(
+                self.address,
+                f"a worker cannot import the code ({exc}): install the same twolink-pin on every worker",
+            )
+        else:
+            return exc
+        error.__cause__ = exc
+        return error
+
+    def _check_bound(self, reports: _Reports, limit_s: float, name: str) -> None:
         """Raise :class:`TaskTimeout` for the first task running for longer than ``limit_s``."""
-        now = time.monotonic()
-        with lock:
-            late = [i for i, t0 in started.items() if now - t0 > limit_s]
+        late = reports.late(limit_s)
         if late:
             raise TaskTimeout(self.address, name, min(late), limit_s, owned=self.cluster is not None)
 
@@ -353,52 +383,15 @@ def open_cluster(
         ClusterError: Dask is not installed, the scheduler cannot be reached or has no
             worker, or the LocalCluster does not start.
     """
-    if (scheduler is None) == (workers is None):
-        raise InvalidParameterError(
-            "scheduler/workers", (scheduler, workers), "exactly one of a scheduler address and a worker count"
-        )
-    if not (isinstance(timeout, (int, float)) and not isinstance(timeout, bool) and 0 < timeout < 1e6):
-        raise InvalidParameterError("timeout", timeout, "a number of seconds > 0")
-    if workers is not None and not (
-        isinstance(workers, int) and not isinstance(workers, bool) and 1 <= workers <= MAX_WORKERS
-    ):
-        raise InvalidParameterError("workers", workers, f"a whole number from 1 to {MAX_WORKERS}")
+    _check_cluster_options(scheduler, workers, timeout)
     address = scheduler_address(scheduler) if scheduler is not None else "127.0.0.1 (LocalCluster)"
     require_dask()
-    from distributed import Client
-
     if scheduler is not None:
-        probe(address, timeout)
-        handshake(address, timeout)
-        try:
-            client = Client(address, timeout=timeout, set_as_default=False)
-        except (OSError, TimeoutError) as exc:
-            raise ClusterError(address, f"cannot connect within {timeout:g} s ({exc})") from None
-        engine = DaskEngine(
-            client, address, f"scheduler {address}", dashboard=_dashboard(client.dashboard_link)
-        )
+        engine = _remote_engine(address, timeout)
     else:
         assert workers is not None
-        cluster, client = start_local(
-            address,
-            dict(
-                n_workers=workers,
-                threads_per_worker=1,
-                processes=True,
-                host="127.0.0.1",
-                scheduler_port=0,
-                dashboard_address="127.0.0.1:0",
-                preload=list(preload) or [__name__],
-                env={LOCAL_WORKER: "1"},
-            ),
-        )
-        engine = DaskEngine(
-            client,
-            str(cluster.scheduler_address),
-            f"LocalCluster of {workers} worker{'s' if workers != 1 else ''} at {cluster.scheduler_address}",
-            cluster=cluster,
-            dashboard=_dashboard(cluster.dashboard_link),
-        )
+        engine = _local_engine(address, workers, preload)
+    client = engine.client
     try:
         try:
             client.wait_for_workers(1, timeout=timeout)
@@ -413,6 +406,59 @@ def open_cluster(
         raise
     else:
         engine.close()
+
+
+def _check_cluster_options(scheduler: str | None, workers: int | None, timeout: float) -> None:
+    """Raise unless exactly one of ``scheduler`` and ``workers`` is given, ``workers`` is 1 to
+    :data:`MAX_WORKERS` and ``timeout`` a number of seconds > 0."""
+    if (scheduler is None) == (workers is None):
+        raise InvalidParameterError(
+            "scheduler/workers", (scheduler, workers), "exactly one of a scheduler address and a worker count"
+        )
+    if not (isinstance(timeout, (int, float)) and not isinstance(timeout, bool) and 0 < timeout < 1e6):
+        raise InvalidParameterError("timeout", timeout, "a number of seconds > 0")
+    if workers is not None and not (
+        isinstance(workers, int) and not isinstance(workers, bool) and 1 <= workers <= MAX_WORKERS
+    ):
+        raise InvalidParameterError("workers", workers, f"a whole number from 1 to {MAX_WORKERS}")
+
+
+def _remote_engine(address: str, timeout: float) -> DaskEngine:
+    """An engine on the running scheduler at ``address``, checked to answer within ``timeout`` [s]."""
+    from distributed import Client
+
+    probe(address, timeout)
+    handshake(address, timeout)
+    try:
+        client = Client(address, timeout=timeout, set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise ClusterError(address, f"cannot connect within {timeout:g} s ({exc})") from None
+    return DaskEngine(client, address, f"scheduler {address}", dashboard=_dashboard(client.dashboard_link))
+
+
+def _local_engine(address: str, workers: int, preload: Sequence[str]) -> DaskEngine:
+    """An engine owning a new LocalCluster of ``workers`` single-threaded processes, all bound
+    to 127.0.0.1, whose workers import ``preload`` (default this module) when they start."""
+    cluster, client = start_local(
+        address,
+        dict(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            scheduler_port=0,
+            dashboard_address="127.0.0.1:0",
+            preload=list(preload) or [__name__],
+            env={LOCAL_WORKER: "1"},
+        ),
+    )
+    return DaskEngine(
+        client,
+        str(cluster.scheduler_address),
+        f"LocalCluster of {workers} worker{'s' if workers != 1 else ''} at {cluster.scheduler_address}",
+        cluster=cluster,
+        dashboard=_dashboard(cluster.dashboard_link),
+    )
 
 
 __all__ = [

@@ -56,7 +56,6 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-import uuid
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -93,23 +92,23 @@ from twolink_pin.studies.sweep_rows import (
     METRIC_UNITS,
     PERCENTILES,
     ChunkRows,
-    _Prepared,
+    PreparedSweep,
     environment,
     input_columns,
     metric_columns,
     summarize,
 )
-from twolink_pin.studies.sweep_transport import RobotSource, SweepJob, _law_file, _versions, run_chunk_task
+from twolink_pin.studies.sweep_transport import RobotSource, SweepJob, run_chunk_task, versions_text
 from twolink_pin.studies.sweep_writers import (
     FIGURE_MAX_RUNS,
     FIGURE_METRICS,
     SUMMARY_MEMORY,
-    _figure,
-    _json_rows,
-    _Sink,
+    RowSink,
+    json_row_writer,
     save_distribution_figure,
     summarize_dataset,
     sweep_metadata,
+    write_figure,
 )
 from twolink_pin.trajectory import Trajectory
 
@@ -199,107 +198,157 @@ def run_sweep(
         OutputError: ``out_dir`` is someone else's folder or cannot be written.
     """
     cls = config.run.law_class()
-    prepared = _Prepared(config, cls, robot, trajectory, keep_trajectories)
+    prepared = PreparedSweep(config, cls, robot, trajectory, keep_trajectories)
     check_output_directory(out_dir, MARKER)  # before a cluster is started or reached
     schema = table_schema(prepared.header, prepared.units, sweep_metadata(config, robot, cls, trajectory))
-    here = environment()
     with contextlib.ExitStack() as stack:
-        engine = None
-        if client is not None:
-            if scheduler is not None or workers is not None:
-                raise InvalidParameterError("client", client, "no scheduler or workers beside a client")
-            from twolink_pin.studies.cluster import engine_for
-
-            engine = engine_for(client)
-        elif scheduler is not None or workers is not None:
-            from twolink_pin.studies.cluster import open_cluster
-
-            engine = stack.enter_context(open_cluster(scheduler, workers, timeout, preload=(__name__,)))
-            if notify is not None:
-                notify(f"sweep on {engine.description}")
-                if engine.dashboard:
-                    notify(f"dashboard: {engine.dashboard}")
+        engine = _engine(stack, client, scheduler, workers, timeout, notify)
         chunk = config.chunk or auto_chunk(config.samples, None if engine is None else engine.slots)
         ranges = [(s, min(s + chunk, config.samples)) for s in range(0, config.samples, chunk)]
         started = time.perf_counter()
         with output_directory(out_dir, MARKER) as stage:
-            with atomic_write(stage / "runs.csv") as csv_file, _json_rows(stage / "runs.json") as json_rows:
-                sink = _Sink(stage, prepared, schema, csv_file, json_rows)
+            with (
+                atomic_write(stage / "runs.csv") as csv_file,
+                json_row_writer(stage / "runs.json") as json_rows,
+            ):
+                sink = RowSink(stage, prepared, schema, csv_file, json_rows)
                 if engine is None:
-                    for start, stop in ranges:
-
-                        def chunk_progress(done: int, start: int = start) -> None:
-                            if progress is not None:
-                                progress(start + done, config.samples)
-
-                        sink.add(prepared.run(start, stop, config.threads, chunk_progress))
+                    _run_in_process(prepared, ranges, sink, progress)
                 else:
-                    job = SweepJob(
-                        uuid.uuid4().hex,
-                        config,
-                        cls.__name__,
-                        _law_file(cls),
-                        RobotSource.of(robot),
-                        trajectory,
-                        keep_trajectories,
-                        config.threads or 1,
-                    )
-                    finished = [0, 0]  # runs in finished chunks, runs last shown
-
-                    def partial(running: dict[int, int]) -> None:
-                        done = finished[0] + sum(running.values())
-                        if progress is not None and done > finished[1]:
-                            finished[1] = min(done, config.samples)
-                            progress(finished[1], config.samples)
-
-                    tasks = [(job, start, stop) for start, stop in ranges]
-                    results = engine.run(
-                        run_chunk_task, tasks, name="sweep", progress=partial, limit_s=run_limit()
-                    )
-                    with _named_timeout(cls, ranges), contextlib.closing(results):
-                        for _, worker, rows in results:
-                            if rows.environment != here:
-                                raise ClusterError(
-                                    worker,
-                                    f"runs {_versions(rows.environment)} but the client {_versions(here)}: its "
-                                    "runs would not be bit-identical; install the same versions everywhere",
-                                )
-                            sink.add(rows)
-                            finished[0] += rows.stop - rows.start
-                            partial({})
+                    job = SweepJob.of(config, cls, robot, trajectory, keep_trajectories)
+                    _run_on_cluster(engine, job, cls, ranges, sink, progress)
                 assert sink.next == config.samples and not sink.early
             seconds = time.perf_counter() - started
-            summary = summarize_dataset(stage / RUNS_FOLDER, prepared.metric_columns)
-            summary = {
-                "controller": cls.name,
-                "robot": robot.name,
-                "samples": config.samples,
-                "seed": config.seed,
-                "q0_spread": config.q0_spread,
-                "param_error": config.param_error,
-                "gains": {g.name: [g.low, g.high] for g in config.gains},
-                "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
-                "duration": config.run.simulation.duration,
-                "dt": config.run.simulation.dt,
-                "control_period": config.run.simulation.control_period,
-                "method": config.run.simulation.method,
-                "lam": config.run.lam,
-                "saturate": config.run.plant.saturate,
-                "friction_smoothing": config.run.friction_smoothing,
-                "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
-                **summary,
-            }
-            write_json(stage / "summary.json", summary)
-            files = [stage / "runs.csv", stage / "runs.json", stage / RUNS_FOLDER, stage / "summary.json"]
-            files += sink.kept
-            if summary["diverged"] == summary["runs"]:  # nothing to draw: the table and summary say so
-                summary["note"] = f"every one of the {summary['runs']} runs diverged: no distributions.png"
-                write_json(stage / "summary.json", summary)
-            elif plot:
-                files.append(_figure(stage, config.samples, robot.nv, cls.name, prepared.task))
+            summary, files = _conclude(stage, prepared, sink, robot, plot)
         description = "in-process" if engine is None else engine.description
     out = Path(out_dir)
     return SweepOutput(summary, tuple(out / f.name for f in files), seconds, description, chunk)
+
+
+def _engine(
+    stack: contextlib.ExitStack,
+    client: Any,
+    scheduler: str | None,
+    workers: int | None,
+    timeout: float,
+    notify: Callable[[str], None] | None,
+) -> Any:
+    """Where the chunks run: None (in this process), the given client's cluster, or a cluster
+    opened on ``stack`` (a scheduler's, or a new LocalCluster of ``workers``), announced
+    through ``notify``."""
+    if client is not None:
+        if scheduler is not None or workers is not None:
+            raise InvalidParameterError("client", client, "no scheduler or workers beside a client")
+        from twolink_pin.studies.cluster import engine_for
+
+        return engine_for(client)
+    if scheduler is None and workers is None:
+        return None
+    from twolink_pin.studies.cluster import open_cluster
+
+    engine = stack.enter_context(open_cluster(scheduler, workers, timeout, preload=(__name__,)))
+    if notify is not None:
+        notify(f"sweep on {engine.description}")
+        if engine.dashboard:
+            notify(f"dashboard: {engine.dashboard}")
+    return engine
+
+
+def _run_in_process(
+    prepared: PreparedSweep,
+    ranges: list[tuple[int, int]],
+    sink: RowSink,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Run the chunks one after the other in this process, each into ``sink``."""
+    samples = prepared.config.samples
+    for start, stop in ranges:
+
+        def chunk_progress(done: int, start: int = start) -> None:
+            if progress is not None:
+                progress(start + done, samples)
+
+        sink.add(prepared.run(start, stop, prepared.config.threads, chunk_progress))
+
+
+def _run_on_cluster(
+    engine: Any,
+    job: SweepJob,
+    cls: type[Controller],
+    ranges: list[tuple[int, int]],
+    sink: RowSink,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Run the chunks of ``job`` (a study of the law ``cls``) as tasks on ``engine``'s cluster,
+    each into ``sink`` as it arrives in run order; a worker whose versions differ from this
+    process's is refused."""
+    here = environment()
+    samples = job.config.samples
+    finished = [0, 0]  # runs in finished chunks, runs last shown
+
+    def partial(running: dict[int, int]) -> None:
+        done = finished[0] + sum(running.values())
+        if progress is not None and done > finished[1]:
+            finished[1] = min(done, samples)
+            progress(finished[1], samples)
+
+    tasks = [(job, start, stop) for start, stop in ranges]
+    results = engine.run(run_chunk_task, tasks, name="sweep", progress=partial, limit_s=run_limit())
+    with _named_timeout(cls, ranges), contextlib.closing(results):
+        for _, worker, rows in results:
+            if rows.environment != here:
+                raise ClusterError(
+                    worker,
+                    f"runs {versions_text(rows.environment)} but the client {versions_text(here)}: its "
+                    "runs would not be bit-identical; install the same versions everywhere",
+                )
+            sink.add(rows)
+            finished[0] += rows.stop - rows.start
+            partial({})
+
+
+def _conclude(
+    stage: Path, prepared: PreparedSweep, sink: RowSink, robot: RobotModel, plot: bool
+) -> tuple[dict[str, Any], list[Path]]:
+    """After the runs: ``summary.json`` from the dataset in ``stage`` and ``distributions.png``
+    (if ``plot`` and some run did not diverge); returns the summary and every file written."""
+    config, cls = prepared.config, prepared.cls
+    summary = _summary(config, robot, cls, summarize_dataset(stage / RUNS_FOLDER, prepared.metric_columns))
+    write_json(stage / "summary.json", summary)
+    files = [stage / "runs.csv", stage / "runs.json", stage / RUNS_FOLDER, stage / "summary.json"]
+    files += sink.kept
+    if summary["diverged"] == summary["runs"]:  # nothing to draw: the table and summary say so
+        summary["note"] = f"every one of the {summary['runs']} runs diverged: no distributions.png"
+        write_json(stage / "summary.json", summary)
+    elif plot:
+        files.append(write_figure(stage, config.samples, robot.nv, cls.name, prepared.task))
+    return summary, files
+
+
+def _summary(
+    config: SweepConfig, robot: RobotModel, cls: type[Controller], found: dict[str, Any]
+) -> dict[str, Any]:
+    """``summary.json``: the study's settings (law, robot, draws' ranges, simulation, torque
+    limits [N·m]), then what :func:`summarize_dataset` ``found``."""
+    return {
+        "controller": cls.name,
+        "robot": robot.name,
+        "samples": config.samples,
+        "seed": config.seed,
+        "q0_spread": config.q0_spread,
+        "param_error": config.param_error,
+        "gains": {g.name: [g.low, g.high] for g in config.gains},
+        "wrench_scale": None if config.wrench_scale is None else list(config.wrench_scale),
+        "duration": config.run.simulation.duration,
+        "dt": config.run.simulation.dt,
+        "control_period": config.run.simulation.control_period,
+        "method": config.run.simulation.method,
+        "lam": config.run.lam,
+        "saturate": config.run.plant.saturate,
+        "friction_smoothing": config.run.friction_smoothing,
+        "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
+        **found,
+    }
 
 
 __all__ = [

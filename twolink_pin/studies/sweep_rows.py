@@ -154,7 +154,7 @@ class ChunkRows:
         return self.start + int(self.inputs.shape[0])
 
 
-class _Prepared:
+class PreparedSweep:
     """What every chunk of a study shares: the law's class and base scenario, the columns."""
 
     def __init__(

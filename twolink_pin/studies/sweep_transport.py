@@ -8,6 +8,7 @@ import hashlib
 import shutil
 import tempfile
 import threading
+import uuid
 from collections import OrderedDict
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -19,7 +20,7 @@ from twolink_pin.controllers import Controller
 from twolink_pin.model import RobotModel
 from twolink_pin.studies.cluster import ClusterError
 from twolink_pin.studies.sweep_cases import SweepConfig
-from twolink_pin.studies.sweep_rows import ChunkRows, _Prepared
+from twolink_pin.studies.sweep_rows import ChunkRows, PreparedSweep
 from twolink_pin.trajectory import Trajectory
 
 # -- on a worker -------------------------------------------------------------------------------------
@@ -123,7 +124,28 @@ class SweepJob:
     threads: int
     """Threads of the batch engine per task."""
 
-    def prepare(self) -> _Prepared:
+    @classmethod
+    def of(
+        cls,
+        config: SweepConfig,
+        law: type[Controller],
+        robot: RobotModel,
+        trajectory: Trajectory,
+        record: bool,
+    ) -> SweepJob:
+        """A new sweep's job (a fresh token) of the study ``config`` of ``law`` on ``robot``."""
+        return cls(
+            uuid.uuid4().hex,
+            config,
+            law.__name__,
+            law_source(law),
+            RobotSource.of(robot),
+            trajectory,
+            record,
+            config.threads or 1,
+        )
+
+    def prepare(self) -> PreparedSweep:
         """The shared part of the chunks, built on this worker."""
         from twolink_pin.controllers.loading import load_controller
 
@@ -133,7 +155,7 @@ class SweepJob:
             cls = load_controller(f"{path}:{self.law_class_name}")
         else:
             cls = self.config.run.law_class()
-        return _Prepared(self.config, cls, robot, self.trajectory, self.record)
+        return PreparedSweep(self.config, cls, robot, self.trajectory, self.record)
 
 
 _STORE: list[Path] = []
@@ -158,7 +180,7 @@ def _stored(name: str, text: str) -> Path:
     return path
 
 
-_PREPARED: OrderedDict[str, _Prepared] = OrderedDict()
+_PREPARED: OrderedDict[str, PreparedSweep] = OrderedDict()
 _PREPARED_LOCK = threading.Lock()
 _PREPARED_KEEP = 4
 
@@ -180,7 +202,7 @@ def run_chunk_task(
     return prepared.run(start, stop, job.threads, progress)
 
 
-def _law_file(cls: type[Controller]) -> tuple[str, str] | None:
+def law_source(cls: type[Controller]) -> tuple[str, str] | None:
     """``(file name, source)`` of a law loaded from a file, else None (an importable law)."""
     if not cls.__module__.startswith("twolink_pin_user_"):
         return None
@@ -190,5 +212,5 @@ def _law_file(cls: type[Controller]) -> tuple[str, str] | None:
     return path.name, path.read_text(encoding="utf-8")
 
 
-def _versions(env: Sequence[tuple[str, str]]) -> str:
+def versions_text(env: Sequence[tuple[str, str]]) -> str:
     return ", ".join(f"{name} {version}" for name, version in env)

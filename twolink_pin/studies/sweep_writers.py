@@ -30,8 +30,8 @@ from twolink_pin.studies.sweep_rows import (
     METRIC_UNITS,
     TASK_COLUMNS,
     ChunkRows,
+    PreparedSweep,
     _joint_columns,
-    _Prepared,
     _stats,
 )
 from twolink_pin.trajectory import Trajectory
@@ -39,14 +39,14 @@ from twolink_pin.trajectory import Trajectory
 # -- the table -----------------------------------------------------------------------------------------
 
 
-class _Sink:
+class RowSink:
     """Writes each chunk to its Parquet file as it arrives, and the rows to runs.csv and
     runs.json in run order (a chunk that arrives early is read back from its file)."""
 
     def __init__(
         self,
         stage: Path,
-        prepared: _Prepared,
+        prepared: PreparedSweep,
         schema: Any,
         csv_file: Any,
         json_rows: Callable[[list[str]], None],
@@ -187,7 +187,7 @@ def sweep_metadata(
 
 
 @contextlib.contextmanager
-def _json_rows(path: Path) -> Iterator[Callable[[list[str]], None]]:
+def json_row_writer(path: Path) -> Iterator[Callable[[list[str]], None]]:
     """``runs.json``: an array of row objects, one per line; ``write`` takes rows as JSON texts."""
     with atomic_write(path) as f:
         f.write("[")
@@ -204,7 +204,7 @@ def _json_rows(path: Path) -> Iterator[Callable[[list[str]], None]]:
         f.write("\n]\n")
 
 
-def _figure(stage: Path, samples: int, nv: int, controller: str, task: bool = False) -> Path:
+def write_figure(stage: Path, samples: int, nv: int, controller: str, task: bool = False) -> Path:
     """``distributions.png`` from the dataset: only the plotted columns (the task metrics
     first for a task-space law, ``task``), of at most :data:`FIGURE_MAX_RUNS` runs (every
     k-th beyond)."""

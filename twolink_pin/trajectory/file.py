@@ -192,6 +192,58 @@ def read_trajectory_file(
         raise InvalidParameterError(
             f"{file}: {unknown[0]}", document[unknown[0]], f"only the keys {sorted(KEYS)}"
         )
+    times = _via_times(file, document)
+    period = document.get("period")
+    if period is not None and not (
+        isinstance(period, (int, float)) and not isinstance(period, bool) and math.isfinite(period)
+    ):
+        raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
+    if "rpy" in document and "positions" not in document:
+        raise InvalidParameterError(f"{file}: rpy", document["rpy"], "orientations beside 'positions' (m)")
+    given = [key for key in ("joints", "positions") if key in document]
+    if len(given) != 1:
+        raise InvalidParameterError(
+            f"{file}", given or None, "exactly one of 'joints' (rad) and 'positions' (m)"
+        )
+    key = given[0]
+    rows: Sequence[Any] = document[key]
+    if not isinstance(rows, list) or len(rows) != times.size:
+        raise InvalidParameterError(
+            f"{file}: {key}",
+            f"{len(rows) if isinstance(rows, list) else type(rows).__name__} rows",
+            f"one row per time ({times.size})",
+        )
+    if key == "joints":
+        via_q = _joint_rows(file, rows, robot)
+    else:
+        points, seed = _position_rows(file, document, rows, robot)
+        if "rpy" in document:
+            return _pose_file(file, document, robot, times, points, seed, period)
+        try:
+            via_q = cartesian_via_q(robot, points, seed)
+        except InverseKinematicsError as err:
+            raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
+    closing = float(np.abs(via_q[-1] - via_q[0]).max())
+    if closing > CLOSURE_TOLERANCE:
+        raise InvalidParameterError(
+            f"{file}: {key}[{len(rows) - 1}]",
+            rows[-1],
+            f"the first via point {rows[0]} again (to {CLOSURE_TOLERANCE:g} rad in joint space): the reference "
+            "repeats every period, so it must end where it starts",
+        )
+    try:
+        trajectory = JointTrajectory.from_via_q(
+            tuple(times), via_q, None if period is None else float(period)
+        )
+    except InvalidParameterError as err:
+        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    check_trajectory_limits(robot, trajectory, f"{file}")
+    return trajectory
+
+
+def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:
+    """The file's via-point times [s]: 2 to :data:`MAX_VIA_POINTS` of them, within
+    ±:data:`MAX_TIME`, strictly increasing by at least :data:`MIN_TIME_STEP`."""
     if "times" not in document:
         raise InvalidParameterError(f"{file}: times", None, "a list of via-point times [s]")
     times = _numbers(file, "times", document["times"], "a list of times [s]")
@@ -220,78 +272,47 @@ def read_trajectory_file(
             float(times[k + 1]),
             f"strictly increasing times: > times[{k}] = {times[k]:g} s",
         )
-    period = document.get("period")
-    if period is not None and not (
-        isinstance(period, (int, float)) and not isinstance(period, bool) and math.isfinite(period)
-    ):
-        raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
-    if "rpy" in document and "positions" not in document:
-        raise InvalidParameterError(f"{file}: rpy", document["rpy"], "orientations beside 'positions' (m)")
-    given = [key for key in ("joints", "positions") if key in document]
-    if len(given) != 1:
-        raise InvalidParameterError(
-            f"{file}", given or None, "exactly one of 'joints' (rad) and 'positions' (m)"
-        )
-    key = given[0]
-    rows: Sequence[Any] = document[key]
-    if not isinstance(rows, list) or len(rows) != times.size:
-        raise InvalidParameterError(
-            f"{file}: {key}",
-            f"{len(rows) if isinstance(rows, list) else type(rows).__name__} rows",
-            f"one row per time ({times.size})",
-        )
-    if key == "joints":
-        for k, row in enumerate(rows):
-            if not isinstance(row, list) or len(row) != robot.nv:
-                raise InvalidParameterError(
-                    f"{file}: joints[{k}]",
-                    row,
-                    f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
-                )
-        via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
-        check_within_limits(robot, via_q, f"{file}: joints")  # the URDF's limits first: the better message
-        _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
-    else:
-        width = {len(row) if isinstance(row, list) else -1 for row in rows}
-        if len(width) != 1 or width.pop() not in (2, 3):
+    return times
+
+
+def _joint_rows(file: Path, rows: Sequence[Any], robot: RobotModel) -> np.ndarray:
+    """The ``joints`` rows as via points [rad], shape (V, nv): nv finite numbers per row, within
+    the URDF's limits and ±:data:`MAX_ANGLE`."""
+    for k, row in enumerate(rows):
+        if not isinstance(row, list) or len(row) != robot.nv:
             raise InvalidParameterError(
-                f"{file}: positions",
-                rows,
-                "rows of 3 coordinates (x, y, z) [m], or 2 (x, y) for a planar arm, all alike",
+                f"{file}: joints[{k}]",
+                row,
+                f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
             )
-        points = _numbers(file, "positions", rows, "end-effector positions [m]", MAX_POSITION, "m")
-        seed = None
-        if "seed" in document:
-            seed = _numbers(
-                file, "seed", document["seed"], f"{robot.nv} joint positions [rad]", MAX_ANGLE, "rad"
-            )
-            if seed.shape != (robot.nv,):
-                raise InvalidParameterError(
-                    f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
-                )
-            check_within_limits(robot, seed[None, :], f"{file}: seed")
-        if "rpy" in document:
-            return _pose_file(file, document, robot, times, points, seed, period)
-        try:
-            via_q = cartesian_via_q(robot, points, seed)
-        except InverseKinematicsError as err:
-            raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
-    closing = float(np.abs(via_q[-1] - via_q[0]).max())
-    if closing > CLOSURE_TOLERANCE:
+    via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
+    check_within_limits(robot, via_q, f"{file}: joints")  # the URDF's limits first: the better message
+    _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
+    return via_q
+
+
+def _position_rows(
+    file: Path, document: dict[str, Any], rows: Sequence[Any], robot: RobotModel
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """The ``positions`` rows as end-effector points [m], shape (V, 3) or (V, 2), and the
+    IK's ``seed`` [rad] (None if the file gives none), checked."""
+    width = {len(row) if isinstance(row, list) else -1 for row in rows}
+    if len(width) != 1 or width.pop() not in (2, 3):
         raise InvalidParameterError(
-            f"{file}: {key}[{len(rows) - 1}]",
-            rows[-1],
-            f"the first via point {rows[0]} again (to {CLOSURE_TOLERANCE:g} rad in joint space): the reference "
-            "repeats every period, so it must end where it starts",
+            f"{file}: positions",
+            rows,
+            "rows of 3 coordinates (x, y, z) [m], or 2 (x, y) for a planar arm, all alike",
         )
-    try:
-        trajectory = JointTrajectory.from_via_q(
-            tuple(times), via_q, None if period is None else float(period)
-        )
-    except InvalidParameterError as err:
-        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
-    check_trajectory_limits(robot, trajectory, f"{file}")
-    return trajectory
+    points = _numbers(file, "positions", rows, "end-effector positions [m]", MAX_POSITION, "m")
+    seed = None
+    if "seed" in document:
+        seed = _numbers(file, "seed", document["seed"], f"{robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
+        if seed.shape != (robot.nv,):
+            raise InvalidParameterError(
+                f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
+            )
+        check_within_limits(robot, seed[None, :], f"{file}: seed")
+    return points, seed
 
 
 def _pose_file(

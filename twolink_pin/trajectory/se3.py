@@ -222,6 +222,39 @@ def pose_trajectory(
     P = np.asarray(positions, dtype=float)
     R = np.asarray(rotations, dtype=float)
     n = len(times_t)
+    _check_via_poses(P, R, n)
+    posture = robot.home if seed is None else np.asarray(seed, dtype=float)
+    q = posture
+    try:
+        q = solve_pose(robot, P[0], R[0], q, posture=posture)
+    except InverseKinematicsError as err:
+        raise InverseKinematicsError(err.target, f"via pose 0: {err.reason}", err.q) from None
+    paths = []
+    via_q = [q]
+    worst_p = worst_r = 0.0
+    data = robot.model.createData()
+    for k in range(n - 1):
+        path, q, seg_p, seg_r = _segment_path(
+            robot, data, P, R, k, q, posture, via_q[0] if k == n - 2 else None
+        )
+        paths.append(path)
+        via_q.append(q)
+        worst_p, worst_r = max(worst_p, seg_p), max(worst_r, seg_r)
+    span = times_t[-1] - times_t[0]
+    return PoseTrajectory(
+        np.array(times_t),
+        P,
+        R,
+        np.array(via_q),
+        paths,
+        span if period is None else period,
+        (worst_p, worst_r),
+    )
+
+
+def _check_via_poses(P: np.ndarray, R: np.ndarray, n: int) -> None:
+    """Raise unless ``P`` [m] is (n, 3) and ``R`` (n, 3, 3), finite, of rotation matrices, and
+    the last pose is the first again (the reference repeats)."""
     if P.shape != (n, 3) or R.shape != (n, 3, 3):
         raise InvalidParameterError(
             "via poses", f"{P.shape}, {R.shape}", f"positions ({n}, 3) and rotations ({n}, 3, 3)"
@@ -238,60 +271,51 @@ def pose_trajectory(
             f"{gap:.3g} m or rad from the first",
             "the first via pose again (the reference repeats)",
         )
-    posture = robot.home if seed is None else np.asarray(seed, dtype=float)
-    q = posture
-    try:
-        q = solve_pose(robot, P[0], R[0], q, posture=posture)
-    except InverseKinematicsError as err:
-        raise InverseKinematicsError(err.target, f"via pose 0: {err.reason}", err.q) from None
-    grid = np.linspace(0.0, 1.0, IK_SAMPLES + 1)
-    paths = []
-    via_q = [q]
-    worst_p = worst_r = 0.0
-    data = robot.model.createData()
-    for k in range(n - 1):
-        phi = pin.log3(R[k].T @ R[k + 1])
-        qs = []
-        for s in grid:
-            try:
-                q = solve_pose(
-                    robot, P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q, posture=posture
-                )
-            except InverseKinematicsError as err:
-                raise InverseKinematicsError(
-                    err.target, f"segment {k} (via pose {k} → {k + 1}) at s = {s:.3g}: {err.reason}", err.q
-                ) from None
-            qs.append(q)
-        if k == n - 2:  # the closing pose: the first configuration again, or the path does not repeat
-            closing = float(np.abs(qs[-1] - via_q[0]).max())
-            if closing > JOINT_CLOSURE_TOLERANCE:
-                raise InvalidParameterError(
-                    f"via poses[{n - 1}]",
-                    f"reached at a configuration {closing:.3g} rad from the first",
-                    f"the first configuration again (to {JOINT_CLOSURE_TOLERANCE:g} rad): the joint path must "
-                    "repeat too (the path crossed to another inverse-kinematics branch; add via poses or a seed)",
-                )
-            qs[-1] = via_q[0]
-        from scipy.interpolate import make_interp_spline  # 0.8 s to import: only for pose paths
 
-        path = make_interp_spline(grid, np.array(qs), k=5)
-        paths.append(path)
-        via_q.append(qs[-1])
-        mid = 0.5 * (grid[1:] + grid[:-1])
-        for s, qm in zip(mid, path(mid), strict=True):
-            pin.framesForwardKinematics(robot.model, data, qm)
-            frame = data.oMf[robot.ee_frame_id]
-            worst_p = max(worst_p, float(np.linalg.norm(frame.translation - (P[k] + s * (P[k + 1] - P[k])))))
-            worst_r = max(
-                worst_r, float(np.linalg.norm(pin.log3(frame.rotation.T @ R[k] @ pin.exp3(s * phi))))
+
+def _segment_path(
+    robot: RobotModel,
+    data: pin.Data,
+    P: np.ndarray,
+    R: np.ndarray,
+    k: int,
+    q: np.ndarray,
+    posture: np.ndarray,
+    closing: np.ndarray | None,
+) -> tuple[BSpline, np.ndarray, float, float]:
+    """Segment k's joint path (via pose k → k + 1, the pose interpolated on SE(3)) from ``q``
+    [rad]: the IK at :data:`IK_SAMPLES` + 1 points, a quintic spline through them, its end
+    configuration (``closing``, the first via configuration, for the last segment, which must
+    reach it) and its worst position [m] and orientation [rad] error between the points."""
+    grid = np.linspace(0.0, 1.0, IK_SAMPLES + 1)
+    phi = pin.log3(R[k].T @ R[k + 1])
+    qs = []
+    for s in grid:
+        try:
+            q = solve_pose(robot, P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q, posture=posture)
+        except InverseKinematicsError as err:
+            raise InverseKinematicsError(
+                err.target, f"segment {k} (via pose {k} → {k + 1}) at s = {s:.3g}: {err.reason}", err.q
+            ) from None
+        qs.append(q)
+    if closing is not None:  # the closing pose: the first configuration again, or the path does not repeat
+        gap = float(np.abs(qs[-1] - closing).max())
+        if gap > JOINT_CLOSURE_TOLERANCE:
+            raise InvalidParameterError(
+                f"via poses[{k + 1}]",
+                f"reached at a configuration {gap:.3g} rad from the first",
+                f"the first configuration again (to {JOINT_CLOSURE_TOLERANCE:g} rad): the joint path must "
+                "repeat too (the path crossed to another inverse-kinematics branch; add via poses or a seed)",
             )
-    span = times_t[-1] - times_t[0]
-    return PoseTrajectory(
-        np.array(times_t),
-        P,
-        R,
-        np.array(via_q),
-        paths,
-        span if period is None else period,
-        (worst_p, worst_r),
-    )
+        qs[-1] = closing
+    from scipy.interpolate import make_interp_spline  # 0.8 s to import: only for pose paths
+
+    path = make_interp_spline(grid, np.array(qs), k=5)
+    worst_p = worst_r = 0.0
+    mid = 0.5 * (grid[1:] + grid[:-1])
+    for s, qm in zip(mid, path(mid), strict=True):
+        pin.framesForwardKinematics(robot.model, data, qm)
+        frame = data.oMf[robot.ee_frame_id]
+        worst_p = max(worst_p, float(np.linalg.norm(frame.translation - (P[k] + s * (P[k + 1] - P[k])))))
+        worst_r = max(worst_r, float(np.linalg.norm(pin.log3(frame.rotation.T @ R[k] @ pin.exp3(s * phi)))))
+    return path, qs[-1], worst_p, worst_r

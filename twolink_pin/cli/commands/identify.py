@@ -14,6 +14,8 @@ from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
     from twolink_pin.identification import RunLog
+    from twolink_pin.identification.excitation import Excitation, ExcitationDesign
+    from twolink_pin.identification.measures import ExcitationMeasures
     from twolink_pin.model import RobotModel
     from twolink_pin.trajectory import Trajectory
 
@@ -235,35 +237,15 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def cmd_excite(args: argparse.Namespace) -> int:
-    from twolink_pin.identification import ExcitationDesign, ExcitationLimits, optimise_excitation
-    from twolink_pin.identification.measures import averaged_adaptation, excitation_measures
+    from twolink_pin.identification import optimise_excitation
+    from twolink_pin.identification.excitation_check import check_excitation_work, excitation_problem
+    from twolink_pin.identification.measures import excitation_measures
     from twolink_pin.trajectory import default_trajectory, write_trajectory_file
 
     robot = robot_from_args(args)
     if Path(args.out).suffix.lower() not in (".json", ".toml"):
         raise InvalidParameterError("--out", args.out, "a trajectory file name ending in .json or .toml")
-    limits = ExcitationLimits(
-        position_margin=args.position_margin,
-        velocity_fraction=args.velocity_fraction,
-        acceleration=args.acceleration,
-        torque_fraction=args.torque_fraction,
-    )
-    design = ExcitationDesign(
-        harmonics=args.harmonics,
-        period=args.period,
-        criterion=args.criterion,
-        samples=args.samples,
-        starts=args.starts,
-        max_iterations=args.max_iterations,
-        seed=args.seed,
-        limits=limits,
-    )
-    from twolink_pin.identification.excitation_check import (
-        check_excitation_work,
-        excitation_problem,
-        excitation_verdict,
-    )
-
+    design = _excitation_design(args)
     check_excitation_work(robot.nv, args.harmonics, args.samples, args.starts, args.max_iterations)
     bar = progress_bar(args.starts * args.max_iterations, "it", f"excite {robot.name}")
     with bar:
@@ -274,6 +256,60 @@ def cmd_excite(args: argparse.Namespace) -> int:
         return 1
     written = write_trajectory_file(args.out, excitation.trajectory)
     default = excitation_measures(robot, default_trajectory(robot))
+    payload = _excitation_payload(robot, design, excitation, written, default)
+    figures: list[str] = []
+    if args.plot:
+        from twolink_pin.files import removed_on_failure
+        from twolink_pin.plotting.identification import save_excitation_figures
+
+        with removed_on_failure(args.plot) as folder:
+            figures = [
+                str(p)
+                for p in save_excitation_figures(
+                    robot, excitation.trajectory, folder, limits=excitation.limits
+                )
+            ]
+    payload["figures"] = figures
+    emit(args, payload, "\n".join(_excitation_lines(robot, design, excitation, written, default, payload)))
+    return 0
+
+
+def _excitation_design(args: argparse.Namespace) -> ExcitationDesign:
+    """The design ``excite``'s options ask for (harmonics, period, criterion, optimiser, limits)."""
+    from twolink_pin.identification import ExcitationDesign, ExcitationLimits
+
+    limits = ExcitationLimits(
+        position_margin=args.position_margin,
+        velocity_fraction=args.velocity_fraction,
+        acceleration=args.acceleration,
+        torque_fraction=args.torque_fraction,
+    )
+    return ExcitationDesign(
+        harmonics=args.harmonics,
+        period=args.period,
+        criterion=args.criterion,
+        samples=args.samples,
+        starts=args.starts,
+        max_iterations=args.max_iterations,
+        seed=args.seed,
+        limits=limits,
+    )
+
+
+def _excitation_payload(
+    robot: RobotModel,
+    design: ExcitationDesign,
+    excitation: Excitation,
+    written: Path,
+    default: ExcitationMeasures,
+) -> dict[str, Any]:
+    """``excite --json``: the excitation's measures beside the ``default`` trajectory's, the
+    optimiser's account, the verdict, the peaks, the Fourier table and the adaptive law's
+    slowest averaged time constants [s] on both trajectories (``figures`` added later)."""
+    from twolink_pin.identification.excitation_check import excitation_verdict
+    from twolink_pin.identification.measures import averaged_adaptation
+    from twolink_pin.trajectory import default_trajectory
+
     payload: dict[str, Any] = {
         "robot": robot.name,
         "file": str(written),
@@ -314,19 +350,21 @@ def cmd_excite(args: argparse.Namespace) -> int:
         ).slowest_time_constant
     except InvalidParameterError:  # pragma: no cover - the built-in adaptive law always applies
         pass
-    figures: list[str] = []
-    if args.plot:
-        from twolink_pin.files import removed_on_failure
-        from twolink_pin.plotting.identification import save_excitation_figures
+    return payload
 
-        with removed_on_failure(args.plot) as folder:
-            figures = [
-                str(p)
-                for p in save_excitation_figures(
-                    robot, excitation.trajectory, folder, limits=excitation.limits
-                )
-            ]
-    payload["figures"] = figures
+
+def _excitation_lines(
+    robot: RobotModel,
+    design: ExcitationDesign,
+    excitation: Excitation,
+    written: Path,
+    default: ExcitationMeasures,
+    payload: dict[str, Any],
+) -> list[str]:
+    """``excite``'s text: the design, the optimiser's account, the verdict, the measures beside
+    the default trajectory's, the peaks and the figures."""
+    from twolink_pin.identification.excitation_check import excitation_verdict
+
     which = "the report's trajectory" if robot.name == "twolink" else "the default trajectory"
     lines = [
         f"excitation for {robot.name} ({design.criterion}): {design.harmonics} harmonics, period {design.period:g} s "
@@ -349,6 +387,5 @@ def cmd_excite(args: argparse.Namespace) -> int:
     lines.append(
         f"  peaks |q̇| {fmt(peaks['v_max'], 3)} rad/s, |q̈| {fmt(peaks['a_max'], 3)} rad/s², |τ| {fmt(peaks['tau_max'], 3)} N·m"
     )
-    lines += [f"  figure {f}" for f in figures]
-    emit(args, payload, "\n".join(lines))
-    return 0
+    lines += [f"  figure {f}" for f in payload["figures"]]
+    return lines

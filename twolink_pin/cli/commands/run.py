@@ -233,36 +233,7 @@ def _say_failed(failed: dict[str, str], where: str) -> None:
 
 
 def cmd_animate(args: argparse.Namespace) -> int:
-    import signal
-
-    if args.from_file:
-        typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
-        ignored = sorted(typed & args.run_options)  # the parser's run options (cli.common_options.run_group)
-        if args.controller is not None or ignored:
-            raise InvalidParameterError(
-                "--from",
-                args.from_file,
-                "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
-                + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
-            )
-    if args.from_file:
-        robot, reference, result = _saved_run(args)
-        spec = _saved_spec(args)
-        controller = _saved_controller(spec, robot)
-    elif args.controller is None:
-        raise InvalidParameterError(
-            "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
-        )
-    else:
-        from twolink_pin.simulation import simulate
-
-        robot = robot_from_args(args)
-        reference = trajectory_from_args(args, robot)
-        spec = run_spec(args, args.controller)
-        spec.check_effective(robot)
-        scenario = spec.build(robot, identified_parameters(spec, robot))
-        controller = scenario.controller
-        result = simulate(*scenario, reference, spec.simulation)
+    robot, reference, result, spec, controller = _run_to_animate(args)
     gains, gains_text = _gains_echo(controller) if controller is not None else (None, "not recorded")
     from twolink_pin.visualization.overlays import run_overlays
 
@@ -290,6 +261,53 @@ def cmd_animate(args: argparse.Namespace) -> int:
             f"animation written to {path}\n  {result.controller} gains {gains_text}",
         )
         return 0
+    _serve_animation(args, robot, result, points, overlays, gains, gains_text)
+    return 0
+
+
+def _run_to_animate(args: argparse.Namespace) -> tuple[Any, Any, Any, Any, Any]:
+    """``(robot, reference, result, spec, controller)`` of the run ``animate`` shows: the saved
+    run of ``--from`` (with no law and no run option beside it), else the law's run now."""
+    if args.from_file:
+        typed = {token.split("=")[0] for token in args.argv if token.startswith("--")}
+        ignored = sorted(typed & args.run_options)  # the parser's run options (cli.common_options.run_group)
+        if args.controller is not None or ignored:
+            raise InvalidParameterError(
+                "--from",
+                args.from_file,
+                "no CONTROLLER and no simulation option with it (it replays a saved run as it was); got "
+                + ", ".join(([f"CONTROLLER {args.controller}"] if args.controller else []) + ignored),
+            )
+        robot, reference, result = _saved_run(args)
+        spec = _saved_spec(args)
+        return robot, reference, result, spec, _saved_controller(spec, robot)
+    if args.controller is None:
+        raise InvalidParameterError(
+            "CONTROLLER", None, "a controller (name, file.py:Class) or --from FILE.npz"
+        )
+    from twolink_pin.simulation import simulate
+
+    robot = robot_from_args(args)
+    reference = trajectory_from_args(args, robot)
+    spec = run_spec(args, args.controller)
+    spec.check_effective(robot)
+    scenario = spec.build(robot, identified_parameters(spec, robot))
+    result = simulate(*scenario, reference, spec.simulation)
+    return robot, reference, result, spec, scenario.controller
+
+
+def _serve_animation(
+    args: argparse.Namespace,
+    robot: Any,
+    result: Any,
+    points: Any,
+    overlays: dict[str, Any],
+    gains: Any,
+    gains_text: str,
+) -> None:
+    """Serve the run in a meshcat viewer until Ctrl-C or SIGTERM."""
+    import signal
+
     from twolink_pin.visualization import serve
 
     def _stop(signum: int, frame: object) -> None:
@@ -320,7 +338,6 @@ def cmd_animate(args: argparse.Namespace) -> int:
             threading.Event().wait()
         except KeyboardInterrupt:
             print("stopping the viewer", file=sys.stderr)
-    return 0
 
 
 def cmd_report(args: argparse.Namespace) -> int:
