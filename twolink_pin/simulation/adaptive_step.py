@@ -88,8 +88,7 @@ def integrate_adaptive(
         ControllerError: the law raised or returned the wrong shape.
     """
     nv, nz = q0.shape[1], z0.shape[1]
-    n = config.steps
-    dt = config.duration / n
+    n, dt = config.steps, config.duration / config.steps
     t = np.arange(n + 1) * dt
     name = controller.name
     terms = SingleRunTerms(controller)
