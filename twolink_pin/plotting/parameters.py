@@ -278,6 +278,28 @@ def _parameter_summary_figure(
     time_axes, bar_axes = axes[:time_rows], axes[time_rows:]
     end = float(t[-1])
 
+    curves = _norm_panels(time_axes, t, p_error, groups, normalised, unscaled)
+    for ax, (unit, group) in zip(bar_axes, groups.items()):
+        _bar_panel(ax, unit, group, p_error, p_true, names, relative, end)
+    _unblock_legends(fig, curves)
+    what = f"{kind} parameter estimation error p̂ − p ({len(columns)} parameters)"
+    if any(not _is_indexed(names[i]) for i in columns):
+        what += "\nβk: the k-th estimated parameter (result.parameter_names[k − 1]), shown by its first term"
+    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    return fig
+
+
+def _norm_panels(
+    time_axes: Sequence[Axes],
+    t: np.ndarray,
+    p_error: np.ndarray,
+    groups: dict[str, list[int]],
+    normalised: dict[str, np.ndarray],
+    unscaled: Sequence[str],
+) -> list[tuple[Axes, np.ndarray, np.ndarray]]:
+    """The summary's panels over time [s]: the ``normalised`` error of each unit's parameters
+    in one, then the error norm [u] of each ``unscaled`` unit; returns their curves (for
+    :func:`_unblock_legends`)."""
     curves = []
     if normalised:
         ax = time_axes[0]
@@ -308,41 +330,48 @@ def _parameter_summary_figure(
         ax.legend(loc="upper right", fontsize=8)
     if time_axes:
         time_axes[-1].set_xlabel("t [s]")
+    return curves
 
-    for ax, (unit, group) in zip(bar_axes, groups.items()):
-        ax.set_label(f"final [{unit}]")
-        y = np.arange(len(group))
-        ax.barh(y, p_error[0, group], height=0.8, color=INITIAL_COLOR, label="t = 0")
-        ax.barh(y, p_error[-1, group], height=0.42, color=ACTUAL_COLOR, label=f"t = {end:g} s")
-        ax.set_yticks(y, [_short_label(names[i], i + 1) for i in group], fontsize=7)
-        ax.set_ylim(len(group) - 0.5, -0.5)  # the first parameter on top
-        ax.axvline(0.0, color="0.3", lw=0.8)
-        ax.grid(True, axis="x", alpha=0.3)
-        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
-        ax.set_xlabel(f"p̂ − p [{unit}]", fontsize=9)
-        ax.set_title(
-            f"{len(group)} parameters [{unit}]: error at t = 0 (grey) and at t = {end:g} s (blue)",
-            fontsize=9,
-        )
-        twin = ax.twinx()
-        twin.set_label(f"relative [{unit}]")
-        twin.set_ylim(ax.get_ylim())
-        texts = [
-            _percent(100.0 * p_error[-1, i] / p_true[i])
-            if i in relative
-            else "p = 0"
-            if p_true[i] == 0
-            else "|p| ≈ 0"
-            for i in group
-        ]
-        twin.set_yticks(y, texts, fontsize=7)
-        twin.set_ylabel(f"(p̂ − p) / p at t = {end:g} s", fontsize=8)
-    _unblock_legends(fig, curves)
-    what = f"{kind} parameter estimation error p̂ − p ({len(columns)} parameters)"
-    if any(not _is_indexed(names[i]) for i in columns):
-        what += "\nβk: the k-th estimated parameter (result.parameter_names[k − 1]), shown by its first term"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
-    return fig
+
+def _bar_panel(
+    ax: Axes,
+    unit: str,
+    group: Sequence[int],
+    p_error: np.ndarray,
+    p_true: np.ndarray,
+    names: Sequence[str],
+    relative: set[int],
+    end: float,
+) -> None:
+    """One unit's bars: ``p̂_i − p_i`` [unit] at t = 0 and at ``end`` [s] per parameter of
+    ``group``, with the final relative error [%] (of the ``relative`` columns) on a twin axis."""
+    ax.set_label(f"final [{unit}]")
+    y = np.arange(len(group))
+    ax.barh(y, p_error[0, group], height=0.8, color=INITIAL_COLOR, label="t = 0")
+    ax.barh(y, p_error[-1, group], height=0.42, color=ACTUAL_COLOR, label=f"t = {end:g} s")
+    ax.set_yticks(y, [_short_label(names[i], i + 1) for i in group], fontsize=7)
+    ax.set_ylim(len(group) - 0.5, -0.5)  # the first parameter on top
+    ax.axvline(0.0, color="0.3", lw=0.8)
+    ax.grid(True, axis="x", alpha=0.3)
+    ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
+    ax.set_xlabel(f"p̂ − p [{unit}]", fontsize=9)
+    ax.set_title(
+        f"{len(group)} parameters [{unit}]: error at t = 0 (grey) and at t = {end:g} s (blue)",
+        fontsize=9,
+    )
+    twin = ax.twinx()
+    twin.set_label(f"relative [{unit}]")
+    twin.set_ylim(ax.get_ylim())
+    texts = [
+        _percent(100.0 * p_error[-1, i] / p_true[i])
+        if i in relative
+        else "p = 0"
+        if p_true[i] == 0
+        else "|p| ≈ 0"
+        for i in group
+    ]
+    twin.set_yticks(y, texts, fontsize=7)
+    twin.set_ylabel(f"(p̂ − p) / p at t = {end:g} s", fontsize=8)
 
 
 # ------------------------------------------------------------------------ a run
