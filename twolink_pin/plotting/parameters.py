@@ -37,10 +37,10 @@ from twolink_pin.plotting._style import (
     PARAM_ROW_HEIGHT,
     SUMMARY_WIDTH,
     SUPTITLE_HEIGHT,
-    _fix_margins,
-    _new_figure,
-    _title,
-    _unblock_legends,
+    figure_title,
+    fix_margins,
+    new_figure,
+    unblock_legends,
 )
 from twolink_pin.simulation import SimulationResult
 
@@ -79,7 +79,7 @@ def _parameter_symbol(name: str) -> str:
     return rf"${name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
 
 
-def _check_parameters(result: SimulationResult) -> None:
+def check_parameters(result: SimulationResult) -> None:
     """The result declares a name, a unit and a known kind for every estimated parameter.
 
     Raises:
@@ -162,7 +162,7 @@ def _parameter_curves_figure(
     style = {i: _line_style(k) for k, i in enumerate(columns)}
 
     rows = len(groups) + (1 if relative else 0)
-    fig = _new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
+    fig = new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
     axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
     legend_width = 0.0
     for ax, (unit, group) in zip(axes, groups.items()):
@@ -192,9 +192,9 @@ def _parameter_curves_figure(
     axes[-1].set_xlim(t[0], t[-1])
     fig.set_size_inches(PARAM_FIGSIZE[0] + legend_width, fig.get_size_inches()[1])
     what = f"{kind} parameter estimation error p̂ − p"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    fig.suptitle(figure_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
     if legend_width == 0.0:  # every legend inside its panel (an outside one: constrained layout)
-        _fix_margins(fig, PARAM_MARGINS)
+        fix_margins(fig, PARAM_MARGINS)
     return fig
 
 
@@ -271,9 +271,7 @@ def _parameter_summary_figure(
     unscaled = [unit for unit in groups if unit not in normalised]
     time_rows = (1 if normalised else 0) + len(unscaled)
     heights = [NORM_PANEL_HEIGHT] * time_rows + [BAR_HEIGHT * len(g) + 0.1 for g in groups.values()]
-    fig = _new_figure(
-        (SUMMARY_WIDTH, sum(heights) + PANEL_DECORATION_HEIGHT * len(heights) + SUPTITLE_HEIGHT)
-    )
+    fig = new_figure((SUMMARY_WIDTH, sum(heights) + PANEL_DECORATION_HEIGHT * len(heights) + SUPTITLE_HEIGHT))
     axes = list(fig.subplots(len(heights), 1, height_ratios=heights, squeeze=False)[:, 0])
     time_axes, bar_axes = axes[:time_rows], axes[time_rows:]
     end = float(t[-1])
@@ -281,11 +279,11 @@ def _parameter_summary_figure(
     curves = _norm_panels(time_axes, t, p_error, groups, normalised, unscaled)
     for ax, (unit, group) in zip(bar_axes, groups.items()):
         _bar_panel(ax, unit, group, p_error, p_true, names, relative, end)
-    _unblock_legends(fig, curves)
+    unblock_legends(fig, curves)
     what = f"{kind} parameter estimation error p̂ − p ({len(columns)} parameters)"
     if any(not _is_indexed(names[i]) for i in columns):
         what += "\nβk: the k-th estimated parameter (result.parameter_names[k − 1]), shown by its first term"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    fig.suptitle(figure_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
     return fig
 
 
@@ -299,7 +297,7 @@ def _norm_panels(
 ) -> list[tuple[Axes, np.ndarray, np.ndarray]]:
     """The summary's panels over time [s]: the ``normalised`` error of each unit's parameters
     in one, then the error norm [u] of each ``unscaled`` unit; returns their curves (for
-    :func:`_unblock_legends`)."""
+    :func:`unblock_legends`)."""
     curves = []
     if normalised:
         ax = time_axes[0]
@@ -377,7 +375,7 @@ def _bar_panel(
 # ------------------------------------------------------------------------ a run
 
 
-def _parameter_figures(
+def parameter_figures(
     result: SimulationResult, figure_numbers: Mapping[str, int], heading: str
 ) -> dict[str, Figure]:
     """The parameter figures of a run with estimates: key → figure, ``param_error`` for the
@@ -388,7 +386,7 @@ def _parameter_figures(
     Raises:
         InvalidParameterError: the result lacks a name, unit or known kind for a parameter.
     """
-    _check_parameters(result)
+    check_parameters(result)
     figures: dict[str, Figure] = {}
     for kind in PARAMETER_KINDS:
         columns = [i for i, k in enumerate(result.parameter_kinds) if k == kind]
