@@ -41,8 +41,8 @@ from twolink_pin.plotting.distribution import _distribution_figure
 from twolink_pin.plotting.parameters import (
     MANY_PARAMETERS,
     RELATIVE_FLOOR,
-    _parameter_figures,
     _relative_columns,
+    parameter_figures,
 )
 from twolink_pin.plotting.run import _simulation_figures, _torque_figure
 from twolink_pin.plotting.trajectory import _motion_plane, _trajectory_figures
@@ -639,10 +639,10 @@ def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, n
         assert labels == ["normalised", *(f"final [{u}]" for u in units), *(f"relative [{u}]" for u in units)]
         assert sum(len(_final_bars(param.axes[1 + k])) for k in range(len(units))) == n_p
 
-    real_save = _style._save
+    real_save = _style.save_figure
     rendered = ("trajectory_workspace.png", "adaptive_torque.png", "adaptive_param_error.png")
     monkeypatch.setattr(  # render the three largest figures, only name the others (speed)
-        _style, "_save", lambda fig, path: real_save(fig, path) if path.name in rendered else path
+        _style, "save_figure", lambda fig, path: real_save(fig, path) if path.name in rendered else path
     )
     with warnings.catch_warnings():
         warnings.simplefilter("error", UserWarning)
@@ -673,7 +673,7 @@ def test_many_parameters_show_norms_and_one_bar_pair_each(many: SimulationResult
     time, equal to the norms computed here (from p̂(0) at t = 0), and one bar panel per unit
     with an initial and a final bar per parameter (36 final bars in all), their widths
     p̂(0) − p and p̂(T) − p, labelled β<k> with the first term of the k-th name."""
-    fig = _parameter_figures(many, {}, "controller adaptive")["param_error"]
+    fig = parameter_figures(many, {}, "controller adaptive")["param_error"]
     units = ("kg·m²", "kg·m")
     assert [ax.get_label() for ax in fig.axes] == [
         "normalised",
@@ -710,7 +710,7 @@ def test_relative_errors_only_where_the_true_value_is_not_negligible(many: Simul
     double pendulum's 5.8e-7 kg·m and 6.4e-11 kg·m get no relative curve, the twolink's
     p1, p2, p3 all do."""
     assert RELATIVE_FLOOR == 0.01
-    fig = _parameter_figures(many, {}, "controller adaptive")["param_error"]
+    fig = parameter_figures(many, {}, "controller adaptive")["param_error"]
     assert many.p_hat is not None and many.p_true is not None
     err = many.p_hat - many.p_true
     seen = set()
@@ -734,7 +734,7 @@ def test_relative_errors_only_where_the_true_value_is_not_negligible(many: Simul
     pendulum = np.array([5.8018e-07, 4.2854e-02, 4.0784e-03, 6.4385e-11, 3.3530e-02, 4.5579e-03])
     units = ("kg·m", "kg·m", "kg·m²", "kg·m", "kg·m", "kg·m²")
     result = _synthetic_result(tuple(f"p{k}" for k in range(1, 7)), units, ("inertial",) * 6, pendulum, nv=2)
-    relative = _axes(_parameter_figures(result, {}, "controller adaptive")["param_error"], "relative")
+    relative = _axes(parameter_figures(result, {}, "controller adaptive")["param_error"], "relative")
     assert [str(ln.get_label()).split(":")[0] for ln in _data_lines(relative)] == [
         rf"$p_{{{k}}}$" for k in (2, 3, 5, 6)
     ]
@@ -747,7 +747,7 @@ def test_friction_the_plant_lacks_gets_error_norms() -> None:
     names = tuple(f"V{j}" for j in range(1, 8)) + tuple(f"C{j}" for j in range(1, 8))
     units = ("N·m·s/rad",) * 7 + ("N·m",) * 7
     result = _synthetic_result(names, units, ("friction",) * 14, np.zeros(14), nv=7)
-    fig = _parameter_figures(result, {}, "controller adaptive")["friction_error"]
+    fig = parameter_figures(result, {}, "controller adaptive")["friction_error"]
     assert [ax.get_label() for ax in fig.axes] == [
         "norm [N·m·s/rad]",
         "norm [N·m]",
@@ -814,15 +814,15 @@ def test_a_label_wider_than_the_fixed_margins_gets_constrained_layout(tmp_path: 
     """Fixed margins too narrow for a panel's tick labels (they would be cut at the left edge)
     are replaced by constrained layout when the figure is saved: the labels then lie inside
     the figure and the PNG has the figure's size."""
-    fig = _style._new_figure((4.0, 3.0))
+    fig = _style.new_figure((4.0, 3.0))
     ax = fig.subplots()
     ax.plot([0.0, 1.0], [0.0, 1.0])
     ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:.1f} rad, a wide tick label"))
-    _style._fix_margins(fig, _style.Margins(left=0.3, right=0.1, bottom=0.4, top=0.2))
+    _style.fix_margins(fig, _style.Margins(left=0.3, right=0.1, bottom=0.4, top=0.2))
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
     assert min(t.get_window_extent(renderer).x0 for t in ax.get_yticklabels()) < 0  # cut off
-    path = _style._save(fig, tmp_path / "wide.png")
+    path = _style.save_figure(fig, tmp_path / "wide.png")
     _assert_inside_figure(fig)
     assert ax.get_position().x0 * 4.0 > 1.0  # room made for the labels
     _assert_png(path, (4.0, 3.0))
@@ -831,7 +831,7 @@ def test_a_label_wider_than_the_fixed_margins_gets_constrained_layout(tmp_path: 
 def test_log_tick_labels_read_as_matplotlibs(pd_figures: dict[str, Figure]) -> None:
     """The plain-text log labels (10⁻⁸, 2×10⁻³) say what matplotlib's mathtext ones say, tick
     for tick, and the state figure's log panel uses them."""
-    fig = _style._new_figure((4.0, 3.0))
+    fig = _style.new_figure((4.0, 3.0))
     ax = fig.subplots()
     ax.set_yscale("log")
     ax.set_ylim(1e-16, 1e6)
@@ -937,13 +937,13 @@ def test_custom_prefix_and_every_friction_figure(
     """A given prefix replaces the controller's name (the default, see the test above),
     every figure of an adaptive-friction run is saved, and the friction figure decodes."""
     written: list[str] = []
-    real_save = _style._save
+    real_save = _style.save_figure
 
     def record(fig: Figure, path: Path) -> Path:
         written.append(path.name)
         return real_save(fig, path) if path.name.endswith("friction_error.png") else path
 
-    monkeypatch.setattr(_style, "_save", record)
+    monkeypatch.setattr(_style, "save_figure", record)
     suffixes = [*RUN_SUFFIXES, "param_error", "friction_error"]
     paths = plotting.save_simulation_figures(friction, tmp_path, prefix="run7")
     assert written == [p.name for p in paths] == [f"run7_{k}.png" for k in suffixes]
@@ -1041,7 +1041,7 @@ def test_figures_are_freed_after_saving(
 ) -> None:
     """No figure survives a save (no pyplot registry, nothing cached)."""
     refs: list[weakref.ref[Figure]] = []
-    monkeypatch.setattr(_style, "_save", lambda fig, path: refs.append(weakref.ref(fig)) or path)
+    monkeypatch.setattr(_style, "save_figure", lambda fig, path: refs.append(weakref.ref(fig)) or path)
     plotting.save_trajectory_figures(ROBOT, TRAJ, check, tmp_path)
     plotting.save_simulation_figures(pd, tmp_path)
     gc.collect()

@@ -28,7 +28,7 @@ class Axis(NamedTuple):
 def drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[Axis]]:
     """Every figure saved, by file name: its axes."""
     figures: dict[str, list[Axis]] = {}
-    save = _style._save
+    save = _style.save_figure
 
     def keep(fig: Any, path: Path) -> Path:
         top = max((ax.get_position().y1 for ax in fig.axes), default=0.0)
@@ -38,7 +38,7 @@ def drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[Axis]]:
         ]
         return save(fig, path)
 
-    monkeypatch.setattr(_style, "_save", keep)
+    monkeypatch.setattr(_style, "save_figure", keep)
     return figures
 
 

@@ -42,7 +42,7 @@ from twolink_pin.studies.sweep import (
     run_sweep,
     sweep_metadata,
 )
-from twolink_pin.studies.sweep_cases import _chunk_law
+from twolink_pin.studies.sweep_cases import chunk_law
 from twolink_pin.trajectory import build_trajectory
 
 ROBOT = load_robot()
@@ -261,7 +261,7 @@ def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None
     """kp=LO:HI sets both joints' Kp per run; kd2 only the second Kd; model_scale is robust's β."""
     study = _study(param_error=0.0)
     cases = Cases(study, ROBOT, 0, 12)
-    law = _chunk_law(study, ROBOT, cases, make_scenario("pd", ROBOT).controller)
+    law = chunk_law(study, ROBOT, cases, make_scenario("pd", ROBOT).controller)
     np.testing.assert_array_equal(
         np.broadcast_to(law.gains.kp, (12, 2)), np.repeat(cases.gains["kp"][:, None], 2, axis=1)
     )
@@ -270,7 +270,7 @@ def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None
     robust = replace(
         study, run=RunSpec(law="robust", simulation=SHORT), gains=(GainRange("model_scale", 0.2, 0.3),)
     )
-    built = _chunk_law(robust, ROBOT, Cases(robust, ROBOT, 0, 12), make_scenario("robust", ROBOT).controller)
+    built = chunk_law(robust, ROBOT, Cases(robust, ROBOT, 0, 12), make_scenario("robust", ROBOT).controller)
     assert isinstance(built, WrongModel) and np.all(
         (built.gains.model_scale >= 0.2) & (built.gains.model_scale <= 0.3)
     )
@@ -446,7 +446,7 @@ def test_a_drawn_matrix_gain_is_a_per_run_stack_and_run_i_is_that_single_run(tmp
     )
     nominal = make_scenario("osc", ROBOT).controller
     cases = Cases(study, ROBOT, 0, 4)
-    law = _chunk_law(study, ROBOT, cases, nominal)
+    law = chunk_law(study, ROBOT, cases, nominal)
     assert np.shape(law.gains.kp) == (4, 3, 3) and np.shape(law.gains.kd) == (4, 3, 3)
     np.testing.assert_array_equal(law.gains.kd, cases.gains["kd"][:, None, None] * np.eye(3))
     np.testing.assert_array_equal(law.gains.kp[:, 0, 0], cases.gains["kp1"])
@@ -470,5 +470,5 @@ def test_a_drawn_matrix_that_is_not_positive_definite_is_refused_naming_the_run(
         run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "o", plot=False)
     with pytest.raises(InvalidParameterError, match="diagonal entry from 1 to 3"):
         bad = _study(controller="osc", samples=3, gains=(GainRange("kp4", 1.0, 2.0),))
-        _chunk_law(bad, ROBOT, Cases(bad, ROBOT, 0, 3), make_scenario("osc", ROBOT).controller)
+        chunk_law(bad, ROBOT, Cases(bad, ROBOT, 0, 3), make_scenario("osc", ROBOT).controller)
     assert not (tmp_path / "o").exists()

@@ -252,7 +252,13 @@ def _add_model_commands(sub: Any, c: Any) -> None:
 
 
 def _add_run_commands(sub: Any, c: Any) -> None:
-    """The commands that run laws: ``simulate``, ``compare``, ``animate``, ``report``."""
+    """The commands that run laws: ``simulate``, ``compare``, ``animate``, ``tune``, ``report``."""
+    for add in (_add_simulate, _add_compare, _add_animate, _add_tune, _add_report):
+        add(sub, c)
+
+
+def _add_simulate(sub: Any, c: Any) -> None:
+    """``simulate``: one law's run, its figures and saved result."""
     p = sub.add_parser("simulate", help="closed-loop simulation of one control law")
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
@@ -264,6 +270,9 @@ def _add_run_commands(sub: Any, c: Any) -> None:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_simulate)
 
+
+def _add_compare(sub: Any, c: Any) -> None:
+    """``compare``: several laws on one robot, their table and figures."""
     p = sub.add_parser(
         "compare", help="several laws on one robot: the comparison table (md, csv, json) and figures"
     )
@@ -284,6 +293,9 @@ def _add_run_commands(sub: Any, c: Any) -> None:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_compare)
 
+
+def _add_animate(sub: Any, c: Any) -> None:
+    """``animate``: a run (new or saved) in meshcat, served or as one HTML file."""
     p = sub.add_parser("animate", help="the tracked motion in meshcat: live in the browser, or one HTML file")
     p.add_argument("controller", nargs="?", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
@@ -305,6 +317,9 @@ def _add_run_commands(sub: Any, c: Any) -> None:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_animate, run_options=run_option_strings(p))
 
+
+def _add_tune(sub: Any, c: Any) -> None:
+    """``tune``: a law's gains live in the browser."""
     p = sub.add_parser(
         "tune", help="tune a law live in the browser: move a gain, the run is simulated again and shown"
     )
@@ -327,6 +342,9 @@ def _add_run_commands(sub: Any, c: Any) -> None:
     add_robot_options(p)
     p.set_defaults(func=c.cmd_tune)
 
+
+def _add_report(sub: Any, c: Any) -> None:
+    """``report``: the whole pipeline as one offline HTML page."""
     p = sub.add_parser("report", help="the whole pipeline as one offline HTML page (index.html) in DIR")
     p.add_argument("--out", default="out", metavar="DIR", help="output directory (default out)")
     add_sim_options(p)
@@ -359,13 +377,28 @@ def _add_run_commands(sub: Any, c: Any) -> None:
 
 def _add_sweep_command(sub: Any, c: Any) -> None:
     """``sweep``: the Monte Carlo study."""
-    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
-    from twolink_pin.studies.sweep import MAX_CHUNK, MAX_SAMPLES
-
     p = sub.add_parser(
         "sweep", help="Monte Carlo study of one law on the batch engine: table, summary, histograms"
     )
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
+    _add_sweep_draws(p)
+    p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
+    add_disturbance_options(p)
+    _add_sweep_engine(p)
+    p.add_argument(
+        "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
+    )
+    p.add_argument("--no-plot", action="store_true", help="skip distributions.png")
+    add_sim_options(p)
+    add_robot_options(p)
+    p.set_defaults(func=c.cmd_sweep)
+
+
+def _add_sweep_draws(p: argparse.ArgumentParser) -> None:
+    """The study's runs and what each draws: count, seed, initial error, parameter error,
+    gain ranges, wrench scale."""
+    from twolink_pin.studies.sweep import MAX_SAMPLES
+
     p.add_argument(
         "--samples",
         type=whole(1, MAX_SAMPLES),
@@ -408,8 +441,13 @@ def _add_sweep_command(sub: Any, c: Any) -> None:
         metavar="LO:HI",
         help="draw each run's factor on --wrench uniformly in [LO, HI], e.g. 0:2",
     )
-    p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
-    add_disturbance_options(p)
+
+
+def _add_sweep_engine(p: argparse.ArgumentParser) -> None:
+    """Where and how the chunks run: threads, chunk size, a LocalCluster or a scheduler."""
+    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
+    from twolink_pin.studies.sweep import MAX_CHUNK
+
     p.add_argument(
         "--threads",
         type=whole(1, 256),
@@ -449,10 +487,3 @@ def _add_sweep_command(sub: Any, c: Any) -> None:
         metavar="S",
         help=f"seconds for the scheduler to answer and have a worker (default {CONNECT_TIMEOUT:g})",
     )
-    p.add_argument(
-        "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
-    )
-    p.add_argument("--no-plot", action="store_true", help="skip distributions.png")
-    add_sim_options(p)
-    add_robot_options(p)
-    p.set_defaults(func=c.cmd_sweep)

@@ -39,7 +39,7 @@ from typing import Any, ClassVar, Generic, NamedTuple, Protocol, TypeVar
 import numpy as np
 
 from twolink_pin.controllers.gains import Gains as GainsBase
-from twolink_pin.controllers.gains import _spec, as_matrix, check_width, runs_of
+from twolink_pin.controllers.gains import as_matrix, check_width, gain_spec, runs_of
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -434,7 +434,7 @@ class Controller(abc.ABC, Generic[G]):
             gains = dataclasses.replace(gains, **{name: derived[name] for name in missing})
         matrices = {}
         for f in dataclasses.fields(gains):
-            spec = _spec(f)
+            spec = gain_spec(f)
             value = getattr(gains, f.name)
             if spec.matrix and value is not None:
                 width, what = {

@@ -102,11 +102,11 @@ def spec_of(gains_type: type[Gains] | Gains, name: str) -> GainSpec:
     """The :class:`GainSpec` of field ``name``."""
     for f in fields(gains_type):
         if f.name == name:
-            return _spec(f)
+            return gain_spec(f)
     raise KeyError(name)
 
 
-def _spec(f: Any) -> GainSpec:
+def gain_spec(f: Any) -> GainSpec:
     spec = f.metadata.get("gain")
     if spec is None:  # a plain dataclass field: a positive scalar without unit
         return GainSpec("scalar", "", "positive", "")
@@ -298,7 +298,7 @@ class Gains:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            object.__setattr__(self, f.name, _validate(f.name, getattr(self, f.name), _spec(f)))
+            object.__setattr__(self, f.name, _validate(f.name, getattr(self, f.name), gain_spec(f)))
 
     def values(self) -> dict[str, Any]:
         """Field name → value (float, array or None)."""
@@ -309,7 +309,7 @@ class Gains:
         its rows, ``kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]] 1/s²``."""
         parts = []
         for f in fields(self):
-            value, spec = getattr(self, f.name), _spec(f)
+            value, spec = getattr(self, f.name), gain_spec(f)
             text = "from the robot" if value is None else format_gain(value, digits)
             parts.append(f"{f.name} = {text}{' ' + spec.unit if spec.unit else ''}")
         return ", ".join(parts)

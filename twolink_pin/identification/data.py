@@ -245,10 +245,10 @@ def _read_csv(path: Path, nv: int) -> RunLog:
 
 def _read_npz(path: Path, nv: int) -> RunLog:
     raw = read_input_file(path, MAX_LOG_BYTES, "a run log (.csv or .npz)")
-    from twolink_pin.simulation.storage import _claimed_values  # the one header reader
+    from twolink_pin.simulation.storage import claimed_values  # the one header reader
 
     try:  # the sizes the arrays claim, from their headers, before anything is inflated
-        claimed = _claimed_values(io.BytesIO(raw))  # type: ignore[arg-type]
+        claimed = claimed_values(io.BytesIO(raw))  # type: ignore[arg-type]
     except (OSError, ValueError, EOFError, KeyError, zipfile.BadZipFile) as exc:
         raise InputFileError(
             str(path), f"is not a readable .npz archive ({type(exc).__name__}: {exc})"

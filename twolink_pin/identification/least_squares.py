@@ -326,36 +326,12 @@ def _identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | N
     filtered = filter_log(log, opts.zero_phase)
     t = filtered.t
     split = t[0] + (1.0 - opts.validation) * (t[-1] - t[0])
-    fitting = filtered.valid & (t < split)
-    stride = (
-        opts.stride
-        if opts.stride is not None
-        else max(1, round(1.0 / (SAMPLES_PER_CUTOFF * opts.zero_phase.cutoff_hz * filtered.dt)))
-    )
-    rows = np.flatnonzero(fitting)[::stride]
-    needed = math.ceil((pset.size + 1) / robot.nv)
-    if rows.size < max(needed, 2):
-        raise InputFileError(
-            where,
-            f"leaves {rows.size} samples to fit after dropping {np.count_nonzero(~filtered.valid)} of {t.size} "
-            f"(within {opts.zero_phase.guard:.3g} s of an end{' or a velocity reversal' if opts.zero_phase.reversal_guard else ''}, or slower than "
-            f"{opts.zero_phase.min_speed:g} rad/s) and keeping every {stride}th; identifying {pset.size} parameters "
-            f"from {robot.nv} joints needs at least {max(needed, 2)}: log a longer run",
-        )
+    rows, stride = _fit_rows(filtered, robot, pset, opts, split, where)
     W = pset.observation(
         robot.model, filtered.q[rows], filtered.v[rows], filtered.a[rows], filtered.coulomb[rows]
     )
     y = filtered.tau[rows]
-    stacked = W.reshape(-1, pset.size)
-    singular = np.linalg.svd(stacked, compute_uv=False)
-    condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else math.inf
-    if not condition < MAX_CONDITION:
-        raise InvalidParameterError(
-            "log",
-            f"{where}: observation matrix with condition number {condition:.3g}",
-            f"a motion that excites every parameter (condition < {MAX_CONDITION:.0e}); the least excited "
-            f"combination is {_poorly_excited(W, pset.names)}: use an excitation trajectory (twolink-pin excite)",
-        )
+    condition = _checked_condition(W, pset, where)
     lags = math.ceil(CORRELATION_TIMES / (opts.zero_phase.cutoff_hz * filtered.dt * stride))
     Z = _instruments(log, filtered, robot, pset, rows, opts) if opts.instruments else None
     theta, covariance, sigma = solve(W, y, opts.weighted, rows, lags, Z)
@@ -399,6 +375,53 @@ def _identify(log: RunLog, robot: RobotModel, options: IdentificationOptions | N
         method="least squares" if Z is None else "instrumental variables",
         gram=weighted.T @ weighted,
     )
+
+
+def _fit_rows(
+    filtered: FilteredLog,
+    robot: RobotModel,
+    pset: ParameterSet,
+    opts: IdentificationOptions,
+    split: float,
+    where: str,
+) -> tuple[np.ndarray, int]:
+    """The samples that enter the fit and the stride between them: the valid ones before the
+    validation part (``t < split`` [s]), every ``stride``-th (default: :data:`SAMPLES_PER_CUTOFF`
+    per period of the filter's cutoff); an error if too few are left for ``pset``."""
+    t = filtered.t
+    fitting = filtered.valid & (t < split)
+    stride = (
+        opts.stride
+        if opts.stride is not None
+        else max(1, round(1.0 / (SAMPLES_PER_CUTOFF * opts.zero_phase.cutoff_hz * filtered.dt)))
+    )
+    rows = np.flatnonzero(fitting)[::stride]
+    needed = math.ceil((pset.size + 1) / robot.nv)
+    if rows.size < max(needed, 2):
+        raise InputFileError(
+            where,
+            f"leaves {rows.size} samples to fit after dropping {np.count_nonzero(~filtered.valid)} of {t.size} "
+            f"(within {opts.zero_phase.guard:.3g} s of an end{' or a velocity reversal' if opts.zero_phase.reversal_guard else ''}, or slower than "
+            f"{opts.zero_phase.min_speed:g} rad/s) and keeping every {stride}th; identifying {pset.size} parameters "
+            f"from {robot.nv} joints needs at least {max(needed, 2)}: log a longer run",
+        )
+    return rows, stride
+
+
+def _checked_condition(W: np.ndarray, pset: ParameterSet, where: str) -> float:
+    """The condition number of the stacked observation matrix ``W`` (K, nv, p); an error
+    naming the least excited combination when it is :data:`MAX_CONDITION` or more."""
+    stacked = W.reshape(-1, pset.size)
+    singular = np.linalg.svd(stacked, compute_uv=False)
+    condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else math.inf
+    if not condition < MAX_CONDITION:
+        raise InvalidParameterError(
+            "log",
+            f"{where}: observation matrix with condition number {condition:.3g}",
+            f"a motion that excites every parameter (condition < {MAX_CONDITION:.0e}); the least excited "
+            f"combination is {_poorly_excited(W, pset.names)}: use an excitation trajectory (twolink-pin excite)",
+        )
+    return condition
 
 
 def validation_of(

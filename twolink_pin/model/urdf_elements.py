@@ -1,7 +1,7 @@
 """The checks of one URDF ``<link>`` and one ``<joint>``, and how URDF numbers are read.
 
 Split from :mod:`.urdf_validation`, which checks the document, the names and the tree and
-calls :func:`_check_link` and :func:`_check_joint` for each element; its docstring lists
+calls :func:`check_link` and :func:`check_joint` for each element; its docstring lists
 every check (items 4 and 5 are here). Each check raises
 :class:`~twolink_pin.errors.InvalidURDFError` naming the file, the element and what was
 expected.
@@ -49,7 +49,7 @@ _DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 # --- links ----------------------------------------------------------------------------------
 
 
-def _check_link(link: ET.Element, where: str, path: str) -> None:
+def check_link(link: ET.Element, where: str, path: str) -> None:
     inertials = link.findall("inertial")
     if not inertials:
         return  # A massless link (e.g. a base or an end-effector frame) is fine.
@@ -165,7 +165,7 @@ def _check_origin(origin: ET.Element | None, where: str, path: str) -> None:
 # --- joints ---------------------------------------------------------------------------------
 
 
-def _check_joint(
+def check_joint(
     joint: ET.Element, where: str, link_names: Sequence[str], known: set[str], path: str
 ) -> tuple[str, str]:
     """Check one joint and return its (parent, child) link names."""
@@ -218,7 +218,7 @@ def _link_reference(
         raise InvalidURDFError(
             path,
             f"{where} <{tag}>",
-            f'link="{name}" names no declared link; expected one of {_some(link_names)}',
+            f'link="{name}" names no declared link; expected one of {quoted_names(link_names)}',
         )
     return name
 
@@ -289,7 +289,7 @@ def _finite_vector(raw: str) -> tuple[float, float, float] | None:
     return x, y, z
 
 
-def _some(names: Iterable[str], count: int = 5) -> str:
+def quoted_names(names: Iterable[str], count: int = 5) -> str:
     """Up to ``count`` quoted names, for a message."""
     names = list(names)
     shown = ", ".join(f"'{name}'" for name in names[:count])

@@ -73,9 +73,9 @@ from twolink_pin.model.urdf_elements import (
     AXIS_JOINT_TYPES,
     JOINT_TYPES,
     TRIANGLE_RTOL,
-    _check_joint,
-    _check_link,
-    _some,
+    check_joint,
+    check_link,
+    quoted_names,
 )
 
 __all__ = [
@@ -235,10 +235,10 @@ def _validate_robot(robot: ET.Element, path: str) -> None:
     link_names = _names(links, "link", path)
     joint_names = _names(joints, "joint", path)
     for link, name in zip(links, link_names, strict=True):
-        _check_link(link, f"link '{name}'", path)
+        check_link(link, f"link '{name}'", path)
     known = set(link_names)
     edges = [
-        _check_joint(joint, f"joint '{name}'", link_names, known, path)
+        check_joint(joint, f"joint '{name}'", link_names, known, path)
         for joint, name in zip(joints, joint_names, strict=True)
     ]
     _check_tree(link_names, joint_names, edges, path)
@@ -293,7 +293,7 @@ def _check_tree(
         raise InvalidURDFError(
             path,
             _ROBOT,
-            f"has {len(roots)} root links ({_some(roots)}); expected exactly one link that is no "
+            f"has {len(roots)} root links ({quoted_names(roots)}); expected exactly one link that is no "
             "joint's child (the links must form one connected tree)",
         )
 

@@ -128,23 +128,23 @@ LEGEND_PLACES: tuple[LegendPlace, ...] = (
     "upper center",
 )
 """Where a torque panel's legend may go, in order of preference; the first is where it is
-made (see :func:`_unblock_legends`)."""
+made (see :func:`unblock_legends`)."""
 
 
 # ------------------------------------------------------------------ figures and files
 
 
-def _new_figure(figsize: tuple[float, float]) -> Figure:
+def new_figure(figsize: tuple[float, float]) -> Figure:
     """A non-GUI figure with its own Agg canvas and constrained layout (a figure type with
-    fixed :class:`Margins` replaces it with :func:`_fix_margins` once its panels exist)."""
+    fixed :class:`Margins` replaces it with :func:`fix_margins` once its panels exist)."""
     fig = Figure(figsize=figsize, dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
 
 
-def _fix_margins(fig: Figure, margins: Margins) -> None:
+def fix_margins(fig: Figure, margins: Margins) -> None:
     """Place the panels of ``fig`` (one grid) with ``margins`` [in] instead of constrained
-    layout. :func:`_save` checks after drawing that the tick and axis labels fit and falls
+    layout. :func:`save_figure` checks after drawing that the tick and axis labels fit and falls
     back to constrained layout when they do not (an unusually long tick label)."""
     width, height = fig.get_size_inches()
     spec = fig.axes[0].get_subplotspec()
@@ -161,10 +161,10 @@ def _fix_margins(fig: Figure, margins: Margins) -> None:
         wspace=margins.wspace / panel_w,
         hspace=margins.hspace / panel_h,
     )
-    fig._twolink_margins = margins  # type: ignore[attr-defined]  # read by _save
+    fig._twolink_margins = margins  # type: ignore[attr-defined]  # read by save_figure
 
 
-def _rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tuple[float, float]:
+def rows_figsize(base: tuple[float, float], rows: int, row_height: float) -> tuple[float, float]:
     """``base`` (the size for two rows) grown or shrunk by ``row_height`` per row [in]."""
     return (base[0], base[1] + row_height * (rows - 2))
 
@@ -221,7 +221,7 @@ def _lay_out_once(fig: Figure) -> None:
             fig.set_layout_engine(None)  # None (not "none", a placeholder savefig still pre-draws for)
 
 
-def _save(fig: Figure, path: Path) -> Path:
+def save_figure(fig: Figure, path: Path) -> Path:
     """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default).
 
     The figure is drawn once on its Agg canvas; a figure with fixed :class:`Margins` whose
@@ -231,7 +231,7 @@ def _save(fig: Figure, path: Path) -> Path:
     fmt = path.suffix[1:].lower() or "png"
     _lay_out_once(fig)
     canvas = fig.canvas
-    assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (_new_figure)
+    assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (new_figure)
     canvas.draw()
     if getattr(fig, "_twolink_margins", None) is not None and fig.axes and not _labels_fit(fig):
         fig.set_layout_engine("constrained")
@@ -270,18 +270,18 @@ class PowerOfTenFormatter(LogFormatter):
         return power if mantissa == 1 else f"{mantissa:g}×{power}"
 
 
-def _plain_log_ticks(ax: Axes, axis: Literal["x", "y"] = "y") -> None:
+def plain_log_ticks(ax: Axes, axis: Literal["x", "y"] = "y") -> None:
     """Label ``ax``'s log ``axis`` with :class:`PowerOfTenFormatter` (major and minor ticks)."""
     target = ax.yaxis if axis == "y" else ax.xaxis
     target.set_major_formatter(PowerOfTenFormatter())
     target.set_minor_formatter(PowerOfTenFormatter(labelOnlyBase=False))  # as matplotlib's default
 
 
-def _save_all(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], prefix: str) -> list[Path]:
+def save_figures(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], prefix: str) -> list[Path]:
     """Save each figure as ``out_dir/<prefix><key>.png`` in order, then clear them all."""
     out = Path(out_dir)
     try:
-        return [_save(fig, out / f"{prefix}{key}.png") for key, fig in figures.items()]
+        return [save_figure(fig, out / f"{prefix}{key}.png") for key, fig in figures.items()]
     finally:
         for fig in figures.values():
             fig.clear()
@@ -290,7 +290,7 @@ def _save_all(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], pr
 # ---------------------------------------------------------------------------- titles
 
 
-def _check_figure_numbers(figure_numbers: Mapping[str, int] | None) -> Mapping[str, int]:
+def check_figure_numbers(figure_numbers: Mapping[str, int] | None) -> Mapping[str, int]:
     """``figure_numbers`` or an empty mapping; each value a positive integer.
 
     Raises:
@@ -310,7 +310,7 @@ def _check_figure_numbers(figure_numbers: Mapping[str, int] | None) -> Mapping[s
     return figure_numbers
 
 
-def _title(what: str, key: str, figure_numbers: Mapping[str, int], heading: str | None = None) -> str:
+def figure_title(what: str, key: str, figure_numbers: Mapping[str, int], heading: str | None = None) -> str:
     """A figure title: ``heading`` on its own line (if any), then ``what``.
 
     When ``figure_numbers`` has ``key``, "— cf. report Fig. N" ends the first line.
@@ -323,7 +323,7 @@ def _title(what: str, key: str, figure_numbers: Mapping[str, int], heading: str 
 # ------------------------------------------------------------- helpers on the axes
 
 
-def _envelope(t: np.ndarray, x: np.ndarray, windows: int = ENVELOPE_WINDOWS) -> tuple[np.ndarray, np.ndarray]:
+def envelope(t: np.ndarray, x: np.ndarray, windows: int = ENVELOPE_WINDOWS) -> tuple[np.ndarray, np.ndarray]:
     """Max ``|x|`` over consecutive windows: (window start times [s], maxima, >= LOG_FLOOR)."""
     n = len(t)
     width = max(1, n // windows)
@@ -332,7 +332,7 @@ def _envelope(t: np.ndarray, x: np.ndarray, windows: int = ENVELOPE_WINDOWS) -> 
     return t[starts], np.maximum(peaks, LOG_FLOOR)
 
 
-def _free_spot(
+def free_spot(
     ax: Axes,
     x: np.ndarray,
     y: np.ndarray,
@@ -392,7 +392,7 @@ def _legend_box(ax: Axes, loc: LegendPlace, size: tuple[float, float], pad: floa
     return Bbox.from_bounds(x0[horizontal], y0[vertical], w, h)
 
 
-def _unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.ndarray]]) -> None:
+def unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.ndarray]]) -> None:
     """Move each "upper right" legend that covers a point of its axes' curves to a free place.
 
     ``curves`` gives, per axes whose legend was made at ``loc="upper right"``, the points
@@ -432,7 +432,7 @@ def _unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.nd
             legend.set_loc(best)
 
 
-def _limit_lines(ax: Axes, limit: float, peak: float, label: bool = True) -> bool:
+def limit_lines(ax: Axes, limit: float, peak: float, label: bool = True) -> bool:
     """Draw ``±limit`` [N·m] dashed; keep them in view unless far beyond ``peak`` [N·m].
 
     Returns whether the limit is in view. When it is not, the y range stays on the data and

@@ -31,7 +31,7 @@ def _end_effector_figure(robot: RobotModel, result: SimulationResult, title: str
     actual, desired = end_effector_paths(robot, result)
     spread = np.ptp(desired, axis=0)
     h, v = (int(i) for i in np.sort(np.argsort(spread)[-2:]))  # the plane the desired path spans most
-    fig = _style._new_figure(CARTESIAN_FIGSIZE)
+    fig = _style.new_figure(CARTESIAN_FIGSIZE)
     path_ax, error_ax = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.4]})
     path_ax.set_label("path")
     error_ax.set_label("distance")
@@ -69,4 +69,4 @@ def save_end_effector_figure(
     path spans most. Right: ``|x − x_d|`` [mm] over time on a log scale, with the last
     period's maximum in the title.
     """
-    return _style._save(_end_effector_figure(robot, result, title), Path(path))
+    return _style.save_figure(_end_effector_figure(robot, result, title), Path(path))

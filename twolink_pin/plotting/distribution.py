@@ -17,7 +17,7 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plotting import _style
-from twolink_pin.plotting._style import ACTUAL_COLOR, ERROR_COLOR, _new_figure
+from twolink_pin.plotting._style import ACTUAL_COLOR, ERROR_COLOR, new_figure
 
 DEFAULT_TITLE = "Distribution of metrics over the sweep"
 """Title of a distribution figure when none is given."""
@@ -55,7 +55,7 @@ def _distribution_figure(rows: Mapping[str, np.ndarray], title: str | None = Non
     n = len(values)
     ncols = min(3, n)
     nrows = math.ceil(n / ncols)
-    fig = _new_figure((4.0 * ncols + 0.5, 3.2 * nrows + 0.6))
+    fig = new_figure((4.0 * ncols + 0.5, 3.2 * nrows + 0.6))
     axes = fig.subplots(nrows, ncols, squeeze=False).ravel()
     for ax, (name, x) in zip(axes, values.items()):
         finite = x[np.isfinite(x)]
@@ -99,6 +99,6 @@ def save_distribution_figure(
     """
     fig = _distribution_figure(rows, title)
     try:
-        return _style._save(fig, Path(out_path))
+        return _style.save_figure(fig, Path(out_path))
     finally:
         fig.clear()

@@ -34,11 +34,11 @@ from twolink_pin.plotting._style import (
     ERROR_COLOR,
     LIMIT_COLOR,
     Margins,
-    _fix_margins,
-    _new_figure,
-    _plain_log_ticks,
-    _save,
-    _save_all,
+    fix_margins,
+    new_figure,
+    plain_log_ticks,
+    save_figure,
+    save_figures,
 )
 
 ROW_HEIGHT = 2.3
@@ -64,7 +64,7 @@ def _short(name: str) -> str:
 def _validation_figure(identification: Any) -> Figure:
     validation = identification.validation
     nv = validation.tau_measured.shape[1]
-    fig = _new_figure((WIDTH, 1.2 + ROW_HEIGHT * nv))
+    fig = new_figure((WIDTH, 1.2 + ROW_HEIGHT * nv))
     axes = fig.subplots(nv, 2, squeeze=False, width_ratios=(3.0, 1.4))
     t = validation.t
     shown = t <= t[0] + SHOWN_SECONDS
@@ -102,13 +102,13 @@ def _validation_figure(identification: Any) -> Figure:
         f"({t[0]:.3g}–{t[-1]:.3g} s, not fitted)\nfiltered at {identification.cutoff_hz:g} Hz; "
         f"condition number {identification.condition_number:.3g}"
     )
-    _fix_margins(fig, VALIDATION_MARGINS)
+    fix_margins(fig, VALIDATION_MARGINS)
     return fig
 
 
 def _estimates_figure(identification: Any) -> Figure:
     n = identification.size
-    fig = _new_figure((WIDTH, 1.6 + 0.32 * n))
+    fig = new_figure((WIDTH, 1.6 + 0.32 * n))
     ax = fig.subplots()
     y = np.arange(n)[::-1]
     labels = [f"{_short(name)} [{unit}]" for name, unit in zip(identification.names, identification.units)]
@@ -162,7 +162,7 @@ def save_identification_figures(
     Returns:
         The paths written.
     """
-    return _save_all(_identification_figures(identification), out_dir, prefix)
+    return save_figures(_identification_figures(identification), out_dir, prefix)
 
 
 def _excitation_figure(
@@ -172,7 +172,7 @@ def _excitation_figure(
     t = trajectory.t0 + np.linspace(0.0, trajectory.period, 2001)
     ref = trajectory.sample(t)
     tau = np.asarray(check.tau)
-    fig = _new_figure((WIDTH, 1.0 + 1.9 * nv))
+    fig = new_figure((WIDTH, 1.0 + 1.9 * nv))
     axes = fig.subplots(nv, 4, squeeze=False, sharex=True)
     model = robot.model
     if limits is None:
@@ -237,7 +237,7 @@ def _excitation_figure(
     )
     which = "the limits it was designed within" if limits is not None else "the URDF's limits"
     fig.suptitle(f"{robot.name}: excitation ({extra}) over one period; dashed: {which}")
-    _fix_margins(fig, EXCITATION_MARGINS)
+    fix_margins(fig, EXCITATION_MARGINS)
     return fig
 
 
@@ -258,12 +258,12 @@ def save_excitation_figures(
         from twolink_pin.feasibility import check_torques
 
         check = check_torques(robot, trajectory)
-    return _save_all({"excitation": _excitation_figure(robot, trajectory, limits, check)}, out_dir, "")
+    return save_figures({"excitation": _excitation_figure(robot, trajectory, limits, check)}, out_dir, "")
 
 
 def _convergence_figure(runs: Mapping[str, Mapping[str, Any]], fraction: float, title: str | None) -> Figure:
     panels = len(runs)
-    fig = _new_figure((WIDTH, 1.2 + 2.6 * panels))
+    fig = new_figure((WIDTH, 1.2 + 2.6 * panels))
     axes = fig.subplots(panels, 1, squeeze=False)[:, 0]
     colors = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink")
     for ax, (label, run) in zip(axes, runs.items()):
@@ -299,7 +299,7 @@ def _convergence_figure(runs: Mapping[str, Mapping[str, Any]], fraction: float, 
         ax.set_title(f"{label}: {note}" + (f"; {extra}" if extra else ""), fontsize=10)
         ax.set_ylabel("|p̂ − p| / |p|")
         ax.set_ylim(1e-10, 10.0)
-        _plain_log_ticks(ax)
+        plain_log_ticks(ax)
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(loc="lower left", fontsize=8, ncols=len(run["names"]) + 1)
     axes[-1].set_xlabel("t [s]")
@@ -307,7 +307,7 @@ def _convergence_figure(runs: Mapping[str, Mapping[str, Any]], fraction: float, 
         title
         or "adaptive estimates along different references (solid: simulated; dotted: averaged model exp(−ΓG t))"
     )
-    _fix_margins(fig, CONVERGENCE_MARGINS)
+    fix_margins(fig, CONVERGENCE_MARGINS)
     return fig
 
 
@@ -328,13 +328,13 @@ def save_convergence_figure(
         raise InvalidParameterError("runs", runs, "at least one run")
     fig = _convergence_figure(runs, fraction, title)
     try:
-        return _save(fig, Path(path))
+        return save_figure(fig, Path(path))
     finally:
         fig.clear()
 
 
 def _coverage_figure(z: np.ndarray, names: Sequence[str], title: str) -> Figure:
-    fig = _new_figure((WIDTH, 4.6))
+    fig = new_figure((WIDTH, 4.6))
     hist, bars = fig.subplots(1, 2, width_ratios=(1.2, 1.0))
     pooled = z.ravel()
     pooled = pooled[np.isfinite(pooled)]
@@ -378,6 +378,6 @@ def save_coverage_figure(
         raise InvalidParameterError("z", f"shape {z.shape}", f"(seeds, {len(names)}): one column per name")
     fig = _coverage_figure(z, names, title)
     try:
-        return _save(fig, Path(path))
+        return save_figure(fig, Path(path))
     finally:
         fig.clear()

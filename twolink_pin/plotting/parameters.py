@@ -37,10 +37,10 @@ from twolink_pin.plotting._style import (
     PARAM_ROW_HEIGHT,
     SUMMARY_WIDTH,
     SUPTITLE_HEIGHT,
-    _fix_margins,
-    _new_figure,
-    _title,
-    _unblock_legends,
+    figure_title,
+    fix_margins,
+    new_figure,
+    unblock_legends,
 )
 from twolink_pin.simulation import SimulationResult
 
@@ -79,7 +79,7 @@ def _parameter_symbol(name: str) -> str:
     return rf"${name[0]}_{{{name[1:]}}}$" if _is_indexed(name) else name
 
 
-def _check_parameters(result: SimulationResult) -> None:
+def check_parameters(result: SimulationResult) -> None:
     """The result declares a name, a unit and a known kind for every estimated parameter.
 
     Raises:
@@ -162,7 +162,7 @@ def _parameter_curves_figure(
     style = {i: _line_style(k) for k, i in enumerate(columns)}
 
     rows = len(groups) + (1 if relative else 0)
-    fig = _new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
+    fig = new_figure((PARAM_FIGSIZE[0], PARAM_FIGSIZE[1] + PARAM_ROW_HEIGHT * (rows - 1)))
     axes = fig.subplots(rows, 1, sharex=True, squeeze=False)[:, 0]
     legend_width = 0.0
     for ax, (unit, group) in zip(axes, groups.items()):
@@ -192,9 +192,9 @@ def _parameter_curves_figure(
     axes[-1].set_xlim(t[0], t[-1])
     fig.set_size_inches(PARAM_FIGSIZE[0] + legend_width, fig.get_size_inches()[1])
     what = f"{kind} parameter estimation error p̂ − p"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    fig.suptitle(figure_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
     if legend_width == 0.0:  # every legend inside its panel (an outside one: constrained layout)
-        _fix_margins(fig, PARAM_MARGINS)
+        fix_margins(fig, PARAM_MARGINS)
     return fig
 
 
@@ -271,13 +271,33 @@ def _parameter_summary_figure(
     unscaled = [unit for unit in groups if unit not in normalised]
     time_rows = (1 if normalised else 0) + len(unscaled)
     heights = [NORM_PANEL_HEIGHT] * time_rows + [BAR_HEIGHT * len(g) + 0.1 for g in groups.values()]
-    fig = _new_figure(
-        (SUMMARY_WIDTH, sum(heights) + PANEL_DECORATION_HEIGHT * len(heights) + SUPTITLE_HEIGHT)
-    )
+    fig = new_figure((SUMMARY_WIDTH, sum(heights) + PANEL_DECORATION_HEIGHT * len(heights) + SUPTITLE_HEIGHT))
     axes = list(fig.subplots(len(heights), 1, height_ratios=heights, squeeze=False)[:, 0])
     time_axes, bar_axes = axes[:time_rows], axes[time_rows:]
     end = float(t[-1])
 
+    curves = _norm_panels(time_axes, t, p_error, groups, normalised, unscaled)
+    for ax, (unit, group) in zip(bar_axes, groups.items()):
+        _bar_panel(ax, unit, group, p_error, p_true, names, relative, end)
+    unblock_legends(fig, curves)
+    what = f"{kind} parameter estimation error p̂ − p ({len(columns)} parameters)"
+    if any(not _is_indexed(names[i]) for i in columns):
+        what += "\nβk: the k-th estimated parameter (result.parameter_names[k − 1]), shown by its first term"
+    fig.suptitle(figure_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
+    return fig
+
+
+def _norm_panels(
+    time_axes: Sequence[Axes],
+    t: np.ndarray,
+    p_error: np.ndarray,
+    groups: dict[str, list[int]],
+    normalised: dict[str, np.ndarray],
+    unscaled: Sequence[str],
+) -> list[tuple[Axes, np.ndarray, np.ndarray]]:
+    """The summary's panels over time [s]: the ``normalised`` error of each unit's parameters
+    in one, then the error norm [u] of each ``unscaled`` unit; returns their curves (for
+    :func:`unblock_legends`)."""
     curves = []
     if normalised:
         ax = time_axes[0]
@@ -308,47 +328,54 @@ def _parameter_summary_figure(
         ax.legend(loc="upper right", fontsize=8)
     if time_axes:
         time_axes[-1].set_xlabel("t [s]")
+    return curves
 
-    for ax, (unit, group) in zip(bar_axes, groups.items()):
-        ax.set_label(f"final [{unit}]")
-        y = np.arange(len(group))
-        ax.barh(y, p_error[0, group], height=0.8, color=INITIAL_COLOR, label="t = 0")
-        ax.barh(y, p_error[-1, group], height=0.42, color=ACTUAL_COLOR, label=f"t = {end:g} s")
-        ax.set_yticks(y, [_short_label(names[i], i + 1) for i in group], fontsize=7)
-        ax.set_ylim(len(group) - 0.5, -0.5)  # the first parameter on top
-        ax.axvline(0.0, color="0.3", lw=0.8)
-        ax.grid(True, axis="x", alpha=0.3)
-        ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
-        ax.set_xlabel(f"p̂ − p [{unit}]", fontsize=9)
-        ax.set_title(
-            f"{len(group)} parameters [{unit}]: error at t = 0 (grey) and at t = {end:g} s (blue)",
-            fontsize=9,
-        )
-        twin = ax.twinx()
-        twin.set_label(f"relative [{unit}]")
-        twin.set_ylim(ax.get_ylim())
-        texts = [
-            _percent(100.0 * p_error[-1, i] / p_true[i])
-            if i in relative
-            else "p = 0"
-            if p_true[i] == 0
-            else "|p| ≈ 0"
-            for i in group
-        ]
-        twin.set_yticks(y, texts, fontsize=7)
-        twin.set_ylabel(f"(p̂ − p) / p at t = {end:g} s", fontsize=8)
-    _unblock_legends(fig, curves)
-    what = f"{kind} parameter estimation error p̂ − p ({len(columns)} parameters)"
-    if any(not _is_indexed(names[i]) for i in columns):
-        what += "\nβk: the k-th estimated parameter (result.parameter_names[k − 1]), shown by its first term"
-    fig.suptitle(_title(what, PARAMETER_FIGURES[kind], figure_numbers, heading), fontsize=11)
-    return fig
+
+def _bar_panel(
+    ax: Axes,
+    unit: str,
+    group: Sequence[int],
+    p_error: np.ndarray,
+    p_true: np.ndarray,
+    names: Sequence[str],
+    relative: set[int],
+    end: float,
+) -> None:
+    """One unit's bars: ``p̂_i − p_i`` [unit] at t = 0 and at ``end`` [s] per parameter of
+    ``group``, with the final relative error [%] (of the ``relative`` columns) on a twin axis."""
+    ax.set_label(f"final [{unit}]")
+    y = np.arange(len(group))
+    ax.barh(y, p_error[0, group], height=0.8, color=INITIAL_COLOR, label="t = 0")
+    ax.barh(y, p_error[-1, group], height=0.42, color=ACTUAL_COLOR, label=f"t = {end:g} s")
+    ax.set_yticks(y, [_short_label(names[i], i + 1) for i in group], fontsize=7)
+    ax.set_ylim(len(group) - 0.5, -0.5)  # the first parameter on top
+    ax.axvline(0.0, color="0.3", lw=0.8)
+    ax.grid(True, axis="x", alpha=0.3)
+    ax.ticklabel_format(axis="x", style="sci", scilimits=(-3, 4))
+    ax.set_xlabel(f"p̂ − p [{unit}]", fontsize=9)
+    ax.set_title(
+        f"{len(group)} parameters [{unit}]: error at t = 0 (grey) and at t = {end:g} s (blue)",
+        fontsize=9,
+    )
+    twin = ax.twinx()
+    twin.set_label(f"relative [{unit}]")
+    twin.set_ylim(ax.get_ylim())
+    texts = [
+        _percent(100.0 * p_error[-1, i] / p_true[i])
+        if i in relative
+        else "p = 0"
+        if p_true[i] == 0
+        else "|p| ≈ 0"
+        for i in group
+    ]
+    twin.set_yticks(y, texts, fontsize=7)
+    twin.set_ylabel(f"(p̂ − p) / p at t = {end:g} s", fontsize=8)
 
 
 # ------------------------------------------------------------------------ a run
 
 
-def _parameter_figures(
+def parameter_figures(
     result: SimulationResult, figure_numbers: Mapping[str, int], heading: str
 ) -> dict[str, Figure]:
     """The parameter figures of a run with estimates: key → figure, ``param_error`` for the
@@ -359,7 +386,7 @@ def _parameter_figures(
     Raises:
         InvalidParameterError: the result lacks a name, unit or known kind for a parameter.
     """
-    _check_parameters(result)
+    check_parameters(result)
     figures: dict[str, Figure] = {}
     for kind in PARAMETER_KINDS:
         columns = [i for i, k in enumerate(result.parameter_kinds) if k == kind]

@@ -35,20 +35,20 @@ from twolink_pin.plotting._style import (
     SIM_TORQUE_MARGINS,
     STATE_FIGSIZE,
     STATE_MARGINS,
-    _check_figure_numbers,
-    _envelope,
-    _fix_margins,
-    _free_spot,
-    _limit_lines,
-    _new_figure,
-    _plain_log_ticks,
-    _rows_figsize,
-    _save_all,
-    _title,
-    _unblock_legends,
+    check_figure_numbers,
+    envelope,
+    figure_title,
+    fix_margins,
+    free_spot,
+    limit_lines,
+    new_figure,
+    plain_log_ticks,
+    rows_figsize,
+    save_figures,
     shade_spans,
+    unblock_legends,
 )
-from twolink_pin.plotting.parameters import _check_parameters, _parameter_figures
+from twolink_pin.plotting.parameters import check_parameters, parameter_figures
 from twolink_pin.simulation import SimulationResult
 
 SIM_TORQUE_ROW_HEIGHT = 2.75
@@ -86,7 +86,7 @@ def _state_figure(
     split = float(t[0] + min(result.reference_period, duration / 3.0))
     margin = 0.01 * duration  # keeps what happens at t = 0 off the axis spine
 
-    fig = _new_figure(STATE_FIGSIZE)
+    fig = new_figure(STATE_FIGSIZE)
     axd = fig.subplot_mosaic(
         [["signal", "signal"], ["error", "error-late"], ["error-log", "error-log"]],
         height_ratios=(1.5, 1.0, 1.0),
@@ -117,11 +117,11 @@ def _state_figure(
     _late_ylim(late, error[after] if after.any() else error)
     late.set_title(f"${esym}$ for t ≥ {split:g} s (own scale)", fontsize=9)
 
-    te, env = _envelope(t, error)
+    te, env = envelope(t, error)
     log.semilogy(
         te, env, color=ERROR_COLOR, lw=1.2, drawstyle="steps-post", label=f"max $|{esym}|$ per window"
     )
-    _plain_log_ticks(log)
+    plain_log_ticks(log)
     log.set_ylim(max(LOG_FLOOR, 0.3 * float(env.min())), 3.0 * float(env.max()))
     width = float(te[1] - te[0]) if len(te) > 1 else duration
     log.set_ylabel(f"$|{esym}|$ [{unit}]")
@@ -135,9 +135,10 @@ def _state_figure(
     what = "velocity" if derivative else "position"
     key = f"theta{j + 1}{'dot' if derivative else ''}"
     fig.suptitle(
-        _title(f"joint {j + 1} {what}: actual vs desired, error", key, figure_numbers, heading), fontsize=11
+        figure_title(f"joint {j + 1} {what}: actual vs desired, error", key, figure_numbers, heading),
+        fontsize=11,
     )
-    _fix_margins(fig, STATE_MARGINS)
+    fix_margins(fig, STATE_MARGINS)
     return fig
 
 
@@ -150,7 +151,7 @@ def _torque_figure(
     """Applied (and commanded, if clipped) torque per joint: whole run and last period."""
     t = result.t
     nv = result.tau.shape[1]
-    fig = _new_figure(_rows_figsize(SIM_TORQUE_FIGSIZE, nv, SIM_TORQUE_ROW_HEIGHT))
+    fig = new_figure(rows_figsize(SIM_TORQUE_FIGSIZE, nv, SIM_TORQUE_ROW_HEIGHT))
     axes = fig.subplots(nv, 2, sharex="col", width_ratios=(1.6, 1.0), squeeze=False)
     period = result.reference_period
     last = t >= max(t[0], t[-1] - period)
@@ -166,7 +167,7 @@ def _torque_figure(
                 ax.plot(tt, command, color=COMMAND_COLOR, lw=1.0, ls="--", label="commanded")
             ax.plot(tt, result.tau[mask, j], color=ACTUAL_COLOR, lw=1.3, label=rf"applied $\tau_{{{j + 1}}}$")
             peak_cmd = float(np.abs(command).max())
-            _limit_lines(ax, limit, peak_cmd)
+            limit_lines(ax, limit, peak_cmd)
             ax.axhline(0.0, color="0.8", lw=0.6)
             ax.grid(True, alpha=0.3)
             ax.set_xlim(tt[0] - (0.01 * (tt[-1] - tt[0]) if col == 0 else 0.0), tt[-1])
@@ -176,7 +177,7 @@ def _torque_figure(
                 tk, yk = float(tt[k]), float(command[k])
                 note = "clipped by the plant" if result.saturate else "not saturated in this run"
                 lines = np.linspace(tt[0], tt[-1], 200)
-                spot = _free_spot(
+                spot = free_spot(
                     ax,
                     np.concatenate([tt, lines, lines]),
                     np.concatenate([result.tau[mask, j], np.full(200, limit), np.full(200, -limit)]),
@@ -205,11 +206,11 @@ def _torque_figure(
         ax.set_xlabel("t [s]")
     sat = "saturated at the limits" if result.saturate else "no saturation"
     heading = heading if heading is not None else _heading(result, None)
-    fig.suptitle(_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
-    _fix_margins(fig, SIM_TORQUE_MARGINS)
+    fig.suptitle(figure_title(f"joint torques ({sat})", "torque", figure_numbers or {}, heading), fontsize=11)
+    fix_margins(fig, SIM_TORQUE_MARGINS)
     shown = np.concatenate([result.tau, result.tau_command]) if clipped else result.tau
     times = np.concatenate([t, t]) if clipped else t
-    _unblock_legends(fig, [(axes[j, 0], times, shown[:, j]) for j in range(nv)])
+    unblock_legends(fig, [(axes[j, 0], times, shown[:, j]) for j in range(nv)])
     return fig
 
 
@@ -233,11 +234,11 @@ def _simulation_figures(
             integer, ``title`` is not a string, or the result lacks a name, unit or known
             kind for an estimated parameter.
     """
-    numbers = _check_figure_numbers(figure_numbers)
+    numbers = check_figure_numbers(figure_numbers)
     if title is not None and not isinstance(title, str):
         raise InvalidParameterError("title", title, "a string (the law's display title) or None")
     if result.p_error is not None:
-        _check_parameters(result)  # before drawing anything
+        check_parameters(result)  # before drawing anything
     heading = _heading(result, title)
     nv = result.nv
     figures: dict[str, Figure] = {}
@@ -247,7 +248,7 @@ def _simulation_figures(
         figures[f"theta{j + 1}dot"] = _state_figure(result, j, True, numbers, heading)
     figures["torque"] = _torque_figure(result, numbers, heading)
     if result.p_error is not None:
-        figures |= _parameter_figures(result, numbers, heading)
+        figures |= parameter_figures(result, numbers, heading)
     from twolink_pin.plotting.state import state_figure
 
     state = state_figure(result, heading)
@@ -317,4 +318,4 @@ def save_simulation_figures(
         if key.startswith("theta") or key == "torque":
             shade_spans(fig, spans, result.t)
     prefix = result.controller if prefix is None else prefix
-    return _save_all(figures, out_dir, f"{prefix}_" if prefix else "")
+    return save_figures(figures, out_dir, f"{prefix}_" if prefix else "")

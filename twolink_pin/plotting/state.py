@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from twolink_pin.plotting._style import _new_figure
+from twolink_pin.plotting._style import new_figure
 from twolink_pin.simulation.result import SimulationResult
 
 
@@ -23,7 +23,7 @@ def state_figure(result: SimulationResult, heading: str) -> Figure | None:
     if not columns:
         return None
     units = list(dict.fromkeys(result.state_units[i] for i in columns))
-    fig = _new_figure((8.0, 1.0 + 2.4 * len(units)))
+    fig = new_figure((8.0, 1.0 + 2.4 * len(units)))
     axes = fig.subplots(len(units), 1, sharex=True, squeeze=False)[:, 0]
     t = np.asarray(result.t)
     for ax, unit in zip(axes, units, strict=True):

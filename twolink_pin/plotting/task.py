@@ -25,7 +25,7 @@ def _task_error_figure(robot: RobotModel, result: SimulationResult, title: str |
     t = np.asarray(result.t)
     position = 1e3 * np.linalg.norm(errors.position, axis=1)
     angle = np.degrees(np.linalg.norm(errors.orientation, axis=1))
-    fig = _style._new_figure(TASK_FIGSIZE)
+    fig = _style.new_figure(TASK_FIGSIZE)
     axes = fig.subplots(2, 1, sharex=True)
     for ax, values, label, unit, (rms, peak, late) in (
         (axes[0], position, "position error |p − p_d|", "mm", m[0:3]),
@@ -58,4 +58,4 @@ def save_task_error_figure(
     titles; ``spans`` (``(start, stop)`` [s], a wrench acting) shaded."""
     fig = _task_error_figure(robot, result, title)
     _style.shade_spans(fig, spans, np.asarray(result.t))
-    return _style._save(fig, Path(path))
+    return _style.save_figure(fig, Path(path))

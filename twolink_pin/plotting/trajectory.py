@@ -36,15 +36,15 @@ from twolink_pin.plotting._style import (
     TORQUE_ROW_HEIGHT,
     WORKSPACE_3D_FIGSIZE,
     WORKSPACE_FIGSIZE,
-    _check_figure_numbers,
-    _fix_margins,
-    _free_spot,
-    _limit_lines,
-    _new_figure,
-    _rows_figsize,
-    _save_all,
-    _title,
-    _unblock_legends,
+    check_figure_numbers,
+    figure_title,
+    fix_margins,
+    free_spot,
+    limit_lines,
+    new_figure,
+    rows_figsize,
+    save_figures,
+    unblock_legends,
 )
 from twolink_pin.trajectory import JointTrajectory
 
@@ -65,7 +65,7 @@ def _joint_trajectory_figure(
     """Joint ``j``'s desired position, velocity, acceleration and jerk over one period."""
     t = trajectory.t0 + np.linspace(0.0, trajectory.period, samples)
     ref = trajectory.sample(t)
-    fig = _new_figure(JOINT_FIGSIZE)
+    fig = new_figure(JOINT_FIGSIZE)
     axes = fig.subplots(4, 1, sharex=True)
     name = rf"$\theta_{{{j + 1}}}$"
     rows = (
@@ -95,8 +95,8 @@ def _joint_trajectory_figure(
     axes[-1].set_xlabel("t [s]")
     axes[-1].set_xlim(t[0], t[-1])
     what = f"desired {name} and its derivatives over one period (T = {trajectory.period:g} s)"
-    fig.suptitle(_title(what, f"theta{j + 1}", figure_numbers))
-    _fix_margins(fig, JOINT_MARGINS)
+    fig.suptitle(figure_title(what, f"theta{j + 1}", figure_numbers))
+    fix_margins(fig, JOINT_MARGINS)
     return fig
 
 
@@ -230,7 +230,7 @@ def _workspace_figure_3d(
     across = 0 if np.ptp(path[:, 0]) >= np.ptp(path[:, 1]) else 1
     side_plane = [across, 2]
 
-    fig = _new_figure(WORKSPACE_3D_FIGSIZE)
+    fig = new_figure(WORKSPACE_3D_FIGSIZE)
     grid = fig.add_gridspec(1, 3, width_ratios=(1.3, 1.0, 1.0))
     view = fig.add_subplot(grid[0], projection="3d")
     top, side = fig.add_subplot(grid[1]), fig.add_subplot(grid[2])
@@ -275,7 +275,7 @@ def _workspace_figure_3d(
     top.set_title("end-effector path from above (x-y), arrows: direction of motion", fontsize=10)
     side.set_title(f"from the side ({'xy'[across]}-z)", fontsize=10)
     what = f"arm and end-effector path in 3-D over one period (T = {trajectory.period:g} s)"
-    fig.suptitle(_title(what, "workspace", figure_numbers))
+    fig.suptitle(figure_title(what, "workspace", figure_numbers))
     return fig
 
 
@@ -298,7 +298,7 @@ def _workspace_figure(
     mid_arms = joint_positions(robot, trajectory.sample(np.sort(quarter_t)).q)[:, :, plane]
     in_xy = plane == [0, 1] and float(np.ptp(points[:, :, 2])) <= PLANAR_TOLERANCE
 
-    fig = _new_figure(WORKSPACE_FIGSIZE)
+    fig = new_figure(WORKSPACE_FIGSIZE)
     full, zoom = fig.subplots(1, 2, width_ratios=(1.0, 1.15))
     full.set_label("workspace")
     zoom.set_label("path")
@@ -334,20 +334,20 @@ def _workspace_figure(
     full.set_title(f"arm poses {where}", fontsize=10)
     full.legend(loc="upper left" if annulus else "best", fontsize=8)
     what = f"arm and end-effector path in the {h_name}-{v_name} plane over one period (T = {trajectory.period:g} s)"
-    fig.suptitle(_title(what, "workspace", figure_numbers))
+    fig.suptitle(figure_title(what, "workspace", figure_numbers))
     return fig
 
 
 def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]) -> Figure:
     """Each joint's desired torque with its ``±limit`` lines and its peak annotated."""
     nv = check.tau.shape[1]
-    fig = _new_figure(_rows_figsize(TORQUE_FIGSIZE, nv, TORQUE_ROW_HEIGHT))
+    fig = new_figure(rows_figsize(TORQUE_FIGSIZE, nv, TORQUE_ROW_HEIGHT))
     axes = fig.subplots(nv, 1, sharex=True, squeeze=False)[:, 0]
     for j, ax in enumerate(axes):
         ax.set_label(f"tau{j + 1}")
         limit = float(check.limits[j])
         ax.plot(check.t, check.tau[:, j], color=ACTUAL_COLOR, lw=1.6, label=rf"desired $\tau_{{{j + 1}}}$")
-        _limit_lines(ax, limit, float(check.peak[j]))
+        limit_lines(ax, limit, float(check.peak[j]))
         k = int(np.argmin(np.abs(check.t - check.peak_time[j])))
         tp, yp = float(check.t[k]), float(check.tau[k, j])
         ax.plot(tp, yp, "o", color=ERROR_COLOR, ms=6, zorder=4)
@@ -357,7 +357,7 @@ def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]
             if math.isfinite(limit)
             else "no limit in the URDF"
         )
-        spot = _free_spot(ax, check.t, check.tau[:, j], (0.36, 0.2), (tp, yp), (LEGEND_BOX, NOTE_BOX))
+        spot = free_spot(ax, check.t, check.tau[:, j], (0.36, 0.2), (tp, yp), (LEGEND_BOX, NOTE_BOX))
         ax.annotate(
             f"peak |τ{j + 1}| = {check.peak[j]:.3g} N·m\nat t = {tp:.2f} s ({share})",
             (tp, yp),
@@ -379,9 +379,9 @@ def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]
     else:
         verdict = ("within" if check.within_limits else "EXCEEDS") + " the motor limits"
     what = f"desired torques M q̈ + C q̇ + g along one period: {verdict}"
-    fig.suptitle(_title(what, "desired_torque", figure_numbers))
-    _fix_margins(fig, TORQUE_MARGINS)
-    _unblock_legends(fig, [(ax, check.t, check.tau[:, j]) for j, ax in enumerate(axes)])
+    fig.suptitle(figure_title(what, "desired_torque", figure_numbers))
+    fix_margins(fig, TORQUE_MARGINS)
+    unblock_legends(fig, [(ax, check.t, check.tau[:, j]) for j, ax in enumerate(axes)])
     return fig
 
 
@@ -411,7 +411,7 @@ def _trajectory_figures(
         raise InvalidParameterError("check", f"tau shape {check.tau.shape}", f"shape (N, {robot.nv})")
     if isinstance(samples, bool) or not (isinstance(samples, int) and samples >= 2):
         raise InvalidParameterError("samples", samples, "an integer >= 2")
-    numbers = _check_figure_numbers(figure_numbers)
+    numbers = check_figure_numbers(figure_numbers)
     figures: dict[str, Figure] = {}
     for j in range(robot.nv):
         figures[f"theta{j + 1}"] = _joint_trajectory_figure(trajectory, j, samples, numbers)
@@ -463,4 +463,4 @@ def save_trajectory_figures(
         OutputError: ``out_dir`` cannot be created or written.
     """
     figures = _trajectory_figures(robot, trajectory, check, figure_numbers=figure_numbers)
-    return _save_all(figures, out_dir, "trajectory_")
+    return save_figures(figures, out_dir, "trajectory_")

@@ -53,7 +53,7 @@ is refused, not allocated)."""
 REQUIRED = ("controller", "t", "q", "v", "q_des")
 
 
-def _claimed_values(path: str | os.PathLike[str]) -> int:
+def claimed_values(path: str | os.PathLike[str]) -> int:
     """Numbers the archive's arrays claim to hold, from their ``.npy`` headers (read without
     decompressing the data)."""
     total = 0
@@ -104,7 +104,7 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
     name = os.fspath(path)
     check_input_file(path, MAX_RESULT_BYTES, "a saved simulation result (.npz)")
     try:
-        claimed = _claimed_values(path)
+        claimed = claimed_values(path)
         if claimed > MAX_RESULT_VALUES:
             raise InputFileError(
                 name, f"its arrays claim more than {MAX_RESULT_VALUES:g} numbers; refusing to unpack it"

@@ -253,7 +253,7 @@ def _matrix_draws(config: SweepConfig, cases: Cases, base: Controller) -> dict[s
     return out
 
 
-def _chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Controller) -> Controller:
+def chunk_law(config: SweepConfig, robot: RobotModel, cases: Cases, base: Controller) -> Controller:
     """One law object for the chunk: drawn gains and believed parameters per run."""
     cls = type(base)
     n = len(cases.q0_offset)

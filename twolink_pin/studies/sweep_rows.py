@@ -17,7 +17,7 @@ from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
-from twolink_pin.studies.sweep_cases import Cases, SweepConfig, _chunk_law, gain_target
+from twolink_pin.studies.sweep_cases import Cases, SweepConfig, chunk_law, gain_target
 from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
 
@@ -31,7 +31,7 @@ samples × (steps + 1) × 3 nv (q, q̇, τ_command)."""
 # -- rows -----------------------------------------------------------------------------------------
 
 
-def _joint_columns(prefix: str, nv: int) -> list[str]:
+def joint_columns(prefix: str, nv: int) -> list[str]:
     return [f"{prefix}{j + 1}" for j in range(nv)]
 
 
@@ -50,7 +50,7 @@ def metric_columns(nv: int, parameter_names: Sequence[str] = (), task: bool = Fa
     of a task-space law (``task``), the final estimates."""
     columns: list[str] = []
     for stem in METRIC_UNITS:
-        columns += _joint_columns(stem, nv)
+        columns += joint_columns(stem, nv)
     if task:
         columns += list(TASK_COLUMNS)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
@@ -59,7 +59,7 @@ def metric_columns(nv: int, parameter_names: Sequence[str] = (), task: bool = Fa
 
 def input_columns(config: SweepConfig, nv: int, parameter_names: Sequence[str]) -> list[str]:
     """Names of the input columns of a row, in order."""
-    columns = ["run", *_joint_columns("q0_offset", nv)]
+    columns = ["run", *joint_columns("q0_offset", nv)]
     columns += [f"param_factor_{name}" for name in parameter_names]
     columns += [f"gain_{g.name}" for g in config.gains]
     if config.wrench_scale is not None:
@@ -91,7 +91,7 @@ def _chunk_rows(
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
 
 
-def _stats(column: np.ndarray) -> dict[str, float | None]:
+def percentile_stats(column: np.ndarray) -> dict[str, float | None]:
     if column.size == 0:
         return {"median": None, "p5": None, "p95": None}
     p5, p50, p95 = np.percentile(column, PERCENTILES)
@@ -111,7 +111,7 @@ def summarize(
         "runs": int(diverged.size),
         "diverged": int(diverged.sum()),
         "limit_exceeded": int((exceeded & keep).sum()),
-        "metrics": {name: _stats(metrics[keep, j]) for j, name in enumerate(names)},
+        "metrics": {name: percentile_stats(metrics[keep, j]) for j, name in enumerate(names)},
     }
 
 
@@ -191,7 +191,7 @@ class PreparedSweep:
         self.task = bool(cls.task_space)  # the law's class declares it
         self.metric_columns = metric_columns(nv, estimated, self.task)
         self.header = [*self.input_columns, *FLAG_COLUMNS, *self.metric_columns]
-        units = {"run": "", **{c: "rad" for c in _joint_columns("q0_offset", nv)}}
+        units = {"run": "", **{c: "rad" for c in joint_columns("q0_offset", nv)}}
         units.update({f"param_factor_{n}": "" for n in self.parameter_names})
         for g in config.gains:
             key, _ = gain_target(cls, g.name)
@@ -200,7 +200,7 @@ class PreparedSweep:
             units["wrench_scale"] = ""
         units.update(limit_exceeded="", diverged="", diverged_at="s")
         for stem, unit in METRIC_UNITS.items():
-            units.update({c: unit for c in _joint_columns(stem, nv)})
+            units.update({c: unit for c in joint_columns(stem, nv)})
         if self.task:
             units.update(TASK_COLUMNS)
         if law.estimates:
@@ -215,7 +215,7 @@ class PreparedSweep:
         """Draw and simulate runs ``start .. stop − 1``; ``progress(runs done)`` meanwhile."""
         config = self.config
         cases = Cases(config, self.robot, start, stop)
-        law = _chunk_law(config, self.robot, cases, self.base.controller)
+        law = chunk_law(config, self.robot, cases, self.base.controller)
         size = stop - start
 
         def steps(done: int, total: int) -> None:

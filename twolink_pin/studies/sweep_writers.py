@@ -31,8 +31,8 @@ from twolink_pin.studies.sweep_rows import (
     TASK_COLUMNS,
     ChunkRows,
     PreparedSweep,
-    _joint_columns,
-    _stats,
+    joint_columns,
+    percentile_stats,
 )
 from twolink_pin.trajectory import Trajectory
 
@@ -124,7 +124,7 @@ def summarize_dataset(folder: str | Path, names: Sequence[str]) -> dict[str, Any
     for first in range(0, len(names), per_pass):
         columns = read_columns(folder, names[first : first + per_pass])
         for name, column in columns.items():
-            stats[name] = _stats(column[keep])
+            stats[name] = percentile_stats(column[keep])
         del columns
     return {
         "runs": int(diverged.size),
@@ -224,7 +224,7 @@ of a task-space law: :data:`~twolink_pin.studies.sweep_rows.TASK_COLUMNS`)."""
 
 def _figure_columns(nv: int, task: bool) -> list[str]:
     """The columns ``distributions.png`` shows, in order."""
-    joints = [name for stem in FIGURE_METRICS for name in _joint_columns(stem, nv)]
+    joints = [name for stem in FIGURE_METRICS for name in joint_columns(stem, nv)]
     return [*TASK_COLUMNS, *joints] if task else joints
 
 
@@ -243,7 +243,7 @@ def save_distribution_figure(
 
     keep = ~diverged
     task = TASK_COLUMNS.keys() <= set(names)
-    units = {name: METRIC_UNITS[stem] for stem in FIGURE_METRICS for name in _joint_columns(stem, nv)}
+    units = {name: METRIC_UNITS[stem] for stem in FIGURE_METRICS for name in joint_columns(stem, nv)}
     units |= TASK_COLUMNS
     rows = {
         f"{name} [{units[name]}]": metrics[keep, list(names).index(name)]

@@ -103,8 +103,45 @@ def start_bridge(host: str = "127.0.0.1", port: int | None = None) -> Bridge:
     Raises:
         OutputError: the server cannot listen on ``host:port`` (in use, no such address).
     """
-    import tornado.web
     import zmq
+
+    bridge_class = _bound_bridge_class()
+    started: queue.Queue[Any] = queue.Queue()
+
+    def run() -> None:
+        loop = asyncio.new_event_loop()
+        asyncio.set_event_loop(loop)
+        try:
+            bridge = bridge_class(zmq_url="tcp://127.0.0.1:*", host=host, port=0 if port is None else port)
+            bridge.zmq_url = bridge.zmq_socket.getsockopt_string(zmq.LAST_ENDPOINT)
+            sockets = bridge.app.http_server._sockets.values()
+            bridge.fileserver_port = next(iter(sockets)).getsockname()[1]
+            bridge.web_url = f"http://{_url_host(host)}:{bridge.fileserver_port}/static/"
+        except BaseException as exc:
+            started.put(exc)
+            loop.close()
+            return
+        started.put(bridge)
+        try:
+            bridge.run()
+        finally:
+            bridge.ioloop.close(all_fds=True)
+
+    thread = threading.Thread(target=run, name=f"meshcat-bridge-{host}", daemon=True)
+    thread.start()
+    result = started.get(timeout=30)
+    if isinstance(result, BaseException):
+        thread.join(timeout=5)
+        if isinstance(result, OSError):
+            raise OutputError(f"{host}:{port}", f"cannot listen there ({result.strerror})") from result
+        raise result
+    return Bridge(result, thread, host)
+
+
+def _bound_bridge_class() -> Any:
+    """meshcat's ``ZMQWebSocketBridge`` whose page and WebSocket server listen on its ``host``
+    only, that logs requests at debug level and releases its ZMQ socket when it cannot start."""
+    import tornado.web
 
     import_meshcat()
     from meshcat.servers.zmqserver import (
@@ -156,33 +193,4 @@ def start_bridge(host: str = "127.0.0.1", port: int | None = None) -> Bridge:
             app.bind_address = self.host
             return app
 
-    started: queue.Queue[Any] = queue.Queue()
-
-    def run() -> None:
-        loop = asyncio.new_event_loop()
-        asyncio.set_event_loop(loop)
-        try:
-            bridge = _BoundBridge(zmq_url="tcp://127.0.0.1:*", host=host, port=0 if port is None else port)
-            bridge.zmq_url = bridge.zmq_socket.getsockopt_string(zmq.LAST_ENDPOINT)
-            sockets = bridge.app.http_server._sockets.values()
-            bridge.fileserver_port = next(iter(sockets)).getsockname()[1]
-            bridge.web_url = f"http://{_url_host(host)}:{bridge.fileserver_port}/static/"
-        except BaseException as exc:
-            started.put(exc)
-            loop.close()
-            return
-        started.put(bridge)
-        try:
-            bridge.run()
-        finally:
-            bridge.ioloop.close(all_fds=True)
-
-    thread = threading.Thread(target=run, name=f"meshcat-bridge-{host}", daemon=True)
-    thread.start()
-    result = started.get(timeout=30)
-    if isinstance(result, BaseException):
-        thread.join(timeout=5)
-        if isinstance(result, OSError):
-            raise OutputError(f"{host}:{port}", f"cannot listen there ({result.strerror})") from result
-        raise result
-    return Bridge(result, thread, host)
+    return _BoundBridge

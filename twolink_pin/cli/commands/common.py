@@ -125,7 +125,7 @@ def _run_one(
     return simulate(controller, plant, reference, spec.simulation)
 
 
-def _gains_echo(controller: Any) -> tuple[dict[str, Any], str]:
+def gains_echo(controller: Any) -> tuple[dict[str, Any], str]:
     """The gains a law ran with, for ``--json`` (:func:`~twolink_pin.run_spec.gains_used`) and
     for the text (``kp = (350, 300) N·m/rad, …``): what every command that runs a law echoes."""
     from twolink_pin.run_spec import gains_used

@@ -152,7 +152,7 @@ def cmd_controllers(args: argparse.Namespace) -> int:
     from dataclasses import fields
 
     from twolink_pin.controllers import available_controllers
-    from twolink_pin.controllers.gains import _spec, default_as_json
+    from twolink_pin.controllers.gains import default_as_json, gain_spec
     from twolink_pin.controllers.loading import broken_plugins
 
     rows: list[dict[str, Any]] = []
@@ -160,11 +160,11 @@ def cmd_controllers(args: argparse.Namespace) -> int:
         gains: list[dict[str, Any]] = [
             {
                 "name": f.name,
-                "per": _spec(f).per,
-                "matrix": _spec(f).matrix,
-                "unit": _spec(f).unit,
+                "per": gain_spec(f).per,
+                "matrix": gain_spec(f).matrix,
+                "unit": gain_spec(f).unit,
                 "default": default_as_json(cls.Gains, f.name),
-                "doc": _spec(f).doc,
+                "doc": gain_spec(f).doc,
             }
             for f in fields(cls.Gains)
         ]

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from twolink_pin.cli.commands.common import (
-    _gains_echo,
+    gains_echo,
     identified_parameters,
     robot_from_args,
     run_spec,
@@ -67,7 +67,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     if task is not None:
         payload["task_metrics"] = task.as_dict()
     q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
-    gains, gains_text = _gains_echo(scenario.controller)
+    gains, gains_text = gains_echo(scenario.controller)
     payload |= {
         "gains": gains,
         "plant": plant_description(scenario),
@@ -234,7 +234,7 @@ def _say_failed(failed: dict[str, str], where: str) -> None:
 
 def cmd_animate(args: argparse.Namespace) -> int:
     robot, reference, result, spec, controller = _run_to_animate(args)
-    gains, gains_text = _gains_echo(controller) if controller is not None else (None, "not recorded")
+    gains, gains_text = gains_echo(controller) if controller is not None else (None, "not recorded")
     from twolink_pin.visualization.overlays import run_overlays
 
     overlays = run_overlays(None if spec is None else spec.plant.wrench, result.t)

@@ -6,11 +6,11 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import _gains_echo, robot_from_args, run_spec, trajectory_from_args
+from twolink_pin.cli.commands.common import gains_echo, robot_from_args, run_spec, trajectory_from_args
 from twolink_pin.cli.output import emit, progress_bar
 
 if TYPE_CHECKING:
-    pass
+    from twolink_pin.studies.sweep import SweepOutput
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
@@ -69,7 +69,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         if bars:
             bars[0].close()
     summary = output.summary
-    gains, gains_text = _gains_echo(config.run.build(robot).controller)  # the nominal law's
+    gains, gains_text = gains_echo(config.run.build(robot).controller)  # the nominal law's
     drawn = {g.name: [g.low, g.high] for g in config.gains}
     if args.json:
         payload = {
@@ -80,6 +80,15 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         }
         emit(args, {**payload, "engine": output.engine, "chunk": output.chunk}, "")
         return 0
+    emit(args, {}, "\n".join(_sweep_lines(summary, output, gains_text, drawn)))
+    return 0
+
+
+def _sweep_lines(
+    summary: dict[str, Any], output: SweepOutput, gains_text: str, drawn: dict[str, list[float]]
+) -> list[str]:
+    """``sweep``'s text: the counts, where it ran, the gains (nominal and ``drawn`` ranges), the
+    percentiles of every metric and the files written."""
     lines = [
         f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
         f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
@@ -95,5 +104,4 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if "note" in summary:
         lines.append(f"  {summary['note']}")
     lines += [f"  wrote {f}" for f in output.files]
-    emit(args, {}, "\n".join(lines))
-    return 0
+    return lines
