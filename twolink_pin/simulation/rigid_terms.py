@@ -243,7 +243,7 @@ class RigidBodyTerms:
         placement = np.empty((n, 4, 4))  # homogeneous, as in _fused_pass
         jacobian = np.empty((n, 6, self._nv))
         drift = np.empty((n, 6))
-        for qi, vi, H, J, a in zip(Q, V, placement, jacobian, drift, strict=True):
+        for _, qi, vi, H, J, a in zip(range(n), Q, V, placement, jacobian, drift, strict=False):  # as above
             pin.forwardKinematics(model, data, qi, vi, zero)
             pin.computeJointJacobians(model, data)
             H[...] = pin.updateFramePlacement(model, data, fid).homogeneous
@@ -273,8 +273,11 @@ class RigidBodyTerms:
         # The Data's own arrays (views that Pinocchio fills in place at every call)
         M_data, bias_data, gravity_data = data.M, data.nle, data.g
         runs_models = models if len(models) == n else [models[0]] * n
-        # Each run's rows as views (``row[...] = x`` costs less than ``out[i] = x``)
-        rows = zip(runs_models, Q, V, placement, jacobian, drift, upper, bias, gravity, strict=True)
+        # Each run's rows as views (``row[...] = x`` costs less than ``out[i] = x``). Every
+        # sequence has n rows, and the list comes first: zip stops on it without asking the
+        # arrays for a row past their end (numpy formats an IndexError message for each,
+        # ~4k instructions: what strict=True would cost a single run, 9 times).
+        rows = zip(runs_models, Q, V, placement, jacobian, drift, upper, bias, gravity, strict=False)
         for model, qi, vi, H, J, a, M, b, g in rows:
             pin.computeAllTerms(model, data, qi, vi)
             H[...] = pin.updateFramePlacement(model, data, fid).homogeneous
