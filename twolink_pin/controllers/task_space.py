@@ -13,18 +13,27 @@ x and y); orientation is left to the joints. This is :func:`task_rows`' choice; 
 ``home``, not at it, because a home can be singular (the twolink's, stretched along x, moves
 its tip in y only).
 
-**Singularities.** ``Λ = (J M⁻¹ Jᵀ)⁻¹`` is formed from the eigen-decomposition of
-``J M⁻¹ Jᵀ`` normalised to a unit diagonal, ``S J M⁻¹ Jᵀ S = U diag(s) Uᵀ`` with
-``S = diag(J M⁻¹ Jᵀ)^(-1/2)`` (so that its eigenvalues have no unit whatever the rows'
-units: 1/kg for a force, 1/(kg·m²) for a moment); when ``s_min < ε``
-(:data:`SINGULAR_RATIO`) it becomes ``S U diag(s / (s² + ρ²)) Uᵀ S`` with ``ρ² = ε² − s_min²``
-(damped least squares with a damping that grows from 0 at the threshold, Nakamura and Hanafusa, *J. Dyn. Sys., Meas.,
-Control* 108(3), 1986; Chiaverini, *IEEE Trans. Robot. Autom.* 13(3), 1997), and the law warns
-once (:class:`SingularityWarning`) and counts the damped evaluations.
+**Singularities.** ``Λ = (J M⁻¹ Jᵀ)⁻¹`` is formed as ``S B⁻¹ S`` from ``J M⁻¹ Jᵀ`` normalised to
+a unit diagonal, ``B = S J M⁻¹ Jᵀ S`` with ``S = diag(J M⁻¹ Jᵀ)^(-1/2)`` (so that its eigenvalues
+have no unit whatever the rows' units: 1/kg for a force, 1/(kg·m²) for a moment). Write
+``B = U diag(s) Uᵀ``. When ``s_min < ε`` (:data:`SINGULAR_RATIO`) Λ becomes
+``S U diag(s / (s² + ρ²)) Uᵀ S`` with ``ρ² = ε² − s_min²`` (damped least squares with a damping
+that grows from 0 at the threshold, Nakamura and Hanafusa, *J. Dyn. Sys., Meas., Control*
+108(3), 1986; Chiaverini, *IEEE Trans. Robot. Autom.* 13(3), 1997), and the law warns once
+(:class:`SingularityWarning`) and counts the damped evaluations.
+
+The eigenvalues are computed only for the runs that may need the damping: every run's ``B⁻¹``
+is first taken by LU (``numpy.linalg.inv``, a third of ``eigh``'s cost on a 6 × 6), and a run
+whose inverse has a Frobenius norm ``‖B⁻¹‖_F ≤ 1/ε`` keeps it — every eigenvalue of a symmetric
+``B`` then has ``|s| ≥ 1/‖B⁻¹‖_F ≥ ε``, so it would not be damped (:func:`certified_inverse`).
+The rest (``s_min < √k ε`` at most: the bound is within ``√k`` of ``1/s_min``) take the
+eigen-decomposition above, damped or not as ``s_min`` says. Each run's path depends on its own
+matrix only: a batch still equals its single runs bit for bit.
 """
 
 from __future__ import annotations
 
+import contextlib
 import warnings
 from typing import NamedTuple
 
@@ -176,6 +185,22 @@ def block_gain(linear: np.ndarray, angular: np.ndarray, rows: np.ndarray) -> np.
     return out
 
 
+def certified_inverse(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``B⁻¹`` (N, k, k) for symmetric (N, k, k) ``B``, and per run whether the inverse certifies
+    that no eigenvalue of ``B`` is below ``ε`` in magnitude (:data:`SINGULAR_RATIO`):
+    ``‖B⁻¹‖_F² ≤ 1/ε²`` (the Frobenius norm bounds the spectral radius ``1/|s|_min``). A run whose
+    LU meets an exact zero pivot gets no inverse (``inf``) and no certificate."""
+    try:
+        inverse = np.linalg.inv(B)
+    except np.linalg.LinAlgError:  # an exactly singular run stops the batch's inv: run by run
+        inverse = np.full_like(B, np.inf)
+        for i, b in enumerate(B):
+            with contextlib.suppress(np.linalg.LinAlgError):
+                inverse[i] = np.linalg.inv(b)
+    flat = inverse.reshape(inverse.shape[0], -1)
+    return inverse, np.vecdot(flat, flat) <= SINGULAR_RATIO**-2
+
+
 class TaskInertia:
     """``Λ = (J M⁻¹ Jᵀ)⁻¹``, damped near singularities, for a law named ``law``."""
 
@@ -189,7 +214,16 @@ class TaskInertia:
         """Λ from ``A = J M⁻¹ Jᵀ`` (N, k, k) at time ``t`` [s]."""
         scale = 1.0 / np.sqrt(A.diagonal(0, 1, 2))  # the rows' units (1/kg, 1/(kg·m²)) out
         S = scale[:, :, None] * scale[:, None, :]  # S_ij = scale_i scale_j
-        s, U = np.linalg.eigh(A * S)
+        B = A * S
+        core, certain = certified_inverse(B)
+        if not np.logical_and.reduce(certain):  # some run may be near a singularity
+            uncertain = ~certain
+            core[uncertain] = self._eigen_inverse(B[uncertain], t)
+        return core * S
+
+    def _eigen_inverse(self, B: np.ndarray, t: float) -> np.ndarray:
+        """``U diag(s / (s² + ρ²)) Uᵀ`` for (n, k, k) ``B = U diag(s) Uᵀ`` (the module doc)."""
+        s, U = np.linalg.eigh(B)
         if np.minimum.reduce(np.abs(s[:, 0])) < SINGULAR_RATIO:  # ρ² > 0 for some run
             rho2 = np.maximum(SINGULAR_RATIO**2 - s[:, :1] ** 2, 0.0)
             near = rho2[:, 0] > 0
@@ -201,13 +235,12 @@ class TaskInertia:
                     f"normalised J M⁻¹ Jᵀ is {float(np.min(s[near, 0])):.3g} < {SINGULAR_RATIO:g}): the task "
                     "inertia is damped and the task no longer tracked exactly",
                     SingularityWarning,
-                    stacklevel=3,
+                    stacklevel=4,
                 )
             inverse = s / (s * s + rho2)
         else:  # ρ = 0 for every run: s / (s² + 0), the same bits without the sum
             inverse = s / (s * s)
-        core = np.matmul(U * inverse[:, None, :], U.transpose(0, 2, 1))
-        return core * S
+        return np.matmul(U * inverse[:, None, :], U.transpose(0, 2, 1))
 
 
 def null_space_torque(J: np.ndarray, MinvJt: np.ndarray, Lam: np.ndarray, tau0: np.ndarray) -> np.ndarray:

@@ -240,19 +240,16 @@ class RigidBodyTerms:
             if len(models) in (1, n):
                 return self._fused_pass(fid, q, v, Q, V, models, data)
         model, data, zero = self._kinematics, self._kinematics_data, self._zero
-        position = np.empty((n, 3))
-        rotation = np.empty((n, 3, 3))
+        placement = np.empty((n, 4, 4))  # homogeneous, as in _fused_pass
         jacobian = np.empty((n, 6, self._nv))
         drift = np.empty((n, 6))
-        for i in range(n):
-            pin.forwardKinematics(model, data, Q[i], V[i], zero)
+        for _, qi, vi, H, J, a in zip(range(n), Q, V, placement, jacobian, drift, strict=False):  # as above
+            pin.forwardKinematics(model, data, qi, vi, zero)
             pin.computeJointJacobians(model, data)
-            placement = pin.updateFramePlacement(model, data, fid)
-            position[i] = placement.translation
-            rotation[i] = placement.rotation
-            jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
-            drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
-        return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
+            H[...] = pin.updateFramePlacement(model, data, fid).homogeneous
+            J[...] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
+            a[...] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
+        return _frame_terms(placement, jacobian, drift)
 
     def _fused_pass(
         self,
@@ -267,8 +264,7 @@ class RigidBodyTerms:
         """The frame by one ``pin.computeAllTerms`` per run, with ``M̂``, ``Ĉ q̇ + ĝ`` and ``ĝ`` of
         the same pass kept by value for :meth:`mass`, :meth:`bias`, :meth:`gravity`."""
         n, nv = Q.shape
-        position = np.empty((n, 3))
-        rotation = np.empty((n, 3, 3))
+        placement = np.empty((n, 4, 4))  # homogeneous: one Python-level copy instead of two
         jacobian = np.empty((n, 6, nv))
         drift = np.empty((n, 6))
         upper = np.empty((n, nv, nv))
@@ -277,23 +273,34 @@ class RigidBodyTerms:
         # The Data's own arrays (views that Pinocchio fills in place at every call)
         M_data, bias_data, gravity_data = data.M, data.nle, data.g
         runs_models = models if len(models) == n else [models[0]] * n
-        for i, (model, qi, vi) in enumerate(zip(runs_models, Q, V, strict=True)):
+        # Each run's rows as views (``row[...] = x`` costs less than ``out[i] = x``). Every
+        # sequence has n rows, and the list comes first: zip stops on it without asking the
+        # arrays for a row past their end (numpy formats an IndexError message for each,
+        # ~4k instructions: what strict=True would cost a single run, 9 times).
+        rows = zip(runs_models, Q, V, placement, jacobian, drift, upper, bias, gravity, strict=False)
+        for model, qi, vi, H, J, a, M, b, g in rows:
             pin.computeAllTerms(model, data, qi, vi)
-            placement = pin.updateFramePlacement(model, data, fid)
-            position[i] = placement.translation
-            rotation[i] = placement.rotation
-            jacobian[i] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
-            drift[i] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
-            upper[i] = M_data
-            bias[i] = bias_data
-            gravity[i] = gravity_data
+            H[...] = pin.updateFramePlacement(model, data, fid).homogeneous
+            J[...] = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)
+            a[...] = pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector
+            M[...] = M_data
+            b[...] = bias_data
+            g[...] = gravity_data
         if q.shape[0] == n:
             self._last_mass = ((q.dtype, q.shape, q.tobytes()), self._symmetric(upper))
             self._last_gravity = ((q.dtype, q.shape, q.tobytes()), frozen(gravity))
             if v.shape[0] == n:
                 key = (q.dtype, v.dtype, q.shape, v.shape, q.tobytes(), v.tobytes())
                 self._last_bias = (key, frozen(bias))
-        return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
+        return _frame_terms(placement, jacobian, drift)
+
+
+def _frame_terms(placement: np.ndarray, jacobian: np.ndarray, drift: np.ndarray) -> FrameTerms:
+    """Read-only :class:`FrameTerms` from (N, 4, 4) homogeneous placements (position and rotation
+    copied out contiguous), Jacobians and drifts."""
+    position = np.ascontiguousarray(placement[:, :3, 3])
+    rotation = np.ascontiguousarray(placement[:, :3, :3])
+    return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
 
 
 class RigidBodyTermsMixin:
