@@ -301,7 +301,7 @@ def sweep_section(quick: bool) -> dict[str, Any]:
         print(f"\nsweep throughput: skipped, Dask is not installed ({cluster.INSTALL_HINT})")
         return {}
     horizons = {"twolink": (0.05,), "ur5": (0.05,)} if quick else SWEEP_HORIZONS
-    budget = {"twolink": 20.0, "ur5": 2.0} if quick else SWEEP_BUDGET
+    budget = {"twolink": 5.0, "ur5": 1.0} if quick else SWEEP_BUDGET
     least = 40 if quick else 500
     repeats = 1 if quick else 3
     rows: list[dict[str, Any]] = []
@@ -932,7 +932,7 @@ def identification_section(quick: bool) -> dict[str, Any]:
 
     ur5 = load_robot("ur5")
     fixture = Path(__file__).resolve().parents[1] / "tests" / "fixtures" / "ur5_excitation.json"
-    duration = 8.0 if quick else 20.0
+    duration = 3.0 if quick else 20.0
     log = add_noise(simulate_log(ur5, read_trajectory_file(fixture, ur5), duration=duration), 1e-5, 0.05, 0)
     options = IdentificationOptions()
     start = time.perf_counter()
@@ -975,7 +975,7 @@ def ur5_commands_section(quick: bool) -> dict[str, Any]:
 
     from twolink_pin.cli import main
 
-    iterations = 10 if quick else 100
+    iterations = 3 if quick else 100
     rows: dict[str, Any] = {}
     with tempfile.TemporaryDirectory() as folder:
         for name, argv, documented in (
@@ -996,7 +996,7 @@ def ur5_commands_section(quick: bool) -> dict[str, Any]:
             ),
             (
                 "identify_ur5_cli",
-                ["identify", "--robot", "ur5", *(["--duration", "8"] if quick else [])],
+                ["identify", "--robot", "ur5", *(["--duration", "3"] if quick else [])],
                 None,
             ),
         ):
