@@ -654,7 +654,7 @@ UNCLEAR = [
     C("unclear-simulate-arm3-q0-offset-two", f"simulate pd {SIM} --robot arm3.urdf --q0-offset 0.1 0.2", 2, err=("3 joint|3 values|nv = 3", "0.1"), setup=(urdf("arm3"),)),
     C("unclear-simulate-arm3-q0-offset-one", f"simulate pd {SIM} --robot arm3.urdf --q0-offset 0.1", 0, setup=(urdf("arm3"),)),
     C("unclear-simulate-arm3-gain-two", f"simulate pd {SIM} --robot arm3.urdf --gain kp=100,200", 2, err=("kp", "3"), setup=(urdf("arm3"),)),
-    C("unclear-compare-arm3", f"compare {SIM} --robot arm3.urdf --no-plot --out c", 0, setup=(urdf("arm3"),)),
+    C("unclear-compare-arm3", f"compare {SIM} --robot arm3.urdf --no-plot --out c", 0, setup=(urdf("arm3"),), warns=("twolink-pin: warning: impedance: near a singularity at t = ",), note="the planar 3R's task is x and y (read near its stretched home): impedance passes near a singularity at t = 0.48 s and says so in one line"),
     C("unclear-sweep-arm3", f"sweep pd --samples 3 {SIM} --robot arm3.urdf --no-plot --out s", 0, setup=(urdf("arm3"),)),
     C("unclear-animate-arm3", f"animate pd {SIM} --robot arm3.urdf --html a.html", 0, setup=(urdf("arm3"),), exists=("a.html",)),
     C("unclear-simulate-arm2", f"simulate computed-torque {SIM} --robot arm2.urdf", 0, setup=(urdf("arm2"),)),

@@ -23,6 +23,7 @@ import argparse
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -120,7 +121,9 @@ def main(argv: Sequence[str] | None = None) -> int:
             previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupts.on_signal)
     try:
         ready("running")
-        return _run(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning  # one line each, not Python's file:line and source
+            return _run(args)
     except (SimulationDivergedError, ControllerError) as exc:
         if isinstance(exc, ControllerError) and _debug(args):  # the law's own traceback
             import traceback
@@ -176,6 +179,19 @@ def _say(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
     except (OSError, ValueError):
         pass
+
+
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """A warning raised while a command runs (a task-space law near a singularity, say), as one
+    ``twolink-pin: warning: …`` line on stderr."""
+    _say(f"twolink-pin: warning: {message}")
 
 
 def _close_stdout() -> None:
