@@ -119,6 +119,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, interrupts.on_signal)}
         if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:  # a background job ignores Ctrl-C
             previous[signal.SIGINT] = signal.signal(signal.SIGINT, interrupts.on_signal)
+    unraisable, sys.unraisablehook = sys.unraisablehook, _signal_in_a_finalizer(sys.unraisablehook)
     try:
         ready("running")
         with warnings.catch_warnings():
@@ -156,8 +157,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         )
         return 1
     finally:
+        sys.unraisablehook = unraisable
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+
+
+def _signal_in_a_finalizer(previous: Any) -> Any:
+    """``sys.unraisablehook`` while a command runs: an interrupt raised by the signal handler
+    inside a finalizer (a ``__del__``, a weakref callback), where Python can only print it as
+    "Exception ignored in …" with a traceback, is dropped silently: the signal is recorded in
+    :data:`_signalled` and the command's outcome stands. Everything else goes to ``previous``."""
+
+    def hook(unraisable: Any) -> None:
+        if isinstance(unraisable.exc_value, (Terminated, KeyboardInterrupt)):
+            return
+        previous(unraisable)
+
+    return hook
 
 
 def _debug(args: argparse.Namespace) -> bool:
