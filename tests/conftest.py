@@ -102,6 +102,9 @@ the tests marked ``slow`` in their own files."""
 CLUSTER_TESTS: tuple[str, ...] = ("tests/test_run_timeout.py::test_a_sweep_on_dask_workers",)
 """Node-id prefixes outside test_cluster.py that start Dask workers."""
 
+PROCESS_RUNS = ("proc", "signal", "setpriv", "fullfs", "devsandbox")
+"""Corpus cases run as processes of their own (signals, limits, sandboxes): ``slow`` (111
+cases, about a third of ``make check``'s time; ``make test`` runs them)."""
 CLUSTER_OPTIONS = ("--workers", "--scheduler")
 """A corpus case whose command has one of these starts Dask workers: marked ``cluster``."""
 
@@ -139,6 +142,8 @@ def _mark(item: pytest.Item) -> None:
     case = item.callspec.params.get("case") if hasattr(item, "callspec") else None
     if _file(item) != "test_corpus.py" or not hasattr(case, "argv"):
         return
+    if case.run in PROCESS_RUNS:
+        item.add_marker("slow")  # a process of its own (~1–3 s each): make test's, not make check's
     commands = [case.argv, *(step.arg for step in case.setup if step.kind == "cli")]
     if any(argv[:1] == ("sweep",) and any(o in argv for o in CLUSTER_OPTIONS) for argv in commands):
         item.add_marker("cluster")  # workers start before the options are all checked
