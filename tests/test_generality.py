@@ -40,6 +40,33 @@ def test_unknown_example_robot_is_named() -> None:
         example_robot_urdf("no_such_robot.urdf")
 
 
+def test_a_urdf_by_path_lists_the_installed_robots_once_per_process(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A path is compared with every catalog robot's URDF; the distribution's ~1000 files are
+    listed once, not once per robot and per load (0.1 s each: six per load before)."""
+    import importlib.metadata
+
+    from twolink_pin.model import catalog
+
+    listed = []
+    files = importlib.metadata.files
+
+    def counted(name: str) -> object:
+        listed.append(name)
+        return files(name)
+
+    path = tmp_path / "my_pendulum.urdf"
+    path.write_bytes(example_robot_urdf(ROBOTS[0]).read_bytes())
+    monkeypatch.setattr(importlib.metadata, "files", counted)
+    catalog._located.cache_clear()  # what this process looked up before is forgotten
+    catalog._distribution_files.cache_clear()
+    for _ in range(3):
+        assert catalog.resolve(path)[1].name == "my_pendulum"
+    assert catalog.resolve(example_robot_urdf(ROBOTS[0]))[1].name == "double_pendulum"
+    assert listed == ["example-robot-data"]
+
+
 def test_a_catalog_urdf_by_path_gets_its_profile_and_the_base_parameters(robot) -> None:
     """example-robot-data's file by path is the catalog's robot: its name, no gain presets, and
     p = β, the identifiable base parameters (4 for the horizontal arm, 6 under gravity)."""

@@ -9,6 +9,7 @@ module names no robot's code. :func:`resolve` turns what a user typed
 from __future__ import annotations
 
 import dataclasses
+import functools
 import importlib.metadata
 import os
 from collections.abc import Callable
@@ -30,19 +31,39 @@ def example_robot_urdf(relative: str) -> Path:
         InvalidURDFError: the distribution is not installed or has no such file.
     """
     require_type(relative, str, "relative", "a path inside example-robot-data's robots folder (str)")
+    return _located("robots/" + relative.lstrip("/"))
+
+
+@functools.cache
+def _located(suffix: str) -> Path:
+    """The installed file whose path ends in ``suffix``, looked up once per process: listing
+    the distribution's ~1000 files costs ~0.1 s, and a URDF given by path is compared with
+    every catalog robot's (:func:`resolve`). A failed lookup raises and is not remembered."""
+    files = _distribution_files()
+    if files is None:
+        raise InvalidURDFError(
+            suffix.removeprefix("robots/"),
+            "example-robot-data",
+            "not installed (pip install example-robot-data)",
+        )
+    for text, file in files:
+        if text.endswith(suffix):
+            return Path(str(file.locate()))
+    raise InvalidURDFError(
+        suffix.removeprefix("robots/"),
+        "example-robot-data",
+        f"no file ending in {suffix!r} in the installed distribution",
+    )
+
+
+@functools.cache
+def _distribution_files() -> tuple[tuple[str, importlib.metadata.PackagePath], ...] | None:
+    """example-robot-data's files with their paths as text, None if it is not installed."""
     try:
         files = importlib.metadata.files("example-robot-data") or []
     except importlib.metadata.PackageNotFoundError:
-        raise InvalidURDFError(
-            relative, "example-robot-data", "not installed (pip install example-robot-data)"
-        ) from None
-    suffix = "robots/" + relative.lstrip("/")
-    for file in files:
-        if str(file).endswith(suffix):
-            return Path(str(file.locate()))
-    raise InvalidURDFError(
-        relative, "example-robot-data", f"no file ending in {suffix!r} in the installed distribution"
-    )
+        return None
+    return tuple((str(file), file) for file in files)
 
 
 CATALOG: dict[str, Callable[[], tuple[Path, RobotProfile]]] = {}
