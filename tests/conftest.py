@@ -38,6 +38,7 @@ GROUPS: dict[str, str] = {
     "test_physical.py": "physical",  # identify --physical (cvxpy + Clarabel)
     "test_plotting.py": "plotting",  # closed-loop runs and their figures
     "test_controllers.py": "controllers",  # two 8-s adaptive runs (Lyapunov checks)
+    "test_simulation.py": "simulation",  # the cached 3-s DOP853 reference runs (conftest_sim.run)
     "test_tune_browser.py": "tune",  # Chromium on two live tune servers
 }
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
@@ -119,6 +120,7 @@ FIRST: tuple[str, ...] = (
     "test_docs_images.py",  # 218 s
     "test_plotting.py",  # 210 s, grouped
     "test_new_laws.py",  # 345 s, ungrouped
+    "test_simulation.py",  # 49 s quiet, grouped
     "test_visualization.py",  # 114 s, grouped
     "test_physical.py",  # 110 s, grouped
     "test_bags.py",  # 93 s, grouped
