@@ -25,6 +25,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import one_row
 from twolink_pin.dynamics import friction_regressor, regressor
@@ -93,7 +94,8 @@ def excitation_measures(
 def measures_of(W: np.ndarray, samples: int, period: float, names: tuple[str, ...]) -> ExcitationMeasures:
     """:class:`ExcitationMeasures` of a stacked observation matrix of ``samples`` instants
     evenly spread over ``period`` [s]."""
-    singular = np.linalg.svd(W, compute_uv=False)
+    with one_blas_thread():  # a tall matrix: OpenBLAS's threads only slow it (twolink_pin/blas.py)
+        singular = np.linalg.svd(W, compute_uv=False)
     condition = float(singular[0] / singular[-1]) if singular[-1] > 0 else float("inf")
     eigen = np.sort(singular**2)[: W.shape[1]] / samples  # mean over the period = (1/T) ∫ dt
     return ExcitationMeasures(condition, np.sort(eigen), float(eigen.min() * period), period, names)
@@ -128,16 +130,20 @@ class AveragedAdaptation(NamedTuple):
         """
         import scipy.linalg  # 0.5 s to import: not at every process's start-up
 
+        with one_blas_thread():  # small matrices: OpenBLAS's threads made an expm 15 ms, not 0.1
+            return self._predicted_error(scipy.linalg.expm, np.asarray(initial), t)
+
+    def _predicted_error(self, expm: Any, initial: np.ndarray, t: np.ndarray) -> np.ndarray:
         times = np.atleast_1d(np.asarray(t, dtype=float))
         step = np.diff(times)
         if len(times) > 2 and np.allclose(step, step[0], rtol=1e-12, atol=0.0):
             out = np.empty((len(times), np.size(initial)))
-            out[0] = scipy.linalg.expm(-self.rate_matrix * times[0]) @ initial
-            advance = scipy.linalg.expm(-self.rate_matrix * step[0])
+            out[0] = expm(-self.rate_matrix * times[0]) @ initial
+            advance = expm(-self.rate_matrix * step[0])
             for k in range(1, len(times)):
                 out[k] = advance @ out[k - 1]
             return out
-        return np.array([scipy.linalg.expm(-self.rate_matrix * tk) @ initial for tk in times])
+        return np.array([expm(-self.rate_matrix * tk) @ initial for tk in times])
 
     def time_to_within(self, initial: np.ndarray, true: np.ndarray, fraction: float = 0.05) -> float:
         """First time [s] at which the averaged model has every ``|p̃_i| <= fraction |p_i|``
