@@ -63,6 +63,12 @@ def twolink_log(twolink):
     return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=30.0)
 
 
+@pytest.fixture(scope="module")
+def twolink_log_1khz(twolink):
+    """A noise-free closed-loop log along the stored excitation: 20 s at 1 kHz (the noise tests')."""
+    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
+
+
 def _relative_errors(estimate: np.ndarray, true: np.ndarray) -> np.ndarray:
     """|θ̂ − θ| / |θ|, and |θ̂| for parameters whose true value is 0 (in the unit of the others)."""
     return np.abs(estimate - true) / np.where(np.abs(true) > 0, np.abs(true), 1.0)
@@ -287,12 +293,12 @@ def test_noise_free_ur5_recovered_to_1e6() -> None:
 
 
 @pytest.mark.slow
-def test_stated_sigma_is_honest_over_50_noise_seeds(twolink) -> None:
+def test_stated_sigma_is_honest_over_50_noise_seeds(twolink, twolink_log_1khz: RunLog) -> None:
     """50 seeds of σ_q = 1e-4 rad, σ_τ = 0.05 N·m on a 20-s log, instrumental variables (the
     default when the reference is known): every parameter's true value is within ±3σ in at
     least 90 % of the seeds, 97 % over all (a Gaussian gives 99.7 %), and the normalised errors
     scatter like N(0, 1) within a factor 1.5 (measured: 99.0 %, 0.78–1.19)."""
-    log = simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
+    log = twolink_log_1khz
     options = IdentificationOptions(validation=0.0)
     z = np.array(
         [
@@ -308,10 +314,12 @@ def test_stated_sigma_is_honest_over_50_noise_seeds(twolink) -> None:
     assert np.all((z.std(axis=0) > 1 / 1.5) & (z.std(axis=0) < 1.5))
 
 
-def test_least_squares_is_biased_by_position_noise_and_instruments_are_not(twolink) -> None:
+def test_least_squares_is_biased_by_position_noise_and_instruments_are_not(
+    twolink, twolink_log_1khz: RunLog
+) -> None:
     """σ_q = 1e-4 rad, 10 seeds: least squares underestimates link2.Izz by ~8 % (errors in
     variables, 6 times its stated σ); instrumental variables are within 1 %."""
-    log = simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
+    log = twolink_log_1khz
     ls, iv = [], []
     for seed in range(10):
         noisy = add_noise(log, 1e-4, 0.05, seed)
