@@ -59,8 +59,8 @@ def twolink():
 
 @pytest.fixture(scope="module")
 def twolink_log(twolink):
-    """A noise-free closed-loop log along the twolink's stored excitation: 30 s at 2 kHz."""
-    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=30.0)
+    """A noise-free closed-loop log along the twolink's stored excitation: 20 s at 2 kHz."""
+    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0)
 
 
 @pytest.fixture(scope="module")
@@ -282,11 +282,12 @@ def test_noise_free_twolink_recovered_to_1e6(twolink, twolink_log: RunLog) -> No
 
 
 def test_noise_free_ur5_recovered_to_1e6() -> None:
-    """The UR5's 36 base parameters and 12 friction coefficients from 20 s along an excitation
-    written by ``twolink-pin excite --robot ur5`` (tests/fixtures/ur5_excitation.json)."""
+    """The UR5's 36 base parameters and 12 friction coefficients from 10 s (one period; measured
+    3.7e-7) along an excitation written by ``twolink-pin excite --robot ur5``
+    (tests/fixtures/ur5_excitation.json)."""
     ur5 = load_robot("ur5")
     trajectory = read_trajectory_file(FIXTURES / "ur5_excitation.json", ur5)
-    log = simulate_log(ur5, trajectory, duration=20.0)
+    log = simulate_log(ur5, trajectory, duration=10.0)
     result = identify(log, ur5, IdentificationOptions(validation=0.0))
     assert result.size == 48
     assert _relative_errors(result.estimate, result.true).max() < 1e-6
@@ -558,7 +559,7 @@ def test_a_parameter_file_of_another_robot_is_refused(tmp_path: Path, twolink) -
 def test_cli_identify_says_when_the_3_sigma_count_tests_nothing(capsys: pytest.CaptureFixture[str]) -> None:
     """On noise-free simulated data σ is rounding and filtering: the ±3σ count says so; with
     torque noise it is a test of σ and carries no such note."""
-    short = ["identify", "--duration", "12", "--dt", "0.001"]
+    short = ["identify", "--duration", "4", "--dt", "0.001"]
     assert main(short) == 0
     clean = capsys.readouterr().out.splitlines()[-1]
     assert clean.startswith("  true values within ±3σ:") and "noise-free data" in clean
@@ -702,7 +703,7 @@ def test_the_summary_says_which_parameter_file_a_run_used(
     """``simulate --model`` / ``--p0``: the text names the file and what it did; the JSON too;
     without one, neither says anything."""
     saved = tmp_path / "p.json"
-    assert main(["identify", "--duration", "8", "--save", str(saved), "--json"]) == 0
+    assert main(["identify", "--duration", "3", "--save", str(saved), "--json"]) == 0
     capsys.readouterr()
     assert main(["simulate", "computed-torque", "--model", str(saved), "--duration", "0.05"]) == 0
     line = f"  law's model believes the parameters of {saved} (--model); the plant is twolink's own"
