@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     out = Path(args.out)
     seeds = 5 if args.quick else 200
-    duration = 5.0 if args.quick else 30.0
+    duration = 2.0 if args.quick else 30.0
     numbers: dict[str, object] = {}
     robot = load_robot("twolink")
 
@@ -94,7 +94,7 @@ def main(argv: list[str] | None = None) -> int:
     (out / "excitation.png").replace(out / "identification_excitation.png")
 
     # 2. Noise-free recovery.
-    log = simulate_log(robot, excitation, duration=12.0 if args.quick else 40.0)
+    log = simulate_log(robot, excitation, duration=3.0 if args.quick else 40.0)
     found = identify(log, robot)
     numbers["twolink_noise_free"] = {
         "max_relative_error": relative(found.estimate, found.true),
@@ -103,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
     }
     ur5 = load_robot("ur5")
     ur5_trajectory = read_trajectory_file(ROOT / "tests" / "fixtures" / "ur5_excitation.json", ur5)
-    ur5_log = simulate_log(ur5, ur5_trajectory, 6.0 if args.quick else 20.0)
+    ur5_log = simulate_log(ur5, ur5_trajectory, 2.0 if args.quick else 20.0)
     ur5_found = identify(ur5_log, ur5, IdentificationOptions(validation=0.0))
     numbers["ur5_noise_free"] = {
         "parameters": ur5_found.size,
@@ -122,7 +122,7 @@ def main(argv: list[str] | None = None) -> int:
     assert written
 
     # 3. The Monte Carlo.
-    mc_log = simulate_log(robot, excitation, duration=12.0 if args.quick else 20.0, dt=1e-3)
+    mc_log = simulate_log(robot, excitation, duration=3.0 if args.quick else 20.0, dt=1e-3)
     monte_carlo = []
     for noise_q, noise_tau in NOISE_LEVELS[2:3] if args.quick else NOISE_LEVELS:
         for instruments in (True, False):

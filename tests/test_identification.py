@@ -59,8 +59,14 @@ def twolink():
 
 @pytest.fixture(scope="module")
 def twolink_log(twolink):
-    """A noise-free closed-loop log along the twolink's stored excitation: 30 s at 2 kHz."""
-    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=30.0)
+    """A noise-free closed-loop log along the twolink's stored excitation: 20 s at 2 kHz."""
+    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0)
+
+
+@pytest.fixture(scope="module")
+def twolink_log_1khz(twolink):
+    """A noise-free closed-loop log along the stored excitation: 20 s at 1 kHz (the noise tests')."""
+    return simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
 
 
 def _relative_errors(estimate: np.ndarray, true: np.ndarray) -> np.ndarray:
@@ -276,23 +282,24 @@ def test_noise_free_twolink_recovered_to_1e6(twolink, twolink_log: RunLog) -> No
 
 
 def test_noise_free_ur5_recovered_to_1e6() -> None:
-    """The UR5's 36 base parameters and 12 friction coefficients from 20 s along an excitation
-    written by ``twolink-pin excite --robot ur5`` (tests/fixtures/ur5_excitation.json)."""
+    """The UR5's 36 base parameters and 12 friction coefficients from 10 s (one period; measured
+    3.7e-7) along an excitation written by ``twolink-pin excite --robot ur5``
+    (tests/fixtures/ur5_excitation.json)."""
     ur5 = load_robot("ur5")
     trajectory = read_trajectory_file(FIXTURES / "ur5_excitation.json", ur5)
-    log = simulate_log(ur5, trajectory, duration=20.0)
+    log = simulate_log(ur5, trajectory, duration=10.0)
     result = identify(log, ur5, IdentificationOptions(validation=0.0))
     assert result.size == 48
     assert _relative_errors(result.estimate, result.true).max() < 1e-6
 
 
 @pytest.mark.slow
-def test_stated_sigma_is_honest_over_50_noise_seeds(twolink) -> None:
+def test_stated_sigma_is_honest_over_50_noise_seeds(twolink, twolink_log_1khz: RunLog) -> None:
     """50 seeds of σ_q = 1e-4 rad, σ_τ = 0.05 N·m on a 20-s log, instrumental variables (the
     default when the reference is known): every parameter's true value is within ±3σ in at
     least 90 % of the seeds, 97 % over all (a Gaussian gives 99.7 %), and the normalised errors
     scatter like N(0, 1) within a factor 1.5 (measured: 99.0 %, 0.78–1.19)."""
-    log = simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
+    log = twolink_log_1khz
     options = IdentificationOptions(validation=0.0)
     z = np.array(
         [
@@ -308,10 +315,12 @@ def test_stated_sigma_is_honest_over_50_noise_seeds(twolink) -> None:
     assert np.all((z.std(axis=0) > 1 / 1.5) & (z.std(axis=0) < 1.5))
 
 
-def test_least_squares_is_biased_by_position_noise_and_instruments_are_not(twolink) -> None:
+def test_least_squares_is_biased_by_position_noise_and_instruments_are_not(
+    twolink, twolink_log_1khz: RunLog
+) -> None:
     """σ_q = 1e-4 rad, 10 seeds: least squares underestimates link2.Izz by ~8 % (errors in
     variables, 6 times its stated σ); instrumental variables are within 1 %."""
-    log = simulate_log(twolink, twolink_excitation.identification_excitation(), duration=20.0, dt=1e-3)
+    log = twolink_log_1khz
     ls, iv = [], []
     for seed in range(10):
         noisy = add_noise(log, 1e-4, 0.05, seed)
@@ -550,7 +559,7 @@ def test_a_parameter_file_of_another_robot_is_refused(tmp_path: Path, twolink) -
 def test_cli_identify_says_when_the_3_sigma_count_tests_nothing(capsys: pytest.CaptureFixture[str]) -> None:
     """On noise-free simulated data σ is rounding and filtering: the ±3σ count says so; with
     torque noise it is a test of σ and carries no such note."""
-    short = ["identify", "--duration", "12", "--dt", "0.001"]
+    short = ["identify", "--duration", "4", "--dt", "0.001"]
     assert main(short) == 0
     clean = capsys.readouterr().out.splitlines()[-1]
     assert clean.startswith("  true values within ±3σ:") and "noise-free data" in clean
@@ -694,7 +703,7 @@ def test_the_summary_says_which_parameter_file_a_run_used(
     """``simulate --model`` / ``--p0``: the text names the file and what it did; the JSON too;
     without one, neither says anything."""
     saved = tmp_path / "p.json"
-    assert main(["identify", "--duration", "8", "--save", str(saved), "--json"]) == 0
+    assert main(["identify", "--duration", "3", "--save", str(saved), "--json"]) == 0
     capsys.readouterr()
     assert main(["simulate", "computed-torque", "--model", str(saved), "--duration", "0.05"]) == 0
     line = f"  law's model believes the parameters of {saved} (--model); the plant is twolink's own"

@@ -26,9 +26,9 @@ class Axis(NamedTuple):
 
 @pytest.fixture
 def drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[Axis]]:
-    """Every figure saved, by file name: its axes."""
+    """Every figure saved, by file name: its axes. No PNG is rendered (no assertion reads one;
+    tests/test_plotting.py checks the files)."""
     figures: dict[str, list[Axis]] = {}
-    save = _style.save_figure
 
     def keep(fig: Any, path: Path) -> Path:
         top = max((ax.get_position().y1 for ax in fig.axes), default=0.0)
@@ -36,7 +36,7 @@ def drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[Axis]]:
             Axis(ax.get_xlim(), _spans(ax), [t.get_text() for t in ax.texts], ax.get_position().y1 == top)
             for ax in fig.axes
         ]
-        return save(fig, path)
+        return Path(path)
 
     monkeypatch.setattr(_style, "save_figure", keep)
     return figures
