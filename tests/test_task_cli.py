@@ -39,7 +39,7 @@ def test_simulate_shows_a_task_space_laws_errors_in_mm_and_deg(
 ) -> None:
     saved = tmp_path / "run.npz"
     argv = ["simulate", "osc", "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.3"]
-    # no --plot: drawing a 6-joint run's figures was 3/4 of this test; that simulate --plot writes
+    # no --plot: drawing a 6-joint run's figures was 3/4 of this test; that simulate --plot saves
     # osc_task_error.png is tests/test_plotting_spans.py's, the figure's content is checked below
     assert main([*argv, "--json", "--save", str(saved)]) == 0
     payload = json.loads(capsys.readouterr().out)
