@@ -208,39 +208,34 @@ def test_a_refused_value_shows_the_laws_message_and_the_server_stays_up(pd: Tune
     assert pd.next(ran)["gains"]["kp"][0] == 1.0
 
 
-def test_ctrl_c_ends_the_server_cleanly(pd: Tune) -> None:
-    code, err = pd.interrupt()
-    assert code == 0, err
-    assert "Traceback" not in err
-    assert "stopping the tuner" in err
-
-
-def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_controls(driver: Any) -> None:
-    """Two tabs on one tuner: a gain moved in the first is the second's control value and
-    both show that run; the second closed and opened again draws the arm and has the controls
-    and the latest run."""
+def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_controls(
+    pd: Tune, driver: Any
+) -> None:
+    """Two tabs on one tuner (the first is the page the tests above drove): a gain moved in
+    the first is the second's control value and both show that run; the second closed and
+    opened again draws the arm and has the controls and the latest run."""
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 
-    tune = Tune("pd", *SHORT)
     first_tab = driver.current_window_handle
+    assert driver.current_url == pd.url
     try:
-        tune.next(ran)
-        driver.get(tune.url)
         thumb = slider(driver, "kp joint 1 [N·m/rad]")
+        before = [x for x in pd.seen if ran(x)][-1]["gains"]["kp"]
         driver.switch_to.new_window("tab")
         second_tab = driver.current_window_handle
-        driver.get(tune.url)
+        driver.get(pd.url)
         slider(driver, "kp joint 1 [N·m/rad]")
         driver.switch_to.window(first_tab)
         press(thumb, Keys.ARROW_RIGHT)
-        line = tune.next(ran)
-        assert line["gains"]["kp"] == [351.0, 300.0]
+        line = pd.next(ran)
+        moved = before[0] + 1.0
+        assert line["gains"]["kp"] == [moved, before[1]]
         shown = f"run {line['run']}: "
 
         def latest(d: Any) -> bool:
             value = slider(d, "kp joint 1 [N·m/rad]").get_attribute("aria-valuenow")
-            return float(value) == 351.0 and shown in page_text(d)
+            return float(value) == moved and shown in page_text(d)
 
         WebDriverWait(driver, WAIT).until(latest)
         driver.switch_to.window(second_tab)
@@ -248,7 +243,7 @@ def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_con
         driver.close()
         driver.switch_to.window(first_tab)
         driver.switch_to.new_window("tab")
-        driver.get(tune.url)
+        driver.get(pd.url)
         WebDriverWait(driver, WAIT).until(latest)
         assert {"kp joint 1 [N·m/rad]", "kd joint 2 [N·m·s/rad]"} <= set(labels(driver))
         WebDriverWait(driver, WAIT).until(
@@ -260,7 +255,13 @@ def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_con
                 driver.switch_to.window(handle)
                 driver.close()
         driver.switch_to.window(first_tab)
-        tune.stop()
+
+
+def test_ctrl_c_ends_the_server_cleanly(pd: Tune) -> None:
+    code, err = pd.interrupt()
+    assert code == 0, err
+    assert "Traceback" not in err
+    assert "stopping the tuner" in err
 
 
 @pytest.fixture(scope="module")
