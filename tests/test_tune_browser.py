@@ -53,7 +53,10 @@ class Tune:
         self.seen: list[dict[str, Any]] = []
         self.stderr: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
-        threading.Thread(target=lambda: self.stderr.extend(self.proc.stderr), daemon=True).start()  # type: ignore[arg-type]
+        self.stderr_reader = threading.Thread(
+            target=lambda: self.stderr.extend(self.proc.stderr), daemon=True
+        )  # type: ignore[arg-type]
+        self.stderr_reader.start()
         self.url = self.next(lambda line: "url" in line)["url"]
 
     def _read(self) -> None:
@@ -79,7 +82,7 @@ class Tune:
         """Ctrl-C: the exit status and stderr."""
         self.proc.send_signal(signal.SIGINT)
         code = self.proc.wait(timeout=WAIT)
-        time.sleep(0)  # the stderr reader ends with the pipe
+        self.stderr_reader.join(WAIT)  # it ends with the pipe: all of stderr is read
         return code, "".join(self.stderr)
 
     def stop(self) -> None:
