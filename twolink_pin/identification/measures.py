@@ -24,7 +24,6 @@ from __future__ import annotations
 from typing import Any, NamedTuple
 
 import numpy as np
-import scipy.linalg
 
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import one_row
@@ -127,6 +126,8 @@ class AveragedAdaptation(NamedTuple):
         equal to an ``expm`` per time to rounding: ~1e-14 relative over 300 points, 1 ms
         instead of 0.6 s); other times one ``expm`` each.
         """
+        import scipy.linalg  # 0.4 s to import: not at the import of the package (a run of the twolink)
+
         times = np.atleast_1d(np.asarray(t, dtype=float))
         step = np.diff(times)
         if len(times) > 2 and np.allclose(step, step[0], rtol=1e-12, atol=0.0):

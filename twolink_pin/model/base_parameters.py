@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
-import scipy.linalg
 
 from twolink_pin.model.parameters import (
     BODY_PARAMETER_NAMES,
@@ -90,6 +89,8 @@ def _preferred_columns(W: np.ndarray, rank: int, bodies: int) -> np.ndarray | No
     norms = np.linalg.norm(W[:, order], axis=0)
     live = norms > RANK_TOLERANCE * max(float(norms.max()), 1e-300)
     candidates = order[live]
+    import scipy.linalg  # 0.4 s to import: only for robots without a profile's parameter map
+
     R = scipy.linalg.qr(W[:, candidates], mode="r")[0]
     diagonal = np.abs(np.diag(R))[: len(candidates)]
     independent = diagonal > np.sqrt(RANK_TOLERANCE) * norms[live][: diagonal.size]
@@ -114,6 +115,8 @@ class BaseParameterMap(ParameterMap):
         n_pi = N_BODY_PARAMETERS * (model.njoints - 1)
         count = samples if samples is not None else max(40, (3 * n_pi) // max(1, model.nv))
         W = _stacked_regressor(model, count, seed)
+        import scipy.linalg  # 0.4 s to import: only for robots without a profile's parameter map
+
         _, R, pivots = scipy.linalg.qr(W, mode="economic", pivoting=True)
         diagonal = np.abs(np.diag(R))
         rank = (
