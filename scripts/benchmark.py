@@ -396,7 +396,7 @@ threads = None if sys.argv[1] == "default" else int(sys.argv[1])
 robot = load_robot(); trajectory = default_trajectory(robot)
 controller, plant = make_scenario("pd", robot)
 offsets = np.random.default_rng(0).uniform(-0.1, 0.1, (1000, robot.nv))
-config = SimulationConfig(duration=0.2)
+config = SimulationConfig(duration=float(sys.argv[2]))
 simulate_batch(controller, plant, trajectory, SimulationConfig(duration=0.01), q0_offsets=offsets,
                threads=threads, progress=False)  # warm-up
 print("ready", flush=True)
@@ -407,15 +407,19 @@ print(time.perf_counter() - start, batch.threads, flush=True)
 """
 CONTENTION_N, CONTENTION_DURATION = 1000, 0.2
 """The issue's contention case: pd, N = 1000, 0.2 s simulated."""
+QUICK_CONTENTION_DURATION = 0.05
+"""``--quick``: the same batch, 0.05 s simulated (the smoke test's eight processes)."""
 
 
-def _two_at_once(threads: str, copies: int = 2) -> tuple[list[float], int]:
-    """``copies`` copies of the pd batch started together (each in its own process, all ready
-    first; one copy: the batch alone, the machine otherwise free); their seconds per 30-s
-    simulation and the thread count they used."""
+def _two_at_once(
+    threads: str, copies: int = 2, duration: float = CONTENTION_DURATION
+) -> tuple[list[float], int]:
+    """``copies`` copies of the pd batch of ``duration`` [s] started together (each in its own
+    process, all ready first; one copy: the batch alone, the machine otherwise free); their
+    seconds per 30-s simulation and the thread count they used."""
     children = [
         subprocess.Popen(
-            [sys.executable, "-c", _CONTENDER, threads],
+            [sys.executable, "-c", _CONTENDER, threads, str(duration)],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -434,14 +438,16 @@ def _two_at_once(threads: str, copies: int = 2) -> tuple[list[float], int]:
         for child in children:
             if child.poll() is None:
                 child.kill()
-    scale = FULL / CONTENTION_DURATION / CONTENTION_N
+    scale = FULL / duration / CONTENTION_N
     return [float(out[0]) * scale for out in outputs], int(outputs[0][1])
 
 
-def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) -> dict[str, Any]:
-    """Two copies of the batch at once, at the default thread count, 1 and 2 threads, per
-    simulation against the baseline timed in between (the issue: default 6.2 s, 1 thread
-    0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
+def contention_section(
+    baseline: Callable[[], Any], scale: float, repeats: int, duration: float = CONTENTION_DURATION
+) -> dict[str, Any]:
+    """Two copies of the batch (``duration`` [s] simulated) at once, at the default thread
+    count, 1 and 2 threads, per simulation against the baseline timed in between (the issue:
+    default 6.2 s, 1 thread 0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
     rows: dict[str, list[float]] = {"default": [], "1": [], "2": []}
     alone: dict[str, list[float]] = {"default": [], "1": []}  # one copy: the machine free
     used = used_alone = 0
@@ -449,16 +455,16 @@ def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) 
     for _ in range(repeats):  # interleaved: load drift hits all alike
         base_times.append(_timed(baseline))
         for threads in rows:
-            seconds, count = _two_at_once(threads)
+            seconds, count = _two_at_once(threads, duration=duration)
             rows[threads].append(max(seconds))  # the slower copy: what the user waits for
             used = count if threads == "default" else used
         for threads in alone:
-            seconds, count = _two_at_once(threads, copies=1)
+            seconds, count = _two_at_once(threads, copies=1, duration=duration)
             alone[threads].append(seconds[0])
             used_alone = count if threads == "default" else used_alone
     base = min(base_times) * scale
     print(
-        f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {CONTENTION_DURATION:g} s simulated, "
+        f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {duration:g} s simulated, "
         f"separate processes started together); seconds per 30-s simulation of the slower copy, min of {repeats} "
         f"(median), ratio to the baseline ({base:.3f} s) of this section; load average "
         f"{[round(x, 2) for x in os.getloadavg()]}"
@@ -1110,7 +1116,8 @@ def main(argv: list[str] | None = None) -> int:
 
     scale = FULL / single_duration
     if args.shared_only or args.contention_only:
-        results.update(contention_section(baseline, scale, repeats))
+        contention_duration = QUICK_CONTENTION_DURATION if quick else CONTENTION_DURATION
+        results.update(contention_section(baseline, scale, repeats, contention_duration))
         if not quick and not args.contention_only:
             results.update(sweep_200_section())
         if args.json:
@@ -1228,7 +1235,7 @@ def main(argv: list[str] | None = None) -> int:
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)
-    budget = 5.0 if quick else 1000.0  # simulated run-seconds per measurement
+    budget = 1.0 if quick else 1000.0  # simulated run-seconds per measurement
     print("\nbatch scaling, pd: seconds per 30-s simulation (ratio to the baseline)")
     print(f"  {'N':>6s} {'simulated':>10s} {'1 thread':>20s} {'2 threads':>20s}")
     scaling = []
@@ -1252,7 +1259,8 @@ def main(argv: list[str] | None = None) -> int:
             + note
         )
     results["batch_scaling"] = scaling
-    results.update(contention_section(baseline, scale, 1 if quick else 3))
+    contention_duration = QUICK_CONTENTION_DURATION if quick else CONTENTION_DURATION
+    results.update(contention_section(baseline, scale, 1 if quick else 3, contention_duration))
 
     # -- sweep memory ---------------------------------------------------------------------------------
     sweep_sizes = (100, 1000) if quick else (1000, 10000)
