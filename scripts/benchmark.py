@@ -206,30 +206,46 @@ def high_water_mib():  # VmHWM: this process's peak RSS (ru_maxrss would carry t
         return next(int(line.split()[1]) for line in f if line.startswith("VmHWM")) / 1024
 
 robot = load_robot(); trajectory = default_trajectory(robot)
-samples, duration, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+samples, duration, out, trace = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], sys.argv[4] == "trace"
 config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1,
                      q0_spread=0.1, param_error=0.2, gains=(GainRange("kp", 100.0, 400.0),))
 before = high_water_mib()
-tracemalloc.start()
+if trace:
+    tracemalloc.start()
 output = run_sweep(config, robot, trajectory, out, plot=False)
-traced = tracemalloc.get_traced_memory()[1]
-print(before, high_water_mib(), traced / 2**20, output.seconds)
+traced = tracemalloc.get_traced_memory()[1] / 2**20 if trace else float("nan")
+print(before, high_water_mib(), traced, output.seconds)
 """
 
 
-def _child_memory(script: str, *args: object) -> dict[str, float]:
+def _child_memory(script: str, *args: object) -> dict[str, Any]:
     """Run a sweep ``script`` in a fresh process; its printed peak RSS before / after the sweep,
-    Python allocations' peak [MiB] and the sweep's seconds."""
+    Python allocations' peak [MiB] (None when not traced) and the sweep's seconds."""
     done = subprocess.run(
         [sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True, check=True
     )
     before, peak, traced, seconds = (float(x) for x in done.stdout.split())
-    return {"rss_before_mib": before, "rss_peak_mib": peak, "python_peak_mib": traced, "seconds": seconds}
+    python_peak = None if math.isnan(traced) else traced
+    return {
+        "rss_before_mib": before,
+        "rss_peak_mib": peak,
+        "python_peak_mib": python_peak,
+        "seconds": seconds,
+    }
 
 
-def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
-    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations."""
-    return {"samples": samples, **_child_memory(_SWEEP_CHILD, samples, duration, out)}
+def _python_peak(memory: dict[str, Any]) -> str:
+    """``Python allocations peak … MiB`` of a child's ``memory``, or that it was not traced."""
+    if memory["python_peak_mib"] is None:
+        return "Python allocations not traced (--quick)"
+    return f"Python allocations peak {memory['python_peak_mib']:6.1f} MiB"
+
+
+def _sweep_memory(samples: int, duration: float, out: str, trace: bool = True) -> dict[str, Any]:
+    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations
+    (traced unless ``trace`` is false: ``--quick``, tracemalloc makes the sweep ~2x slower)."""
+    flag = "trace" if trace else "-"
+    return {"samples": samples, **_child_memory(_SWEEP_CHILD, samples, duration, out, flag)}
 
 
 # -- sweep throughput on Dask ---------------------------------------------------------------------
@@ -264,29 +280,34 @@ def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask work
 
 if __name__ == "__main__":
     samples, duration, out, workers = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
-    scheduler = sys.argv[5] if len(sys.argv) > 5 else None  # a running cluster of `workers` workers
+    trace = sys.argv[5] == "trace"
+    scheduler = sys.argv[6] if len(sys.argv) > 6 else None  # a running cluster of `workers` workers
     robot = load_robot(); trajectory = default_trajectory(robot)
     config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1, q0_spread=0.05)
     before = high_water_mib()
-    tracemalloc.start()
+    if trace:
+        tracemalloc.start()
     where = {"scheduler": scheduler} if scheduler else {"workers": workers or None}
     output = run_sweep(config, robot, trajectory, out, plot=True, **where)
-    traced = tracemalloc.get_traced_memory()[1]
-    print(before, high_water_mib(), traced / 2**20, output.seconds)
+    traced = tracemalloc.get_traced_memory()[1] / 2**20 if trace else float("nan")
+    print(before, high_water_mib(), traced, output.seconds)
 """
 
 
 def _client_memory(
-    samples: int, duration: float, workers: int, out: str, scheduler: str | None = None
-) -> dict[str, float]:
+    samples: int, duration: float, workers: int, out: str, scheduler: str | None = None, trace: bool = True
+) -> dict[str, Any]:
     """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0;
     on the running cluster at ``scheduler`` of ``workers`` workers when given, else on a
-    LocalCluster of its own)."""
+    LocalCluster of its own); Python allocations traced unless ``trace`` is false (``--quick``:
+    under tracemalloc the lazy imports of Dask, matplotlib and pyarrow and the figure cost
+    ~10 s of CPU per child, the sweep itself ~1 s)."""
     where = () if scheduler is None else (scheduler,)
+    flag = "trace" if trace else "-"
     return {
         "samples": samples,
         "workers": workers,
-        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers, *where),
+        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers, flag, *where),
     }
 
 
@@ -366,15 +387,13 @@ def sweep_section(quick: bool) -> dict[str, Any]:
         for samples in sizes:
             for workers in (0, 2):
                 scheduler = engines["2w"].address if workers else None
-                mem = _client_memory(
-                    samples, 0.05, workers, os.path.join(tmp, f"{samples}-{workers}"), scheduler
-                )
+                out = os.path.join(tmp, f"{samples}-{workers}")
+                mem = _client_memory(samples, 0.05, workers, out, scheduler, trace=not quick)
                 memory.append(mem)
                 label = "in-process" if workers == 0 else "--workers 2 (client only)"
                 print(
                     f"  {label:26s} {samples:6d} runs: peak RSS {mem['rss_peak_mib']:7.1f} MiB (after imports "
-                    f"{mem['rss_before_mib']:6.1f} MiB), Python allocations peak {mem['python_peak_mib']:6.1f} MiB, "
-                    f"{mem['seconds']:.1f} s"
+                    f"{mem['rss_before_mib']:6.1f} MiB), {_python_peak(mem)}, {mem['seconds']:.1f} s"
                 )
     return {
         "sweep_throughput": rows,
@@ -1274,12 +1293,11 @@ def main(argv: list[str] | None = None) -> int:
     memory = []
     with tempfile.TemporaryDirectory() as tmp:
         for samples in sweep_sizes:
-            mem = _sweep_memory(samples, sweep_duration, os.path.join(tmp, str(samples)))
+            mem = _sweep_memory(samples, sweep_duration, os.path.join(tmp, str(samples)), trace=not quick)
             memory.append(mem)
             print(
                 f"  {samples:6d} runs: peak RSS {mem['rss_peak_mib']:7.1f} MiB (after imports and setup "
-                f"{mem['rss_before_mib']:6.1f} MiB), Python allocations peak {mem['python_peak_mib']:6.1f} MiB, "
-                f"{mem['seconds']:.1f} s"
+                f"{mem['rss_before_mib']:6.1f} MiB), {_python_peak(mem)}, {mem['seconds']:.1f} s"
             )
     results["sweep_memory"] = memory
 
