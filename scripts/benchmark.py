@@ -206,30 +206,46 @@ def high_water_mib():  # VmHWM: this process's peak RSS (ru_maxrss would carry t
         return next(int(line.split()[1]) for line in f if line.startswith("VmHWM")) / 1024
 
 robot = load_robot(); trajectory = default_trajectory(robot)
-samples, duration, out = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3]
+samples, duration, out, trace = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], sys.argv[4] == "trace"
 config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1,
                      q0_spread=0.1, param_error=0.2, gains=(GainRange("kp", 100.0, 400.0),))
 before = high_water_mib()
-tracemalloc.start()
+if trace:
+    tracemalloc.start()
 output = run_sweep(config, robot, trajectory, out, plot=False)
-traced = tracemalloc.get_traced_memory()[1]
-print(before, high_water_mib(), traced / 2**20, output.seconds)
+traced = tracemalloc.get_traced_memory()[1] / 2**20 if trace else float("nan")
+print(before, high_water_mib(), traced, output.seconds)
 """
 
 
-def _child_memory(script: str, *args: object) -> dict[str, float]:
+def _child_memory(script: str, *args: object) -> dict[str, Any]:
     """Run a sweep ``script`` in a fresh process; its printed peak RSS before / after the sweep,
-    Python allocations' peak [MiB] and the sweep's seconds."""
+    Python allocations' peak [MiB] (None when not traced) and the sweep's seconds."""
     done = subprocess.run(
         [sys.executable, "-c", script, *map(str, args)], capture_output=True, text=True, check=True
     )
     before, peak, traced, seconds = (float(x) for x in done.stdout.split())
-    return {"rss_before_mib": before, "rss_peak_mib": peak, "python_peak_mib": traced, "seconds": seconds}
+    python_peak = None if math.isnan(traced) else traced
+    return {
+        "rss_before_mib": before,
+        "rss_peak_mib": peak,
+        "python_peak_mib": python_peak,
+        "seconds": seconds,
+    }
 
 
-def _sweep_memory(samples: int, duration: float, out: str) -> dict[str, float]:
-    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations."""
-    return {"samples": samples, **_child_memory(_SWEEP_CHILD, samples, duration, out)}
+def _python_peak(memory: dict[str, Any]) -> str:
+    """``Python allocations peak … MiB`` of a child's ``memory``, or that it was not traced."""
+    if memory["python_peak_mib"] is None:
+        return "Python allocations not traced (--quick)"
+    return f"Python allocations peak {memory['python_peak_mib']:6.1f} MiB"
+
+
+def _sweep_memory(samples: int, duration: float, out: str, trace: bool = True) -> dict[str, Any]:
+    """Peak memory of a PD sweep in a fresh process: peak RSS before / after, Python allocations
+    (traced unless ``trace`` is false: ``--quick``, tracemalloc makes the sweep ~2x slower)."""
+    flag = "trace" if trace else "-"
+    return {"samples": samples, **_child_memory(_SWEEP_CHILD, samples, duration, out, flag)}
 
 
 # -- sweep throughput on Dask ---------------------------------------------------------------------
@@ -264,29 +280,34 @@ def high_water_mib():  # VmHWM: this process's peak RSS (the client's; Dask work
 
 if __name__ == "__main__":
     samples, duration, out, workers = int(sys.argv[1]), float(sys.argv[2]), sys.argv[3], int(sys.argv[4])
-    scheduler = sys.argv[5] if len(sys.argv) > 5 else None  # a running cluster of `workers` workers
+    trace = sys.argv[5] == "trace"
+    scheduler = sys.argv[6] if len(sys.argv) > 6 else None  # a running cluster of `workers` workers
     robot = load_robot(); trajectory = default_trajectory(robot)
     config = SweepConfig(RunSpec(law="pd", simulation=SimulationConfig(duration=duration)), samples, seed=1, q0_spread=0.05)
     before = high_water_mib()
-    tracemalloc.start()
+    if trace:
+        tracemalloc.start()
     where = {"scheduler": scheduler} if scheduler else {"workers": workers or None}
     output = run_sweep(config, robot, trajectory, out, plot=True, **where)
-    traced = tracemalloc.get_traced_memory()[1]
-    print(before, high_water_mib(), traced / 2**20, output.seconds)
+    traced = tracemalloc.get_traced_memory()[1] / 2**20 if trace else float("nan")
+    print(before, high_water_mib(), traced, output.seconds)
 """
 
 
 def _client_memory(
-    samples: int, duration: float, workers: int, out: str, scheduler: str | None = None
-) -> dict[str, float]:
+    samples: int, duration: float, workers: int, out: str, scheduler: str | None = None, trace: bool = True
+) -> dict[str, Any]:
     """Peak memory of the sweep's client (the whole sweep in-process when ``workers`` is 0;
     on the running cluster at ``scheduler`` of ``workers`` workers when given, else on a
-    LocalCluster of its own)."""
+    LocalCluster of its own); Python allocations traced unless ``trace`` is false (``--quick``:
+    under tracemalloc the lazy imports of Dask, matplotlib and pyarrow and the figure cost
+    ~10 s of CPU per child, the sweep itself ~1 s)."""
     where = () if scheduler is None else (scheduler,)
+    flag = "trace" if trace else "-"
     return {
         "samples": samples,
         "workers": workers,
-        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers, *where),
+        **_child_memory(_CLIENT_CHILD, samples, duration, out, workers, flag, *where),
     }
 
 
@@ -366,15 +387,13 @@ def sweep_section(quick: bool) -> dict[str, Any]:
         for samples in sizes:
             for workers in (0, 2):
                 scheduler = engines["2w"].address if workers else None
-                mem = _client_memory(
-                    samples, 0.05, workers, os.path.join(tmp, f"{samples}-{workers}"), scheduler
-                )
+                out = os.path.join(tmp, f"{samples}-{workers}")
+                mem = _client_memory(samples, 0.05, workers, out, scheduler, trace=not quick)
                 memory.append(mem)
                 label = "in-process" if workers == 0 else "--workers 2 (client only)"
                 print(
                     f"  {label:26s} {samples:6d} runs: peak RSS {mem['rss_peak_mib']:7.1f} MiB (after imports "
-                    f"{mem['rss_before_mib']:6.1f} MiB), Python allocations peak {mem['python_peak_mib']:6.1f} MiB, "
-                    f"{mem['seconds']:.1f} s"
+                    f"{mem['rss_before_mib']:6.1f} MiB), {_python_peak(mem)}, {mem['seconds']:.1f} s"
                 )
     return {
         "sweep_throughput": rows,
@@ -396,7 +415,7 @@ threads = None if sys.argv[1] == "default" else int(sys.argv[1])
 robot = load_robot(); trajectory = default_trajectory(robot)
 controller, plant = make_scenario("pd", robot)
 offsets = np.random.default_rng(0).uniform(-0.1, 0.1, (1000, robot.nv))
-config = SimulationConfig(duration=0.2)
+config = SimulationConfig(duration=float(sys.argv[2]))
 simulate_batch(controller, plant, trajectory, SimulationConfig(duration=0.01), q0_offsets=offsets,
                threads=threads, progress=False)  # warm-up
 print("ready", flush=True)
@@ -407,15 +426,19 @@ print(time.perf_counter() - start, batch.threads, flush=True)
 """
 CONTENTION_N, CONTENTION_DURATION = 1000, 0.2
 """The issue's contention case: pd, N = 1000, 0.2 s simulated."""
+QUICK_CONTENTION_DURATION = 0.05
+"""``--quick``: the same batch, 0.05 s simulated (the smoke test's eight processes)."""
 
 
-def _two_at_once(threads: str, copies: int = 2) -> tuple[list[float], int]:
-    """``copies`` copies of the pd batch started together (each in its own process, all ready
-    first; one copy: the batch alone, the machine otherwise free); their seconds per 30-s
-    simulation and the thread count they used."""
+def _two_at_once(
+    threads: str, copies: int = 2, duration: float = CONTENTION_DURATION
+) -> tuple[list[float], int]:
+    """``copies`` copies of the pd batch of ``duration`` [s] started together (each in its own
+    process, all ready first; one copy: the batch alone, the machine otherwise free); their
+    seconds per 30-s simulation and the thread count they used."""
     children = [
         subprocess.Popen(
-            [sys.executable, "-c", _CONTENDER, threads],
+            [sys.executable, "-c", _CONTENDER, threads, str(duration)],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
@@ -434,14 +457,16 @@ def _two_at_once(threads: str, copies: int = 2) -> tuple[list[float], int]:
         for child in children:
             if child.poll() is None:
                 child.kill()
-    scale = FULL / CONTENTION_DURATION / CONTENTION_N
+    scale = FULL / duration / CONTENTION_N
     return [float(out[0]) * scale for out in outputs], int(outputs[0][1])
 
 
-def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) -> dict[str, Any]:
-    """Two copies of the batch at once, at the default thread count, 1 and 2 threads, per
-    simulation against the baseline timed in between (the issue: default 6.2 s, 1 thread
-    0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
+def contention_section(
+    baseline: Callable[[], Any], scale: float, repeats: int, duration: float = CONTENTION_DURATION
+) -> dict[str, Any]:
+    """Two copies of the batch (``duration`` [s] simulated) at once, at the default thread
+    count, 1 and 2 threads, per simulation against the baseline timed in between (the issue:
+    default 6.2 s, 1 thread 0.85 s, 2 threads 3.7 s per copy, before the passive wait policy)."""
     rows: dict[str, list[float]] = {"default": [], "1": [], "2": []}
     alone: dict[str, list[float]] = {"default": [], "1": []}  # one copy: the machine free
     used = used_alone = 0
@@ -449,16 +474,16 @@ def contention_section(baseline: Callable[[], Any], scale: float, repeats: int) 
     for _ in range(repeats):  # interleaved: load drift hits all alike
         base_times.append(_timed(baseline))
         for threads in rows:
-            seconds, count = _two_at_once(threads)
+            seconds, count = _two_at_once(threads, duration=duration)
             rows[threads].append(max(seconds))  # the slower copy: what the user waits for
             used = count if threads == "default" else used
         for threads in alone:
-            seconds, count = _two_at_once(threads, copies=1)
+            seconds, count = _two_at_once(threads, copies=1, duration=duration)
             alone[threads].append(seconds[0])
             used_alone = count if threads == "default" else used_alone
     base = min(base_times) * scale
     print(
-        f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {CONTENTION_DURATION:g} s simulated, "
+        f"\ncontention: two copies of the pd batch at once (N = {CONTENTION_N}, {duration:g} s simulated, "
         f"separate processes started together); seconds per 30-s simulation of the slower copy, min of {repeats} "
         f"(median), ratio to the baseline ({base:.3f} s) of this section; load average "
         f"{[round(x, 2) for x in os.getloadavg()]}"
@@ -1110,7 +1135,8 @@ def main(argv: list[str] | None = None) -> int:
 
     scale = FULL / single_duration
     if args.shared_only or args.contention_only:
-        results.update(contention_section(baseline, scale, repeats))
+        contention_duration = QUICK_CONTENTION_DURATION if quick else CONTENTION_DURATION
+        results.update(contention_section(baseline, scale, repeats, contention_duration))
         if not quick and not args.contention_only:
             results.update(sweep_200_section())
         if args.json:
@@ -1228,7 +1254,7 @@ def main(argv: list[str] | None = None) -> int:
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)
-    budget = 5.0 if quick else 1000.0  # simulated run-seconds per measurement
+    budget = 1.0 if quick else 1000.0  # simulated run-seconds per measurement
     print("\nbatch scaling, pd: seconds per 30-s simulation (ratio to the baseline)")
     print(f"  {'N':>6s} {'simulated':>10s} {'1 thread':>20s} {'2 threads':>20s}")
     scaling = []
@@ -1252,7 +1278,8 @@ def main(argv: list[str] | None = None) -> int:
             + note
         )
     results["batch_scaling"] = scaling
-    results.update(contention_section(baseline, scale, 1 if quick else 3))
+    contention_duration = QUICK_CONTENTION_DURATION if quick else CONTENTION_DURATION
+    results.update(contention_section(baseline, scale, 1 if quick else 3, contention_duration))
 
     # -- sweep memory ---------------------------------------------------------------------------------
     sweep_sizes = (100, 1000) if quick else (1000, 10000)
@@ -1266,12 +1293,11 @@ def main(argv: list[str] | None = None) -> int:
     memory = []
     with tempfile.TemporaryDirectory() as tmp:
         for samples in sweep_sizes:
-            mem = _sweep_memory(samples, sweep_duration, os.path.join(tmp, str(samples)))
+            mem = _sweep_memory(samples, sweep_duration, os.path.join(tmp, str(samples)), trace=not quick)
             memory.append(mem)
             print(
                 f"  {samples:6d} runs: peak RSS {mem['rss_peak_mib']:7.1f} MiB (after imports and setup "
-                f"{mem['rss_before_mib']:6.1f} MiB), Python allocations peak {mem['python_peak_mib']:6.1f} MiB, "
-                f"{mem['seconds']:.1f} s"
+                f"{mem['rss_before_mib']:6.1f} MiB), {_python_peak(mem)}, {mem['seconds']:.1f} s"
             )
     results["sweep_memory"] = memory
 

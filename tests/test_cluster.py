@@ -267,7 +267,7 @@ def test_killing_a_worker_in_the_middle_of_its_task_still_gives_the_identical_ta
     the worker that is running a chunk is killed with SIGKILL. Dask reschedules its chunks on
     the other; the table equals the in-process one."""
     study = replace(
-        STUDY, samples=240, chunk=30, run=replace(STUDY.run, simulation=SimulationConfig(duration=1.0))
+        STUDY, samples=240, chunk=30, run=replace(STUDY.run, simulation=SimulationConfig(duration=0.25))
     )
     run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "reference", plot=False)
     processes = DaskProcesses(tmp_path, workers=2, nanny=False)
@@ -309,7 +309,7 @@ def test_killing_a_worker_in_the_middle_of_its_task_still_gives_the_identical_ta
 def _sweep_process(out: Path, where: list[str]) -> subprocess.Popen[str]:
     argv = [TWOLINK_PIN, "sweep", "pd", "--samples", "4000", "--duration", "1", "--q0-spread", "0.1"]
     return subprocess.Popen(
-        [*argv, "--chunk", "50", *where, "--out", str(out), "--no-plot"],
+        [*argv, "--chunk", "10", *where, "--out", str(out), "--no-plot"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
