@@ -27,6 +27,12 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
+# Loaded before a command runs, not on its first use (the law baseline's np.random.get_state,
+# user_code): a Ctrl-C that lands inside numpy.random's extension-module initialisation is
+# reported there as an unraisable error, not raised, and a long run went on. scipy.linalg,
+# which pulled it in at start-up, is no longer imported there.
+import numpy.random  # noqa: F401
+
 from twolink_pin import interrupts
 from twolink_pin.cli import guard
 from twolink_pin.cli.parser import build_parser
