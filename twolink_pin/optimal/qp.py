@@ -13,6 +13,7 @@ independently of the solver's own report.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -23,6 +24,9 @@ DEFAULT_EPS = 1e-9
 """Absolute tolerance on the primal and dual residuals (ProxQP's ``eps_abs``)."""
 DEFAULT_MAX_ITER = 10_000
 """Most ProxQP iterations of one solve."""
+INFEASIBILITY_EPS = 1e-9
+"""ProxQP's primal and dual infeasibility tolerances (its default, 1e-4, declared feasible
+trajectory steps infeasible)."""
 
 
 class QP(NamedTuple):
@@ -42,8 +46,9 @@ class QP(NamedTuple):
     """Lower bounds of ``C x`` (``-inf``: none), shape (n_in,)."""
     u: np.ndarray | None = None
     """Upper bounds of ``C x`` (``inf``: none), shape (n_in,)."""
-    labels: tuple[str, ...] | None = None
-    """What each inequality row is, for messages (one per row of ``C``)."""
+    labels: Sequence[str] | None = None
+    """What each inequality row is, for messages (one per row of ``C``; any sequence: a long
+    one may make its labels when one is read)."""
 
 
 class QPSolution(NamedTuple):
@@ -95,6 +100,8 @@ def solve_qp(
     eps: float = DEFAULT_EPS,
     max_iter: int = DEFAULT_MAX_ITER,
     what: str = "QP",
+    accept: float | None = None,
+    explain: bool = True,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -104,6 +111,10 @@ def solve_qp(
         eps: Absolute tolerance of the primal and dual residuals.
         max_iter: Most iterations.
         what: The problem in words, for messages (``"the MPC replan at t = 1.2 s"``).
+        accept: When ProxQP stops at ``max_iter`` with both residuals below this, its point
+            is the answer (an SQP step needs no more than a descent direction; None: never).
+        explain: Whether a failure names the constraint that cannot hold (a second solve;
+            False where the failure is an answer in itself, a feasibility probe's).
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
@@ -114,27 +125,40 @@ def solve_qp(
 
     proxqp = proxsuite.proxqp
     n = qp.g.shape[0]
-    kwargs = {}
-    if warm is not None:
-        kwargs = {"x": warm.x, "y": warm.y, "z": warm.z, "initial_guess": proxqp.InitialGuess.WARM_START}
+    m = 0 if qp.A is None else qp.A.shape[0]
+    k = 0 if qp.C is None else qp.C.shape[0]
+    solver = proxqp.dense.QP(n, m, k)
+    settings = solver.settings
+    settings.eps_abs, settings.eps_rel, settings.max_iter = eps, 0.0, max_iter
     # the duality gap checked too: without it ProxQP may stop with an active bound 1e-5 away
-    result = proxqp.dense.solve(
-        qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, eps_abs=eps, eps_rel=0.0, max_iter=max_iter,
-        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=0.0, **kwargs,
-    )  # fmt: skip
+    settings.check_duality_gap = True
+    settings.eps_duality_gap_abs, settings.eps_duality_gap_rel = eps, 0.0
+    # ProxQP's default infeasibility certificate (1e-4) fired on feasible trajectory steps
+    # (badly scaled rows); a problem that cannot hold is still told apart below
+    settings.eps_primal_inf = settings.eps_dual_inf = INFEASIBILITY_EPS
+    solver.init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
+    if warm is not None:
+        settings.initial_guess = proxqp.InitialGuess.WARM_START
+        solver.solve(warm.x, warm.y, warm.z)
+    else:
+        solver.solve()
+    result = solver.results
     info = result.info
     status = info.status
-    if status != proxqp.PROXQP_SOLVED:
+    near = (
+        accept is not None
+        and status == proxqp.PROXQP_MAX_ITER_REACHED
+        and max(info.pri_res, info.dua_res) <= accept
+    )
+    if status != proxqp.PROXQP_SOLVED and not near:
         # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
         # the closest feasible point tells a problem that cannot hold from a slow one
-        infeasible = _infeasible_reason(qp, eps, max_iter)
+        infeasible = _infeasible_reason(qp, eps, max_iter) if explain else None
         reason = infeasible or (
             f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
             f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
         )
         raise OptimizationError(what, reason, int(info.iter))
-    m = 0 if qp.A is None else qp.A.shape[0]
-    k = 0 if qp.C is None else qp.C.shape[0]
     x = np.array(result.x[:n], dtype=float)
     return QPSolution(
         x,
