@@ -24,6 +24,9 @@ DEFAULT_EPS = 1e-9
 """Absolute tolerance on the primal and dual residuals (ProxQP's ``eps_abs``)."""
 DEFAULT_MAX_ITER = 10_000
 """Most ProxQP iterations of one solve."""
+PROXIMAL_RHO = 1e-8
+"""ProxQP's proximal step on the primal variables (its default 1e-6 was large beside the
+smallest curvature of the trajectory optimiser's steps: 1635 iterations instead of 200)."""
 INFEASIBILITY_EPS = 1e-9
 """ProxQP's primal and dual infeasibility tolerances (its default, 1e-4, declared feasible
 trajectory steps infeasible)."""
@@ -136,6 +139,7 @@ def solve_qp(
     # ProxQP's default infeasibility certificate (1e-4) fired on feasible trajectory steps
     # (badly scaled rows); a problem that cannot hold is still told apart below
     settings.eps_primal_inf = settings.eps_dual_inf = INFEASIBILITY_EPS
+    settings.default_rho = PROXIMAL_RHO
     solver.init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
     if warm is not None:
         settings.initial_guess = proxqp.InitialGuess.WARM_START

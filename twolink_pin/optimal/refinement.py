@@ -53,7 +53,7 @@ def _excess_points(
     ``tolerance``, and the largest excess."""
     ev = problem.with_check_points(fine).evaluate(x)
     rows = np.maximum(ev.lower - ev.inequality, ev.inequality - ev.upper)
-    limit_rows = rows[: rows.size - (problem.layout.segments if problem.layout.free_durations else 0)]
+    limit_rows = rows[: problem.grid_rows(fine.size)]
     if not limit_rows.size:
         return np.zeros(0, dtype=int), -np.inf
     per_point = np.concatenate(

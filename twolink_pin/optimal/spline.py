@@ -100,6 +100,19 @@ class BSplineBasis:
             B = B @ D
         return B
 
+    def derivative_coefficients(self, order: int) -> np.ndarray:
+        """``D_order ⋯ D_1`` (shape (n − order, n)): the coefficients of the spline's
+        ``order``-th derivative, a degree ``p − order`` B-spline on the inner knots. B-spline
+        basis functions are non-negative and sum to one, so the derivative lies between the
+        smallest and largest of these coefficients everywhere (the convex-hull property): a
+        bound on them bounds the derivative between every two knots, with no grid."""
+        if not (isinstance(order, int) and 0 <= order <= self.degree):
+            raise InvalidParameterError("order", order, f"a derivative from 0 to {self.degree}")
+        out = np.eye(self.size)
+        for D in self._differences[:order]:
+            out = D @ out
+        return out
+
     def matrices(self, s: np.ndarray, orders: int = 3) -> tuple[np.ndarray, ...]:
         """``(B_0, .., B_orders)`` at ``s``."""
         return tuple(self.matrix(s, r) for r in range(orders + 1))

@@ -65,7 +65,7 @@ class SQPOptions:
 
     max_iterations: int = 60
     step_tolerance: float = 1e-9
-    cost_tolerance: float = 1e-8
+    cost_tolerance: float = 1e-5
     feasibility: float = 1e-6
     damping: float = 1e-3
     qp_tolerance: float = 1e-9

@@ -142,7 +142,11 @@ class TrajectoryProblem:
         cost_points: Where the integrals are evaluated (a quadrature).
         check_points: Where the limits are constrained.
         pins: Equalities at points.
-        kinds: The limit kinds constrained (default all four, where given).
+        kinds: The limit kinds constrained at the check points (default all four, where given).
+        hull: Kinds of ``position``, ``velocity``, ``acceleration`` constrained on the spline's
+            coefficients instead (:meth:`~twolink_pin.optimal.spline.BSplineBasis.derivative_coefficients`:
+            everywhere, no grid; conservative by how far a control point lies outside its curve;
+            few rows, where an active arc at the check points made many, degenerate ones).
         margin: Fraction of each limit kept free (default 1e-5: more than the SQP's
             feasibility tolerance, so what it leaves stays inside the limit).
         time_scale: A typical segment duration [s] (scales the equality rows).
@@ -158,6 +162,7 @@ class TrajectoryProblem:
     check_points: Points
     pins: tuple[Pin, ...] = ()
     kinds: tuple[LimitKind, ...] = KINDS
+    hull: tuple[LimitKind, ...] = ()
     margin: float = 1e-5
     time_scale: float = 1.0
     min_duration: float = 1e-3
@@ -360,6 +365,14 @@ class TrajectoryProblem:
                 else:
                     J = layout.jacobian(x, points, kind.order or 0, value)
                 jacs.append((J[:, given, :] / scale[given][None, :, None]).reshape(-1, layout.size))
+        for kind in self.hull:
+            rows = self._hull_rows(x, kind, jacobians)
+            if rows is not None:
+                values.append(rows[0])
+                lowers.append(rows[1])
+                uppers.append(rows[2])
+                if jacobians:
+                    jacs.append(rows[3])
         if layout.free_durations:
             S = layout.segments
             values.append(layout.durations_of(x) / self.min_duration)
@@ -372,6 +385,41 @@ class TrajectoryProblem:
             return np.zeros(0), np.zeros(0), np.zeros(0), np.zeros((0, layout.size)) if jacobians else None
         jac = np.concatenate(jacs) if jacobians else None
         return np.concatenate(values), np.concatenate(lowers), np.concatenate(uppers), jac
+
+    def grid_rows(self, points: int) -> int:
+        """How many of the inequality rows are at the check points, for ``points`` of them
+        (they come first, kind by kind, each point's given joints in turn)."""
+        return points * sum(int(self.limits.given(kind).sum()) for kind in self.kinds)
+
+    def _hull_rows(
+        self, x: np.ndarray, kind: LimitKind, jacobians: bool
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+        """``kind``'s rows on the coefficients of its derivative (``hull``): value, bounds,
+        Jacobian (empty without ``jacobians``); None when no joint has the limit."""
+        layout, limits = self.layout, self.limits
+        given = limits.given(kind)
+        if not given.any():
+            return None
+        order = kind.order or 0
+        scale, lo, hi = self.row_bounds(kind, *limits.bounds(kind))
+        M = layout.basis.derivative_coefficients(order)  # (m, n)
+        C, h = layout.coefficients(x), layout.durations_of(x)
+        S, m, nv = layout.segments, M.shape[0], layout.nv
+        value = np.einsum("an,snj->saj", M, C) / (h[:, None, None] ** order)  # (S, m, nv)
+        rows = (value[:, :, given] / scale[given]).ravel()
+        count = S * m * int(given.sum())
+        lower, upper = np.tile(lo[given], S * m), np.tile(hi[given], S * m)
+        if not jacobians:
+            return rows, lower, upper, np.zeros((0, layout.size))
+        J = np.zeros((S, m, nv, layout.size))
+        j = np.arange(nv)
+        for k in range(S):
+            block = np.einsum("an,ij->aijn", M / h[k] ** order, np.eye(nv))  # [a, row joint, coef, joint]
+            J[k, :, :, k * layout.block : (k + 1) * layout.block] = block.transpose(0, 1, 3, 2).reshape(m, nv, -1)
+            if layout.free_durations and order > 0:
+                J[k, :, j, S * layout.block + k] = (-order * value[k] / h[k]).T
+        J = J[:, :, given, :] / scale[given][None, None, :, None]
+        return rows, lower, upper, J.reshape(count, layout.size)
 
     def row_bounds(
         self, kind: LimitKind, lower: np.ndarray, upper: np.ndarray
@@ -413,11 +461,20 @@ class _RowLabels(Sequence[str]):
             given = problem.limits.given(kind)
             if given.any():
                 self.blocks.append((kind.name, np.flatnonzero(given)))
+        self.hull: list[tuple[str, np.ndarray, int]] = []
+        layout = problem.layout
+        for kind in problem.hull:
+            given = problem.limits.given(kind)
+            if given.any():
+                m = layout.basis.size - (kind.order or 0)
+                self.hull.append((kind.name, np.flatnonzero(given), layout.segments * m))
+        self.coefficients = layout.basis.size
         self.durations = problem.layout.segments if problem.layout.free_durations else 0
         self.min_duration = problem.min_duration
 
     def __len__(self) -> int:
-        return sum(len(self.times) * joints.size for _, joints in self.blocks) + self.durations
+        grid = sum(len(self.times) * joints.size for _, joints in self.blocks)
+        return grid + sum(n * joints.size for _, joints, n in self.hull) + self.durations
 
     def __getitem__(self, i: int) -> str:  # type: ignore[override]
         for name, joints in self.blocks:
@@ -426,6 +483,13 @@ class _RowLabels(Sequence[str]):
                 k, j = divmod(i, joints.size)
                 joint = int(joints[j])
                 return f"the {name} limit of joint {joint + 1} ({self.names[joint]}) at t = {self.times[k]:.4g} s"
+            i -= n
+        for name, joints, count in self.hull:
+            n = count * joints.size
+            if i < n:
+                k, j = divmod(i, joints.size)
+                joint = int(joints[j])
+                return f"the {name} limit of joint {joint + 1} ({self.names[joint]}) on its spline's coefficient {k}"
             i -= n
         return f"the duration of segment {i} >= {self.min_duration:g} s"
 

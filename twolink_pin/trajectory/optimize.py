@@ -42,6 +42,8 @@ from twolink_pin import interrupts
 from twolink_pin.dynamics.derivatives import RneaDerivatives
 from twolink_pin.errors import InvalidParameterError, OptimizationError, require_type
 from twolink_pin.limits import (
+    ACCELERATION,
+    EFFORT,
     POSITION,
     VELOCITY,
     JointLimits,
@@ -89,6 +91,8 @@ CHECK = 4
 """Points per spline piece at which the limits are constrained (the fine grid: ten times more)."""
 EFFORT_GRID = 20
 """Points per spline piece of the grid on which the results' ``∫ τᵀτ dt`` and limits are reported."""
+HULL = (POSITION, VELOCITY, ACCELERATION)
+"""The limits kept on the spline's coefficients (everywhere, no grid); effort at the check points."""
 MAX_ITERATIONS = 60
 """Default most SQP iterations per solve."""
 
@@ -211,8 +215,8 @@ def _spline_problem(
     ends = layout.points(np.zeros(2, dtype=int), np.array([0.0, 1.0]))
     pins = (Pin("via", at_vias, 0, vias.q), *tuple(Pin("rest", ends, r, np.zeros((2, nv))) for r in rest))
     return TrajectoryProblem(
-        layout, RneaDerivatives(robot.model, friction), limits, cost,
-        layout.quadrature(), layout.grid(CHECK), pins, time_scale=span / (times.size - 1),
+        layout, RneaDerivatives(robot.model, friction), limits, cost, layout.quadrature(), layout.grid(CHECK), pins,
+        kinds=(EFFORT,), hull=HULL, time_scale=span / (times.size - 1),
     )  # fmt: skip
 
 
