@@ -36,6 +36,13 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         ("trajectory", "feasibility"),
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
+    (
+        "optimal",
+        "Limits and optimisation",
+        "Every joint limit, where a motion rides them, and the one optimisation core (splines, "
+        "SQP on Pinocchio's derivatives, ProxQP).",
+        ("limits", "optimal"),
+    ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),
     (
         "simulation",

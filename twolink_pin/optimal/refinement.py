@@ -23,7 +23,7 @@ from twolink_pin.optimal.layout import Points
 from twolink_pin.optimal.sqp import SQPOptions, SQPResult, solve_sqp
 from twolink_pin.optimal.transcription import TrajectoryProblem
 
-FINE = 10
+FINE = 25
 """The fine grid has this many times the check grid's points per knot interval."""
 ROUNDS = 6
 """Most solves (the first and those after adding points)."""

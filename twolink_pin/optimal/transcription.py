@@ -415,7 +415,9 @@ class TrajectoryProblem:
         j = np.arange(nv)
         for k in range(S):
             block = np.einsum("an,ij->aijn", M / h[k] ** order, np.eye(nv))  # [a, row joint, coef, joint]
-            J[k, :, :, k * layout.block : (k + 1) * layout.block] = block.transpose(0, 1, 3, 2).reshape(m, nv, -1)
+            J[k, :, :, k * layout.block : (k + 1) * layout.block] = block.transpose(0, 1, 3, 2).reshape(
+                m, nv, -1
+            )
             if layout.free_durations and order > 0:
                 J[k, :, j, S * layout.block + k] = (-order * value[k] / h[k]).T
         J = J[:, :, given, :] / scale[given][None, None, :, None]

@@ -155,9 +155,26 @@ def _vias(trajectory: Trajectory) -> _Vias:
     )
 
 
-def check_vias(robot: RobotModel, vias: _Vias, limits: JointLimits) -> None:
-    """Raise (bad input) for a via point outside a joint's position range, or one where gravity
-    alone needs more than an effort limit (the arm could not even hold still there)."""
+def _check_speeds(vias: _Vias, limits: JointLimits) -> None:
+    """Raise (bad input) where two via points are further apart than a joint's velocity limit
+    lets it go in the time between them (the mean velocity, which any motion reaches)."""
+    mean = np.abs(np.diff(vias.q, axis=0)) / np.diff(vias.times)[:, None]
+    over = mean / limits.velocity
+    if np.any(over > 1.0):
+        k, j = (int(i) for i in np.unravel_index(np.argmax(over), over.shape))
+        raise InvalidParameterError(
+            f"velocity limit of joint {j + 1} ({limits.joint_names[j]})",
+            f"{limits.velocity[j]:g} rad/s",
+            f"at least the mean {mean[k, j]:.4g} rad/s from via point {k} to {k + 1} ({vias.times[k]:g} s to "
+            f"{vias.times[k + 1]:g} s): via points too far apart for their times",
+        )
+
+
+def check_vias(robot: RobotModel, vias: _Vias, limits: JointLimits, timed: bool = True) -> None:
+    """Raise (bad input) for a via point outside a joint's position range, two via points
+    further apart than a velocity limit lets a joint go between their times, or a via point
+    where gravity alone needs more than an effort limit (the arm could not even hold still
+    there). ``timed``: the via times are kept (the velocity check applies)."""
     lower, upper = limits.bounds(POSITION)
     for k, q in enumerate(vias.q):
         outside = (q < lower) | (q > upper)
@@ -168,6 +185,8 @@ def check_vias(robot: RobotModel, vias: _Vias, limits: JointLimits) -> None:
                 f"{q[j]:.6g} rad",
                 f"a position within its range [{lower[j]:g}, {upper[j]:g}] rad",
             )
+    if timed:
+        _check_speeds(vias, limits)
     data = robot.create_data()
     for k, q in enumerate(vias.q):
         g = pin.computeGeneralizedGravity(robot.model, data, q)
@@ -398,7 +417,7 @@ def optimize(
     start = time.perf_counter()
     wanted = (joint_limits(robot) if limits is None else limits).scaled(limit_scale)
     vias = _vias(via)
-    check_vias(robot, vias, wanted)
+    check_vias(robot, vias, wanted, timed=cost == "effort")
     from twolink_pin.blas import one_blas_thread
 
     options = SQPOptions(max_iterations=max_iterations)

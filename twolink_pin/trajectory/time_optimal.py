@@ -607,9 +607,9 @@ def _timings(
             sd = _solve(robot, stage, working, friction, what)
             timings.append(_timing(piece, stage, sd, 0.0 if not timings else float(timings[-1].t[-1])))
         excess = max(_timing_excess(robot, timing, inner, friction) for timing in timings)
-        if excess <= 0:
+        if excess <= 1e-9:  # of the inner limits: MARGIN inside the wanted ones
             return timings
-        working = working.scaled(1.0 / (1.0 + excess))
+        working = working.scaled(1.0 / (1.0 + max(2.0 * excess, 1e-6)))
     raise OptimizationError(
         what,
         f"the retimed path still exceeds a limit by {excess:.3g} of it between grid points",
