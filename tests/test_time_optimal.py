@@ -159,7 +159,7 @@ def test_a_sampled_trajectory_refuses_what_cannot_repeat() -> None:
         SampledTrajectory(t, q, np.zeros((3, 1)), np.zeros((3, 1)))
     with pytest.raises(InvalidParameterError, match="at most twice"):
         SampledTrajectory(np.array([0.0, 0.0, 1.0]), np.zeros((3, 1)), np.zeros((3, 1)), np.zeros((3, 1)))
-    with pytest.raises(InvalidParameterError, match="only the\\s+acceleration may jump"):
+    with pytest.raises(InvalidParameterError, match=r"only the\s+acceleration may jump"):
         SampledTrajectory(
             np.array([0.0, 1.0, 1.0, 2.0]),
             np.array([[0.0], [1.0], [1.1], [0.0]]),

@@ -36,7 +36,7 @@ def add_within_limits_options(p: argparse.ArgumentParser, retime: bool) -> None:
 
 def add_optimize_command(sub: Any, c: Any) -> None:
     """``optimize``: an optimal trajectory through the reference's via points."""
-    from twolink_pin.trajectory.optimize import COSTS, MAX_ITERATIONS
+    from twolink_pin.trajectory.optimal import COSTS, MAX_ITERATIONS
 
     p = sub.add_parser(
         "optimize",

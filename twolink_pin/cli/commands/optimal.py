@@ -80,7 +80,7 @@ def _save(args: argparse.Namespace, trajectory: Any) -> str | None:
 def time_optimal_command(args: argparse.Namespace, robot: RobotModel, reference: Trajectory) -> int:
     """``trajectory --time-optimal``: the reference's path retimed within the limits."""
     from twolink_pin.limits import reference_motion
-    from twolink_pin.trajectory.time_optimal import time_optimal, verify_motion
+    from twolink_pin.trajectory.retiming import time_optimal, verify_motion
 
     _check_save(args.save)
     friction, source = _friction(args, robot)
@@ -126,8 +126,8 @@ def time_optimal_command(args: argparse.Namespace, robot: RobotModel, reference:
 def cmd_optimize(args: argparse.Namespace) -> int:
     """``optimize``: the least effort or the shortest duration through the via points."""
     from twolink_pin.limits import reference_motion
-    from twolink_pin.trajectory.optimize import optimize
-    from twolink_pin.trajectory.time_optimal import verify_motion
+    from twolink_pin.trajectory.optimal import optimize
+    from twolink_pin.trajectory.retiming import verify_motion
 
     _check_save(args.save)
     robot = robot_from_args(args)

@@ -24,7 +24,8 @@ allow on that grid (constraints at both ends of each interval: ``toppra``'s inte
 discretisation). :data:`GRIDPOINTS` intervals over the whole path.
 
 **Friction** (when asked, the plant's :class:`~twolink_pin.dynamics.Friction`): the Coulomb
-torque ``C sgn(q̇) = C sgn(q')`` is known along the path (``ṡ >= 0``) and joins ``c``; the
+torque ``C sgn(q̇) = C sgn(q')`` is known along the path (``ṡ >= 0``) and joins ``c`` (where a
+joint's tangent changes sign within an interval, both bounds take the worse side); the
 viscous torque ``V q' ṡ = V q' √x`` is not linear in ``x``. On the side of the limit it pushes
 towards it is bounded by the tangent ``√x <= (x + x_r)/(2 √x_r)`` (conservative, exact at
 ``x = x_r``), on the other side dropped (conservative too); ``x_r`` is the previous pass's
@@ -97,7 +98,10 @@ FRICTION_PASSES = 3
 TIGHTENING_ROUNDS = 4
 """Most retimings with the limits tightened by what the check grid finds beyond them."""
 MARGIN = 1e-3
-"""The timing keeps this fraction of each limit free, for the samples' interpolation."""
+"""The timing keeps this fraction of each limit free: for what happens between TOPP-RA's
+grid points (it keeps the limits at :data:`SUBPOINTS` + 1 points of each interval) and for
+the samples' interpolation, so that the check (:data:`VERIFY` points per sample interval)
+passes at the first try; where it does not, the limits are tightened by twice what it found."""
 REPRESENTATION = 1e-5
 """Acceleration error sought of the samples' interpolation, a fraction of the path's largest
 acceleration (an interval is halved, at most :data:`MAX_LEVEL` times, until it is met)."""
@@ -295,9 +299,23 @@ def _stage(robot: RobotModel, piece: _Piece, grid: np.ndarray, friction: Frictio
     c = np.array([pin.rnea(model, data, x, zero, zero) for x in q])
     a = np.array([pin.rnea(model, data, x, zero, d1) for x, d1 in zip(q, dq)]) - c
     b = np.array([pin.rnea(model, data, x, d1, d2) for x, d1, d2 in zip(q, dq, ddq)]) - c
-    if friction is not None:
-        c = c + np.asarray(friction.coulomb) * np.sign(dq)
     return _Stage(s, q, dq, ddq, a, b, c)
+
+
+def _coulomb_signs(stage: _Stage) -> tuple[np.ndarray, np.ndarray]:
+    """The sign of the Coulomb torque ``C sgn(q̇) = C sgn(q')`` at each point, as the upper and
+    the lower bound of the torque see it: where a joint's tangent changes sign (or vanishes)
+    within an interval, the flip can fall anywhere between its points, so both bounds take
+    the worse side there (+1 for the upper, −1 for the lower)."""
+    sign = np.sign(stage.dq)
+    K = SUBPOINTS
+    n = (stage.s.size - 1) // K
+    blocks = np.concatenate([sign[:-1].reshape(n, K, -1), sign[K::K][:, None, :]], axis=1)  # (n, K + 1, nv)
+    mixed = (blocks.min(axis=1) != blocks.max(axis=1)) | (blocks == 0).any(axis=1)  # (n, nv)
+    point_mixed = np.zeros_like(sign, dtype=bool)
+    point_mixed[:-1] = np.repeat(mixed, K, axis=0)
+    point_mixed[K::K] |= mixed  # an interval's end point belongs to its rows too
+    return np.where(point_mixed, 1.0, sign), np.where(point_mixed, -1.0, sign)
 
 
 def _speed_bound(stage: _Stage, limits: JointLimits) -> np.ndarray:
@@ -321,6 +339,10 @@ def _params(
         eff, acc = limits.given(EFFORT), np.isfinite(limits.acceleration)
         a, b, c = stage.a[:, eff], stage.b[:, eff], stage.c[:, eff]
         up_b, up_c, lo_b, lo_c = b.copy(), c.copy(), b.copy(), c.copy()
+        if friction is not None:
+            up, lo = _coulomb_signs(stage)
+            coulomb = np.asarray(friction.coulomb)[eff]
+            up_c, lo_c = up_c + coulomb * up[:, eff], lo_c + coulomb * lo[:, eff]
         if friction is not None and x_ref is not None:
             xr = np.maximum(np.interp(stage.s, grid, x_ref), 1e-12)[:, None]
             slope = np.asarray(friction.viscous)[eff] * stage.dq[:, eff]
@@ -465,18 +487,6 @@ def _exact(timing: _Timing, interval: np.ndarray, tau: np.ndarray) -> tuple[np.n
     )
 
 
-def _timing_excess(
-    robot: RobotModel, timing: _Timing, limits: JointLimits, friction: Friction | None
-) -> float:
-    """The largest excess (a fraction of the limit) of a velocity, acceleration or effort
-    limit along the exact timing, :data:`VERIFY` + 1 points per interval, both ends included."""
-    n = timing.u.size
-    interval = np.repeat(np.arange(n), VERIFY + 1)
-    tau = np.tile(np.linspace(0.0, 1.0, VERIFY + 1), n)
-    t, q, v, a = _exact(timing, interval, tau)
-    return float(_over(Motion(t, q, v, a, _torque(robot, q, v, a, friction)), limits, VERIFY).max())
-
-
 def _rows(timings: list[_Timing], levels: list[np.ndarray]) -> tuple[np.ndarray, ...]:
     """Samples of the timings: each grid interval at ``2^level + 1`` evenly spaced times,
     both ends included (each interior grid point twice: its acceleration before and after)."""
@@ -590,31 +600,29 @@ def _over(motion: Motion, limits: JointLimits, per_interval: int) -> np.ndarray:
     return worst.reshape(-1, per_interval + 1).max(axis=1)
 
 
-def _timings(
+def _timed(
     robot: RobotModel,
+    trajectory: Trajectory,
     pieces: list[_Piece],
     stages: list[_Stage],
-    wanted: JointLimits,
+    limits: JointLimits,
     friction: Friction | None,
-) -> list[_Timing]:
-    """Each piece timed within ``wanted`` less :data:`MARGIN`, exactly between the grid points
-    too (the limits tightened by what the check grid finds beyond them, and timed again)."""
-    inner = wanted.scaled(1.0 - MARGIN)
-    working, what, excess = inner, "the time-optimal retiming", np.inf
-    for _ in range(TIGHTENING_ROUNDS):
-        timings: list[_Timing] = []
-        for piece, stage in zip(pieces, stages, strict=True):
-            sd = _solve(robot, stage, working, friction, what)
-            timings.append(_timing(piece, stage, sd, 0.0 if not timings else float(timings[-1].t[-1])))
-        excess = max(_timing_excess(robot, timing, inner, friction) for timing in timings)
-        if excess <= 1e-9:  # of the inner limits: MARGIN inside the wanted ones
-            return timings
-        working = working.scaled(1.0 / (1.0 + max(2.0 * excess, 1e-6)))
-    raise OptimizationError(
-        what,
-        f"the retimed path still exceeds a limit by {excess:.3g} of it between grid points",
-        TIGHTENING_ROUNDS,
+) -> tuple[SampledTrajectory, list[_Timing]]:
+    """Each piece timed within ``limits`` (TOPP-RA), one after the other, and the samples of
+    the whole: what :func:`time_optimal` checks."""
+    timings: list[_Timing] = []
+    for piece, stage in zip(pieces, stages, strict=True):
+        sd = _solve(robot, stage, limits, friction, "the time-optimal retiming")
+        timings.append(_timing(piece, stage, sd, 0.0 if not timings else float(timings[-1].t[-1])))
+    scale = max(
+        float(np.abs(_rows(timings, [np.zeros(t.u.size, dtype=int) for t in timings])[3]).max()), 1e-9
     )
+    t, q, v, a = _represented(timings, REPRESENTATION * scale)
+    same = np.flatnonzero(np.diff(t) == 0)
+    q[same + 1], v[same + 1] = q[same], v[same]  # a junction of two pieces: one configuration
+    q[-1], v[-1] = q[0], v[0]  # the path closes (to its IK's digits for an SE(3) reference)
+    tau = _torque(robot, q, v, a, friction)
+    return SampledTrajectory(t, q, v, a, tau, _via_times(trajectory, timings)), timings
 
 
 def time_optimal(
@@ -666,26 +674,24 @@ def time_optimal(
         _check_rest(
             robot, stage, wanted, "the path" if len(stages) == 1 else f"segment {k} (via pose {k} → {k + 1})"
         )
-    timings = _timings(robot, pieces, stages, wanted, friction)
-    scale = max(
-        float(np.abs(_rows(timings, [np.zeros(t.u.size, dtype=int) for t in timings])[3]).max()), 1e-9
+    working, excess = wanted.scaled(1.0 - MARGIN), np.inf
+    for _ in range(TIGHTENING_ROUNDS):
+        result, _ = _timed(robot, trajectory, pieces, stages, working, friction)
+        motion = verify_motion(robot, result, VERIFY, friction)
+        excess = float(_over(motion, wanted, VERIFY).max())
+        if excess <= 0:
+            original = float(getattr(trajectory, "span", trajectory.period))
+            return TimeOptimal(
+                result, result.period, original, wanted, check_motion(motion, wanted),
+                active_limits(motion, wanted), int(sum(st.grid.size - 1 for st in stages)),
+                time.perf_counter() - start,
+            )  # fmt: skip
+        working = working.scaled(1.0 / (1.0 + 2.0 * excess + MARGIN))
+    raise OptimizationError(
+        "the time-optimal retiming",
+        f"the retimed path still exceeds a limit by {excess:.3g} of it on the check grid",
+        TIGHTENING_ROUNDS,
     )
-    t, q, v, a = _represented(timings, REPRESENTATION * scale)
-    same = np.flatnonzero(np.diff(t) == 0)
-    q[same + 1], v[same + 1] = q[same], v[same]  # a junction of two pieces: one configuration
-    q[-1], v[-1] = q[0], v[0]  # the path closes (to its IK's digits for an SE(3) reference)
-    result = SampledTrajectory(t, q, v, a, _torque(robot, q, v, a, friction), _via_times(trajectory, timings))
-    motion = verify_motion(robot, result, VERIFY, friction)
-    excess = float(_over(motion, wanted, VERIFY).max())
-    if excess > 0:
-        raise OptimizationError(
-            "the time-optimal retiming", f"its samples exceed a limit by {excess:.3g} of it", 1
-        )
-    original = float(getattr(trajectory, "span", trajectory.period))
-    return TimeOptimal(
-        result, result.period, float(original), wanted, check_motion(motion, wanted),
-        active_limits(motion, wanted), int(sum(st.grid.size - 1 for st in stages)), time.perf_counter() - start,
-    )  # fmt: skip
 
 
 __all__ = ["GRIDPOINTS", "VERIFY", "TimeOptimal", "path_pieces", "time_optimal", "verify_motion"]

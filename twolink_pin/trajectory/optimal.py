@@ -21,7 +21,7 @@ derivative continuous where they meet (equalities in the coefficients and durati
 rest to rest (zero velocity; the acceleration jumps across the period as a time-optimal
 retiming's does), a little ``∫‖q⃛‖² dt`` (a millionth of the duration's scale) to choose among
 equally fast paths. It starts from the time-optimal retiming of the reference
-(:func:`~twolink_pin.trajectory.time_optimal.time_optimal`): its via times and its motion; the
+(:func:`~twolink_pin.trajectory.retiming.time_optimal`): its via times and its motion; the
 SQP's merit never accepts a longer one, so its result is no longer than the retiming (it is
 free to leave the reference's path between the via points).
 
@@ -59,9 +59,9 @@ from twolink_pin.optimal.sqp import SQPOptions
 from twolink_pin.optimal.transcription import Cost, Pin, TrajectoryProblem
 from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
+from twolink_pin.trajectory.retiming import TimeOptimal, time_optimal
 from twolink_pin.trajectory.sampled import SampledTrajectory
 from twolink_pin.trajectory.se3 import PoseTrajectory
-from twolink_pin.trajectory.time_optimal import TimeOptimal, time_optimal
 
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
@@ -83,6 +83,10 @@ is not; then bisection)."""
 SEARCH_TOLERANCE = 4e-3
 """It stops when the shortest feasible and the longest infeasible scaling are this close
 (relative)."""
+TIME_MARGIN = 1e-3
+"""The fraction of each limit a minimum-time spline keeps free: near-bang-bang, its torque
+turns fast, and between the check grid's points (100 per piece) it rose up to 3e-5 of a limit
+(1e-5 was the margin)."""
 PROBE_ITERATIONS = 25
 """SQP iterations of one probe (a probe that needs more counts as infeasible)."""
 PROBE_QP_ITERATIONS = 400
@@ -215,6 +219,7 @@ def _spline_problem(
     friction: Friction | None,
     cost: Cost,
     rest: tuple[int, ...],
+    margin: float = 1e-5,
 ) -> TrajectoryProblem:
     """One spline through the via points at ``times`` [s] (its knots :func:`_pieces` apart),
     at rest at both ends to the derivatives ``rest``, its limits at :data:`CHECK` points per piece."""
@@ -235,7 +240,7 @@ def _spline_problem(
     pins = (Pin("via", at_vias, 0, vias.q), *tuple(Pin("rest", ends, r, np.zeros((2, nv))) for r in rest))
     return TrajectoryProblem(
         layout, RneaDerivatives(robot.model, friction), limits, cost, layout.quadrature(), layout.grid(CHECK), pins,
-        kinds=(EFFORT,), hull=HULL, time_scale=span / (times.size - 1),
+        kinds=(EFFORT,), hull=HULL, margin=margin, time_scale=span / (times.size - 1),
     )  # fmt: skip
 
 
@@ -268,7 +273,7 @@ def _probe(
     """A spline through the via points at ``scale · times`` [s] within every limit (the least
     ``∫‖q⃛‖² dt``, from the variables ``x0``: the same in normalised time at every scale), or
     None when the solver finds none in :data:`PROBE_ITERATIONS` SQP iterations."""
-    problem = _spline_problem(robot, times * scale, vias, limits, friction, Cost(jerk=1.0), (1,))
+    problem = _spline_problem(robot, times * scale, vias, limits, friction, Cost(jerk=1.0), (1,), TIME_MARGIN)
     options = SQPOptions(max_iterations=PROBE_ITERATIONS, qp_iterations=PROBE_QP_ITERATIONS, explain=False)
     try:
         solved = solve_within_limits(problem, x0, options, per_piece=CHECK, rounds=3, what="a probe")
@@ -286,7 +291,7 @@ def _time_search(
     limit (module docstring: steps down, then bisection, each probe a feasibility solve); the
     SQP iterations."""
     times = retimed.via_times - retimed.via_times[0]
-    start = _spline_problem(robot, times, vias, limits, friction, Cost(jerk=1.0), (1,))
+    start = _spline_problem(robot, times, vias, limits, friction, Cost(jerk=1.0), (1,), TIME_MARGIN)
     x0 = _fit(start, retimed, float(retimed.via_times[0]))
     spent = [0]
     best = None
@@ -337,7 +342,7 @@ def _knot_samples(
 
 
 def effort_integral(
-    robot: RobotModel, trajectory: Trajectory, friction: Friction | None = None, samples: int = 20001
+    robot: RobotModel, trajectory: Trajectory, friction: Friction | None = None, samples: int = 4001
 ) -> float:
     """``∫ τᵀτ dt`` over one period [N²·m²·s]: RNEA (plus ``friction``) on ``samples`` evenly
     spaced instants, trapezoid."""
@@ -480,7 +485,7 @@ def _report(
     start: float,
 ) -> OptimalTrajectory:
     """The result measured: its effort and the reference's, via errors, the limits on a fine grid."""
-    from twolink_pin.trajectory.time_optimal import verify_motion
+    from twolink_pin.trajectory.retiming import verify_motion
 
     motion = verify_motion(robot, result, EFFORT_GRID, friction)
     check = check_motion(motion, limits)
