@@ -4,9 +4,11 @@
 ``rigid_body.py``      M (CRBA), C (Christoffel), g, RNEA, ABA, the polarised regressor
 ``polarisation.py``    the two-copy pair and forest: ``M a + C(q, v) w + g`` in one RNEA
 ``friction.py``        viscous + Coulomb friction and its regressor
+``derivatives.py``     RNEA and its derivatives at many points: what the optimisation core linearises
 =====================  ==================================================================
 """
 
+from twolink_pin.dynamics.derivatives import InverseDynamics, InverseDynamicsTerms, RneaDerivatives
 from twolink_pin.dynamics.friction import Friction, friction_regressor, smooth_sign
 from twolink_pin.dynamics.polarisation import polarisation_forest, polarisation_pair
 from twolink_pin.dynamics.rigid_body import (
@@ -24,6 +26,9 @@ from twolink_pin.dynamics.rigid_body import (
 __all__ = [
     "ABA_CONVENTION",
     "Friction",
+    "InverseDynamics",
+    "InverseDynamicsTerms",
+    "RneaDerivatives",
     "coriolis_matrix",
     "forward_dynamics",
     "friction_regressor",

@@ -5,9 +5,11 @@ the checks of a reference, the crossings of a run, retiming, optimisation and co
 ``kinds.py``                the four kinds (position, velocity, acceleration, effort), :class:`Motion`
 ``joint_limits.py``         :class:`JointLimits`, :func:`joint_limits` (read from a robot)
 ``check.py``                :func:`check_limits`: a reference against every limit over a period
+``active.py``               :func:`active_limits`: where a motion rides each limit
 ==========================  ================================================================
 """
 
+from twolink_pin.limits.active import ActiveLimit, active_limits
 from twolink_pin.limits.check import KindCheck, LimitsCheck, check_limits, check_motion, reference_motion
 from twolink_pin.limits.joint_limits import JointLimits, joint_limits
 from twolink_pin.limits.kinds import (
@@ -27,11 +29,13 @@ __all__ = [
     "KINDS",
     "POSITION",
     "VELOCITY",
+    "ActiveLimit",
     "JointLimits",
     "KindCheck",
     "LimitKind",
     "LimitsCheck",
     "Motion",
+    "active_limits",
     "check_limits",
     "check_motion",
     "joint_limits",

@@ -16,6 +16,8 @@ import os
 from collections.abc import Sequence
 from pathlib import Path
 
+import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from twolink_pin.limits import ACCELERATION, EFFORT, VELOCITY, JointLimits, LimitKind, Motion
@@ -36,6 +38,26 @@ REFERENCE_COLOR = "0.55"
 """Colour of the reference drawn beside the motion."""
 ACTIVE_COLOR = "tab:orange"
 """Shade of the stretches where the panel's limit is active."""
+
+
+OFF_SCALE = 4.0
+"""A limit more than this many times the peak is not drawn to scale: a note gives it."""
+
+
+def _limit(ax: Axes, limit: float, peak: float, unit: str) -> None:
+    """``±limit`` dashed, in view unless far beyond ``peak``: then the axis stays on the data and
+    a note gives the limit and the peak as a fraction of it."""
+    if not math.isfinite(limit):
+        return
+    if limit <= OFF_SCALE * max(peak, 1e-300):
+        ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.1, label=f"±limit ({limit:.4g} {unit})")
+        ax.axhline(-limit, color=LIMIT_COLOR, ls="--", lw=1.1)
+        ax.set_ylim(-1.15 * limit, 1.45 * limit)  # room for the legend above the +limit line
+        return
+    ax.text(
+        0.005, 0.03, f"±{limit:.4g} {unit} limit off scale: the peak is {100 * peak / limit:.1f} % of it",
+        transform=ax.transAxes, fontsize=8, color=LIMIT_COLOR, va="bottom",
+    )  # fmt: skip
 
 
 def _panel_figure(
@@ -61,13 +83,14 @@ def _panel_figure(
             span = float(reference.t[-1] - reference.t[0]) or 1.0
             t_ref = motion.t[0] + (reference.t - reference.t[0]) * duration / span
             ax.plot(
-                t_ref, ref_values[:, j], color=REFERENCE_COLOR, lw=0.9, label="reference (time stretched)"
+                t_ref,
+                ref_values[:, j],
+                color=REFERENCE_COLOR,
+                lw=0.9,
+                label="the reference, its time scaled to this one",
             )
         ax.plot(motion.t, values[:, j], color=ACTUAL_COLOR, lw=1.3, label=f"{symbol}{j + 1}")
-        limit = float(upper[j])
-        if math.isfinite(limit):
-            ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.1, label=f"±limit ({limit:.4g} {kind.unit})")
-            ax.axhline(-limit, color=LIMIT_COLOR, ls="--", lw=1.1)
+        _limit(ax, float(upper[j]), float(np.abs(values[:, j]).max()), kind.unit)
         for stretch in active:
             if stretch.kind is kind and stretch.joint == j:
                 ax.axvspan(
@@ -81,7 +104,8 @@ def _panel_figure(
         ax.grid(alpha=0.3)
         ax.legend(loc="upper right", fontsize=7.5)
     axes[-1].set_xlabel("t [s]")
-    fig.suptitle(f"{title}: {kind.name} against its limits (shaded: active)", fontsize=10)
+    what = "torque" if kind is EFFORT else kind.name
+    fig.suptitle(f"{title}: {what} against its limits (shaded: a limit active)", fontsize=10)
     return fig
 
 
