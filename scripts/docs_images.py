@@ -232,7 +232,9 @@ def within_limits() -> list[Path]:
     polynomial = reference_motion(robot, reference, 2001)
     retimed = time_optimal(robot, reference)
     least = optimize(robot, reference, "effort")
-    print(f"retimed: {retimed.duration:.4f} s; least effort {least.effort:.4g} against {least.reference_effort:.4g}")
+    print(
+        f"retimed: {retimed.duration:.4f} s; least effort {least.effort:.4g} against {least.reference_effort:.4g}"
+    )
     wanted = {
         "time_optimal_torque.png": "within_limits_time_optimal_torque.png",
         "time_optimal_velocity.png": "within_limits_time_optimal_velocity.png",

@@ -177,3 +177,18 @@ def test_a_joint_trajectory_round_trip_through_a_retiming_keeps_its_period_contr
     np.testing.assert_allclose(a.q, b.q, atol=1e-12)
     np.testing.assert_allclose(traj.sample(0.0).v, 0.0, atol=1e-12)
     assert isinstance(default_trajectory(twolink), JointTrajectory)
+
+
+def test_reading_a_samples_file_rechecks_the_position_range(tmp_path, twolink, retimed) -> None:
+    """A saved retiming edited to carry joint 1 past its range is refused when read, naming the
+    joint and its limits, as every trajectory file is."""
+    import json
+
+    write_trajectory_file(tmp_path / "fast.json", retimed.trajectory)
+    document = json.loads((tmp_path / "fast.json").read_text())
+    document["samples"]["q"][5][0] = 3.5
+    (tmp_path / "edited.json").write_text(json.dumps(document))
+    with pytest.raises(
+        InvalidParameterError, match=r"samples\.q\[5\]\[0\].*joint 1 \(joint1\) within its limits"
+    ):
+        read_trajectory_file(tmp_path / "edited.json", twolink)
