@@ -666,9 +666,10 @@ def time_optimal(
     require_type(trajectory, Trajectory, "trajectory", "a Trajectory (twolink_pin.default_trajectory)")
     if not (isinstance(gridpoints, int) and not isinstance(gridpoints, bool) and 20 <= gridpoints <= 100_000):
         raise InvalidParameterError("gridpoints", gridpoints, "an integer from 20 to 100000")
-    start = time.perf_counter()
     base = joint_limits(robot) if limits is None else limits
     base.require(VELOCITY, "retime a path to its shortest duration")
+    _toppra()  # imported once (about 1 s), before the clock starts
+    start = time.perf_counter()
     wanted = base.scaled(limit_scale)
     pieces = path_pieces(trajectory)
     lengths = _lengths(pieces)
