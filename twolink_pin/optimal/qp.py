@@ -5,6 +5,12 @@ dense backend: an augmented-Lagrangian interior of primal-dual proximal iteratio
 warm-starts well, Bambade et al. 2022), the solver of the trajectory optimiser's SQP
 steps, the model-predictive law's replans and the constrained task-space law's steps.
 
+A QP solved again and again whose inequalities rarely bind (a constrained law's step) may ask
+for its **unconstrained minimiser first** (``unconstrained_first``): one linear solve of the
+cost's stationarity under the equalities; when that point satisfies every inequality it is the
+QP's solution (the KKT conditions hold with zero inequality multipliers: the start of Goldfarb
+and Idnani's dual active-set method, 1983) and ProxQP is not called.
+
 Each row of ``C`` may carry a label (``"effort of joint 2 at t = 0.31 s"``), so that a
 problem whose constraints cannot all hold names the one most violated by ProxQP's
 closest feasible point. :func:`kkt_residual` measures a solution's optimality
@@ -95,6 +101,7 @@ def solve_qp(
     eps: float = DEFAULT_EPS,
     max_iter: int = DEFAULT_MAX_ITER,
     what: str = "QP",
+    unconstrained_first: bool = False,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -104,12 +111,19 @@ def solve_qp(
         eps: Absolute tolerance of the primal and dual residuals.
         max_iter: Most iterations.
         what: The problem in words, for messages (``"the MPC replan at t = 1.2 s"``).
+        unconstrained_first: First try the minimiser of the cost under the equalities alone
+            (:func:`unconstrained_minimiser`): when it satisfies every inequality it is
+            returned (0 iterations, zero inequality multipliers), else ProxQP solves the QP.
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
             closest feasible point misses one: the row, by its label, and by how much) or
             it stopped without converging (its status and iterations).
     """
+    if unconstrained_first:
+        inside = unconstrained_minimiser(qp)
+        if inside is not None:
+            return inside
     import proxsuite
 
     proxqp = proxsuite.proxqp
@@ -144,6 +158,38 @@ def solve_qp(
         float(info.pri_res),
         float(info.dua_res),
     )
+
+
+def unconstrained_minimiser(qp: QP) -> QPSolution | None:
+    """The minimiser of ``qp``'s cost under its equalities alone — one linear solve of the KKT
+    system ``[H Aᵀ; A 0] (x, y) = (−g, b)`` — when ``H`` is positive definite (a Cholesky
+    factorisation says so) and that point satisfies every inequality, exactly (no tolerance):
+    then it is the QP's solution, with zero inequality multipliers. None otherwise (an
+    inequality would be violated, ``H`` is only semidefinite, or the system is singular)."""
+    H, g = qp.H, qp.g
+    n = g.shape[0]
+    m = 0 if qp.A is None else qp.A.shape[0]
+    try:
+        np.linalg.cholesky(H)
+        if m:
+            assert qp.A is not None and qp.b is not None
+            K = np.zeros((n + m, n + m))
+            K[:n, :n], K[:n, n:], K[n:, :n] = H, qp.A.T, qp.A
+            xy = np.linalg.solve(K, np.concatenate((-g, qp.b)))
+            x, y = xy[:n], xy[n:]
+        else:
+            x, y = np.linalg.solve(H, -g), np.zeros(0)
+    except np.linalg.LinAlgError:
+        return None
+    k = 0 if qp.C is None else qp.C.shape[0]
+    if k:
+        assert qp.C is not None and qp.l is not None and qp.u is not None
+        cx = qp.C @ x
+        if not (np.all(cx >= qp.l) and np.all(cx <= qp.u)):  # NaN fails both: ProxQP then
+            return None
+    stationarity = H @ x + g + (qp.A.T @ y if m and qp.A is not None else 0.0)
+    primal = float(np.abs(qp.A @ x - qp.b).max()) if m and qp.A is not None and qp.b is not None else 0.0
+    return QPSolution(x, y, np.zeros(k), 0, primal, float(np.abs(stationarity).max()))
 
 
 def _infeasible_reason(qp: QP, eps: float, max_iter: int) -> str | None:
