@@ -11,7 +11,6 @@ from twolink_pin.controllers.base import LawInput, LawOutput, Terms
 from twolink_pin.controllers.gains import gain
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
 from twolink_pin.controllers.task_space import posture_acceleration, task_acceleration
-from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import ACCELERATION, EFFORT, POSITION, VELOCITY, JointLimits, LimitKind, joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.optimal import QP, solve_qp
@@ -44,23 +43,14 @@ class QPOSCGains(OSCGains):
             law may use, $0 < f \le 1$ (headroom; the position range is kept); default 1.
     """
 
-    posture_weight: Any = gain(POSTURE_WEIGHT, unit="", doc="posture weight w against the task (0 < w <= 1)")
+    posture_weight: Any = gain(POSTURE_WEIGHT, bound="fraction", doc="posture weight w against the task")
     position_horizon: Any = gain(None, per="joint", unit="s", doc="horizon h of the position damper")
     velocity_horizon: Any = gain(
         VELOCITY_HORIZON, per="joint", unit="s", doc="horizon h_v of the velocity damper"
     )
     limit_scale: Any = gain(
-        1.0, unit="", doc="fraction f of the velocity, acceleration and effort limits used (0 < f <= 1)"
+        1.0, bound="fraction", doc="fraction f of the velocity, acceleration and effort limits used"
     )
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        for name in ("posture_weight", "limit_scale"):
-            value = np.asarray(getattr(self, name))
-            if value.max() > 1.0:
-                raise InvalidParameterError(
-                    name, float(value.max()), "a fraction 0 < value <= 1 (or one per run)"
-                )
 
 
 def default_horizon(limits: JointLimits) -> np.ndarray:
@@ -138,7 +128,8 @@ class QPOperationalSpace(OperationalSpace):
         self.limits = joint_limits(robot)
         """The robot's limits (unscaled: ``limit_scale`` scales them in the QP)."""
         given = [(kind, int(j)) for kind in KINDS_IN_ROWS for j in np.flatnonzero(self.limits.given(kind))]
-        self.labels = tuple(_label(kind, j, self.limits) for kind, j in given)
+        scale = cast(QPOSCGains, self.gains).limit_scale
+        self.labels = tuple(_label(kind, j, self.limits, scale) for kind, j in given)
         """What each inequality row of the QP bounds, in order: effort, acceleration, velocity, position."""
         self._effort = np.array([j for kind, j in given if kind is EFFORT], dtype=int)
         self._joints = np.array([j for kind, j in given if kind is not EFFORT], dtype=int)
@@ -172,12 +163,11 @@ class QPOperationalSpace(OperationalSpace):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         problems = self.problems(x, terms)
-        M, b = terms.mass(x.q), terms.bias(x.q, x.v)
-        tau = np.empty_like(b)
+        accel = np.empty((len(problems), self.robot.nv))  # q̈ per run; then τ = M̂ q̈ + b̂
         for i, qp in enumerate(problems):
             what = f"the QP at t = {x.t:.6g} s" + (f" (run {i})" if len(problems) > 1 else "")
-            tau[i] = M[i] @ solve_qp(qp, what=what, unconstrained_first=True).x + b[i]  # τ = M̂ q̈ + b̂
-        return LawOutput(tau)
+            accel[i] = solve_qp(qp, what=what, unconstrained_first=True).x
+        return LawOutput(np.matvec(terms.mass(x.q), accel) + terms.bias(x.q, x.v))
 
     def problems(self, x: LawInput, terms: Terms) -> list[QP]:
         """The QP of each run at this evaluation (what :meth:`compute` solves; e.g. to inspect
@@ -210,12 +200,18 @@ class QPOperationalSpace(OperationalSpace):
         return [QP(H[i], gradient[i], None, None, C[i], lower[i], upper[i], self.labels) for i in range(runs)]
 
 
-def _label(kind: LimitKind, j: int, limits: JointLimits) -> str:
-    """What row ``(kind, j)`` of the QP bounds, in words."""
+def _label(kind: LimitKind, j: int, limits: JointLimits, scale: Any) -> str:
+    """What row ``(kind, j)`` of the QP bounds, in words, and the quantity the row holds (the
+    bounds a message gives are the row's)."""
     joint = f"joint {j + 1} ({limits.joint_names[j]})"
     if kind is POSITION:
         lo, hi = limits.position_lower[j], limits.position_upper[j]
-        return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} (its damper q + 2h q̇ + h² q̈)"
+        return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} (row: q̈ [rad/s²] in its damper q + 2h q̇ + h² q̈)"
     value = float(getattr(limits, kind.name)[j])
-    damper = " (its damper q̇ + h_v q̈)" if kind is VELOCITY else ""
-    return f"the {kind.name} limit {value:.6g} {kind.unit} of {joint}{damper}"
+    bound = f"{value * scale:.6g}" if isinstance(scale, float) else f"limit_scale × {value:.6g}"
+    row = {
+        EFFORT: "M̂ q̈ = τ − b̂ [N·m]",
+        ACCELERATION: "q̈ [rad/s²]",
+        VELOCITY: "q̈ [rad/s²] in its damper q̇ + h_v q̈",
+    }[kind]
+    return f"the {kind.name} limit |{kind.symbol}| <= {bound} {kind.unit} of {joint} (row: {row})"
