@@ -92,9 +92,13 @@ def test_the_unconstrained_minimiser_first_is_prox_qps_answer(seed: int) -> None
     n, m, k = 6, 2, 8
     M = rng.normal(size=(n, n))
     H, g = M @ M.T + 0.1 * np.eye(n), rng.normal(size=n)
-    A, b = rng.normal(size=(m, n)), rng.normal(size=m)
     C = rng.normal(size=(k, n))
     width = rng.uniform(0.5, 20.0)  # narrow boxes bind, wide ones do not
+    point = np.linalg.lstsq(C, rng.uniform(-0.5, 0.5, k) * width, rcond=None)[0]
+    if not np.all(np.abs(C @ point) <= width):
+        point = np.zeros(n)
+    A = rng.normal(size=(m, n))
+    b = A @ point  # equalities that a point inside every box meets
     qp = QP(H, g, A, b, C, -width * np.ones(k), width * np.ones(k))
     K = np.block([[H, A.T], [A, np.zeros((m, m))]])
     free = np.linalg.solve(K, np.concatenate([-g, b]))[:n]
