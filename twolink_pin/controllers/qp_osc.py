@@ -10,7 +10,7 @@ import numpy as np
 from twolink_pin.controllers.base import LawInput, LawOutput, Terms
 from twolink_pin.controllers.gains import gain
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
-from twolink_pin.controllers.task_space import posture_acceleration, task_acceleration
+from twolink_pin.controllers.task_space import posture_acceleration, row_index, task_acceleration
 from twolink_pin.limits import ACCELERATION, EFFORT, POSITION, VELOCITY, JointLimits, LimitKind, joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.optimal import QP, solve_qp
@@ -131,10 +131,14 @@ class QPOperationalSpace(OperationalSpace):
         scale = cast(QPOSCGains, self.gains).limit_scale
         self.labels = tuple(_label(kind, j, self.limits, scale) for kind, j in given)
         """What each inequality row of the QP bounds, in order: effort, acceleration, velocity, position."""
-        self._effort = np.array([j for kind, j in given if kind is EFFORT], dtype=int)
+        effort = np.array([j for kind, j in given if kind is EFFORT], dtype=int)
+        self._n_effort = effort.size
+        self._effort = row_index(effort) if effort.size else effort  # usually every joint: a slice, a view
         self._joints = np.array([j for kind, j in given if kind is not EFFORT], dtype=int)
         self._kinematic = np.eye(robot.nv)[self._joints]  # the rows of q̈ the other limits bound
-        self._rows = self._row_coefficients(given)
+        lower, upper, a_q, a_v = self._row_coefficients(given)
+        self._rows = (lower, upper, a_q[:, self._n_effort :], a_v[:, self._n_effort :])
+        self._weight = np.asarray(cast(QPOSCGains, self.gains).posture_weight, dtype=float).reshape(-1, 1, 1)
 
     def _row_coefficients(self, given: list[tuple[LimitKind, int]]) -> tuple[np.ndarray, ...]:
         """Per inequality row, ``(lower, upper, a_q, a_v)`` with the row's bounds
@@ -162,18 +166,23 @@ class QPOperationalSpace(OperationalSpace):
         return {"position_horizon": default_horizon(joint_limits(self.robot))}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        problems = self.problems(x, terms)
-        accel = np.empty((len(problems), self.robot.nv))  # q̈ per run; then τ = M̂ q̈ + b̂
+        problems, M, b = self._problems(x, terms)
+        accel = np.empty_like(b)  # q̈ per run; then τ = M̂ q̈ + b̂
+        at = f"the QP at t = {x.t:.6g} s"
         for i, qp in enumerate(problems):
-            what = f"the QP at t = {x.t:.6g} s" + (f" (run {i})" if len(problems) > 1 else "")
+            what = at if len(problems) == 1 else f"{at} (run {i})"
             accel[i] = solve_qp(qp, what=what, unconstrained_first=True).x
-        return LawOutput(np.matvec(terms.mass(x.q), accel) + terms.bias(x.q, x.v))
+        return LawOutput(np.matvec(M, accel) + b)
 
     def problems(self, x: LawInput, terms: Terms) -> list[QP]:
         """The QP of each run at this evaluation (what :meth:`compute` solves; e.g. to inspect
         one, or check its KKT conditions): over ``q̈`` [rad/s²] with ``τ = M̂ q̈ + b̂``
         substituted, so that the effort box is the rows ``M̂ q̈`` within ``±f τ_max − b̂``; the
         inequality rows are labelled in :attr:`labels`."""
+        return self._problems(x, terms)[0]
+
+    def _problems(self, x: LawInput, terms: Terms) -> tuple[list[QP], np.ndarray, np.ndarray]:
+        """:meth:`problems`, and ``M̂`` (N, nv, nv) and ``b̂`` (N, nv) they were built from."""
         g = cast(QPOSCGains, self.gains)
         task = task_acceleration(x, terms, self._index, self._K, self._D)
         J = task.jacobian
@@ -182,22 +191,24 @@ class QPOperationalSpace(OperationalSpace):
         JtLam = np.matmul(Jt, Lam)
         task_hessian = np.matmul(JtLam, J)  # Jᵀ Λ J
         M, b = terms.mass(x.q), terms.bias(x.q, x.v)
-        w = np.asarray(g.posture_weight, dtype=float).reshape(-1, 1, 1)
-        posture = w * (M - task_hessian)  # w Nᵀ M N: the null space (and any damped direction)
+        posture = self._weight * (M - task_hessian)  # w Nᵀ M N: the null space (and any damped direction)
         H = task_hessian + posture
         gradient = -np.matvec(JtLam, task.desired - task.drift) - np.matvec(
             posture, posture_acceleration(x, g.kp_null, g.kd_null)
         )
-        runs = H.shape[0]
+        runs, n_effort = H.shape[0], self._n_effort
         C = np.empty((runs, len(self.labels), self.robot.nv))
-        n_effort = self._effort.size
         C[:, :n_effort] = M[:, self._effort]
         C[:, n_effort:] = self._kinematic
         lower, upper, a_q, a_v = self._rows
-        state = x.q[:, self._joints] * a_q[:, n_effort:] + x.v[:, self._joints] * a_v[:, n_effort:]
-        shift = np.concatenate((-b[:, self._effort], state), axis=1)
+        shift = np.concatenate(
+            (-b[:, self._effort], x.q[:, self._joints] * a_q + x.v[:, self._joints] * a_v), axis=1
+        )
         lower, upper = lower + shift, upper + shift
-        return [QP(H[i], gradient[i], None, None, C[i], lower[i], upper[i], self.labels) for i in range(runs)]
+        problems = [
+            QP(H[i], gradient[i], None, None, C[i], lower[i], upper[i], self.labels) for i in range(runs)
+        ]
+        return problems, M, b
 
 
 def _label(kind: LimitKind, j: int, limits: JointLimits, scale: Any) -> str:
