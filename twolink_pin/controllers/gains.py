@@ -271,6 +271,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     except (TypeError, ValueError):
         raise InvalidParameterError(name, value, _expected(spec)) from None
     allowed = (0, 1) if spec.per == "scalar" else (0, 1, 2)
+    if spec.per == "scalar" and array.ndim == 2 and array.shape[1] == 1:  # validated before: a column
+        array = array[:, 0]  # per run (dataclasses.replace validates every field again)
     if array.ndim not in allowed or array.size == 0:
         raise InvalidParameterError(name, value, f"{_expected(spec)} (got shape {array.shape})")
     bad = ~np.isfinite(array)
