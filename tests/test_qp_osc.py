@@ -254,3 +254,20 @@ def test_a_solver_that_stops_mid_run_fails_the_run_at_that_time(
     assert "controller 'qp-osc' failed at t = 0.05" in err[0] and "ProxQP stopped with status" in err[0], err[
         0
     ]
+
+
+def test_per_run_gains_give_each_run_its_own_qp() -> None:
+    """One law with posture_weight (0.01, 1) and limit_scale (1, 0.4) per run (a sweep's draws,
+    beside osc's matrix gains) drives two runs at the state near joint 4's range as the two
+    single laws do; the weight and the headroom change the answer there."""
+    a, _, near = _near_joint_4s_range()
+    both = QPOperationalSpace(a.robot, a.qp.Gains(posture_weight=[0.01, 1.0], limit_scale=[1.0, 0.4]))
+    assert both.runs == 2
+    x = near._replace(q=np.repeat(near.q, 2, axis=0), v=np.repeat(near.v, 2, axis=0), z=np.zeros((2, 0)))
+    together = both.compute(x, terms_for(both, 2)).tau
+    for i, (w, f) in enumerate([(0.01, 1.0), (1.0, 0.4)]):
+        single = QPOperationalSpace(a.robot, a.qp.Gains(posture_weight=w, limit_scale=f))
+        np.testing.assert_allclose(
+            together[i], single.compute(near, terms_for(single)).tau[0], rtol=0, atol=1e-12
+        )
+    assert np.abs(together[0] - together[1]).max() > 1.0
