@@ -36,6 +36,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         ("trajectory", "feasibility"),
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
+    (
+        "limits",
+        "Limits and optimisation",
+        "Each robot's joint limits and the checks against them; the one QP solve.",
+        ("limits", "optimal"),
+    ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),
     (
         "simulation",
