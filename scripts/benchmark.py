@@ -828,9 +828,14 @@ def qp_osc_section(quick: bool, repeats: int) -> dict[str, Any]:
     fold = read_trajectory_file(HERE.parent / "examples" / "panda_fold_pose.toml", loaded)
     law, plant = make_scenario("qp-osc", loaded)
     demo = SimulationConfig(duration=0.1 if quick else 2.5, dt=DT, q0_offset=(1.5, 0, 0, 0, 0, 0, 0))
-    profiles = {
-        "default reference": _qp_osc_profile(*laws["qp-osc"], reference, config),
-        "limits demo": _qp_osc_profile(law, plant, fold, demo),
+    profiles = {  # the least disturbed of the repeats (the smallest stage time)
+        "default reference": min(
+            (_qp_osc_profile(*laws["qp-osc"], reference, config) for _ in range(repeats)),
+            key=lambda r: r["stage_us"],
+        ),
+        "limits demo": min(
+            (_qp_osc_profile(law, plant, fold, demo) for _ in range(repeats)), key=lambda r: r["stage_us"]
+        ),
     }
     print(
         f"\nqp-osc against osc on the Panda (default reference, 0.05 rad off; {duration:g} s simulated, min of "
@@ -838,7 +843,10 @@ def qp_osc_section(quick: bool, repeats: int) -> dict[str, Any]:
     )
     print(f"  {'osc':10s} {seconds['osc']:10.3f} s")
     print(f"  {'qp-osc':10s} {seconds['qp-osc']:10.3f} s {ratio:7.2f}x osc{_verdict(ratio, QP_OSC_TARGET)}")
-    print("  qp-osc per evaluation: building the QP, solving it (closed form or ProxQP), the whole stage")
+    print(
+        f"  qp-osc per evaluation (least disturbed of {repeats} runs): building the QP, solving it (closed form or "
+        "ProxQP), the whole stage"
+    )
     for label, row in profiles.items():
         print(
             f"  {label:18s} build {row['build_us']:7.1f} us  solve {row['solve_us']:7.1f} us  stage "
