@@ -131,6 +131,10 @@ def _recorded_run(
         raise InvalidParameterError(
             "method", config.method, "'rk4' with a wrench, payload step, sensor noise or delay"
         )
+    if controller.update_period() is not None:
+        raise InvalidParameterError(
+            "method", config.method, f"'rk4' for '{controller.name}', a law that replans (its state jumps)"
+        )
     friction = plant.friction
     if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
         raise InvalidParameterError(
