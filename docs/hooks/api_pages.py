@@ -30,6 +30,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("model", "Model", "Robots from URDF, their parameters and profiles.", ("model",)),
     ("kinematics", "Kinematics", "Forward kinematics, Jacobians, inverse kinematics.", ("kinematics",)),
     (
+        "limits",
+        "Joint limits",
+        "Every limit of a joint, read once; a reference checked against them, a run's crossings.",
+        ("limits",),
+    ),
+    (
         "trajectory",
         "Trajectory",
         "Via points, polynomial references, trajectory files, the torque check.",

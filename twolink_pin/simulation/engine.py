@@ -20,7 +20,9 @@ A plant that pushes back (:mod:`twolink_pin.disturbances`: a wrench, a payload s
 sensor noise, a delay) runs in the same loop: :class:`~twolink_pin.simulation.events.PlantEvents`
 gives each step's dynamics and the noise on what the law measures, and with a delay the law is
 sampled every step (or control period) and a :class:`~twolink_pin.simulation.events.DelayLine`
-applies its torque ``delay`` steps late (details in :mod:`twolink_pin.simulation.events`).
+applies its torque ``delay`` steps late (details in :mod:`twolink_pin.simulation.events`); with
+joint stops the state after each step is put back within the position ranges
+(:mod:`twolink_pin.simulation.stops`).
 
 The law gets its Pinocchio terms from :func:`~twolink_pin.simulation.terms.terms_for`
 and the plant's accelerations come from :func:`~twolink_pin.simulation.forward.dynamics_for`
@@ -242,6 +244,7 @@ class _Run:
         # choose the dynamics of each step, offset what the law measures, delay its torque.
         self.events = events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
         self.line = line = DelayLine(plant.delay) if plant.delay > 0 else None
+        self.stop = events.stop if events is not None and events.stops is not None else None
         self.accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
         noisy = events is not None and events.noise is not None
         self.noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
@@ -262,6 +265,8 @@ class _Run:
         self.alive = np.ones(runs, dtype=bool)
         self.z_start = np.array(z0, dtype=float)
         self.q, self.v, self.z = np.array(q0, dtype=float), np.array(v0, dtype=float), self.z_start.copy()
+        if self.stop is not None:  # a joint that starts beyond its stop starts on it
+            self.q, self.v = self.stop(0.0, self.q, self.v)
         self.steps = _Steps.of(dt, nv, nz)
         self.no_state = np.zeros((runs, 0))
         # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
@@ -278,7 +283,7 @@ class _Run:
     def advance(self, k0: int, k1: int, ref: Any) -> None:
         """Steps ``k0 … k1 − 1``: write each sample, evaluate the law where the run samples it
         (``ref[i]``: the law's reference rows of the block's half-step i), advance the state."""
-        controller, compute, terms, clock, events, line, noise = (
+        controller, compute, terms, clock, events, line, noise, stop = (
             self.controller,
             self.compute,
             self.terms,
@@ -286,6 +291,7 @@ class _Run:
             self.events,
             self.line,
             self.noise,
+            self.stop,
         )
         runs, nv, nz, n, dt, every, sampled, steps, no_state = (
             self.runs,
@@ -344,6 +350,8 @@ class _Run:
                     q, v, z = _stage_step(
                         compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
                     )
+                if stop is not None:  # joint stops: back within the ranges
+                    q, v = stop(t, q, v)
         except (KeyboardInterrupt, SystemExit, MemoryError):
             raise
         except Exception as exc:
