@@ -42,6 +42,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         ("trajectory", "feasibility"),
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
+    (
+        "optimal",
+        "Optimisation",
+        "The one optimisation core: QP solves, transcriptions on Pinocchio's derivatives.",
+        ("optimal",),
+    ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),
     (
         "simulation",
