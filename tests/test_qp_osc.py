@@ -35,7 +35,7 @@ from twolink_pin import (
 )
 from twolink_pin.controllers import QPOperationalSpace, load_controller
 from twolink_pin.errors import InvalidParameterError, OptimizationError
-from twolink_pin.limits import joint_limits
+from twolink_pin.limits import EFFORT, POSITION, joint_limits
 from twolink_pin.optimal import kkt_residual, solve_qp, unconstrained_minimiser
 from twolink_pin.simulation import law_input, terms_for
 
@@ -271,3 +271,17 @@ def test_per_run_gains_give_each_run_its_own_qp() -> None:
             together[i], single.compute(near, terms_for(single)).tau[0], rtol=0, atol=1e-12
         )
     assert np.abs(together[0] - together[1]).max() > 1.0
+
+
+@pytest.mark.parametrize("name", ["ur5", "panda", "kinova", "z1", "twolink"])
+def test_it_runs_on_every_arm_osc_runs_on_within_the_limits(name: str) -> None:
+    """0.2 s of each arm's default reference from 0.05 rad off: every commanded torque within
+    its limit and every joint inside its range at every sample (the Z1's reference passes a wrist
+    singularity, where the QP's posture term holds the damped direction)."""
+    robot = load_robot(name)
+    law, plant = make_scenario("qp-osc", robot)
+    result = simulate(law, plant, default_trajectory(robot), SimulationConfig(duration=0.2, q0_offset=0.05))
+    limits = joint_limits(robot)
+    assert np.all(np.isfinite(result.tau_command))
+    assert limits.excess(EFFORT, result.tau_command).max() <= 1e-9
+    assert limits.excess(POSITION, result.q).max() < 0
