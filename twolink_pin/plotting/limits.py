@@ -12,7 +12,7 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import POSITION, JointLimits
-from twolink_pin.plotting import _style
+from twolink_pin.plotting._style import LIMIT_COLOR, limit_lines, new_figure, save_figure
 from twolink_pin.simulation import SimulationResult
 
 LIMITS_FIGSIZE = (9.0, 6.5)
@@ -37,7 +37,7 @@ def _limits_figure(
     torque_joint: int,
     title: str,
 ) -> Figure:
-    fig = _style.new_figure(LIMITS_FIGSIZE)
+    fig = new_figure(LIMITS_FIGSIZE)
     pos_ax, tau_ax = fig.subplots(2, 1, sharex=True)
     pos_ax.set_label("position")
     tau_ax.set_label("torque")
@@ -56,7 +56,7 @@ def _limits_figure(
         if np.isfinite(bound) and low - (high - low) <= bound <= high + (
             high - low
         ):  # the bounds near the data
-            pos_ax.axhline(bound, color=_style.LIMIT_COLOR, ls=":", lw=1.5)
+            pos_ax.axhline(bound, color=LIMIT_COLOR, ls=":", lw=1.5)
             low, high = min(low, bound), max(high, bound)
     span = high - low
     pos_ax.set_ylim(low - 0.08 * span, high + 0.35 * span)
@@ -69,7 +69,7 @@ def _limits_figure(
     pos_ax.legend(loc="upper right", fontsize=8)
     pos_ax.grid(True, alpha=0.3)
     peak = max(float(np.max(np.abs(r.tau_command[:, k]))) for r in runs.values())
-    _style.limit_lines(tau_ax, float(limits.effort[k]), peak, label=True)
+    limit_lines(tau_ax, float(limits.effort[k]), peak, label=True)
     tau_ax.set_ylabel(f"commanded τ{k + 1} [N·m]")
     tau_ax.set_xlabel("t [s]")
     tau_ax.set_title(f"joint {k + 1} ({name_k}): the torque each law asks for", fontsize=10)
@@ -110,4 +110,4 @@ def save_limits_figure(
         if not 0 <= index < limits.nv:
             raise InvalidParameterError(name, index, f"a joint index 0 … {limits.nv - 1}")
     shown = title or " against ".join(runs) + ": the joint limits"
-    return _style.save_figure(_limits_figure(runs, limits, j, k, shown), Path(path))
+    return save_figure(_limits_figure(runs, limits, j, k, shown), Path(path))
