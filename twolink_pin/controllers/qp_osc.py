@@ -87,15 +87,15 @@ class QPOperationalSpace(OperationalSpace):
     posture's metric $\hat M - J^\top \hat\Lambda J = N^\top \hat M N$ sees only the
     dynamically consistent null space ($N = I - \hat M^{-1} J^\top \hat\Lambda J$), the task's
     only its complement: the two costs do not compete, and without an active constraint the
-    minimiser is, for every $w > 0$, $\ddot q = \hat M^{-1} J^\top \hat\Lambda (\ddot x^* -
-    \dot J \dot q) + N \ddot q_n$ — ``osc``'s acceleration, whose torque $\hat M \ddot q +
-    \hat b$ is ``osc``'s torque. A limit makes them compete, and $w$ weighs the posture against
+    minimiser is, for every $w > 0$,
+    $\ddot q = \hat M^{-1} J^\top \hat\Lambda (\ddot x^* - \dot J \dot q) + N \ddot q_n$ —
+    ``osc``'s acceleration, whose torque $\hat M \ddot q + \hat b$ is ``osc``'s torque. A limit makes them compete, and $w$ weighs the posture against
     the task: one QP rather than two prioritised ones (half the solves; the same answer
     whenever the task can be met exactly). Near a singularity, where ``osc`` damps
     $\hat\Lambda$, the posture term also holds the damped directions (then the two laws differ).
 
-    **Limits as constraints on $\ddot q$.** The velocity damper $\dot q + h_v \ddot q \le
-    \dot q_{max}$ keeps $\dot q \le \dot q_{max}$ for any $h_v > 0$ (Grönwall:
+    **Limits as constraints on $\ddot q$.** The velocity damper
+    $\dot q + h_v \ddot q \le \dot q_{max}$ keeps $\dot q \le \dot q_{max}$ for any $h_v > 0$ (Grönwall:
     $\frac{d}{dt}(\dot q_{max} - \dot q) \ge -(\dot q_{max} - \dot q) / h_v$); a short one
     brakes only near the limit. The position damper is critically damped: for the distance
     $d = q_{max} - q$ it reads $\ddot d + \frac{2}{h} \dot d + \frac{1}{h^2} d \ge 0$, which
