@@ -61,3 +61,55 @@ def test_errors_below_the_integrators_accuracy_are_printed_as_bounds() -> None:
     assert (
         bounded(-2e-7, 1e-6) == "< 1e-6" and bounded(5e-3, 1e-2) == "< 1e-2" and bounded(0.02, 1e-2) == "0.02"
     )
+
+
+CORPUS_URDF = ("axis_minus_z", "axis_x", "prismatic", "tool_offset", "rotated_base", "offset_elbow", "arm3")
+
+
+@pytest.mark.parametrize(
+    "source",
+    [
+        None,
+        "double_pendulum",
+        "asr_twodof",
+        "ur5",
+        "panda",
+        "kinova",
+        "z1",
+        *(f"urdf:{n}" for n in CORPUS_URDF),
+    ],
+)
+def test_poses_of_many_configurations_are_pinocchios_forward_kinematics(source: str | None) -> None:
+    """Second method: the poses the metrics compose for K configurations at once (revolute
+    joints about any axis, prismatic ones, offsets, a tool frame) are Pinocchio's
+    ``framesForwardKinematics`` of each, to 1e-12."""
+    from pathlib import Path
+
+    from twolink_pin.task_metrics import _poses
+
+    if source is not None and source.startswith("urdf:"):
+        source = str(Path(__file__).parent / "corpus" / "urdf" / f"{source[5:]}.urdf")
+    robot = load_robot(source)
+    q = np.random.default_rng(3).uniform(-3.0, 3.0, (60, robot.nq))
+    position, rotation = _poses(robot, q, robot.ee_frame_id)
+    data = robot.model.createData()
+    for k in range(len(q)):
+        pin.framesForwardKinematics(robot.model, data, q[k])
+        placement = data.oMf[robot.ee_frame_id]
+        np.testing.assert_allclose(position[k], placement.translation, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(rotation[k], placement.rotation, rtol=0, atol=1e-12)
+
+
+def test_rotation_angle_is_the_norm_of_log3_near_0_and_near_pi() -> None:
+    from twolink_pin.task_metrics import rotation_angle
+
+    rng = np.random.default_rng(4)
+    axes = rng.normal(size=(40, 3))
+    axes /= np.linalg.norm(axes, axis=1)[:, None]
+    angles = np.concatenate(
+        [[0.0, 1e-12, 1e-7], rng.uniform(0, np.pi, 34), [np.pi - 1e-6, np.pi - 1e-9, np.pi]]
+    )
+    R_des = np.array([pin.exp3(v) for v in rng.normal(size=(40, 3))])
+    R = np.array([pin.exp3(a * v) @ Rd for a, v, Rd in zip(angles, axes, R_des, strict=True)])
+    expected = [np.linalg.norm(pin.log3(r @ rd.T)) for r, rd in zip(R, R_des, strict=True)]
+    np.testing.assert_allclose(rotation_angle(R, R_des), expected, rtol=0, atol=1e-9)
