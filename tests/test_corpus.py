@@ -25,6 +25,7 @@ import pytest
 from corpus import runner
 from corpus.cases import CASES, LIBRARY
 from corpus.cases_limits import LIMITS, LIMITS_LIBRARY
+from corpus.cases_variants import GAINS, GAINS_LIBRARY
 from corpus.spec import URDF, Case, LibCase
 
 
@@ -61,8 +62,8 @@ def _registry() -> Any:
             del sys.modules[name]
 
 
-ALL_CASES = [*CASES, *LIMITS]
-ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY]
+ALL_CASES = [*CASES, *LIMITS, *GAINS]
+ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY, *GAINS_LIBRARY]
 
 
 @pytest.mark.parametrize("case", ALL_CASES, ids=[c.id for c in ALL_CASES])

@@ -17,7 +17,7 @@ from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
-from twolink_pin.studies.sweep_cases import Cases, SweepConfig, chunk_law, gain_target
+from twolink_pin.studies.sweep_cases import Cases, SweepConfig, check_draws, chunk_law, gain_target
 from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
 
@@ -172,6 +172,7 @@ class PreparedSweep:
             record,
         )
         self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
+        check_draws(config, robot, self.base.controller)  # every draw a value simulate takes, first
         nv = robot.nv
         if record:
             kept = config.samples * (config.run.simulation.steps + 1) * 3 * nv
