@@ -88,6 +88,7 @@ def test_format_variant_writes_the_changed_gains_in_order_and_reads_back() -> No
     assert (
         format_variant("pd", {"kp": (350.0, 300.0), "kd": 40.0}, defaults={"kp": [[350, 300]]}) == "pd@kd=40"
     )
+    assert format_variant("pd", {"kp": None, "kd": 40.0}) == "pd@kd=40"  # None: left to the robot
     assert format_variant("computed-torque", {"lam": 0.1 + 0.2}, model="id.urdf") == (
         "computed-torque@lam=0.30000000000000004@model=id.urdf"
     )

@@ -282,6 +282,7 @@ def format_variant(
         gains: Gains by name, written in this order (a law's ``gains.values()`` is its
             declaration order): a number, numbers per joint, or a matrix (one value set;
             written row by row); each number as the shortest text that reads back to it.
+            None (left to the robot) is left out.
         defaults: The law's gains in a default run; a gain equal to its default (the same
             numbers, a scalar equal to a constant row) is left out.
         model: The parameter file the law's model believes (``@model=``).
@@ -297,9 +298,10 @@ def format_variant(
     for name, value in (gains or {}).items():
         if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name) or name in PARAMETER_KEYS:
             raise InvalidParameterError("gain", name, "a gain's field name (not model or p0)")
-        if defaults is not None and name in defaults and defaults[name] is not None and value is not None:
-            if _same_numbers(value, defaults[name]):
-                continue
+        if value is None:  # left to the robot: its default
+            continue
+        if defaults is not None and defaults.get(name) is not None and _same_numbers(value, defaults[name]):
+            continue
         parts.append(f"{name}={_value_text(name, value)}")
     for key, path in (("model", model), ("p0", p0)):
         if path is not None:
