@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers.task_space import rotation_error
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
@@ -164,9 +163,9 @@ def _chain(model: pin.Model, frame_id: int) -> list[Link] | None:
 
 def _times(rotation: np.ndarray, matrix: np.ndarray) -> np.ndarray:
     """``rotation @ matrix`` for a stack of rotations (K, 3, 3) and one matrix (3, 3) or vector
-    (3,): one matrix product of (3K, 3) by it."""
-    k = len(rotation)
-    return (rotation.reshape(3 * k, 3) @ matrix).reshape((k, 3, 3) if matrix.ndim == 2 else (k, 3))
+    (3,): numpy's own sum of products (no BLAS), so each row's result is the same whatever K
+    (a sweep's rows do not depend on its chunks)."""
+    return np.einsum("kij,jl->kil" if matrix.ndim == 2 else "kij,j->ki", rotation, matrix)
 
 
 def _poses(robot: RobotModel, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray]:
@@ -179,8 +178,7 @@ def _poses(robot: RobotModel, q: np.ndarray, frame_id: int) -> tuple[np.ndarray,
     chain = _chain(model, frame_id)
     if chain is None:
         return _poses_one_by_one(model, q, frame_id)
-    with one_blas_thread():  # products of (3K, 3) by (3, 3): OpenBLAS's threads make them 7x slower
-        return _chain_poses(model, chain, q, frame_id)
+    return _chain_poses(model, chain, q, frame_id)
 
 
 def _placed(rotation: np.ndarray, position: np.ndarray, placement: pin.SE3) -> tuple[np.ndarray, np.ndarray]:
