@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 from corpus import runner
 from corpus.cases import CASES, LIBRARY
+from corpus.cases_joint_limits import JOINT_LIMITS
 from corpus.cases_limits import LIMITS, LIMITS_LIBRARY
 from corpus.cases_variants import GAINS, GAINS_LIBRARY
 from corpus.spec import URDF, Case, LibCase
@@ -62,7 +63,7 @@ def _registry() -> Any:
             del sys.modules[name]
 
 
-ALL_CASES = [*CASES, *LIMITS, *GAINS]
+ALL_CASES = [*CASES, *LIMITS, *JOINT_LIMITS, *GAINS]
 ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY, *GAINS_LIBRARY]
 
 

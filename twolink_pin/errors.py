@@ -4,7 +4,7 @@ Every error the package raises on bad input derives from :class:`TwolinkPinError
 Each subclass keeps the offending value(s) as attributes and its message says what was
 expected, so a caller can both show it and act on it. The CLI turns any of them into one
 line on stderr: exit status 2 for bad input, 1 for a run that failed
-(:class:`SimulationDivergedError`, :class:`ControllerError`).
+(:class:`SimulationDivergedError`, :class:`ControllerError`, :class:`OptimizationError`).
 
 Every exception pickles with its attributes (``__reduce__``), so an error raised in a
 worker process (the report's pool, a Dask worker) arrives whole in the parent.
@@ -143,6 +143,26 @@ class ControllerError(TwolinkPinError):
         self.detail = detail
         at = f" at t = {time:.6g} s" if time == time else ""  # NaN: the time is not known (a Dask task)
         super().__init__(f"controller '{controller}' failed{at}: {detail}")
+
+
+class OptimizationError(TwolinkPinError):
+    """An optimisation that did not reach an answer: its constraints cannot all hold, or its
+    solver stopped before converging. A failed run (exit status 1), not bad input.
+
+    Attributes:
+        problem: What was being solved, in words.
+        reason: Why it stopped (the constraint that cannot hold, the solver's status, the
+            remaining violation).
+        iterations: Iterations done.
+    """
+
+    _fields = ("problem", "reason", "iterations")
+
+    def __init__(self, problem: str, reason: str, iterations: int) -> None:
+        self.problem = problem
+        self.reason = reason
+        self.iterations = iterations
+        super().__init__(f"{problem} failed after {iterations} iterations: {reason}")
 
 
 class ControllerSpecError(TwolinkPinError):

@@ -230,6 +230,8 @@ class RunSpec:
                 True,
                 f"a robot with effort limits ({robot.name}'s URDF gives none: nothing to clip)",
             )
+        if plant.position_stops:
+            self._check_stops(robot)
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
             for cls in classes
@@ -294,6 +296,25 @@ class RunSpec:
         if noise is not None and noise.sigma_q == 0 and noise.sigma_v == 0:
             raise InvalidParameterError(
                 "--sensor-noise", "0,0", "a standard deviation > 0 on q or q̇ (0,0 adds no noise)"
+            )
+
+    def _check_stops(self, robot: RobotModel) -> None:
+        """``--joint-stops`` needs a position range on some joint and the RK4 engine."""
+        from twolink_pin.limits import POSITION, joint_limits
+
+        limits = joint_limits(robot)
+        if not limits.given(POSITION).any():
+            raise InvalidParameterError(
+                "--joint-stops",
+                True,
+                f"a robot with a position range on some joint ({robot.name}'s joints "
+                f"{', '.join(limits.joint_names)} have none: nothing to stop at)",
+            )
+        if self.simulation.method != "rk4":
+            raise InvalidParameterError(
+                "--joint-stops",
+                True,
+                f"--method rk4 (the stops act between its steps), not {self.simulation.method}",
             )
 
     def as_dict(self) -> dict[str, Any]:

@@ -30,12 +30,24 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("model", "Model", "Robots from URDF, their parameters and profiles.", ("model",)),
     ("kinematics", "Kinematics", "Forward kinematics, Jacobians, inverse kinematics.", ("kinematics",)),
     (
+        "limits",
+        "Joint limits",
+        "Every limit of a joint, read once; a reference checked against them, a run's crossings.",
+        ("limits",),
+    ),
+    (
         "trajectory",
         "Trajectory",
         "Via points, polynomial references, trajectory files, the torque check.",
         ("trajectory", "feasibility"),
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
+    (
+        "optimal",
+        "Optimisation",
+        "The one optimisation core: QP solves, transcriptions on Pinocchio's derivatives.",
+        ("optimal",),
+    ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),
     (
         "simulation",

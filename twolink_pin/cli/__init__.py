@@ -11,7 +11,7 @@
 =====================  ====================================================================================
 
 Bad input gives one line on stderr and exit status 2; a failed run (a diverged
-simulation, a law that raised) exit status 1; Ctrl-C exit status 130, SIGTERM 143. An
+simulation, a law that raised, an optimisation that did not converge) exit status 1; Ctrl-C exit status 130, SIGTERM 143. An
 unexpected exception (a bug) is one line with exit status 1, or its traceback with
 ``TWOLINK_PIN_DEBUG=1`` or ``twolink-pin --debug``; ``--debug`` also prints the traceback
 of a law that raised.
@@ -36,7 +36,7 @@ import numpy.random  # noqa: F401
 from twolink_pin import interrupts
 from twolink_pin.cli import guard
 from twolink_pin.cli.parser import build_parser
-from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError
+from twolink_pin.errors import ControllerError, OptimizationError, SimulationDivergedError, TwolinkPinError
 from twolink_pin.interrupts import Terminated
 from twolink_pin.readiness import ready
 
@@ -131,7 +131,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         with warnings.catch_warnings():
             warnings.showwarning = _show_warning  # one line each, not Python's file:line and source
             return _run(args)
-    except (SimulationDivergedError, ControllerError) as exc:
+    except (SimulationDivergedError, ControllerError, OptimizationError) as exc:
         if isinstance(exc, ControllerError) and _debug(args):  # the law's own traceback
             import traceback
 

@@ -65,7 +65,8 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
     points."""
     import pinocchio as pin
 
-    from twolink_pin.cli.output import emit, fmt
+    from twolink_pin.cli.commands.model import limits_payload
+    from twolink_pin.cli.output import emit, fmt, limits_check_lines
 
     figures: list[str] = []
     if args.plot:
@@ -82,6 +83,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
         "via_q": traj.via_q.tolist(),
         "ik_error": {"position_m": traj.ik_error[0], "angle_rad": traj.ik_error[1]},
         **check.summary(),
+        **limits_payload(check),
         "figures": figures,
     }
     lines = ["via poses (t [s], position [m], roll-pitch-yaw [rad], q [rad]):"]
@@ -92,6 +94,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
     )
     lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
     lines.append(check.verdict())
+    lines += limits_check_lines(check.limits_check)
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))
     return 0

@@ -16,6 +16,9 @@ A law subclasses :class:`Controller`, states its law in the class docstring, dec
 
 and implements **one** method, :meth:`Controller.compute`, that maps a :class:`LawInput`
 (time, state, reference) to a :class:`LawOutput` (torque τ and, for a law with state, ż).
+A law that plans (the model-predictive law) also declares :meth:`Controller.update_period`
+and :meth:`Controller.update`: a discrete update of its state (the new plan) that the engine
+makes at those instants.
 Every array has a leading run axis: ``q`` is ``(N, nv)`` for N runs advanced together
 (N = 1 for a single run); the reference sample is ``(1, nv)`` (the same for every run).
 Write the law with numpy broadcasting and it never needs to know N.
@@ -192,6 +195,14 @@ class Terms(Protocol):
     def solve_mass(self, q: np.ndarray, b: np.ndarray) -> np.ndarray:
         """``M̂(q)⁻¹ b``, shape (N, nv) for ``b`` of shape (N, nv) or (N, nv, k) for
         (N, nv, k): a linear solve on ``M̂`` (LU), never an explicit inverse."""
+        ...
+
+    def inverse_dynamics_derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Any:
+        """``τ = M̂ a + Ĉ(q, v) v + ĝ`` and its derivatives ``∂τ/∂q``, ``∂τ/∂v`` and
+        ``∂τ/∂a = M̂`` at K states of each run, on the controller's model (Pinocchio's
+        ``computeRNEADerivatives``): arguments of shape (N, K, nv) (row i: run i's states),
+        a :class:`~twolink_pin.dynamics.InverseDynamicsDerivatives` of shapes (N, K, nv) and
+        (N, K, nv, nv). What a law that plans (:meth:`Controller.update`) linearises with."""
         ...
 
     def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
@@ -415,6 +426,21 @@ class Controller(abc.ABC, Generic[G]):
     def initial_state(self) -> np.ndarray:
         """``z(0)``, shape (nz,) or one row per run (N, nz); zeros unless overridden."""
         return np.zeros(self.state_size)
+
+    def update_period(self) -> float | None:
+        """Time [s] between the law's discrete updates of its state (:meth:`update`: a
+        planning law's replans), from t = 0; ``None`` (the default): the law has none.
+        The engine calls :meth:`update` at every multiple of this period, which must be a
+        multiple of the simulation step."""
+        return None
+
+    def update(self, x: LawInput, terms: Terms) -> np.ndarray:
+        """The law's new state ``z``, shape (N, nz), at an update instant (every
+        :meth:`update_period` seconds): what a planning law does when it replans (its plan
+        and warm start are its state, recorded like any state). Called before
+        :meth:`compute` at that instant, with the measured state and the state so far; between
+        updates ``z`` moves only by the ``dz`` :meth:`compute` returns (zeros for a plan)."""
+        raise NotImplementedError(f"{type(self).__name__} declares an update period but no update()")
 
     def scaled_gains(self) -> dict[str, Any]:
         """Values for the per-joint or per-estimate gains left ``None``, derived from the

@@ -15,7 +15,10 @@ What each entry adds to the URDF, and why:
   at 0.001 m as in its SRDF, the Z1's gripper closed at 0 rad): tracking control of the
   arm, the fingers' masses carried by the hand;
 * ``ee_frame``: the tool frame Cartesian via points and the figures refer to;
-* ``q0_offset``: the initial tracking error of a run (:data:`Q0_OFFSET`).
+* ``q0_offset``: the initial tracking error of a run (:data:`Q0_OFFSET`);
+* ``acceleration_limits``: the Panda's joint acceleration limits from Franka's data sheet
+  ("Robot and interface specifications": 15, 7.5, 10, 12.5, 15, 20, 20 rad/s²); the other
+  makers publish none for these arms, and a URDF has no element for them.
 
 Everything else (gains, base parameters, the default trajectory) the toolkit derives
 from the model.
@@ -57,6 +60,8 @@ _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
             # its SRDF's "default" state, (0, −π/4, 0, −3π/4, 0, π/2, π/4): the file writes these
             # to 6 digits, and π/2 cut (not rounded) to 1.5707, 9.6e-5 rad short
             "home": (0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4),
+            # Franka's data sheet ("Robot and interface specifications", q̈max per joint)
+            "acceleration_limits": (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
         },
     ),
     "kinova": (

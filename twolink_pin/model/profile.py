@@ -135,6 +135,9 @@ class RobotProfile:
         locked_positions: Position of each locked joint [rad or m]; ``None``: 0 clipped to its limits.
         home: A configuration the default trajectory and the viewer start from [rad], one
             per joint of the (reduced) model; ``None``: the middle of each joint's range.
+        acceleration_limits: ``|q̈_j| <=`` these [rad/s²], one per joint of the (reduced)
+            model, from the maker's data sheet (a URDF has no acceleration limit); ``None``:
+            none (:mod:`twolink_pin.limits`).
         report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
     """
 
@@ -151,6 +154,7 @@ class RobotProfile:
     locked_joints: tuple[str, ...] = ()
     locked_positions: tuple[float, ...] | None = None
     home: tuple[float, ...] | None = None
+    acceleration_limits: tuple[float, ...] | None = None
     report: ReportProfile = field(default_factory=ReportProfile)
 
 

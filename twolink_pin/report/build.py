@@ -157,6 +157,7 @@ def _build(
             "q0_offset": q0_offset.tolist(),
             "lambda": lams,
             "saturate": options.run.plant.saturate,
+            "joint_stops": options.run.plant.position_stops,
             "friction_smoothing": options.run.friction_smoothing,
         },
         "run": options.run.as_dict(),
@@ -167,7 +168,12 @@ def _build(
         "comparison_csv": table.csv(),
         "overlays": ran.overlays,
         "animation": ran.animation,
-        "warnings": ran.warnings,
+        "warnings": ran.warnings
+        + [  # a run that passed a position range says so (the CLI prints them)
+            f"{name}: {sentence}"
+            for name, (result, metrics, *_) in runs.items()
+            for sentence in metrics.crossings.sentences(result.joint_limits, ("position",))
+        ],
         "animated": ran.animated,
         "errata": errata,
         "identification": ran.identification,
@@ -349,6 +355,8 @@ def _law_entries(
             "parameter_names": list(result.parameter_names),
             "limit_exceeded": result.limit_exceeded.tolist(),
             "limit_exceeded_at": result.first_exceeded_at,
+            "crossings": metrics.crossings.summary(),
+            "crossed": metrics.crossings.sentences(result.joint_limits),
         }
     return controllers, lams
 

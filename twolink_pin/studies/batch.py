@@ -193,11 +193,10 @@ def simulate_batch(
     if record:
         check_recorded_size(config.steps, nv, controller.state_size, n)
     used = threads_for(n, threads) if n > 1 else 1
-    steps = config.steps
-    dt = config.duration / steps
-    observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
+    samples, dt = config.steps + 1, config.duration / config.steps
+    observer = RunningMetrics(n, nv, dt, samples, trajectory.period, plant.joint_limits, plant.applied_torque)
     # Every law moves the end effector: its rows carry the task errors too.
-    task = RunningTaskMetrics(plant.robot, n, dt, steps + 1, trajectory.period)
+    task = RunningTaskMetrics(plant.robot, n, dt, samples, trajectory.period)
     with progress_callback(progress, n) as shown:
         run = integrate(
             controller,

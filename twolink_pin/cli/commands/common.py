@@ -100,6 +100,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
             friction=getattr(args, "plant_friction", None) or "law",
             saturate=args.saturate,
             friction_smoothing=args.friction_smoothing,
+            position_stops=args.joint_stops,
             **plant_events(args),
         ),
         parameters=getattr(args, mode) if mode else None,

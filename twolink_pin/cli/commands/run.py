@@ -44,6 +44,9 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "torque_limits": result.torque_limits.tolist(),
         "limit_exceeded": result.limit_exceeded.tolist(),
         "limit_exceeded_at": result.first_exceeded_at,
+        "limits": result.joint_limits.as_dict(),
+        "crossings": metrics.crossings.summary(),
+        "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
         "p_true": None if result.p_true is None else result.p_true.tolist(),
         "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
@@ -62,6 +65,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     scenario = spec.build(robot, identified_parameters(spec, robot))
     result = simulate(*scenario, trajectory_from_args(args, robot), spec.simulation)
     metrics = compute_metrics(result)
+    for warning in position_warnings(result.controller, result):
+        print(warning, file=sys.stderr)
     payload = _result_payload(result, metrics)
     task = task_summary(result, robot)  # every law: the end effector's errors
     payload["task_metrics"] = task.as_dict()
@@ -106,7 +111,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         ),
         *task_lines(task),
     ]
-    lines += _limit_and_estimate_lines(result)
+    lines += _limit_and_estimate_lines(result, metrics)
     lines += [f"  figure {f}" for f in figures]
     if args.save:
         lines.append(f"  saved {args.save}")
@@ -114,10 +119,22 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _limit_and_estimate_lines(result: Any) -> list[str]:
-    """The summary's lines on torque limits (exceeded, clipped, absent) and, for an adaptive
-    law, its estimates at the end against the truth."""
-    out: list[str] = []
+def position_warnings(name: str, result: SimulationResult) -> list[str]:
+    """One warning per joint of the run of law ``name`` that passed its position range (joint,
+    first time, largest excess), for stderr: a plant never lets it pass silently."""
+    return [
+        f"twolink-pin: warning: {name}: {sentence} (the plant has no stop there: --joint-stops makes "
+        "the range a hard stop)"
+        for sentence in result.crossings.sentences(result.joint_limits, ("position",))
+    ]
+
+
+def _limit_and_estimate_lines(result: Any, metrics: Metrics) -> list[str]:
+    """The summary's lines on the limits (position range and velocity crossed; torque exceeded,
+    clipped, absent) and, for an adaptive law, its estimates at the end against the truth."""
+    out: list[str] = [f"  {s}" for s in metrics.crossings.sentences(result.joint_limits)]
+    if result.position_stops:
+        out.append("  joint stops: each position range a hard stop (--joint-stops)")
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
         if over:
             out.append(
@@ -173,6 +190,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     shared.check_effective(robot, laws)
     rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     reference = trajectory_from_args(args, robot)
+    warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(rows), "run", "compare")
         figures = _ComparisonFigures(args, shared, rows, robot, stage / "figures")
@@ -187,6 +205,10 @@ def cmd_compare(args: argparse.Namespace) -> int:
             tasks[key] = task_metrics(result, robot)  # every law moves the same end effector
             return result
 
+        def on_result(key: str, result: SimulationResult) -> None:
+            warnings.extend(position_warnings(key, result))
+            figures.add(key, result)
+
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
                 bar.update(1)
@@ -194,10 +216,12 @@ def cmd_compare(args: argparse.Namespace) -> int:
                 bar.set_postfix_str(name)
 
         try:
-            table = run_comparison(run, list(rows), progress, figures.add)
+            table = run_comparison(run, list(rows), progress, on_result)
             figures.overlay()
         finally:
             bar.close()
+            for warning in warnings:
+                print(warning, file=sys.stderr)
         table = replace(
             table,
             plants={k: plant_description(r.scenario) for k, r in rows.items()},

@@ -1,0 +1,177 @@
+"""A reference checked against every limit of the arm along one period.
+
+:func:`reference_motion` samples one period of a trajectory on a fine grid and computes
+the torque it demands by inverse dynamics (Pinocchio's RNEA, the robot's model with its
+payload; plus a plant's friction when one is given); :func:`check_limits` compares each
+kind of limit (:mod:`twolink_pin.limits.kinds`) with it, joint by joint: the peak, its
+time, the limit, the margin.
+
+The grid: at least :data:`MIN_SAMPLES` instants over a period and no more than
+:data:`MAX_STEP` apart (1 ms: a polynomial through via points a second apart, or a
+retimed path, changes by far less than its limits' margins between two samples), at most
+:data:`MAX_SAMPLES`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any, NamedTuple
+
+import numpy as np
+import pinocchio as pin
+
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.limits.joint_limits import JointLimits, joint_limits
+from twolink_pin.limits.kinds import KINDS, LimitKind, Motion
+
+if TYPE_CHECKING:
+    from twolink_pin.dynamics import Friction
+    from twolink_pin.model import RobotModel
+    from twolink_pin.trajectory import Trajectory
+
+MIN_SAMPLES = 4001
+"""Fewest instants at which one period is checked."""
+MAX_STEP = 1e-3
+"""Largest time between two checked instants [s] (up to :data:`MAX_SAMPLES`)."""
+MAX_SAMPLES = 200_001
+"""Most instants of one check (a period of 200 s at 1 ms)."""
+
+
+def check_grid(t0: float, period: float, samples: int | None = None) -> np.ndarray:
+    """The instants [s] at which one period from ``t0`` is checked (see the module docstring),
+    or ``samples`` evenly spaced ones, both ends included."""
+    if samples is None:
+        samples = min(MAX_SAMPLES, max(MIN_SAMPLES, math.ceil(period / MAX_STEP) + 1))
+    if not (isinstance(samples, int) and not isinstance(samples, bool) and samples >= 2):
+        raise InvalidParameterError("samples", samples, "an integer >= 2")
+    return t0 + np.linspace(0.0, period, samples)
+
+
+def reference_motion(
+    robot: RobotModel,
+    trajectory: Trajectory,
+    samples: int | None = None,
+    friction: Friction | None = None,
+) -> Motion:
+    """One period of ``trajectory`` on the check grid, with the torque it demands:
+    ``τ = M(q) q̈ + C(q, q̇) q̇ + g(q)`` (RNEA on ``robot``'s model, payload included)
+    ``+ f(q̇)`` with ``friction``."""
+    t = check_grid(trajectory.t0, trajectory.period, samples)
+    ref = trajectory.sample(t)
+    model, data = robot.model, robot.create_data()
+    tau = np.array([pin.rnea(model, data, q, v, a) for q, v, a in zip(ref.q, ref.v, ref.a)])
+    if friction is not None:
+        tau = tau + friction.torque(ref.v)
+    return Motion(t, ref.q, ref.v, ref.a, tau)
+
+
+class KindCheck(NamedTuple):
+    """One kind of limit along a motion, per joint (arrays of shape (nv,))."""
+
+    kind: LimitKind
+    """The kind checked."""
+    peak: np.ndarray
+    """The value nearest its bounds (or furthest beyond): ``max |x|`` for a symmetric
+    kind, the position closest to its range's ends for the position [the kind's unit]."""
+    time: np.ndarray
+    """When the peak happens [s]."""
+    limit: np.ndarray
+    """The bound the peak is compared with (for the position: the nearer end of the
+    range); ``inf`` for a joint without this limit."""
+    margin: np.ndarray
+    """How far inside its bounds the peak stays; negative beyond; ``inf`` without a limit."""
+
+    @property
+    def within_limits(self) -> bool:
+        """Whether every joint stays within its bounds."""
+        return bool(np.all(self.margin >= 0))
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready: ``peak``, ``time``, ``limit``, ``margin`` (``None`` where a joint has
+        no limit) and ``within_limits``."""
+
+        def finite(x: np.ndarray) -> list[float | None]:
+            return [float(v) if math.isfinite(v) else None for v in x.tolist()]
+
+        return {
+            "peak": self.peak.tolist(),
+            "time": self.time.tolist(),
+            "limit": finite(self.limit),
+            "margin": finite(self.margin),
+            "within_limits": self.within_limits,
+        }
+
+
+class LimitsCheck(NamedTuple):
+    """Every kind of limit along a motion (:func:`check_limits`)."""
+
+    motion: Motion
+    """The motion checked."""
+    limits: JointLimits
+    """The limits it was checked against."""
+    kinds: tuple[KindCheck, ...]
+    """One check per kind the motion carries, in :data:`~twolink_pin.limits.kinds.KINDS` order."""
+
+    @property
+    def within_limits(self) -> bool:
+        """Whether every kind holds on every joint."""
+        return all(k.within_limits for k in self.kinds)
+
+    def of(self, name: str) -> KindCheck:
+        """The check of the kind called ``name``."""
+        for k in self.kinds:
+            if k.kind.name == name:
+                return k
+        raise KeyError(name)
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready: one entry per kind (:meth:`KindCheck.summary`) and ``within_limits``."""
+        out: dict[str, Any] = {k.kind.name: k.summary() for k in self.kinds}
+        out["within_limits"] = self.within_limits
+        return out
+
+
+def check_motion(motion: Motion, limits: JointLimits) -> LimitsCheck:
+    """Each kind of ``limits`` that ``motion`` carries, joint by joint."""
+    checks = []
+    for kind in KINDS:
+        values = kind.of(motion)
+        if values is None:
+            continue
+        excess = limits.excess(kind, values)  # (K, nv), -inf where no limit
+        given = limits.given(kind)
+        # a joint with a limit: its worst instant; without: its largest |value|
+        idx = np.where(given, np.argmax(excess, axis=0), np.argmax(np.abs(values), axis=0))
+        cols = np.arange(values.shape[1])
+        at = values[idx, cols]
+        lower, upper = limits.bounds(kind)
+        if kind.symmetric:
+            peak, limit = np.abs(at), upper
+        else:
+            nearer_upper = (upper - at) <= (at - lower)
+            peak, limit = at, np.where(nearer_upper, upper, lower)
+        margin = np.where(given, -excess[idx, cols], np.inf)
+        checks.append(KindCheck(kind, peak, motion.t[idx], limit, margin))
+    return LimitsCheck(motion, limits, tuple(checks))
+
+
+def check_limits(
+    robot: RobotModel,
+    trajectory: Trajectory,
+    *,
+    samples: int | None = None,
+    limits: JointLimits | None = None,
+    friction: Friction | None = None,
+) -> LimitsCheck:
+    """``trajectory`` against every limit of ``robot`` along one period (module docstring:
+    the grid), the torque by inverse dynamics (with ``friction`` when given).
+
+    Args:
+        robot: The arm (its model, payload included, gives the torque).
+        trajectory: The reference.
+        samples: Instants over the period (default: the check grid).
+        limits: The limits (default :func:`~twolink_pin.limits.joint_limits` of ``robot``).
+        friction: A plant's friction added to the torque.
+    """
+    motion = reference_motion(robot, trajectory, samples, friction)
+    return check_motion(motion, joint_limits(robot) if limits is None else limits)

@@ -1,0 +1,177 @@
+"""The one quadratic-program solve every optimisation of the package goes through.
+
+``min ½ xᵀ H x + gᵀ x  s.t.  A x = b,  l <= C x <= u`` solved by ProxQP (``proxsuite``,
+dense backend: an augmented-Lagrangian interior of primal-dual proximal iterations that
+warm-starts well, Bambade et al. 2022), the solver of the trajectory optimiser's SQP
+steps, the model-predictive law's replans and the constrained task-space law's steps.
+
+Each row of ``C`` may carry a label (``"effort of joint 2 at t = 0.31 s"``), so that a
+problem whose constraints cannot all hold names the one most violated by ProxQP's
+closest feasible point. :func:`kkt_residual` measures a solution's optimality
+independently of the solver's own report.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from twolink_pin.errors import OptimizationError
+
+DEFAULT_EPS = 1e-9
+"""Absolute tolerance on the primal and dual residuals (ProxQP's ``eps_abs``)."""
+DEFAULT_MAX_ITER = 10_000
+"""Most ProxQP iterations of one solve."""
+
+
+class QP(NamedTuple):
+    """A dense convex QP; ``None`` for a block that is absent."""
+
+    H: np.ndarray
+    """Hessian, symmetric positive semidefinite, shape (n, n)."""
+    g: np.ndarray
+    """Linear cost, shape (n,)."""
+    A: np.ndarray | None = None
+    """Equality rows, shape (n_eq, n)."""
+    b: np.ndarray | None = None
+    """Equality right-hand side, shape (n_eq,)."""
+    C: np.ndarray | None = None
+    """Inequality rows, shape (n_in, n)."""
+    l: np.ndarray | None = None  # noqa: E741  (the solver's and the literature's name)
+    """Lower bounds of ``C x`` (``-inf``: none), shape (n_in,)."""
+    u: np.ndarray | None = None
+    """Upper bounds of ``C x`` (``inf``: none), shape (n_in,)."""
+    labels: tuple[str, ...] | None = None
+    """What each inequality row is, for messages (one per row of ``C``)."""
+
+
+class QPSolution(NamedTuple):
+    """What :func:`solve_qp` returns."""
+
+    x: np.ndarray
+    """The minimiser, shape (n,)."""
+    y: np.ndarray
+    """Multipliers of the equalities, shape (n_eq,)."""
+    z: np.ndarray
+    """Multipliers of the inequalities (positive: the upper bound active), shape (n_in,)."""
+    iterations: int
+    """ProxQP iterations."""
+    primal_residual: float
+    """ProxQP's primal residual (largest constraint violation)."""
+    dual_residual: float
+    """ProxQP's dual residual."""
+
+
+def kkt_residual(qp: QP, solution: QPSolution) -> float:
+    """The largest violation of the KKT conditions at ``solution``, computed here, not by the
+    solver: stationarity ``‖H x + g + Aᵀ y + Cᵀ z‖∞``, primal feasibility, the sign of each
+    multiplier against the side of its bound, and complementarity ``|z_i| · dist(C_i x,
+    its bound)`` (all in the problem's own units)."""
+    x, y, z = solution.x, solution.y, solution.z
+    stationarity = qp.H @ x + qp.g
+    residuals = []
+    if qp.A is not None and qp.A.size:
+        stationarity = stationarity + qp.A.T @ y
+        residuals.append(np.abs(qp.A @ x - qp.b).max())
+    if qp.C is not None and qp.C.size:
+        assert qp.l is not None and qp.u is not None
+        stationarity = stationarity + qp.C.T @ z
+        cx = qp.C @ x
+        residuals.append(np.maximum(np.maximum(qp.l - cx, cx - qp.u), 0.0).max())
+        upper = np.where(np.isfinite(qp.u), np.abs(qp.u - cx), np.inf)
+        lower = np.where(np.isfinite(qp.l), np.abs(cx - qp.l), np.inf)
+        # z > 0 pushes against the upper bound, z < 0 against the lower one
+        residuals.append((np.maximum(z, 0.0) * np.minimum(upper, 1e300)).max())
+        residuals.append((np.maximum(-z, 0.0) * np.minimum(lower, 1e300)).max())
+    residuals.append(np.abs(stationarity).max())
+    return float(max(residuals))
+
+
+def solve_qp(
+    qp: QP,
+    warm: QPSolution | None = None,
+    *,
+    eps: float = DEFAULT_EPS,
+    max_iter: int = DEFAULT_MAX_ITER,
+    what: str = "QP",
+) -> QPSolution:
+    """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
+
+    Args:
+        qp: The problem.
+        warm: A previous solution of a problem of the same sizes (primal and dual start).
+        eps: Absolute tolerance of the primal and dual residuals.
+        max_iter: Most iterations.
+        what: The problem in words, for messages (``"the MPC replan at t = 1.2 s"``).
+
+    Raises:
+        OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
+            closest feasible point misses one: the row, by its label, and by how much) or
+            it stopped without converging (its status and iterations).
+    """
+    import proxsuite
+
+    proxqp = proxsuite.proxqp
+    n = qp.g.shape[0]
+    kwargs = {}
+    if warm is not None:
+        kwargs = {"x": warm.x, "y": warm.y, "z": warm.z, "initial_guess": proxqp.InitialGuess.WARM_START}
+    # the duality gap checked too: without it ProxQP may stop with an active bound 1e-5 away
+    result = proxqp.dense.solve(
+        qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, eps_abs=eps, eps_rel=0.0, max_iter=max_iter,
+        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=0.0, **kwargs,
+    )  # fmt: skip
+    info = result.info
+    status = info.status
+    if status != proxqp.PROXQP_SOLVED:
+        # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
+        # the closest feasible point tells a problem that cannot hold from a slow one
+        infeasible = _infeasible_reason(qp, eps, max_iter)
+        reason = infeasible or (
+            f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
+            f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
+        )
+        raise OptimizationError(what, reason, int(info.iter))
+    m = 0 if qp.A is None else qp.A.shape[0]
+    k = 0 if qp.C is None else qp.C.shape[0]
+    x = np.array(result.x[:n], dtype=float)
+    return QPSolution(
+        x,
+        np.array(result.y[:m], dtype=float),
+        np.array(result.z[:k], dtype=float),
+        int(info.iter),
+        float(info.pri_res),
+        float(info.dua_res),
+    )
+
+
+def _infeasible_reason(qp: QP, eps: float, max_iter: int) -> str | None:
+    """Which constraint the closest feasible point (ProxQP's infeasibility solve) violates
+    most, or None when it violates none by more than the tolerance."""
+    import proxsuite
+
+    closest = proxsuite.proxqp.dense.solve(
+        qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u,
+        eps_abs=eps, eps_rel=0.0, max_iter=max_iter, primal_infeasibility_solving=True,
+    )  # fmt: skip
+    x = np.asarray(closest.x)
+    tolerance = max(1e3 * eps, 1e-6)
+    if qp.A is not None and qp.A.size:
+        assert qp.b is not None
+        gap = np.abs(qp.A @ x - qp.b)
+        if gap.max() > tolerance:
+            return f"the equality constraints cannot all hold (row {int(np.argmax(gap))} missed by {gap.max():.3g})"
+    if qp.C is None or not qp.C.size:
+        return None
+    assert qp.l is not None and qp.u is not None
+    cx = qp.C @ x
+    excess = np.maximum(qp.l - cx, cx - qp.u)
+    i = int(np.argmax(excess))
+    if excess[i] <= tolerance:
+        return None
+    row = qp.labels[i] if qp.labels is not None and i < len(qp.labels) else f"inequality row {i}"
+    return (
+        f"the constraints cannot all hold: the closest point misses {row} by {excess[i]:.3g} "
+        f"(bounds [{qp.l[i]:.6g}, {qp.u[i]:.6g}], value {cx[i]:.6g})"
+    )
