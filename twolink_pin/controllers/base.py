@@ -324,14 +324,30 @@ class Controller(abc.ABC, Generic[G]):
     @property
     def parameter_names(self) -> tuple[str, ...]:
         """Names of the estimated parameters, in the order of ``z``."""
+        return self.estimated_names(self.robot)
+
+    @classmethod
+    def estimated_names(cls, robot: RobotModel) -> tuple[str, ...]:
+        """Names of the parameters the law estimates on ``robot`` (:attr:`parameter_names`)."""
         names: list[str] = []
-        for kind in self.estimates:
+        for kind in cls.estimates:
             if kind == "inertial":
-                names += self.robot.parameter_map.names
+                names += robot.parameter_map.names
             else:
-                n = self.robot.nv
+                n = robot.nv
                 names += [f"V{j + 1}" for j in range(n)] + [f"C{j + 1}" for j in range(n)]
         return tuple(names)
+
+    @classmethod
+    def gain_widths(cls, robot: RobotModel) -> dict[str, tuple[int, str]]:
+        """For each ``per`` of a gain: how many values it has on ``robot`` and what they are for
+        (``{"joint": (nv, "per joint, nv = 2"), ...}``)."""
+        names = cls.estimated_names(robot)
+        return {
+            "joint": (robot.nv, f"per joint, nv = {robot.nv}"),
+            "estimate": (len(names), f"per estimated parameter: {names}"),
+            "axis": (3, "per world axis x, y, z"),
+        }
 
     @property
     def parameter_units(self) -> tuple[str, ...]:
@@ -459,31 +475,16 @@ class Controller(abc.ABC, Generic[G]):
                 )
             gains = dataclasses.replace(gains, **{name: derived[name] for name in missing})
         matrices = {}
+        widths = self.gain_widths(self.robot)
         for f in dataclasses.fields(gains):
             spec = gain_spec(f)
             value = getattr(gains, f.name)
+            if spec.per == "scalar":
+                continue
+            width, what = widths[spec.per]
             if spec.matrix and value is not None:
-                width, what = {
-                    "joint": (self.robot.nv, f"per joint, nv = {self.robot.nv}"),
-                    "estimate": (
-                        len(self.parameter_names),
-                        f"per estimated parameter: {self.parameter_names}",
-                    ),
-                    "axis": (3, "per world axis x, y, z"),
-                }[spec.per]
                 value = matrices[f.name] = as_matrix(value, width, f.name, spec.unit)
-                check_width(f.name, value, width, what)
-            elif spec.per == "joint":
-                check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")
-            elif spec.per == "estimate":
-                check_width(
-                    f.name,
-                    value,
-                    len(self.parameter_names),
-                    f"per estimated parameter: {self.parameter_names}",
-                )
-            elif spec.per == "axis":
-                check_width(f.name, value, 3, "per world axis x, y, z")
+            check_width(f.name, value, width, what)
         return dataclasses.replace(gains, **matrices) if matrices else gains
 
     def _check_parameters(self, p: Any) -> np.ndarray | None:

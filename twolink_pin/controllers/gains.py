@@ -165,10 +165,10 @@ def _check_matrices(name: str, array: np.ndarray, expected: str) -> np.ndarray:
                 f"{expected}; the symmetry check failed: it is not symmetric "
                 f"(entry [{r}, {c}] = {matrix[r, c]:g} but [{c}, {r}] = {matrix[c, r]:g})",
             )
+        eigenvalues = np.linalg.eigvalsh(matrix)
         try:
             np.linalg.cholesky(matrix)
         except np.linalg.LinAlgError:
-            eigenvalues = np.linalg.eigvalsh(matrix)
             raise InvalidParameterError(
                 where,
                 _shown(matrix),
@@ -176,6 +176,13 @@ def _check_matrices(name: str, array: np.ndarray, expected: str) -> np.ndarray:
                 f"(eigenvalues {', '.join(f'{x:.4g}' for x in eigenvalues[:8])}"
                 f"{', …' if eigenvalues.size > 8 else ''}; smallest {eigenvalues.min():.3g})",
             ) from None
+        if not eigenvalues.min() >= GAIN_RANGE[0]:  # as a number s (s I) must be >= 1e-12
+            raise InvalidParameterError(
+                where,
+                _shown(matrix),
+                f"{expected}; the positive-definite check failed: its smallest eigenvalue "
+                f"{eigenvalues.min():.3g} is below {GAIN_RANGE[0]:g}, the least a gain may be",
+            )
     stack = np.ascontiguousarray(stack)
     stack.setflags(write=False)
     return stack
@@ -196,12 +203,7 @@ def _from_numbers(name: str, numbers: np.ndarray, k: int, expected: str) -> np.n
         return _check_matrices(name, np.diag(numbers), expected)
     if n == k * k:
         return _check_matrices(name, numbers.reshape(k, k), expected)
-    raise InvalidParameterError(
-        name,
-        numbers.tolist(),
-        f"{expected}; the shape check failed: {n} numbers are neither 1, {k} (a diagonal) nor "
-        f"{k * k} (a {k} × {k} matrix, row by row)",
-    )
+    raise InvalidParameterError(name, numbers.tolist(), f"{expected}; {_shape_failed(n, k)}")
 
 
 def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
@@ -388,6 +390,43 @@ def one_row(value: Any, width: int) -> np.ndarray:
     return np.broadcast_to(array.reshape(-1), (width,)).copy()
 
 
+def check_count(name: str, value: Any, spec: GainSpec, width: int, what: str) -> None:
+    """Refuse a value given as numbers (one value set: a number or a flat sequence) whose count
+    the gain cannot take on this robot — before its entries are checked, so that four numbers
+    for a two-joint gain are named as four numbers, not by an entry that is out of range.
+
+    Args:
+        name: The gain's field name.
+        value: The value as given (per-run arrays and matrices are left to the later checks).
+        spec: Its declaration (``per``, ``matrix``).
+        width: How many values ``per`` means here (nv, the estimates, 3 axes).
+        what: What the values are for (``per joint, nv = 2``).
+
+    Raises:
+        InvalidParameterError: the count received and the counts expected.
+    """
+    if spec.per == "scalar" or isinstance(value, (bool, str)) or value is None:
+        return
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return  # not numbers: the value's own check says so
+    if array.ndim != 1:
+        return
+    n = array.size
+    shown = array.tolist() if n <= 24 else f"{n} numbers"
+    if spec.matrix:
+        if n not in (1, width, width * width):
+            expected = MATRIX_EXPECTED.format(unit=f" [{spec.unit}]" if spec.unit else "")
+            raise InvalidParameterError(name, shown, f"{expected}; {_shape_failed(n, width)} ({what})")
+    elif n not in (1, width):
+        raise InvalidParameterError(name, shown, f"1 or {width} numbers ({what}); got {n}")
+
+
+def _shape_failed(n: int, k: int) -> str:
+    return f"the shape check failed: {n} numbers are neither 1, {k} (a diagonal) nor {k * k} (a {k} × {k} matrix, row by row)"
+
+
 def check_width(name: str, value: Any, width: int, what: str) -> None:
     """Raise unless ``value`` (validated) is a scalar, ``width`` values, or per run one or
     ``width`` values (shape ``(N, 1)`` or ``(N, width)``)."""
@@ -402,8 +441,9 @@ def check_width(name: str, value: Any, width: int, what: str) -> None:
     if value.shape[1] not in (1, width):
         rows = value.tolist()
         shown = (rows[0] if len(rows) == 1 else rows) if value.size <= 24 else f"array of shape {value.shape}"
+        got = f"{value.shape[1]} numbers" if value.shape[0] == 1 else f"shape {value.shape}"
         raise InvalidParameterError(
-            name, shown, f"one value or {width} ({what}), or one row of them per run; got shape {value.shape}"
+            name, shown, f"one value or {width} ({what}), or one row of them per run; got {got}"
         )
 
 

@@ -1,12 +1,12 @@
 """Joint limits as design inputs: each kind defined once, read from the model, used alike by
 the checks of a reference, the crossings of a run, retiming, optimisation and constrained laws.
 
-==========================  ================================================================
+==========================  ==========================================================================
 ``kinds.py``                the four kinds (position, velocity, acceleration, effort), :class:`Motion`
 ``joint_limits.py``         :class:`JointLimits`, :func:`joint_limits` (read from a robot)
 ``check.py``                :func:`check_limits`: a reference against every limit over a period
-``crossings.py``            :class:`Crossings`: where a run's motion went past a limit (joint, first time, excess)
-==========================  ================================================================
+``crossings.py``            :class:`Crossings`: where a run's motion went past a limit (joint, when, excess)
+==========================  ==========================================================================
 """
 
 from twolink_pin.limits.check import KindCheck, LimitsCheck, check_limits, check_motion, reference_motion

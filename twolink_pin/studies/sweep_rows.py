@@ -17,7 +17,7 @@ from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
-from twolink_pin.studies.sweep_cases import Cases, SweepConfig, chunk_law, gain_target
+from twolink_pin.studies.sweep_cases import Cases, SweepConfig, check_draws, chunk_law, gain_target
 from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
 
@@ -41,18 +41,17 @@ METRIC_UNITS = metric_units()
 
 
 TASK_COLUMNS = {f"task_{name}": unit for name, unit in TASK_UNITS.items()}
-"""The task-space metric columns of a task-space law's row (:data:`twolink_pin.task_metrics.TASK_UNITS`,
-the one definition), with their units."""
+"""The task-space metric columns of every row (:data:`twolink_pin.task_metrics.TASK_UNITS`, the
+one definition: the end effector's errors, whatever the law), with their units."""
 
 
-def metric_columns(nv: int, parameter_names: Sequence[str] = (), task: bool = False) -> list[str]:
+def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
     """Names of the metric columns of a row, in order: the per-joint metrics, the task metrics
-    of a task-space law (``task``), the final estimates."""
+    (every law moves the end effector), the final estimates."""
     columns: list[str] = []
     for stem in METRIC_UNITS:
         columns += joint_columns(stem, nv)
-    if task:
-        columns += list(TASK_COLUMNS)
+    columns += list(TASK_COLUMNS)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
     return columns
 
@@ -117,8 +116,8 @@ def _chunk_rows(
         inputs.append(cases.wrench_scale[:, None])
     flags, exceeded = _outcomes(result)
     parts = [metric_array(m, stem) for stem in METRIC_UNITS]
-    if result.task_metrics is not None:
-        parts.append(np.column_stack(list(result.task_metrics)))
+    assert result.task_metrics is not None  # simulate_batch gives every law its task errors
+    parts.append(np.column_stack(list(result.task_metrics)))
     if result.p_hat_final is not None:
         parts.append(result.p_hat_final)
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
@@ -227,6 +226,7 @@ class PreparedSweep:
             record,
         )
         self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
+        check_draws(config, robot, self.base.controller)  # every draw a value simulate takes, first
         nv = robot.nv
         if record:
             kept = config.samples * (config.run.simulation.steps + 1) * 3 * nv
@@ -242,8 +242,8 @@ class PreparedSweep:
         law = self.base.controller
         estimated = law.parameter_names if law.estimates else ()
         self.input_columns = input_columns(config, nv, self.parameter_names)
-        self.task = bool(cls.task_space)  # the law's class declares it
-        self.metric_columns = metric_columns(nv, estimated, self.task)
+        self.task = bool(cls.task_space)  # the law's class declares it: its figure shows them first
+        self.metric_columns = metric_columns(nv, estimated)
         self.outcome_columns = outcome_columns(nv)
         self.header = [*self.input_columns, *self.outcome_columns, *self.metric_columns]
         units = {"run": "", **{c: "rad" for c in joint_columns("q0_offset", nv)}}
@@ -260,8 +260,7 @@ class PreparedSweep:
             units.update({c: unit for c in joint_columns(stem, nv)})
         for stem, unit in METRIC_UNITS.items():
             units.update({c: unit for c in joint_columns(stem, nv)})
-        if self.task:
-            units.update(TASK_COLUMNS)
+        units.update(TASK_COLUMNS)
         if law.estimates:
             units.update(
                 {f"p_hat_final_{n}": u for n, u in zip(law.parameter_names, law.parameter_units, strict=True)}

@@ -70,7 +70,7 @@ def cmd_info(args: argparse.Namespace) -> int:
             f"gravity    {fmt(robot.model.gravity.linear, 3)} m/s²",
             f"links      {fmt(robot.link_lengths, 3)} m",
             *limits_table(limits),
-            f"home       q = [{', '.join(f'{x:.9g}' for x in robot.home)}] rad, end effector at",
+            f"home       q = [{', '.join(_exact(x) for x in robot.home)}] rad, end effector at",
             *home_lines,
             f"payload    {robot.payload:g} kg",
             f"parameters {p_text}",
@@ -80,9 +80,20 @@ def cmd_info(args: argparse.Namespace) -> int:
     )
     if args.write_urdf:
         payload["urdf_written"] = str(_write_payload_variant(robot, args.write_urdf))
-        text += f"\nwrote      {payload['urdf_written']}"
+        written = payload["urdf_written"]
+        text += (
+            f"\nwrote      {written}: the arm with its {robot.payload:g}-kg payload, as the plant with "
+            f"--robot {written}, or as the model a law believes with --model {written}"
+        )
     emit(args, payload, text)
     return 0
+
+
+def _exact(x: float) -> str:
+    """``x`` as the shortest text that reads back to it (``1.5707963267948966``, ``0``): the
+    home is printed as the profile defines it, not rounded to a number of digits."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
 
 
 def limits_table(limits: JointLimits) -> list[str]:
