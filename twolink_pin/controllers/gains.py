@@ -47,7 +47,7 @@ from twolink_pin.errors import InvalidParameterError
 
 SHAPES = ("scalar", "joint", "estimate", "axis")
 """What one value of a gain is for."""
-BOUNDS = ("positive", "nonnegative", "any")
+BOUNDS = ("positive", "nonnegative", "any", "fraction")
 """Sign constraints a gain may declare."""
 
 
@@ -82,7 +82,8 @@ def gain(
             per-estimate gains derived from the robot).
         per: ``"scalar"``, ``"joint"`` or ``"estimate"``.
         unit: SI unit, e.g. ``"N·m/rad"``.
-        bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0) or ``"any"``.
+        bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0), ``"any"`` or
+            ``"fraction"`` (0 < value <= 1: a share of something, e.g. of a limit).
         doc: One-line description (shown by the CLI and the report).
         matrix: A symmetric positive-definite matrix gain of size k given by ``per``
             (``"joint"``, ``"estimate"`` or ``"axis"``); ``bound`` is then "positive".
@@ -124,6 +125,7 @@ def _expected(spec: GainSpec) -> str:
         "positive": f" > 0 (from {low:g} to {high:g})",
         "nonnegative": f" >= 0 (0, or from {low:g} to {high:g})",
         "any": f" within ±{high:g}",
+        "fraction": f", a fraction 0 < value <= 1 (from {low:g})",
     }[spec.bound]
     unit = f" [{spec.unit}]" if spec.unit else ""
     return {
@@ -271,6 +273,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     except (TypeError, ValueError):
         raise InvalidParameterError(name, value, _expected(spec)) from None
     allowed = (0, 1) if spec.per == "scalar" else (0, 1, 2)
+    if spec.per == "scalar" and array.ndim == 2 and array.shape[1] == 1:  # validated before: a column
+        array = array[:, 0]  # per run (dataclasses.replace validates every field again)
     if array.ndim not in allowed or array.size == 0:
         raise InvalidParameterError(name, value, f"{_expected(spec)} (got shape {array.shape})")
     bad = ~np.isfinite(array)
@@ -280,6 +284,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
             bad |= ~(array >= GAIN_RANGE[0])
         elif spec.bound == "nonnegative":
             bad |= ~((array == 0) | (array >= GAIN_RANGE[0]))
+        elif spec.bound == "fraction":
+            bad |= ~((array >= GAIN_RANGE[0]) & (array <= 1.0))
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
         where = f"{name}[{', '.join(map(str, index))}]" if index else name

@@ -5,10 +5,11 @@ It sits below ``trajectory/`` and ``controllers/`` and uses only ``model/``, ``d
 and ``limits/``.
 
 ==========================  ================================================================
-``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP), :func:`kkt_residual`
+``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP; the unconstrained
+                            minimiser first on request), :func:`kkt_residual`
 ==========================  ================================================================
 """
 
-from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp
+from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp, unconstrained_minimiser
 
-__all__ = ["QP", "QPSolution", "kkt_residual", "solve_qp"]
+__all__ = ["QP", "QPSolution", "kkt_residual", "solve_qp", "unconstrained_minimiser"]

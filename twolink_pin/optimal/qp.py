@@ -5,6 +5,12 @@ dense backend: an augmented-Lagrangian interior of primal-dual proximal iteratio
 warm-starts well, Bambade et al. 2022), the solver of the trajectory optimiser's SQP
 steps, the model-predictive law's replans and the constrained task-space law's steps.
 
+A QP solved again and again whose inequalities rarely bind (a constrained law's step) may ask
+for its **unconstrained minimiser first** (``unconstrained_first``): one linear solve of the
+cost's stationarity under the equalities; when that point satisfies every inequality it is the
+QP's solution (the KKT conditions hold with zero inequality multipliers: the start of Goldfarb
+and Idnani's dual active-set method, 1983) and ProxQP is not called.
+
 Each row of ``C`` may carry a label (``"effort of joint 2 at t = 0.31 s"``), so that a
 problem whose constraints cannot all hold names the one most violated by ProxQP's
 closest feasible point. :func:`kkt_residual` measures a solution's optimality
@@ -95,6 +101,7 @@ def solve_qp(
     eps: float = DEFAULT_EPS,
     max_iter: int = DEFAULT_MAX_ITER,
     what: str = "QP",
+    unconstrained_first: bool = False,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -104,12 +111,19 @@ def solve_qp(
         eps: Absolute tolerance of the primal and dual residuals.
         max_iter: Most iterations.
         what: The problem in words, for messages (``"the MPC replan at t = 1.2 s"``).
+        unconstrained_first: First try the minimiser of the cost under the equalities alone
+            (:func:`unconstrained_minimiser`): when it satisfies every inequality it is
+            returned (0 iterations, zero inequality multipliers), else ProxQP solves the QP.
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
             closest feasible point misses one: the row, by its label, and by how much) or
             it stopped without converging (its status and iterations).
     """
+    if unconstrained_first:
+        inside = unconstrained_minimiser(qp)
+        if inside is not None:
+            return inside
     import proxsuite
 
     proxqp = proxsuite.proxqp
@@ -127,7 +141,7 @@ def solve_qp(
     if status != proxqp.PROXQP_SOLVED:
         # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
         # the closest feasible point tells a problem that cannot hold from a slow one
-        infeasible = _infeasible_reason(qp, eps, max_iter)
+        infeasible = _infeasible_reason(qp, eps, max_iter, status == proxqp.PROXQP_PRIMAL_INFEASIBLE)
         reason = infeasible or (
             f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
             f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
@@ -146,9 +160,51 @@ def solve_qp(
     )
 
 
-def _infeasible_reason(qp: QP, eps: float, max_iter: int) -> str | None:
+def unconstrained_minimiser(qp: QP) -> QPSolution | None:
+    """The minimiser of ``qp``'s cost under its equalities alone — one linear solve of the KKT
+    system ``[H Aᵀ; A 0] (x, y) = (−g, b)`` — when ``H`` is positive definite (a Cholesky
+    factorisation says so) and that point satisfies every inequality, exactly (no tolerance):
+    then it is the QP's solution, with zero inequality multipliers. None otherwise (an
+    inequality would be violated, ``H`` is only semidefinite, or the system is singular)."""
+    from scipy.linalg import lapack  # imported where used: scipy.linalg is 0.1 s at start-up
+
+    H, g = qp.H, qp.g
+    n = g.shape[0]
+    m = 0 if qp.A is None else qp.A.shape[0]
+    _, x, info = lapack.dposv(H, -g)  # Cholesky of H and the solve: info > 0 when H is not definite
+    if info != 0:
+        return None
+    y = np.zeros(0)
+    if m:
+        assert qp.A is not None and qp.b is not None
+        K = np.zeros((n + m, n + m))
+        K[:n, :n], K[:n, n:], K[n:, :n] = H, qp.A.T, qp.A
+        try:
+            xy = np.linalg.solve(K, np.concatenate((-g, qp.b)))
+        except np.linalg.LinAlgError:
+            return None
+        x, y = xy[:n], xy[n:]
+    k = 0 if qp.C is None else qp.C.shape[0]
+    if k:
+        assert qp.C is not None and qp.l is not None and qp.u is not None
+        cx = qp.C @ x
+        if not ((cx >= qp.l) & (cx <= qp.u)).all():  # NaN fails both: ProxQP then
+            return None
+    stationarity = H @ x + g
+    primal = 0.0
+    if m:
+        assert qp.A is not None and qp.b is not None
+        stationarity += qp.A.T @ y
+        primal = float(np.abs(qp.A @ x - qp.b).max())
+    return QPSolution(x, y, np.zeros(k), 0, primal, float(np.abs(stationarity).max()))
+
+
+def _infeasible_reason(qp: QP, eps: float, max_iter: int, flagged: bool = False) -> str | None:
     """Which constraint the closest feasible point (ProxQP's infeasibility solve) violates
-    most, or None when it violates none by more than the tolerance."""
+    most, or None when it violates none by more than the tolerance: ``max(1e3 eps, 1e-6)``,
+    or ``10 eps`` when ProxQP itself ``flagged`` the problem infeasible (a state at the edge of
+    what its limits allow: the closest point then misses a row by a hair, 1e-7, which is
+    still the row to name)."""
     import proxsuite
 
     closest = proxsuite.proxqp.dense.solve(
@@ -156,7 +212,7 @@ def _infeasible_reason(qp: QP, eps: float, max_iter: int) -> str | None:
         eps_abs=eps, eps_rel=0.0, max_iter=max_iter, primal_infeasibility_solving=True,
     )  # fmt: skip
     x = np.asarray(closest.x)
-    tolerance = max(1e3 * eps, 1e-6)
+    tolerance = 10 * eps if flagged else max(1e3 * eps, 1e-6)
     if qp.A is not None and qp.A.size:
         assert qp.b is not None
         gap = np.abs(qp.A @ x - qp.b)
