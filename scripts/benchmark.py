@@ -35,6 +35,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --shared-only [--quick]  # two batches at once; 200-run sweep, 2 workers
     .venv/bin/python scripts/benchmark.py --big-arms-only [--quick]  # issue 31: Panda osc/impedance, batches, floor
     .venv/bin/python scripts/benchmark.py --tune-only [--quick]    # tune: from a change to updated results
+    .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
@@ -761,6 +762,110 @@ def osc_panda_section(baseline: Callable[[], Any], scale: float, quick: bool, re
     }
 
 
+QP_OSC_TARGET = 2.0
+"""Issue 37's goal: ``qp-osc`` on the Panda at most this many times ``osc``'s time per run."""
+
+
+def _qp_osc_profile(law: Any, plant: Any, reference: Any, config: SimulationConfig) -> dict[str, float]:
+    """One run of ``law`` (qp-osc) with its two parts timed: building the QPs
+    (``_problems``: the task, Λ, the costs and the bounds) and solving them (``solve_qp``: the
+    closed form or ProxQP), and how many evaluations needed ProxQP; µs per evaluation."""
+    import twolink_pin.controllers.qp_osc as module
+
+    spent = {"build": 0.0, "solve": 0.0, "evaluations": 0, "prox": 0}
+    build, solve = type(law)._problems, module.solve_qp
+
+    def timed_build(self: Any, x: Any, terms: Any) -> Any:
+        start = time.perf_counter()
+        out = build(self, x, terms)
+        spent["build"] += time.perf_counter() - start
+        spent["evaluations"] += len(out[0])
+        return out
+
+    def timed_solve(qp: Any, **kwargs: Any) -> Any:
+        start = time.perf_counter()
+        out = solve(qp, **kwargs)
+        spent["solve"] += time.perf_counter() - start
+        spent["prox"] += out.iterations > 0
+        return out
+
+    type(law)._problems, module.solve_qp = timed_build, timed_solve
+    try:
+        start = time.perf_counter()
+        simulate(law, plant, reference, config)
+        total = time.perf_counter() - start
+    finally:
+        type(law)._problems, module.solve_qp = build, solve
+    n = max(1, int(spent["evaluations"]))
+    return {
+        "evaluations": n,
+        "prox_share": spent["prox"] / n,
+        "build_us": spent["build"] / n * 1e6,
+        "solve_us": spent["solve"] / n * 1e6,
+        "stage_us": total / n * 1e6,
+    }
+
+
+def qp_osc_section(quick: bool, repeats: int) -> dict[str, Any]:
+    """Issue 37's goal: ``qp-osc`` against ``osc`` on the Panda, the same single run (its default
+    reference, 0.05 rad off, law at every RK4 stage), timed back to back ``repeats`` times, per
+    30-s run and as the ratio of minima (goal <= 2); then where qp-osc's time goes, per
+    evaluation: building the QP, solving it, the whole stage — on that run (no limit binds)
+    and on docs/limits.md's demo (the folded elbow, 3 kg, a 1.5-rad start: limits bind)."""
+    from twolink_pin import read_trajectory_file
+
+    panda = load_robot("panda")
+    reference = default_trajectory(panda)
+    duration = 0.1 if quick else 2.0
+    config = SimulationConfig(duration=duration, dt=DT, q0_offset=0.05)
+    laws = {name: make_scenario(name, panda) for name in ("osc", "qp-osc")}
+    times: dict[str, list[float]] = {name: [] for name in laws}
+    for _ in range(repeats):
+        for name, (law, plant) in laws.items():
+            times[name].append(_timed(lambda law=law, plant=plant: simulate(law, plant, reference, config)))
+    seconds = {name: min(t) * FULL / duration for name, t in times.items()}
+    ratio = seconds["qp-osc"] / seconds["osc"]
+    loaded = load_robot("panda", payload=3.0)
+    fold = read_trajectory_file(HERE.parent / "examples" / "panda_fold_pose.toml", loaded)
+    law, plant = make_scenario("qp-osc", loaded)
+    demo = SimulationConfig(duration=0.1 if quick else 2.5, dt=DT, q0_offset=(1.5, 0, 0, 0, 0, 0, 0))
+    profiles = {  # the least disturbed of the repeats (the smallest stage time)
+        "default reference": min(
+            (_qp_osc_profile(*laws["qp-osc"], reference, config) for _ in range(repeats)),
+            key=lambda r: r["stage_us"],
+        ),
+        "limits demo": min(
+            (_qp_osc_profile(law, plant, fold, demo) for _ in range(repeats)), key=lambda r: r["stage_us"]
+        ),
+    }
+    print(
+        f"\nqp-osc against osc on the Panda (default reference, 0.05 rad off; {duration:g} s simulated, min of "
+        f"{repeats} back to back): seconds per 30-s run; load average {[round(x, 2) for x in os.getloadavg()]}"
+    )
+    print(f"  {'osc':10s} {seconds['osc']:10.3f} s")
+    print(f"  {'qp-osc':10s} {seconds['qp-osc']:10.3f} s {ratio:7.2f}x osc{_verdict(ratio, QP_OSC_TARGET)}")
+    print(
+        f"  qp-osc per evaluation (least disturbed of {repeats} runs): building the QP, solving it (closed form or "
+        "ProxQP), the whole stage"
+    )
+    for label, row in profiles.items():
+        print(
+            f"  {label:18s} build {row['build_us']:7.1f} us  solve {row['solve_us']:7.1f} us  stage "
+            f"{row['stage_us']:7.1f} us  ProxQP on {100 * row['prox_share']:5.1f} % of {row['evaluations']} evaluations"
+        )
+    return {
+        "qp_osc_panda": {
+            "duration": duration,
+            "repeats": repeats,
+            "osc_seconds": seconds["osc"],
+            "qp_osc_seconds": seconds["qp-osc"],
+            "ratio": ratio,
+            "target": QP_OSC_TARGET,
+            "profile": profiles,
+        }
+    }
+
+
 BIG_ARM_TARGETS = {"osc batch": 8.0, "adaptive batch": 5.0}
 """Issue 31's batch targets per run (× the baseline): osc on the Panda, adaptive on the UR5."""
 
@@ -1172,6 +1277,9 @@ def main(argv: list[str] | None = None) -> int:
         "--tune-only", action="store_true", help="only tune's latency from a change to updated results"
     )
     parser.add_argument(
+        "--qp-osc-only", action="store_true", help="only qp-osc against osc on the Panda (issue 37's goal)"
+    )
+    parser.add_argument(
         "--optimal-only",
         action="store_true",
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
@@ -1205,6 +1313,11 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.qp_osc_only:
+        results.update(qp_osc_section(quick, args.repeats or (1 if quick else 5)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.optimal_only:
         results.update(optimal_section(quick))
         if args.json:
@@ -1352,6 +1465,7 @@ def main(argv: list[str] | None = None) -> int:
     results.update(ur5_section(baseline, scale, quick, repeats))
     results.update(single_runs_section(baseline, scale, quick, repeats))
     results.update(osc_panda_section(baseline, scale, quick, repeats))
+    results.update(qp_osc_section(quick, repeats))
     if not quick:  # the smoke test runs --big-arms-only --quick on its own
         results.update(big_arms_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))

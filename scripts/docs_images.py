@@ -20,6 +20,8 @@ live           live.png: the same run served live (``twolink-pin animate``)     
 figures        trajectory_workspace.png, adaptive_theta1.png                    10 s
 ur5_square     ur5_square_end_effector.png, ur5_square_meshcat.png              40 s
 tune           tune.png: ``twolink-pin tune pd`` in the browser, after one run  30 s
+limits         limits_panda_fold.png, limits_qp_osc_task_error.png:             20 s
+               docs/control_within_limits.md's demo (osc and qp-osc)
 within_limits  within_limits_*.png: the retimed and the least-effort twolink    5 s
 =============  ==============================================================  =========
 """
@@ -217,6 +219,56 @@ def tune() -> list[Path]:
         proc.wait(timeout=60)
 
 
+LIMITS_DEMO = (
+    "compare osc qp-osc --robot panda --payload 3 --trajectory examples/panda_fold_pose.toml "
+    "--q0-offset 1.5 0 0 0 0 0 0 --duration 2.5"
+)
+"""docs/control_within_limits.md's compare command (its runs, without ``--out``)."""
+
+
+def limits() -> list[Path]:
+    """docs/control_within_limits.md: the page's two runs (osc and qp-osc on the Panda carrying
+    3 kg, starting 1.5 rad round from the folded-elbow path) against joint 4's range and joint 6's
+    effort limit, and qp-osc's task error; prints the numbers the page quotes."""
+    import shutil
+
+    from twolink_pin.limits import POSITION, joint_limits
+    from twolink_pin.plotting import save_limits_figure, save_task_error_figure
+
+    robot = load_robot("panda", payload=3.0)
+    trajectory = read_trajectory_file(ROOT / "examples" / "panda_fold_pose.toml", robot)
+    config = SimulationConfig(duration=2.5, q0_offset=(1.5, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0))
+    runs = {}
+    for law in ("osc", "qp-osc"):
+        controller, plant = make_scenario(law, robot)
+        runs[law] = simulate(controller, plant, trajectory, config)
+    bounds = joint_limits(robot)
+    for law, run in runs.items():
+        past = bounds.excess(POSITION, run.q).max(axis=0)
+        share = np.abs(run.tau_command).max(axis=0) / bounds.effort
+        speed = np.abs(run.v).max(axis=0) / bounds.velocity
+        print(
+            f"limits: {law}: joint 4 from {run.q[:, 3].min():.4g} to {run.q[:, 3].max():.4g} rad (past its range by "
+            f"{past[3]:.3g} rad; every joint: largest {past.max():.3g}), peak |tau| / limit {np.round(share, 3).tolist()}, "
+            f"peak |v| / limit {np.round(speed, 3).tolist()}"
+        )
+    out = [
+        save_limits_figure(
+            runs,
+            bounds,
+            IMAGES / "limits_panda_fold.png",
+            position_joint=3,
+            torque_joint=5,
+            title="Panda with 3 kg, starting 1.5 rad round from the folded-elbow path",
+        )
+    ]
+    with tempfile.TemporaryDirectory() as tmp:
+        made = save_task_error_figure(robot, runs["qp-osc"], Path(tmp) / "task.png", title="qp-osc")
+        target = IMAGES / "limits_qp_osc_task_error.png"
+        shutil.copyfile(made, target)
+        out.append(target)
+
+
 def within_limits() -> list[Path]:
     """docs/within_limits.md's figures: the report's path retimed (TOPP-RA), its torque and
     velocity against the limits; the minimum-effort twolink's torque beside the polynomial's."""
@@ -266,6 +318,7 @@ MAKERS: dict[str, Callable[[], list[Path]]] = {
     "figures": figures,
     "ur5_square": ur5_square,
     "tune": tune,
+    "limits": limits,
     "within_limits": within_limits,
 }
 

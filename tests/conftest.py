@@ -50,6 +50,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "test_tutorial.py": ("docs",),  # the tutorial on a fresh kernel
     "test_docs_task_space.py": ("docs",),  # the page's commands: four 16-s UR5 runs and a sweep
     "test_docs_images.py": ("docs",),  # an image maker of scripts/docs_images.py
+    "test_docs_limits.py": ("docs",),  # the page's commands: two 2.5-s Panda runs, one failing at 0.12 s
     "test_report.py": ("report",),  # report builds
     "test_benchmark_script.py": ("slow",),  # scripts/benchmark.py --quick: minutes
 }
@@ -96,6 +97,7 @@ SLOW: tuple[str, ...] = (
     "tests/test_corpus.py::test_command_line[hang-compare-adaptive-",
     "tests/test_corpus.py::test_command_line[hang-animate-from-zip-bomb]",
     "tests/test_corpus.py::test_command_line[hang-identify-data-npz-bomb]",
+    "tests/test_corpus.py::test_command_line[traceback-report-qp-osc-",  # a Panda report: 15 s of CPU
 )
 """Node-id prefixes marked ``slow`` here (``make check`` leaves them to ``make test``), beside
 the tests marked ``slow`` in their own files."""

@@ -364,3 +364,29 @@ def test_the_end_effector_figure_draws_the_distance_pinocchio_gives(tmp_path: Pa
     assert path_ax.get_xlabel() == "y [m]" and path_ax.get_ylabel() == "z [m]"
     written = save_end_effector_figure(robot, result, tmp_path / "ee.png")
     assert written.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_the_pandas_home_is_its_srdf_default_pose_printed_exactly(capsys: pytest.CaptureFixture[str]) -> None:
+    """Issue 38 §9: the SRDF's "default" state writes (0, −π/4, 0, −3π/4, 0, π/2, π/4) to 6 digits
+    and cuts π/2 to 1.5707; the profile holds the fractions of π (each within 1e-4 rad of the
+    file's digits), and ``info`` prints them as they are (was q6 = 1.5707)."""
+    import math
+    import re
+    import xml.etree.ElementTree as ET
+
+    from twolink_pin.cli import main
+    from twolink_pin.model import example_robot_urdf
+
+    srdf = ET.parse(example_robot_urdf("panda_description/srdf/panda.srdf")).getroot()
+    state = next(s for s in srdf.iter("group_state") if s.get("name") == "default")
+    written = [
+        float(next(j for j in state if j.get("name") == f"panda_joint{i}").get("value")) for i in range(1, 8)
+    ]
+    exact = (0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4)
+    home = load_robot("panda").home
+    assert tuple(home) == exact
+    np.testing.assert_allclose(written, exact, rtol=0, atol=1e-4)
+    assert main(["info", "--robot", "panda"]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("home"))
+    printed = re.search(r"q = \[(.*)\] rad", line)
+    assert printed is not None and tuple(float(x) for x in printed[1].split(",")) == exact

@@ -58,6 +58,11 @@ def test_quick_benchmark_prints_positive_ratios_for_every_section() -> None:
     assert set(contention["alone_seconds_per_sim"]) == {"default", "1"}  # one copy alone: default vs 1
     assert all(x > 0 for x in contention["alone_seconds_per_sim"].values())
     assert contention["alone_default_threads"] >= 1
+    qp_osc = results["qp_osc_panda"]  # issue 37: qp-osc against osc on the Panda, and where its time goes
+    assert qp_osc["ratio"] > 0 and qp_osc["osc_seconds"] > 0 and qp_osc["target"] == 2.0
+    demo = qp_osc["profile"]["limits demo"]
+    assert demo["build_us"] > 0 and demo["solve_us"] > 0 and 0 < demo["prox_share"] <= 1
+    assert any("qp-osc" in x and "x osc" in x for x in lines)
 
 
 def test_big_arms_rows_give_ratios_and_the_floor() -> None:

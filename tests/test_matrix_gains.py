@@ -141,3 +141,27 @@ def test_numbers_awaiting_k_survive_a_replace() -> None:
     )
     law = _JointMatrixLaw(load_robot("twolink"), gains)
     np.testing.assert_array_equal(law.gains.kp, [[[300.0, 20.0], [20.0, 250.0]]])
+
+
+def test_a_per_run_scalar_beside_a_matrix_gain_survives_the_matrix_resolution() -> None:
+    """A law resolves a matrix gain by replacing it in its gains (dataclasses.replace), which
+    validates every field again: a per-run scalar, stored as a column (N, 1), must pass that
+    second validation unchanged (it was refused as 'shape (N, 1)': a sweep of such a law failed)."""
+
+    @dataclass(frozen=True, eq=False)
+    class MatrixAndScalar(Gains):
+        k: Any = gain(2.0, per="joint", matrix=True, unit="N·m/rad")
+        w: Any = gain(0.5, bound="fraction")
+
+    class Law(Controller[MatrixAndScalar], register=False):
+        name = "test-matrix-and-scalar"
+        title = "test"
+        Gains = MatrixAndScalar
+
+        def compute(self, x: LawInput, terms: Any) -> LawOutput:
+            return LawOutput(np.zeros_like(x.q))
+
+    law = Law(load_robot(), MatrixAndScalar(k=[1.0, 2.0], w=[0.1, 0.2, 0.3]))
+    assert law.runs == 3 and law.gains.w.shape == (3, 1)
+    np.testing.assert_array_equal(law.gains.w[:, 0], [0.1, 0.2, 0.3])
+    np.testing.assert_array_equal(law.gains.k[0], np.diag([1.0, 2.0]))

@@ -110,7 +110,7 @@ def test_rnea_derivatives_match_finite_differences_and_crba(ur5) -> None:
             np.testing.assert_allclose(terms.dtau_dq[k][:, j], dq, atol=1e-6)
             np.testing.assert_allclose(terms.dtau_dv[k][:, j], dv, atol=1e-6)
         M = pin.crba(ur5.model, data, q[k])
-        np.testing.assert_allclose(terms.M[k], np.triu(M) + np.triu(M, 1).T, atol=1e-12)
+        np.testing.assert_allclose(terms.mass[k], np.triu(M) + np.triu(M, 1).T, atol=1e-12)
 
 
 def test_rnea_derivatives_agree_with_aba_derivatives(ur5) -> None:
@@ -121,7 +121,7 @@ def test_rnea_derivatives_agree_with_aba_derivatives(ur5) -> None:
     terms = RneaDerivatives(ur5.model)(q, v, a)
     data = ur5.model.createData()
     ddq_dq, ddq_dv, minv = pin.computeABADerivatives(ur5.model, data, q[0], v[0], terms.tau[0])
-    M_inv = np.linalg.inv(terms.M[0])
+    M_inv = np.linalg.inv(terms.mass[0])
     np.testing.assert_allclose(ddq_dq, -M_inv @ terms.dtau_dq[0], atol=1e-8)
     np.testing.assert_allclose(ddq_dv, -M_inv @ terms.dtau_dv[0], atol=1e-8)
     np.testing.assert_allclose(np.triu(minv) + np.triu(minv, 1).T, M_inv, atol=1e-8)

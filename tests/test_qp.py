@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from twolink_pin.errors import OptimizationError
-from twolink_pin.optimal import QP, kkt_residual, solve_qp
+from twolink_pin.optimal import QP, kkt_residual, solve_qp, unconstrained_minimiser
 
 
 def test_equality_constrained_qp_equals_the_kkt_system_solved_by_numpy() -> None:
@@ -79,3 +79,46 @@ def test_warm_start_from_the_answer_needs_few_iterations() -> None:
     warm = solve_qp(qp, cold)
     np.testing.assert_allclose(warm.x, cold.x, atol=1e-7)
     assert warm.iterations <= cold.iterations
+
+
+@settings(max_examples=20, deadline=None)
+@given(seed=st.integers(0, 10_000))
+def test_the_unconstrained_minimiser_first_is_prox_qps_answer(seed: int) -> None:
+    """solve_qp(unconstrained_first=True) on random strictly convex QPs with equalities and
+    boxes: when the equality-constrained minimiser (numpy's KKT solve) lies inside every box it
+    is returned after 0 iterations with zero inequality multipliers, else ProxQP's; either way
+    it is ProxQP's answer to 1e-7 and meets the KKT conditions (residual computed here)."""
+    rng = np.random.default_rng(seed)
+    n, m, k = 6, 2, 8
+    M = rng.normal(size=(n, n))
+    H, g = M @ M.T + 0.1 * np.eye(n), rng.normal(size=n)
+    C = rng.normal(size=(k, n))
+    width = rng.uniform(0.5, 20.0)  # narrow boxes bind, wide ones do not
+    point = np.linalg.lstsq(C, rng.uniform(-0.5, 0.5, k) * width, rcond=None)[0]
+    if not np.all(np.abs(C @ point) <= width):
+        point = np.zeros(n)
+    A = rng.normal(size=(m, n))
+    b = A @ point  # equalities that a point inside every box meets
+    qp = QP(H, g, A, b, C, -width * np.ones(k), width * np.ones(k))
+    K = np.block([[H, A.T], [A, np.zeros((m, m))]])
+    free = np.linalg.solve(K, np.concatenate([-g, b]))[:n]
+    inside = bool(np.all(np.abs(C @ free) <= width))
+    first = solve_qp(qp, unconstrained_first=True)
+    prox = solve_qp(qp)
+    assert (first.iterations == 0) == inside
+    if inside:
+        np.testing.assert_allclose(first.x, free, rtol=0, atol=1e-12)
+        assert not first.z.any()
+    np.testing.assert_allclose(first.x, prox.x, atol=1e-7)
+    assert kkt_residual(qp, first) < 1e-6
+
+
+def test_the_unconstrained_minimiser_needs_a_positive_definite_hessian() -> None:
+    """A semidefinite H (min x0² with x1 free, x1 in [0, 1]) has no unique minimiser: the
+    linear solve is not tried, ProxQP answers; an outside minimiser is not returned either."""
+    qp = QP(np.diag([1.0, 0.0]), np.array([-1.0, 0.0]), C=np.eye(2), l=np.zeros(2), u=np.ones(2))
+    assert unconstrained_minimiser(qp) is None
+    assert solve_qp(qp, unconstrained_first=True).iterations > 0
+    outside = QP(np.eye(2), np.array([-2.0, 0.0]), C=np.eye(2), l=np.zeros(2), u=np.ones(2))
+    assert unconstrained_minimiser(outside) is None
+    np.testing.assert_allclose(solve_qp(outside, unconstrained_first=True).x, [1.0, 0.0], atol=1e-8)

@@ -37,10 +37,14 @@ def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> 
         "adaptive-friction": 5.0,
     }
     csv_rows = (report_dir / "comparison.csv").read_text().strip().splitlines()
-    # header, 3 norms + last-period row each; then the gains block: its header and a row per law
-    assert len(csv_rows) == 1 + 4 * len(REPORT_CONTROLLERS) + 1 + len(REPORT_CONTROLLERS)
-    assert csv_rows[1 + 4 * len(REPORT_CONTROLLERS)] == "controller,gains"
-    assert [r.split(",", 1)[0] for r in csv_rows[-len(REPORT_CONTROLLERS) :]] == list(REPORT_CONTROLLERS)
+    # header, 3 norms + last-period row each; then the gains block: its header and a row per law;
+    # then the end effector's errors (every law moves it, issue 38): its header and a row per law
+    n = len(REPORT_CONTROLLERS)
+    assert len(csv_rows) == 1 + 4 * n + 2 * (1 + n)
+    assert csv_rows[1 + 4 * n] == "controller,gains"
+    assert [r.split(",", 1)[0] for r in csv_rows[2 + 4 * n : 2 + 5 * n]] == list(REPORT_CONTROLLERS)
+    assert csv_rows[2 + 5 * n].startswith("controller,task_metric,position_rms_mm")
+    assert [r.split(",", 2)[:2] for r in csv_rows[-n:]] == [[law, "task"] for law in REPORT_CONTROLLERS]
     errata = [e["topic"] for e in results["errata"]]
     assert len(errata) == 6 and "Unstated λ, initial state and norm" in errata
     # which plant each law ran on, as compare says it: the report's plant has friction only

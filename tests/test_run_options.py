@@ -32,6 +32,7 @@ SAMPLES = {
     "--lambda": ["--lambda", "7"],
     "--q0-offset": ["--q0-offset", "0.2"],
     "--saturate": ["--saturate"],
+    "--joint-stops": ["--joint-stops"],
     "--method": ["--method", "adaptive"],
     "--control-period": ["--control-period", "0.01"],
     "--friction-smoothing": ["--friction-smoothing", "0.01"],

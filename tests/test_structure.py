@@ -88,3 +88,24 @@ def test_the_counters_see_what_they_count(tmp_path: Path) -> None:
     tree = ast.parse(f"from twolink_pin.a import _b\ndef f():\n{body}\n")
     assert (tree.body[1].end_lineno or 0) - tree.body[1].lineno + 1 == LONG + 1
     assert isinstance(tree.body[0], ast.ImportFrom) and tree.body[0].names[0].name == "_b"
+
+
+def test_every_folder_of_the_package_is_a_package_setuptools_installs() -> None:
+    """Issue 38 §9: setuptools treats every folder under ``twolink_pin/`` as a package; one that
+    ``pyproject.toml`` does not list (``report/templates``, ``identification/excitations``: data
+    folders) printed a "Package would be ignored" warning per folder in ``make demo``."""
+    import sys
+
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:  # pragma: no cover
+        import tomli as tomllib
+
+    config = tomllib.loads((PACKAGE.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    listed = set(config["tool"]["setuptools"]["packages"])
+    folders = {
+        ".".join(path.relative_to(PACKAGE.parent).parts)
+        for path in [PACKAGE, *PACKAGE.rglob("*")]
+        if path.is_dir() and path.name != "__pycache__"
+    }
+    assert folders - listed == set()

@@ -57,7 +57,29 @@ def test_a_sweep_of_osc_has_the_task_errors_simulate_reports(
         assert summary["metrics"][name]["median"] == pytest.approx(np.median(column), rel=1e-12)
 
 
-def test_a_sweep_of_a_joint_law_has_no_task_columns(tmp_path: Path) -> None:
+def test_a_sweep_of_a_joint_law_has_the_task_errors_fk_of_its_runs_gives(tmp_path: Path) -> None:
+    """Issue 38 §8: a joint-space law moves the same end effector: a sweep of ``pd`` carries the
+    task columns, each row's equal to Pinocchio's FK of that run's q against q_des (the run
+    simulated again with the row's initial offset)."""
+    from test_task_metrics import reference_task_metrics
+
+    from twolink_pin import load_robot, make_scenario, simulate
+    from twolink_pin.simulation import SimulationConfig
+    from twolink_pin.trajectory import default_trajectory
+
     out = tmp_path / "sweep"
-    assert main(["sweep", "pd", "--samples", "2", "--duration", "0.05", "--out", str(out), "--no-plot"]) == 0
-    assert not any(name.startswith("task_") for name in _rows(out / "runs.csv")[0])
+    argv = ["sweep", "pd", "--samples", "2", "--duration", "0.05", "--q0-spread", "0.1"]
+    assert main([*argv, "--out", str(out), "--no-plot"]) == 0
+    rows = _rows(out / "runs.csv")
+    assert all(name in rows[0] for name in TASK)
+    robot = load_robot()
+    for row in rows:
+        offset = (float(row["q0_offset1"]), float(row["q0_offset2"]))
+        result = simulate(
+            *make_scenario("pd", robot),
+            default_trajectory(robot),
+            SimulationConfig(duration=0.05, q0_offset=offset),
+        )
+        expected = reference_task_metrics(robot, result)
+        for name, value in expected.items():
+            assert float(row[f"task_{name}"]) == pytest.approx(value, rel=1e-9, abs=1e-12), name

@@ -62,41 +62,23 @@ def test_simulate_shows_a_task_space_laws_errors_in_mm_and_deg(
     assert f"max {task['orientation_max_deg']:.4g} deg" in text
 
 
-def test_a_joint_space_law_has_no_task_metrics(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["simulate", "pd", "--robot", "ur5", "--duration", "0.1", "--json"]) == 0
-    assert "task_metrics" not in json.loads(capsys.readouterr().out)
-
-
-def test_compare_tabulates_the_task_space_laws(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+def test_compare_tabulates_every_laws_task_errors(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None:
+    """osc and, since issue 38 §8, the joint-space pd: each row of the task table is FK of
+    that law's own saved run against its reference."""
     out = tmp_path / "cmp"
     argv = ["compare", "osc", "pd", "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.2"]
     # --no-plot: the 27 figures of two 6-joint runs took 5/6 of this test; tests/test_plotting.py
     # draws them
     assert main([*argv, "--out", str(out), "--json", "--no-plot"]) == 0
     payload = json.loads(capsys.readouterr().out)
-    assert set(payload["task_metrics"]) == {"osc"}
-    saved = tmp_path / "osc.npz"
-    assert (
-        main(
-            [
-                "simulate",
-                "osc",
-                "--robot",
-                "ur5",
-                "--trajectory",
-                SQUARE,
-                "--duration",
-                "0.2",
-                "--save",
-                str(saved),
-            ]
-        )
-        == 0
-    )
-    result = load_result(saved)
-    mm, _ = _errors(np.asarray(result.q), np.asarray(result.q_des))
-    assert payload["task_metrics"]["osc"]["position_max_mm"] == pytest.approx(mm.max(), rel=1e-9)
+    assert set(payload["task_metrics"]) == {"osc", "pd"}
     markdown = (out / "comparison.md").read_text()
-    section = markdown.split("### task space")[1]
-    assert f"| osc | {np.sqrt(np.mean(mm**2)):.4g} | {mm.max():.4g} |" in section
-    assert "| pd |" not in section.split("###")[0]
+    section = markdown.split("### task space")[1].split("###")[0]
+    for law in ("osc", "pd"):
+        saved = tmp_path / f"{law}.npz"
+        run = ["simulate", law, "--robot", "ur5", "--trajectory", SQUARE, "--duration", "0.2"]
+        assert main([*run, "--save", str(saved)]) == 0
+        result = load_result(saved)
+        mm, _ = _errors(np.asarray(result.q), np.asarray(result.q_des))
+        assert payload["task_metrics"][law]["position_max_mm"] == pytest.approx(mm.max(), rel=1e-9)
+        assert f"| {law} | {np.sqrt(np.mean(mm**2)):.4g} | {mm.max():.4g} |" in section

@@ -10,7 +10,9 @@ uniform output grid (spacing ``dt``):
 
 for ``x`` in ``e`` [rad], ``ė`` [rad/s], ``τ`` [N·m] (the torque applied to the arm),
 plus ``max |e|`` over the last reference period (the steady-state tracking error), the peak
-commanded torque and the first time it exceeded each joint's limit.
+commanded torque, and the run's crossings of its position, velocity and effort limits (joint,
+first time, largest excess: :mod:`twolink_pin.limits.crossings`, the one definition; the
+effort's is the commanded torque's, whose first time is ``first_exceeded_at``).
 
 One definition, :class:`Metrics` (batch first; a single run is its N = 1 row), and one
 implementation: :class:`RunningMetrics` takes samples block by block (the engine hands it
@@ -26,6 +28,8 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError, require_type
+from twolink_pin.limits.crossings import Crossings, RunningCrossings
+from twolink_pin.limits.joint_limits import JointLimits
 
 if TYPE_CHECKING:
     from twolink_pin.simulation import Samples, SimulationResult
@@ -86,8 +90,15 @@ class Metrics(NamedTuple):
     """``max |e|`` over the last reference period [rad]."""
     peak_command: np.ndarray
     """``max |τ_command|`` [N·m] (before saturation)."""
-    first_exceeded_at: np.ndarray
-    """First time [s] ``|τ_command|`` exceeded the joint's limit; NaN if never."""
+    crossings: Crossings
+    """Where the motion went past its position, velocity and effort limits (first time [s],
+    largest excess), :mod:`twolink_pin.limits.crossings`."""
+
+    @property
+    def first_exceeded_at(self) -> np.ndarray:
+        """First time [s] ``|τ_command|`` exceeded the joint's limit; NaN if never (the
+        effort's crossings)."""
+        return self.crossings.effort.first_time
 
     def run(self, i: int) -> Metrics:
         """Run ``i``'s metrics: arrays of shape (nv,)."""
@@ -101,7 +112,7 @@ class Metrics(NamedTuple):
             pick(self.max),
             self.final_period_max_abs_e[i],
             self.peak_command[i],
-            self.first_exceeded_at[i],
+            self.crossings.run(i),
         )
 
     def as_dict(self) -> dict[str, Any]:
@@ -130,7 +141,9 @@ class RunningMetrics:
         dt: Output grid spacing [s].
         samples: Total number of samples K (sample K − 1 ends the run).
         period: Reference period [s] (the "last period" window).
-        limits: Torque limits [N·m], shape (nv,).
+        limits: The joint limits the crossings are counted against
+            (:attr:`~twolink_pin.plant.Plant.joint_limits`), or the effort limits alone [N·m],
+            shape (nv,).
         applied: Maps commanded to applied torque (the plant's saturation).
     """
 
@@ -141,20 +154,24 @@ class RunningMetrics:
         dt: float,
         samples: int,
         period: float,
-        limits: np.ndarray,
+        limits: JointLimits | np.ndarray,
         applied: Callable[[np.ndarray], np.ndarray] | None = None,
     ) -> None:
         self.dt, self.samples = dt, samples
         self.duration = (samples - 1) * dt
         self.last_start = self.duration - period - 1e-12
-        self.limits = np.asarray(limits, dtype=float)
+        if not isinstance(limits, JointLimits):
+            none = np.full(nv, np.inf)
+            names = tuple(f"joint{j + 1}" for j in range(nv))
+            limits = JointLimits(names, -none, none, none, none, np.asarray(limits, dtype=float))
+        self.limits = limits.effort
+        self.crossings = RunningCrossings(limits, runs)
         self.applied = applied if applied is not None else (lambda tau: tau)
         self.square = {name: np.zeros((runs, nv)) for name in _SIGNALS}
         self.ends = {name: np.zeros((runs, nv)) for name in _SIGNALS}
         self.peak = {name: np.zeros((runs, nv)) for name in _SIGNALS}
         self.final_e = np.zeros((runs, nv))
         self.peak_command = np.zeros((runs, nv))
-        self.first_exceeded = np.full((runs, nv), np.nan)
 
     def add(self, samples: Samples) -> None:
         """Add a block of samples (arrays (B, N, nv))."""
@@ -172,13 +189,8 @@ class RunningMetrics:
         late = samples.t >= self.last_start
         if late.any():
             np.maximum(self.final_e, np.abs(e[late]).max(axis=0), out=self.final_e)
-        magnitude = np.abs(samples.tau_command)
-        np.maximum(self.peak_command, magnitude.max(axis=0), out=self.peak_command)
-        over = magnitude > self.limits
-        newly = over.any(axis=0) & np.isnan(self.first_exceeded)
-        if newly.any():
-            first = np.argmax(over, axis=0)
-            self.first_exceeded[newly] = samples.t[first[newly]]
+        np.maximum(self.peak_command, np.abs(samples.tau_command).max(axis=0), out=self.peak_command)
+        self.crossings.add(samples.t, samples.q, samples.v, samples.tau_command)
 
     def result(self, dead: np.ndarray | None = None) -> Metrics:
         """The metrics so far; rows of ``dead`` runs (mask, shape (N,)) are NaN."""
@@ -199,7 +211,7 @@ class RunningMetrics:
             Norms(*(clean(x) for x in mx)),
             clean(self.final_e),
             clean(self.peak_command),
-            clean(self.first_exceeded),
+            self.crossings.result(dead),
         )
 
 
@@ -218,7 +230,8 @@ def _require_finite(result: SimulationResult) -> None:
 
 
 def compute_metrics(result: SimulationResult) -> Metrics:
-    """RMS, L2 and max of ``e``, ``ė``, ``τ`` and the last-period max ``|e|`` of ``result``.
+    """RMS, L2 and max of ``e``, ``ė``, ``τ``, the last-period max ``|e|``, the peak command and
+    the crossings of ``result`` (against :attr:`~twolink_pin.simulation.SimulationResult.joint_limits`).
 
     Raises:
         InvalidParameterError: ``result`` is not a :class:`SimulationResult`, or holds a
@@ -230,8 +243,11 @@ def compute_metrics(result: SimulationResult) -> Metrics:
     _require_finite(result)
 
     nv = result.q.shape[1]
-    running = RunningMetrics(1, nv, result.dt, len(result.t), result.reference_period, result.torque_limits)
     column = lambda x: x[:, None, :]  # noqa: E731  # (K, nv) -> (K, 1, nv)
+    applied = column(result.tau)  # the torque the plant applied, as recorded
+    running = RunningMetrics(
+        1, nv, result.dt, len(result.t), result.reference_period, result.joint_limits, lambda _: applied
+    )
     zeros = np.zeros((len(result.t), 1, 0))
     running.add(
         Samples(
@@ -240,7 +256,7 @@ def compute_metrics(result: SimulationResult) -> Metrics:
             column(result.q),
             column(result.v),
             zeros,
-            column(result.tau),
+            column(result.tau_command),
             column(result.q_des),
             column(result.v_des),
             column(result.a_des),

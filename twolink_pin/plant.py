@@ -4,7 +4,9 @@
 (:class:`twolink_pin.dynamics.Friction`; Pinocchio's ABA ignores URDF friction) and ``sat``
 clips to the URDF torque limits when ``saturate`` is on (off by default, as in the report).
 A plant may also push back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
-sensor noise, a delay; none by default); the engine then runs
+sensor noise, a delay; none by default), and may make each joint's position range a hard
+stop (``position_stops``: :mod:`twolink_pin.simulation.stops`, off by default: a joint then
+passes its range and the run records the crossing); the engine then runs
 :mod:`twolink_pin.simulation.events`.
 
 :class:`Plant` is one frozen value; a variant is :func:`dataclasses.replace` of it.
@@ -29,6 +31,7 @@ import pinocchio as pin
 from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.dynamics import ABA_CONVENTION, Friction
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.limits import JointLimits, joint_limits
 from twolink_pin.model import RobotModel
 
 DEFAULT_FRICTION = (0.4, 0.2)
@@ -73,6 +76,8 @@ class Plant:
         payload_step: Payload picked up at a time (the law not told).
         sensor_noise: Noise on the q, q̇ the law measures.
         delay: Steps between a measurement and the torque it produces.
+        position_stops: Make each joint's position range a hard, perfectly inelastic stop
+            (:mod:`twolink_pin.simulation.stops`); joints without a range have none.
         model: The Pinocchio model integrated (default ``robot.model``; the model after a
             payload step in :func:`~twolink_pin.simulation.events.payload_plant`).
         friction_source: Where ``friction`` comes from, in words (the summaries show it).
@@ -86,10 +91,14 @@ class Plant:
     payload_step: PayloadStep | None = None
     sensor_noise: SensorNoise | None = None
     delay: int = 0
+    position_stops: bool = False
     model: pin.Model = field(default=None, repr=False)
     friction_source: str = ""
     limits: np.ndarray = field(init=False, repr=False)
     """Effort limits [N·m], shape (nv,), read-only."""
+    joint_limits: JointLimits = field(init=False, repr=False)
+    """Every limit of every joint (:func:`~twolink_pin.limits.joint_limits` of the robot): what
+    the run's crossings are counted against and where the stops are."""
 
     def __post_init__(self) -> None:
         robot, friction = self.robot, self.friction
@@ -103,8 +112,9 @@ class Plant:
             raise InvalidParameterError(
                 "friction", friction, f"viscous and coulomb of length nv = {robot.nv}"
             )
-        if not isinstance(self.saturate, bool):
-            raise InvalidParameterError("saturate", self.saturate, "True or False")
+        for name in ("saturate", "position_stops"):
+            if not isinstance(getattr(self, name), bool):
+                raise InvalidParameterError(name, getattr(self, name), "True or False")
         for name, kind in (("wrench", Wrench), ("payload_step", PayloadStep), ("sensor_noise", SensorNoise)):
             value = getattr(self, name)
             if value is not None and not isinstance(value, kind):
@@ -124,12 +134,16 @@ class Plant:
         limits = np.array(robot.torque_limits, dtype=float)
         limits.setflags(write=False)
         object.__setattr__(self, "limits", limits)
+        object.__setattr__(self, "joint_limits", joint_limits(robot))
 
     @property
     def has_events(self) -> bool:
-        """Whether the plant pushes back: a wrench, a payload step, sensor noise or a delay."""
+        """Whether the plant pushes back: a wrench, a payload step, sensor noise, a delay or
+        joint stops."""
         return (
-            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise)) or self.delay > 0
+            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise))
+            or self.delay > 0
+            or self.position_stops
         )
 
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
@@ -177,6 +191,8 @@ class Plant:
             parts.append("sensor noise")
         if self.delay:
             parts.append(f"delay {self.delay} steps")
+        if self.position_stops:
+            parts.append("joint stops")
         return ", ".join(parts)
 
     def friction_dict(self) -> dict[str, Any] | None:
@@ -207,8 +223,11 @@ class PlantOptions:
         payload_step: A payload picked up at a time (the law is not told).
         sensor_noise: Seeded Gaussian noise on the q [rad] and q̇ [rad/s] the law measures.
         delay: Steps between a measurement and the torque it produces.
+        position_stops: Each joint's position range a hard stop (``--joint-stops``;
+            :mod:`twolink_pin.simulation.stops`): off, a joint may pass its range, and the run
+            says so.
 
-    The last four are the plant's events (:mod:`twolink_pin.disturbances`: what each does,
+    The wrench, payload step, sensor noise and delay are the plant's events (:mod:`twolink_pin.disturbances`: what each does,
     and when, on the engine's grid); all off by default, as in the course report.
     """
 
@@ -219,8 +238,11 @@ class PlantOptions:
     payload_step: PayloadStep | None = None
     sensor_noise: SensorNoise | None = None
     delay: int = 0
+    position_stops: bool = False
 
     def __post_init__(self) -> None:
+        if not isinstance(self.position_stops, bool):
+            raise InvalidParameterError("position_stops", self.position_stops, "True or False")
         # as_dict / from_dict: the events come back from JSON as mappings
         for name, kind in (("wrench", Wrench), ("payload_step", PayloadStep), ("sensor_noise", SensorNoise)):
             value = getattr(self, name)
@@ -269,6 +291,7 @@ class PlantOptions:
             payload_step=self.payload_step,
             sensor_noise=self.sensor_noise,
             delay=self.delay,
+            position_stops=self.position_stops,
             friction_source=source,
         )
 

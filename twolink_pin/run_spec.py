@@ -28,14 +28,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.law_variant import Variant
 from twolink_pin.model import RobotModel
 from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, PlantOptions, robot_friction
 from twolink_pin.scenario import Scenario, law_class, make_controller
@@ -113,10 +114,14 @@ class RunSpec:
             raise InvalidParameterError("law", None, "a law (for_law gives a shared spec's law)")
         return law_class(self.law)
 
-    def for_law(self, law: str) -> RunSpec:
+    def for_law(self, law: str | Variant) -> RunSpec:
         """The spec of ``law`` among several: its own gains (``law_gains``), λ if it has one,
         the identified parameters if it uses them (``model``: every law; ``p0``: the laws that
-        estimate)."""
+        estimate). A :class:`~twolink_pin.law_variant.Variant`'s own settings then replace
+        these for its run (its gains over the law's, ``lam`` over ``--lambda``, its parameter
+        file over the shared one)."""
+        if isinstance(law, Variant):
+            return law_spec(self.for_law(law.law), law)
         cls = law_class(law)
         gains = dict(self.gains)
         for name, own in self.law_gains:
@@ -225,6 +230,8 @@ class RunSpec:
                 True,
                 f"a robot with effort limits ({robot.name}'s URDF gives none: nothing to clip)",
             )
+        if plant.position_stops:
+            self._check_stops(robot)
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
             for cls in classes
@@ -291,6 +298,25 @@ class RunSpec:
                 "--sensor-noise", "0,0", "a standard deviation > 0 on q or q̇ (0,0 adds no noise)"
             )
 
+    def _check_stops(self, robot: RobotModel) -> None:
+        """``--joint-stops`` needs a position range on some joint and the RK4 engine."""
+        from twolink_pin.limits import POSITION, joint_limits
+
+        limits = joint_limits(robot)
+        if not limits.given(POSITION).any():
+            raise InvalidParameterError(
+                "--joint-stops",
+                True,
+                f"a robot with a position range on some joint ({robot.name}'s joints "
+                f"{', '.join(limits.joint_names)} have none: nothing to stop at)",
+            )
+        if self.simulation.method != "rk4":
+            raise InvalidParameterError(
+                "--joint-stops",
+                True,
+                f"--method rk4 (the stops act between its steps), not {self.simulation.method}",
+            )
+
     def as_dict(self) -> dict[str, Any]:
         """The spec as JSON-ready data (:meth:`from_dict` reads it back)."""
         sim = dataclasses.asdict(self.simulation)
@@ -326,6 +352,63 @@ class RunSpec:
             simulation=SimulationConfig(**sim),
             shared=bool(data.get("shared", False)),
         )
+
+
+def law_spec(spec: RunSpec, variant: Variant) -> RunSpec:
+    """``spec`` (one law's, :meth:`RunSpec.for_law`) with ``variant``'s settings over it."""
+    gains = dict(spec.gains) | dict(variant.gains)
+    lam = None if "lam" in dict(variant.gains) else spec.lam  # the variant's λ over --lambda
+    parameters, use = spec.parameters, spec.parameters_use
+    if variant.parameters is not None:
+        parameters, use = variant.parameters, variant.parameters_use
+    return dataclasses.replace(
+        spec, gains=tuple(gains.items()), lam=lam, parameters=parameters, parameters_use=use
+    )
+
+
+class Row(NamedTuple):
+    """One row of several runs (``compare``, ``report``): a variant, its spec and its law and plant."""
+
+    variant: Variant
+    """The law and its own settings, as given."""
+    spec: RunSpec
+    """Its run: the shared spec for its law (:meth:`RunSpec.for_law`), its settings over it."""
+    scenario: Scenario
+    """Its law and plant, built once (:meth:`RunSpec.build`)."""
+
+
+def build_rows(
+    shared: RunSpec,
+    variants: Sequence[Variant],
+    robot: RobotModel,
+    read: Callable[[RunSpec], IdentifiedParameters | None] | None = None,
+) -> dict[str, Row]:
+    """Every variant's run built before any runs, keyed by its row's name
+    (:attr:`~twolink_pin.law_variant.Variant.key`): a bad gain of the third law is refused
+    before the first runs, naming its row (``pd@kp=1,2,3: kp = …``).
+
+    Args:
+        shared: The spec the variants share (``law`` None).
+        variants: The rows, in order.
+        robot: The arm.
+        read: Reads a spec's parameter file (default :meth:`RunSpec.read_parameters`); each
+            file is read once.
+
+    Raises:
+        InvalidParameterError: a value a law refuses, named ``ROW: NAME``.
+    """
+    files: dict[str, IdentifiedParameters | None] = {}
+    rows: dict[str, Row] = {}
+    for variant in variants:
+        spec = shared.for_law(variant)
+        if spec.parameters is not None and spec.parameters not in files:
+            files[spec.parameters] = read(spec) if read is not None else spec.read_parameters(robot)
+        try:
+            scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
+        rows[variant.key] = Row(variant, spec, scenario)
+    return rows
 
 
 def gains_used(controller: Controller) -> dict[str, Any]:
@@ -382,8 +465,11 @@ __all__ = [
     "FRICTION_CHOICES",
     "PARAMETER_USES",
     "PlantOptions",
+    "Row",
     "RunSpec",
+    "build_rows",
     "gains_used",
+    "law_spec",
     "make_scenario",
     "plant_description",
 ]

@@ -17,6 +17,7 @@ from typing import Any, NamedTuple
 
 from twolink_pin.controllers import Controller, load_controller
 from twolink_pin.controllers.base import check_state_declaration
+from twolink_pin.controllers.gains import check_count, spec_of
 from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
@@ -106,6 +107,11 @@ def make_controller(
         raise InvalidParameterError(
             "gain", unknown[0], f"one of the gains of '{cls.name}': {', '.join(cls.Gains.field_names())}"
         )
+    widths = cls.gain_widths(robot)
+    for name, value in changes.items():  # the count of numbers before their values
+        spec = spec_of(cls.Gains, name)
+        if spec.per != "scalar":
+            check_count(name, value, spec, *widths[spec.per])
     presets = {k: v for k, v in robot.gain_presets.get(cls.name, {}).items() if k in cls.Gains.field_names()}
     reference = _reference(cls)
     timed = not cls.__module__.startswith("twolink_pin.")  # user code: under --timeout too

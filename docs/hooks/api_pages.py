@@ -30,6 +30,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("model", "Model", "Robots from URDF, their parameters and profiles.", ("model",)),
     ("kinematics", "Kinematics", "Forward kinematics, Jacobians, inverse kinematics.", ("kinematics",)),
     (
+        "limits",
+        "Joint limits",
+        "Every limit of a joint, read once; a reference checked against them, a run's crossings.",
+        ("limits",),
+    ),
+    (
         "trajectory",
         "Trajectory",
         "Via points, polynomial references, trajectory files, the torque check.",
@@ -38,17 +44,17 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
     (
         "optimal",
-        "Limits and optimisation",
-        "Every joint limit, where a motion rides them, and the one optimisation core (splines, "
-        "SQP on Pinocchio's derivatives, ProxQP).",
-        ("limits", "optimal"),
+        "Optimisation",
+        "The one optimisation core: QP solves, B-splines, transcriptions on Pinocchio's derivatives, SQP.",
+        ("optimal",),
     ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, what pushes back on it, a law with its plant, the run description, and the engine.",
-        ("plant", "disturbances", "scenario", "run_spec", "simulation"),
+        "The simulated arm, what pushes back on it, a law with its plant, a law's variants, the run description, "
+        "and the engine.",
+        ("plant", "disturbances", "scenario", "law_variant", "run_spec", "simulation"),
     ),
     ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),

@@ -109,6 +109,13 @@ NOT_DIR = "not a directory|is a file"
 NOT_REGULAR = "not a regular file|device|pipe|fifo"
 EMPTY_PATH = "empty path|empty string|''|\"\"|no path"
 NONEMPTY = "non-empty|not empty"
+PANDA_FOLD = (
+    "times = [0.0, 2.0, 3.0, 5.0]\n"
+    "positions = [[0.32, 0.0, 0.15], [0.32, 0.0, 0.45], [0.32, 0.0, 0.45], [0.32, 0.0, 0.15]]\n"
+    "rpy = [[3.141592653589793, 0.0, 0.0], [3.141592653589793, 0.0, 0.0], [3.141592653589793, 0.0, 0.0], [3.141592653589793, 0.0, 0.0]]\n"
+    "seed = [0.0, -0.3, 0.0, -2.95, 0.0, 2.6, 0.785]\n"
+)
+"""examples/panda_fold_pose.toml (docs/limits.md): the Panda's hand lowered near its base, the elbow folded."""
 VIA_JSON = '{"times": [0, 1, 2], "joints": [[0, 0], [0.5, 0.3], [0, 0]]}\n'
 """A valid joint-space trajectory file for the twolink."""
 
@@ -267,6 +274,13 @@ WRONG = [
     C("wrong-simulate-adaptive-control-period", f"simulate pd {SIM} --method adaptive --control-period 0.01", 2, err=("control", "adaptive")),
     C("wrong-simulate-q0-offset-three-on-twolink", f"simulate pd {SIM} --q0-offset 0.1 0.2 0.3", 2, err=("0.3", "2 joints|2 values|one per joint")),
     C("wrong-simulate-gain-three-on-twolink", f"simulate pd {SIM} --gain kd=1,2,3", 2, err=("kd", "2")),
+    C("wrong-simulate-qp-osc-posture-weight-above-one", f"simulate qp-osc --robot panda --gain posture_weight=2 {SIM}", 2, err=("posture_weight", "<= 1")),
+    C("wrong-simulate-qp-osc-limit-scale-above-one", f"simulate qp-osc --robot panda --gain limit_scale=1.5 {SIM}", 2, err=("limit_scale", "<= 1")),
+    C("wrong-simulate-qp-osc-limit-scale-zero", f"simulate qp-osc --robot panda --gain limit_scale=0 {SIM}", 2, err=("limit_scale", "0 < value")),
+    C("wrong-simulate-qp-osc-horizon-negative", f"simulate qp-osc --robot panda --gain position_horizon=-0.1 {SIM}", 2, err=("position_horizon", "> 0")),
+    C("wrong-simulate-qp-osc-horizon-two-on-panda", f"simulate qp-osc --robot panda --gain velocity_horizon=0.1,0.2 {SIM}", 2, err=("velocity_horizon", "7")),
+    C("wrong-simulate-qp-osc-horizon-nan", f"simulate qp-osc --robot panda --gain position_horizon=nan {SIM}", 2, err=("position_horizon", "nan")),
+    C("wrong-simulate-qp-osc-horizon-tiny", "simulate qp-osc --robot panda --gain velocity_horizon=1e-9 --duration 0.1 --json", (0, 1), err=("qp-osc", "t ="), note="a damper shorter than a step is a clamp RK4 follows roughly: a finished run or a failed one naming the time, never a traceback"),
     # -- options that would do nothing are refused, naming the option and why (issue 30); or done (issue 28 §4)
     C("wrong-noop-simulate-noise-seed-without-noise", f"simulate pd {SIM} --noise-seed 3", 2, err=("--noise-seed", "--sensor-noise")),
     C("wrong-noop-simulate-sensor-noise-zero", f"simulate pd {SIM} --sensor-noise 0,0", 2, err=("--sensor-noise", "0,0")),
@@ -441,6 +455,11 @@ TRACEBACK = [
     C("traceback-sweep-law-raises", f"sweep {LAW}/raiser.py:Raiser --samples 2 {SIM} --no-plot --out s", 1, err=("corpus-raiser", "t ="), absent=("s",)),
     C("traceback-report-law-raises", f"report --duration 1 --workers 1 --no-animation --controller {LAW}/raiser.py:Raiser --out r", 1, err=("corpus-raiser", "t ="), exists=("r/index.html",), note="the page says the law did not finish", timeout=240),
     C("traceback-animate-law-raises", f"animate {LAW}/raiser.py:Raiser {SIM} --html a.html", 1, err=("corpus-raiser", "t ="), absent=("a.html",)),
+    # -- qp-osc: limits that cannot all hold (1 % of the effort cannot hold the Panda up within 1 % of its accelerations), a QP that stops mid-run
+    C("traceback-simulate-qp-osc-limits-cannot-hold", f"simulate qp-osc --robot panda --gain limit_scale=0.01 {SIM}", 1, err=("qp-osc", "t =", "cannot all hold", "of joint")),
+    C("traceback-compare-qp-osc-limits-cannot-hold", "compare osc qp-osc --robot panda --gain qp-osc.limit_scale=0.01 --duration 0.05 --no-plot --out c", 1, err=("qp-osc", "t =", "cannot all hold"), exists=("c/comparison.csv",), checks=(contains("c/comparison.md", "| osc |"),), note="osc's row is written"),
+    C("traceback-report-qp-osc-limits-cannot-hold", "report --robot panda --duration 0.2 --workers 1 --no-animation --no-identification --controller osc --controller qp-osc --gain qp-osc.limit_scale=0.01 --out r", 1, err=("qp-osc", "t =", "cannot all hold"), exists=("r/index.html",), checks=(contains("r/index.html", "cannot all hold"),), note="the page says qp-osc did not finish and why; osc's results are in it", timeout=240),
+    C("traceback-simulate-qp-osc-cannot-hold-mid-run", "simulate qp-osc --robot panda --payload 3 --trajectory fold.toml --q0-offset 1.5 0 0 0 0 0 0 --gain limit_scale=0.25 --duration 0.5", 1, err=("qp-osc", "t = 0.", "cannot all hold", "of joint"), setup=(via("fold.toml", PANDA_FOLD),), note="a quarter of the effort brakes the arm's swing too late: the limits stop being satisfiable partway"),
     # -- saved results that are not
     *(C(f"traceback-animate-from-{name}", "animate --from bad.npz --html a.html", 2, err=("bad.npz",), setup=(step,), absent=("a.html",)) for name, step in NPZ_BAD.items()),
     C("traceback-animate-from-truncated", "animate --from run.npz --html a.html", 2, err=("run.npz",), setup=(SAVED, truncate("run.npz", 2000)), absent=("a.html",)),
@@ -545,7 +564,7 @@ NONFINITE = [
     C("nonfinite-simulate-q0-offset-1e308", f"simulate pd {SIM} --q0-offset 1e308", 2, err=("1e308", f"{MAX_OFFSET:g}")),
     C("nonfinite-simulate-q0-offset-nan", f"simulate pd {SIM} --q0-offset nan", 2, err=("nan",)),
     C("nonfinite-simulate-q0-offset-inf", f"simulate pd {SIM} --q0-offset 0 inf", 2, err=("inf",)),
-    C("nonfinite-simulate-q0-offset-max", f"simulate pd {SIM} --q0-offset {MAX_OFFSET:g}", (0, 1)),
+    C("nonfinite-simulate-q0-offset-max", f"simulate pd {SIM} --q0-offset {MAX_OFFSET:g}", (0, 1), warns=("passed its position range",), note="issue 36: a start that far off is past the ±π range: the run says so"),
     C("nonfinite-simulate-lambda-nan", f"simulate computed-torque {SIM} --lambda nan", 2, err=("nan",)),
     C("nonfinite-simulate-lambda-inf", f"simulate computed-torque {SIM} --lambda inf", 2, err=("inf",)),
     C("nonfinite-simulate-lambda-zero", f"simulate computed-torque {SIM} --lambda 0", 2, err=("0",)),

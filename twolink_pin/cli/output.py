@@ -86,3 +86,31 @@ def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any
         dynamic_ncols=True,
         mininterval=0.5,
     )
+
+
+def limits_check_lines(check: Any) -> list[str]:
+    """A :class:`~twolink_pin.limits.LimitsCheck` as a table: per kind and joint the peak, its
+    time, the limit and the margin (``none``: the robot gives no such limit), then the
+    verdict; the first line says how fine the grid was."""
+    t = check.motion.t
+    step = float(t[1] - t[0]) if len(t) > 1 else 0.0
+    names = check.limits.joint_names
+    width = max(5, *(len(n) for n in names))
+    lines = [
+        f"limits over one period, checked at {len(t)} instants {1e3 * step:.3g} ms apart (torque by RNEA):",
+        f"  {'limit':22s} {'joint':{width}s} {'peak':>11s} {'at t [s]':>9s} {'limit':>11s} {'margin':>11s}",
+    ]
+    failed = []
+    for kind in check.kinds:
+        for j, name in enumerate(names):
+            limit, margin = float(kind.limit[j]), float(kind.margin[j])
+            given = math.isfinite(margin)
+            lines.append(
+                f"  {kind.kind.name + ' [' + kind.kind.unit + ']':22s} {name:{width}s} {kind.peak[j]:11.5g} "
+                f"{kind.time[j]:9.3f} {f'{limit:11.5g}' if given else 'none':>11s} "
+                f"{f'{margin:11.4g}' if given else '':>11s}"
+            )
+            if margin < 0:
+                failed.append(f"{kind.kind.name} of {name}")
+    lines.append("within every limit" if check.within_limits else f"BEYOND A LIMIT: {', '.join(failed)}")
+    return lines

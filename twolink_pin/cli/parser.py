@@ -76,6 +76,13 @@ def add_sim_options(parser: argparse.ArgumentParser) -> None:
         help="q(0) − q_des(0) [rad]: one value for every joint or one per joint (default: the robot's, twolink 0.1 −0.1)",
     )
     p.add_argument("--saturate", action="store_true", help="clip torques at the URDF effort limits")
+    p.add_argument(
+        "--joint-stops",
+        action="store_true",
+        help="make each joint's URDF position range a hard stop: a joint reaching it is held at the bound and "
+        "its velocity into it removed (a perfectly inelastic impact, after each RK4 step; docs/limits.md); "
+        "default: a joint may pass its range, and the run says so",
+    )
     p.add_argument("--method", choices=("rk4", "adaptive"), default="rk4", help="integrator (default rk4)")
     p.add_argument(
         "--control-period",

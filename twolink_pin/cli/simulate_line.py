@@ -48,6 +48,8 @@ def _plant_tokens(spec: RunSpec) -> list[str]:
         tokens += [f"--sensor-noise={_number(n.sigma_q)},{_number(n.sigma_v)}", f"--noise-seed={n.seed}"]
     if plant.delay:
         tokens.append(f"--delay={plant.delay}")
+    if plant.position_stops:
+        tokens.append("--joint-stops")
     return tokens
 
 

@@ -1,7 +1,8 @@
-"""What ``simulate`` and ``compare`` add for a task-space law (one whose class declares
-``task_space = True``): its task-space metrics (position error [mm], orientation error [deg]:
-RMS, max, last period; :func:`~twolink_pin.task_metrics.task_metrics`) in the summary and
-``--json``, and the task-error figure beside the joint ones in ``--plot``; and what
+"""What ``simulate`` and ``compare`` show of the end effector: the task-space metrics of every
+run (position error [mm], orientation error [deg]: RMS, max, last period;
+:func:`~twolink_pin.task_metrics.task_metrics`; a joint-space law moves the same end effector)
+in the summary and ``--json``, and for a task-space law (one whose class declares
+``task_space = True``) the task-error figure beside the joint ones in ``--plot``; and what
 ``trajectory`` shows for a file of via poses (:func:`pose_trajectory_command`)."""
 
 from __future__ import annotations
@@ -23,10 +24,9 @@ def is_task_space(controller: Controller | type) -> bool:
     return bool(getattr(controller, "task_space", False))
 
 
-def task_summary(controller: Controller, result: SimulationResult, robot: RobotModel) -> TaskMetrics | None:
-    """The run's task-space metrics for a task-space law, else None."""
-    if not is_task_space(controller):
-        return None
+def task_summary(result: SimulationResult, robot: RobotModel) -> TaskMetrics:
+    """The run's task-space metrics, whatever the law: a joint-space law moves the same end
+    effector (:func:`~twolink_pin.task_metrics.task_metrics`)."""
     from twolink_pin.task_metrics import task_metrics
 
     return task_metrics(result, robot)
@@ -65,7 +65,8 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
     points."""
     import pinocchio as pin
 
-    from twolink_pin.cli.output import emit, fmt
+    from twolink_pin.cli.commands.model import limits_payload
+    from twolink_pin.cli.output import emit, fmt, limits_check_lines
 
     figures: list[str] = []
     if args.plot:
@@ -82,6 +83,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
         "via_q": traj.via_q.tolist(),
         "ik_error": {"position_m": traj.ik_error[0], "angle_rad": traj.ik_error[1]},
         **check.summary(),
+        **limits_payload(check),
         "figures": figures,
     }
     lines = ["via poses (t [s], position [m], roll-pitch-yaw [rad], q [rad]):"]
@@ -92,6 +94,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
     )
     lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
     lines.append(check.verdict())
+    lines += limits_check_lines(check.limits_check)
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))
     return 0

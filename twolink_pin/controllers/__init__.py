@@ -15,6 +15,7 @@
 ``task_space.py``      what the task-space laws share (task rows, pose error, Λ, null space)
 ``osc.py``             ``osc`` — :class:`OperationalSpace` (Khatib)
 ``impedance.py``       ``impedance`` — :class:`Impedance` (Cartesian impedance + ĝ)
+``qp_osc.py``          ``qp-osc`` — :class:`QPOperationalSpace` (``osc`` as a QP within the limits)
 =====================  ============================================================
 """
 
@@ -41,6 +42,7 @@ from twolink_pin.controllers.pd_gravity import PDGravity, PDGravityGains
 from twolink_pin.controllers.pid import PID, PIDGains
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
 from twolink_pin.controllers.impedance import Impedance, ImpedanceGains
+from twolink_pin.controllers.qp_osc import QPOperationalSpace, QPOSCGains
 from twolink_pin.controllers.loading import available_controllers, load_controller
 
 __all__ = [
@@ -66,6 +68,8 @@ __all__ = [
     "PDGravity",
     "PDGravityGains",
     "PIDGains",
+    "QPOSCGains",
+    "QPOperationalSpace",
     "SlotineLiGains",
     "StateVariable",
     "Terms",

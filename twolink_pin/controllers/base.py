@@ -16,6 +16,9 @@ A law subclasses :class:`Controller`, states its law in the class docstring, dec
 
 and implements **one** method, :meth:`Controller.compute`, that maps a :class:`LawInput`
 (time, state, reference) to a :class:`LawOutput` (torque τ and, for a law with state, ż).
+A law that plans (the model-predictive law) also declares :meth:`Controller.update_period`
+and :meth:`Controller.update`: a discrete update of its state (the new plan) that the engine
+makes at those instants.
 Every array has a leading run axis: ``q`` is ``(N, nv)`` for N runs advanced together
 (N = 1 for a single run); the reference sample is ``(1, nv)`` (the same for every run).
 Write the law with numpy broadcasting and it never needs to know N.
@@ -194,6 +197,14 @@ class Terms(Protocol):
         (N, nv, k): a linear solve on ``M̂`` (LU), never an explicit inverse."""
         ...
 
+    def inverse_dynamics_derivatives(self, q: np.ndarray, v: np.ndarray, a: np.ndarray) -> Any:
+        """``τ = M̂ a + Ĉ(q, v) v + ĝ`` and its derivatives ``∂τ/∂q``, ``∂τ/∂v`` and
+        ``∂τ/∂a = M̂`` at K states of each run, on the controller's model (Pinocchio's
+        ``computeRNEADerivatives``): arguments of shape (N, K, nv) (row i: run i's states),
+        a :class:`~twolink_pin.dynamics.InverseDynamicsDerivatives` of shapes (N, K, nv) and
+        (N, K, nv, nv). What a law that plans (:meth:`Controller.update`) linearises with."""
+        ...
+
     def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
         """Pose, Jacobian and ``J̇ q̇`` of ``frame`` (default: the robot's end effector),
         ``LOCAL_WORLD_ALIGNED``, linear rows first (see :class:`FrameTerms`). Pure
@@ -313,14 +324,30 @@ class Controller(abc.ABC, Generic[G]):
     @property
     def parameter_names(self) -> tuple[str, ...]:
         """Names of the estimated parameters, in the order of ``z``."""
+        return self.estimated_names(self.robot)
+
+    @classmethod
+    def estimated_names(cls, robot: RobotModel) -> tuple[str, ...]:
+        """Names of the parameters the law estimates on ``robot`` (:attr:`parameter_names`)."""
         names: list[str] = []
-        for kind in self.estimates:
+        for kind in cls.estimates:
             if kind == "inertial":
-                names += self.robot.parameter_map.names
+                names += robot.parameter_map.names
             else:
-                n = self.robot.nv
+                n = robot.nv
                 names += [f"V{j + 1}" for j in range(n)] + [f"C{j + 1}" for j in range(n)]
         return tuple(names)
+
+    @classmethod
+    def gain_widths(cls, robot: RobotModel) -> dict[str, tuple[int, str]]:
+        """For each ``per`` of a gain: how many values it has on ``robot`` and what they are for
+        (``{"joint": (nv, "per joint, nv = 2"), ...}``)."""
+        names = cls.estimated_names(robot)
+        return {
+            "joint": (robot.nv, f"per joint, nv = {robot.nv}"),
+            "estimate": (len(names), f"per estimated parameter: {names}"),
+            "axis": (3, "per world axis x, y, z"),
+        }
 
     @property
     def parameter_units(self) -> tuple[str, ...]:
@@ -400,6 +427,21 @@ class Controller(abc.ABC, Generic[G]):
         """``z(0)``, shape (nz,) or one row per run (N, nz); zeros unless overridden."""
         return np.zeros(self.state_size)
 
+    def update_period(self) -> float | None:
+        """Time [s] between the law's discrete updates of its state (:meth:`update`: a
+        planning law's replans), from t = 0; ``None`` (the default): the law has none.
+        The engine calls :meth:`update` at every multiple of this period, which must be a
+        multiple of the simulation step."""
+        return None
+
+    def update(self, x: LawInput, terms: Terms) -> np.ndarray:
+        """The law's new state ``z``, shape (N, nz), at an update instant (every
+        :meth:`update_period` seconds): what a planning law does when it replans (its plan
+        and warm start are its state, recorded like any state). Called before
+        :meth:`compute` at that instant, with the measured state and the state so far; between
+        updates ``z`` moves only by the ``dz`` :meth:`compute` returns (zeros for a plan)."""
+        raise NotImplementedError(f"{type(self).__name__} declares an update period but no update()")
+
     def scaled_gains(self) -> dict[str, Any]:
         """Values for the per-joint or per-estimate gains left ``None``, derived from the
         robot (override in a law whose gains default to ``None``)."""
@@ -433,31 +475,16 @@ class Controller(abc.ABC, Generic[G]):
                 )
             gains = dataclasses.replace(gains, **{name: derived[name] for name in missing})
         matrices = {}
+        widths = self.gain_widths(self.robot)
         for f in dataclasses.fields(gains):
             spec = gain_spec(f)
             value = getattr(gains, f.name)
+            if spec.per == "scalar":
+                continue
+            width, what = widths[spec.per]
             if spec.matrix and value is not None:
-                width, what = {
-                    "joint": (self.robot.nv, f"per joint, nv = {self.robot.nv}"),
-                    "estimate": (
-                        len(self.parameter_names),
-                        f"per estimated parameter: {self.parameter_names}",
-                    ),
-                    "axis": (3, "per world axis x, y, z"),
-                }[spec.per]
                 value = matrices[f.name] = as_matrix(value, width, f.name, spec.unit)
-                check_width(f.name, value, width, what)
-            elif spec.per == "joint":
-                check_width(f.name, value, self.robot.nv, f"per joint, nv = {self.robot.nv}")
-            elif spec.per == "estimate":
-                check_width(
-                    f.name,
-                    value,
-                    len(self.parameter_names),
-                    f"per estimated parameter: {self.parameter_names}",
-                )
-            elif spec.per == "axis":
-                check_width(f.name, value, 3, "per world axis x, y, z")
+            check_width(f.name, value, width, what)
         return dataclasses.replace(gains, **matrices) if matrices else gains
 
     def _check_parameters(self, p: Any) -> np.ndarray | None:

@@ -47,7 +47,7 @@ from twolink_pin.errors import InvalidParameterError
 
 SHAPES = ("scalar", "joint", "estimate", "axis")
 """What one value of a gain is for."""
-BOUNDS = ("positive", "nonnegative", "any")
+BOUNDS = ("positive", "nonnegative", "any", "fraction")
 """Sign constraints a gain may declare."""
 
 
@@ -82,7 +82,8 @@ def gain(
             per-estimate gains derived from the robot).
         per: ``"scalar"``, ``"joint"`` or ``"estimate"``.
         unit: SI unit, e.g. ``"N·m/rad"``.
-        bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0) or ``"any"``.
+        bound: ``"positive"`` (> 0, default), ``"nonnegative"`` (>= 0), ``"any"`` or
+            ``"fraction"`` (0 < value <= 1: a share of something, e.g. of a limit).
         doc: One-line description (shown by the CLI and the report).
         matrix: A symmetric positive-definite matrix gain of size k given by ``per``
             (``"joint"``, ``"estimate"`` or ``"axis"``); ``bound`` is then "positive".
@@ -124,6 +125,7 @@ def _expected(spec: GainSpec) -> str:
         "positive": f" > 0 (from {low:g} to {high:g})",
         "nonnegative": f" >= 0 (0, or from {low:g} to {high:g})",
         "any": f" within ±{high:g}",
+        "fraction": f", a fraction 0 < value <= 1 (from {low:g})",
     }[spec.bound]
     unit = f" [{spec.unit}]" if spec.unit else ""
     return {
@@ -163,10 +165,10 @@ def _check_matrices(name: str, array: np.ndarray, expected: str) -> np.ndarray:
                 f"{expected}; the symmetry check failed: it is not symmetric "
                 f"(entry [{r}, {c}] = {matrix[r, c]:g} but [{c}, {r}] = {matrix[c, r]:g})",
             )
+        eigenvalues = np.linalg.eigvalsh(matrix)
         try:
             np.linalg.cholesky(matrix)
         except np.linalg.LinAlgError:
-            eigenvalues = np.linalg.eigvalsh(matrix)
             raise InvalidParameterError(
                 where,
                 _shown(matrix),
@@ -174,6 +176,13 @@ def _check_matrices(name: str, array: np.ndarray, expected: str) -> np.ndarray:
                 f"(eigenvalues {', '.join(f'{x:.4g}' for x in eigenvalues[:8])}"
                 f"{', …' if eigenvalues.size > 8 else ''}; smallest {eigenvalues.min():.3g})",
             ) from None
+        if not eigenvalues.min() >= GAIN_RANGE[0]:  # as a number s (s I) must be >= 1e-12
+            raise InvalidParameterError(
+                where,
+                _shown(matrix),
+                f"{expected}; the positive-definite check failed: its smallest eigenvalue "
+                f"{eigenvalues.min():.3g} is below {GAIN_RANGE[0]:g}, the least a gain may be",
+            )
     stack = np.ascontiguousarray(stack)
     stack.setflags(write=False)
     return stack
@@ -194,12 +203,7 @@ def _from_numbers(name: str, numbers: np.ndarray, k: int, expected: str) -> np.n
         return _check_matrices(name, np.diag(numbers), expected)
     if n == k * k:
         return _check_matrices(name, numbers.reshape(k, k), expected)
-    raise InvalidParameterError(
-        name,
-        numbers.tolist(),
-        f"{expected}; the shape check failed: {n} numbers are neither 1, {k} (a diagonal) nor "
-        f"{k * k} (a {k} × {k} matrix, row by row)",
-    )
+    raise InvalidParameterError(name, numbers.tolist(), f"{expected}; {_shape_failed(n, k)}")
 
 
 def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
@@ -269,6 +273,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     except (TypeError, ValueError):
         raise InvalidParameterError(name, value, _expected(spec)) from None
     allowed = (0, 1) if spec.per == "scalar" else (0, 1, 2)
+    if spec.per == "scalar" and array.ndim == 2 and array.shape[1] == 1:  # validated before: a column
+        array = array[:, 0]  # per run (dataclasses.replace validates every field again)
     if array.ndim not in allowed or array.size == 0:
         raise InvalidParameterError(name, value, f"{_expected(spec)} (got shape {array.shape})")
     bad = ~np.isfinite(array)
@@ -278,6 +284,8 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
             bad |= ~(array >= GAIN_RANGE[0])
         elif spec.bound == "nonnegative":
             bad |= ~((array == 0) | (array >= GAIN_RANGE[0]))
+        elif spec.bound == "fraction":
+            bad |= ~((array >= GAIN_RANGE[0]) & (array <= 1.0))
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
         where = f"{name}[{', '.join(map(str, index))}]" if index else name
@@ -382,6 +390,43 @@ def one_row(value: Any, width: int) -> np.ndarray:
     return np.broadcast_to(array.reshape(-1), (width,)).copy()
 
 
+def check_count(name: str, value: Any, spec: GainSpec, width: int, what: str) -> None:
+    """Refuse a value given as numbers (one value set: a number or a flat sequence) whose count
+    the gain cannot take on this robot — before its entries are checked, so that four numbers
+    for a two-joint gain are named as four numbers, not by an entry that is out of range.
+
+    Args:
+        name: The gain's field name.
+        value: The value as given (per-run arrays and matrices are left to the later checks).
+        spec: Its declaration (``per``, ``matrix``).
+        width: How many values ``per`` means here (nv, the estimates, 3 axes).
+        what: What the values are for (``per joint, nv = 2``).
+
+    Raises:
+        InvalidParameterError: the count received and the counts expected.
+    """
+    if spec.per == "scalar" or isinstance(value, (bool, str)) or value is None:
+        return
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return  # not numbers: the value's own check says so
+    if array.ndim != 1:
+        return
+    n = array.size
+    shown = array.tolist() if n <= 24 else f"{n} numbers"
+    if spec.matrix:
+        if n not in (1, width, width * width):
+            expected = MATRIX_EXPECTED.format(unit=f" [{spec.unit}]" if spec.unit else "")
+            raise InvalidParameterError(name, shown, f"{expected}; {_shape_failed(n, width)} ({what})")
+    elif n not in (1, width):
+        raise InvalidParameterError(name, shown, f"1 or {width} numbers ({what}); got {n}")
+
+
+def _shape_failed(n: int, k: int) -> str:
+    return f"the shape check failed: {n} numbers are neither 1, {k} (a diagonal) nor {k * k} (a {k} × {k} matrix, row by row)"
+
+
 def check_width(name: str, value: Any, width: int, what: str) -> None:
     """Raise unless ``value`` (validated) is a scalar, ``width`` values, or per run one or
     ``width`` values (shape ``(N, 1)`` or ``(N, width)``)."""
@@ -396,8 +441,9 @@ def check_width(name: str, value: Any, width: int, what: str) -> None:
     if value.shape[1] not in (1, width):
         rows = value.tolist()
         shown = (rows[0] if len(rows) == 1 else rows) if value.size <= 24 else f"array of shape {value.shape}"
+        got = f"{value.shape[1]} numbers" if value.shape[0] == 1 else f"shape {value.shape}"
         raise InvalidParameterError(
-            name, shown, f"one value or {width} ({what}), or one row of them per run; got shape {value.shape}"
+            name, shown, f"one value or {width} ({what}), or one row of them per run; got {got}"
         )
 
 

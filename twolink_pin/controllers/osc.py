@@ -12,10 +12,10 @@ from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,
-    desired_frame,
     null_space_torque,
+    posture_acceleration,
     row_index,
-    task_error,
+    task_acceleration,
     task_rows,
 )
 from twolink_pin.model import RobotModel
@@ -104,21 +104,13 @@ class OperationalSpace(Controller[OSCGains]):
         return self._inertia.damped
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        rows = self._index
-        f = terms.frame(x.q, x.v)
-        J = f.jacobian[:, rows]
-        d = desired_frame(x)  # x_des, R_des, twist_des, accel_des
-        x_dot_des = d.twist[:, rows]
-        x_ddot_des = d.accel[:, rows]
-        e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
-        e_dot = np.matvec(J, x.v) - x_dot_des
-        desired = x_ddot_des - np.matvec(self._D, e_dot) - np.matvec(self._K, e)
+        task = task_acceleration(x, terms, self._index, self._K, self._D)
+        J = task.jacobian
         MinvJt = terms.solve_mass(x.q, J.transpose(0, 2, 1))
         Lam = self._inertia(np.matmul(J, MinvJt), x.t)
-        tau = np.vecmat(np.matvec(Lam, desired - f.drift[:, rows]), J) + terms.bias(x.q, x.v)
+        tau = np.vecmat(np.matvec(Lam, task.desired - task.drift), J) + terms.bias(x.q, x.v)
         if self._redundant:
             g = self.gains
-            posture = x.a_des - g.kp_null * (x.q - x.q_des) - g.kd_null * (x.v - x.v_des)
-            tau0 = np.matvec(terms.mass(x.q), posture)
+            tau0 = np.matvec(terms.mass(x.q), posture_acceleration(x, g.kp_null, g.kd_null))
             tau = tau + null_space_torque(J, MinvJt, Lam, tau0)
         return LawOutput(tau)

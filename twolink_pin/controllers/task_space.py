@@ -1,5 +1,6 @@
-"""What the task-space laws (``osc``, ``impedance``) share: the task's rows, the pose error,
-the damped task-space inertia and the dynamically consistent null-space projection.
+"""What the task-space laws (``osc``, ``qp-osc``, ``impedance``) share: the task's rows, the pose
+error, the desired task and posture accelerations, the damped task-space inertia and the
+dynamically consistent null-space projection.
 
 Conventions are those of :class:`~twolink_pin.controllers.FrameTerms`: world-aligned, linear
 rows first. The orientation error is ``e_o = log(R R_dᵀ)`` — the rotation vector [rad] that
@@ -40,7 +41,7 @@ from typing import NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.controllers.base import LawInput
+from twolink_pin.controllers.base import LawInput, Terms
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -241,6 +242,41 @@ class TaskInertia:
         else:  # ρ = 0 for every run: s / (s² + 0), the same bits without the sum
             inverse = s / (s * s)
         return np.matmul(U * inverse[:, None, :], U.transpose(0, 2, 1))
+
+
+class TaskAcceleration(NamedTuple):
+    """The task's kinematics at the state and the acceleration the task asks for, each on the
+    task's rows (N runs)."""
+
+    jacobian: np.ndarray
+    """``J`` [m/rad; 1], shape (N, k, nv)."""
+    drift: np.ndarray
+    """``J̇ q̇`` [m/s²; rad/s²], shape (N, k)."""
+    desired: np.ndarray
+    """``ẍ* = ẍ_d − D ė − K e`` [m/s²; rad/s²], shape (N, k): the task acceleration that makes
+    the error obey ``ë + D ė + K e = 0`` (:class:`~twolink_pin.controllers.osc.OperationalSpace`)."""
+
+
+def task_acceleration(
+    x: LawInput, terms: Terms, rows: slice | np.ndarray, K: np.ndarray, D: np.ndarray
+) -> TaskAcceleration:
+    """The end effector's Jacobian and ``J̇ q̇`` on ``rows`` (a :func:`row_index`) and the desired
+    task acceleration ``ẍ* = ẍ_d − D (J q̇ − ẋ_d) − K e`` with ``e`` the :func:`task_error`, for
+    the stiffness ``K`` [1/s²] and damping ``D`` [1/s], (R, k, k) (:func:`block_gain`)."""
+    f = terms.frame(x.q, x.v)
+    J = f.jacobian[:, rows]
+    d = desired_frame(x)  # x_des, R_des, twist_des, accel_des
+    e = task_error(f.position, f.rotation, d.position, d.rotation, rows)
+    e_dot = np.matvec(J, x.v) - d.twist[:, rows]
+    desired = d.accel[:, rows] - np.matvec(D, e_dot) - np.matvec(K, e)
+    return TaskAcceleration(J, f.drift[:, rows], desired)
+
+
+def posture_acceleration(x: LawInput, kp_null: np.ndarray | float, kd_null: np.ndarray | float) -> np.ndarray:
+    """``q̈_d − K_n (q − q_d) − D_n (q̇ − q̇_d)`` [rad/s²], shape (N, nv): the joint acceleration
+    the posture task asks for (the joint reference is the posture), ``K_n`` [1/s²] and ``D_n``
+    [1/s] per joint."""
+    return x.a_des - kp_null * (x.q - x.q_des) - kd_null * (x.v - x.v_des)
 
 
 def null_space_torque(J: np.ndarray, MinvJt: np.ndarray, Lam: np.ndarray, tau0: np.ndarray) -> np.ndarray:

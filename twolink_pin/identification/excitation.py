@@ -51,6 +51,7 @@ from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.identification.measures import ExcitationMeasures, excitation_measures
 from twolink_pin.identification.observation import ParameterSet
 from twolink_pin.identification.simulated import plant_friction
+from twolink_pin.limits import VELOCITY, joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.fourier import FourierTrajectory
 
@@ -105,25 +106,22 @@ class ExcitationLimits:
     def resolve(self, robot: RobotModel) -> dict[str, np.ndarray]:
         """Per joint: ``lower``, ``upper`` [rad], ``velocity`` [rad/s], ``acceleration``
         [rad/s²], ``torque`` [N·m] (inf: unbounded)."""
-        model = robot.model
-        lo, hi = (
-            np.array(model.lowerPositionLimit, dtype=float),
-            np.array(model.upperPositionLimit, dtype=float),
-        )
+        limits = joint_limits(robot)
+        lo, hi = np.array(limits.position_lower), np.array(limits.position_upper)
         bounded = np.isfinite(lo) & np.isfinite(hi)
         home = robot.home
         lo = np.where(bounded, lo, home - self.unbounded_range)
         hi = np.where(bounded, hi, home + self.unbounded_range)
         margin = self.position_margin * (hi - lo)
         velocity = (
-            np.where(model.velocityLimit > 0, model.velocityLimit, DEFAULT_VELOCITY) * self.velocity_fraction
+            np.where(limits.given(VELOCITY), limits.velocity, DEFAULT_VELOCITY) * self.velocity_fraction
         )
         return {
             "lower": lo + margin,
             "upper": hi - margin,
             "velocity": np.asarray(velocity, dtype=float),
             "acceleration": np.full(robot.nv, float(self.acceleration)),
-            "torque": np.asarray(robot.torque_limits, dtype=float) * self.torque_fraction,
+            "torque": np.array(limits.effort) * self.torque_fraction,
         }
 
 

@@ -5,12 +5,10 @@ are read from the robot (:mod:`twolink_pin.limits.joint_limits`). Checks of a re
 the crossings of a run, the retiming, the optimiser and the constrained laws all go
 through these four objects, so a fifth kind (jerk, say) is one more object here.
 
-=================  ====================================================================
-``position``       q [rad] between the URDF's ``<limit lower upper>``
-``velocity``       ``|q̇|`` [rad/s] below the URDF's ``<limit velocity>`` (0: none)
-``acceleration``   ``|q̈|`` [rad/s²] below the robot's profile's (a URDF has none)
-``effort``         ``|τ|`` [N·m] below the URDF's ``<limit effort>`` (0: none)
-=================  ====================================================================
+* ``position`` (q, rad): the URDF's ``<limit lower upper>``;
+* ``velocity`` (q̇, rad/s): the URDF's ``<limit velocity>`` (0: none);
+* ``acceleration`` (q̈, rad/s²): the robot's profile (a URDF has none);
+* ``effort`` (τ, N·m): the URDF's ``<limit effort>`` (0: none).
 
 The position limit bounds ``q`` between two values; the others are symmetric boxes
 ``|x| <= limit``.

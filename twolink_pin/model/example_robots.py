@@ -9,7 +9,7 @@ What each entry adds to the URDF, and why:
 
 * ``home``: a configuration inside the joint limits, away from singularities, that the
   default trajectory swings about and the viewer starts from (the Panda's and the Z1's
-  from their SRDF files; the UR5's the usual "elbow up, wrist down" pose; the Kinova's
+  from their SRDF files, the Panda's as the fractions of π its SRDF rounds to 6 digits; the UR5's the usual "elbow up, wrist down" pose; the Kinova's
   SRDF ``arm_up`` with joint 3 taken modulo 2π into its limits);
 * ``locked_joints``: a gripper's finger joints are held fixed (the Panda's two fingers
   at 0.001 m as in its SRDF, the Z1's gripper closed at 0 rad): tracking control of the
@@ -26,6 +26,7 @@ from the model.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from twolink_pin.model import catalog
@@ -56,7 +57,9 @@ _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
             "ee_frame": "panda_hand_tcp",
             "locked_joints": ("panda_finger_joint1", "panda_finger_joint2"),
             "locked_positions": (0.001, 0.001),
-            "home": (0.0, -0.785398, 0.0, -2.35619, 0.0, 1.5707, 0.785398),
+            # its SRDF's "default" state, (0, −π/4, 0, −3π/4, 0, π/2, π/4): the file writes these
+            # to 6 digits, and π/2 cut (not rounded) to 1.5707, 9.6e-5 rad short
+            "home": (0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4),
             # Franka's data sheet ("Robot and interface specifications", q̈max per joint)
             "acceleration_limits": (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
         },

@@ -5,7 +5,8 @@ It sits below ``trajectory/`` and ``controllers/`` and uses only ``model/``, ``d
 and ``limits/``.
 
 ==========================  ================================================================
-``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP), :func:`kkt_residual`
+``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP; the unconstrained
+                            minimiser first on request), :func:`kkt_residual`
 ``spline.py``               :class:`BSplineBasis`: values and derivatives of a B-spline as matrices
 ``layout.py``               :class:`SplineLayout`: a trajectory in spline segments, its variables
                             and Jacobians; :class:`Points` where it is evaluated
@@ -22,7 +23,7 @@ through its ``Terms``.
 """
 
 from twolink_pin.optimal.layout import Points, SplineLayout
-from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp
+from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp, unconstrained_minimiser
 from twolink_pin.optimal.refinement import WithinLimits, solve_within_limits
 from twolink_pin.optimal.spline import BSplineBasis
 from twolink_pin.optimal.sqp import SQPOptions, SQPResult, StepResult, solve_sqp, sqp_step
@@ -47,4 +48,5 @@ __all__ = [
     "solve_sqp",
     "solve_within_limits",
     "sqp_step",
+    "unconstrained_minimiser",
 ]

@@ -35,6 +35,12 @@ from twolink_pin.errors import InvalidParameterError, OptimizationError
 from twolink_pin.optimal.qp import QP, QPSolution, solve_qp
 from twolink_pin.optimal.transcription import Evaluation, TrajectoryProblem
 
+PROXIMAL_RHO = 1e-8
+"""ProxQP's proximal step on the primal variables for the steps' QPs (its default 1e-6 was
+large beside the smallest curvature of these steps: 1635 iterations instead of 200 on the UR5)."""
+INFEASIBILITY_EPS = 1e-9
+"""ProxQP's infeasibility tolerances for the steps' QPs (its default, 1e-4, declared feasible
+steps infeasible: badly scaled rows)."""
 QP_ITERATIONS = 3000
 """Most ProxQP iterations of one step (a step closer than 1000 times its tolerance is taken
 as it is then)."""
@@ -243,7 +249,9 @@ def sqp_step(
     """
     ev = problem.evaluate(x, jacobians=True)
     scaled = _qp(problem, x, ev, 1.0, damping)
-    solution = solve_qp(scaled.qp, _warm(warm, scaled.qp), what=what)
+    solution = solve_qp(
+        scaled.qp, _warm(warm, scaled.qp), what=what, rho=PROXIMAL_RHO, infeasibility_eps=INFEASIBILITY_EPS
+    )
     return StepResult(x + solution.x, solution, ev)
 
 
@@ -279,7 +287,8 @@ class _Loop:
         warm = None if self.warm is None else self.warm._replace(z=z)
         solution = solve_qp(
             scaled.qp, _warm(warm, scaled.qp), eps=options.qp_tolerance, max_iter=options.qp_iterations, what=what,
-            accept=1e3 * options.qp_tolerance, explain=options.explain,
+            accept=1e3 * options.qp_tolerance, explain=options.explain, rho=PROXIMAL_RHO,
+            infeasibility_eps=INFEASIBILITY_EPS,
         )  # fmt: skip
         self.solves += 1
         d = solution.x

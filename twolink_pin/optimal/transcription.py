@@ -31,7 +31,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from twolink_pin.dynamics.derivatives import InverseDynamics, InverseDynamicsTerms
+from twolink_pin.dynamics.derivatives import InverseDynamics, InverseDynamicsDerivatives
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import EFFORT, KINDS, POSITION, JointLimits, LimitKind
 from twolink_pin.optimal.layout import Points, SplineLayout
@@ -224,7 +224,7 @@ class TrajectoryProblem:
 
     def _torques(
         self, kin_cost: list[np.ndarray], kin_check: list[np.ndarray], at_cost: bool, at_check: bool
-    ) -> tuple[np.ndarray, np.ndarray, InverseDynamicsTerms | None, InverseDynamicsTerms | None]:
+    ) -> tuple[np.ndarray, np.ndarray, InverseDynamicsDerivatives | None, InverseDynamicsDerivatives | None]:
         """τ at the cost and check points (one call of the dynamics on both), and the terms."""
         nv = self.layout.nv
         empty = np.zeros((0, nv))
@@ -236,14 +236,18 @@ class TrajectoryProblem:
         a = np.concatenate([k[2] if use else empty for k, use in groups])
         terms = self.dynamics(q, v, a)
         n_cost = self.cost_points.size if at_cost else 0
-        first = InverseDynamicsTerms(*(t[:n_cost] for t in terms)) if at_cost else None
-        second = InverseDynamicsTerms(*(t[n_cost:] for t in terms)) if at_check else None
+        first = InverseDynamicsDerivatives(*(t[:n_cost] for t in terms)) if at_cost else None
+        second = InverseDynamicsDerivatives(*(t[n_cost:] for t in terms)) if at_check else None
         tau_cost = first.tau if first is not None else np.zeros((self.cost_points.size, nv))
         tau_check = second.tau if second is not None else np.zeros((self.check_points.size, nv))
         return tau_cost, tau_check, first, second
 
     def torque_jacobian(
-        self, x: np.ndarray, points: Points, terms: InverseDynamicsTerms, kin: list[np.ndarray] | None = None
+        self,
+        x: np.ndarray,
+        points: Points,
+        terms: InverseDynamicsDerivatives,
+        kin: list[np.ndarray] | None = None,
     ) -> np.ndarray:
         """``∂τ/∂x`` at ``points`` from the dynamics' derivatives (``kin``: q, q̇, q̈ there,
         when known), shape (K, nv, size): ``Σ_r G_r ∂q^{(r)}/∂x`` with ``G = (∂τ/∂q, ∂τ/∂q̇, M)``."""
@@ -251,7 +255,7 @@ class TrajectoryProblem:
         K, nv = points.size, layout.nv
         h = layout.durations_of(x)[points.segment]
         block = np.zeros((K, nv, layout.n, nv))  # [k, a, i, b]: ∂τ_a/∂C_{seg, i, b}
-        for order, G in ((0, terms.dtau_dq), (1, terms.dtau_dv), (2, terms.M)):
+        for order, G in ((0, terms.dtau_dq), (1, terms.dtau_dv), (2, terms.mass)):
             block += np.einsum("kab,ki->kaib", G, points.rows[order] / h[:, None] ** order)
         J = np.zeros((K, nv, layout.size))
         k = np.arange(K)[:, None, None, None]
@@ -262,7 +266,7 @@ class TrajectoryProblem:
             if kin is None:
                 kin = [layout.derivative(x, points, r) for r in range(3)]
             dh = -np.einsum("kab,kb->ka", terms.dtau_dv, kin[1]) - 2.0 * np.einsum(
-                "kab,kb->ka", terms.M, kin[2]
+                "kab,kb->ka", terms.mass, kin[2]
             )
             J[np.arange(K), :, layout.duration_column(points)] = dh / h[:, None]
         return J
@@ -272,7 +276,7 @@ class TrajectoryProblem:
         x: np.ndarray,
         kin: list[np.ndarray],
         tau: np.ndarray,
-        terms: InverseDynamicsTerms | None,
+        terms: InverseDynamicsDerivatives | None,
         jacobians: bool,
     ) -> tuple[np.ndarray, np.ndarray | None]:
         """The cost's residuals and, with ``jacobians``, their Jacobian."""
@@ -341,7 +345,7 @@ class TrajectoryProblem:
         x: np.ndarray,
         kin: list[np.ndarray],
         tau: np.ndarray,
-        terms: InverseDynamicsTerms | None,
+        terms: InverseDynamicsDerivatives | None,
         jacobians: bool,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
         """Limit rows at the check points (divided by their limit, tightened by the margin)

@@ -26,6 +26,10 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
                      to the desired one
 ``task.py``          :func:`save_task_error_figure`: a task-space law's position [mm] and
                      orientation [deg] errors over time
+``overlay.py``       :func:`~twolink_pin.plotting.overlay.save_overlay_figure`: the runs of one
+                     law's variants on the same axes (error envelope, torque)
+``limits.py``        :func:`save_limits_figure`: several runs against one joint's range and
+                     one joint's effort limit
 ===================  =====================================================================
 
 Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,
@@ -36,6 +40,7 @@ tests can check what is drawn. Units: time [s], angles [rad], rates [rad/s], pos
 
 from twolink_pin.plotting.cartesian import save_end_effector_figure
 from twolink_pin.plotting.distribution import save_distribution_figure
+from twolink_pin.plotting.limits import save_limits_figure
 from twolink_pin.plotting.run import save_simulation_figures
 from twolink_pin.plotting.task import save_task_error_figure
 from twolink_pin.plotting.trajectory import save_trajectory_figures
@@ -43,6 +48,7 @@ from twolink_pin.plotting.trajectory import save_trajectory_figures
 __all__ = [
     "save_distribution_figure",
     "save_end_effector_figure",
+    "save_limits_figure",
     "save_simulation_figures",
     "save_task_error_figure",
     "save_trajectory_figures",

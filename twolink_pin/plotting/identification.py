@@ -27,6 +27,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.limits import joint_limits
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     COMMAND_COLOR,
@@ -174,15 +175,14 @@ def _excitation_figure(
     tau = np.asarray(check.tau)
     fig = new_figure((WIDTH, 1.0 + 1.9 * nv))
     axes = fig.subplots(nv, 4, squeeze=False, sharex=True)
-    model = robot.model
-    if limits is None:
-        velocity = np.where(model.velocityLimit > 0, model.velocityLimit, np.inf)
+    if limits is None:  # the robot's own, read once (twolink_pin.limits)
+        own = joint_limits(robot)
         bounds = {
-            "lower": np.asarray(model.lowerPositionLimit),
-            "upper": np.asarray(model.upperPositionLimit),
-            "velocity": np.asarray(velocity, dtype=float),
-            "acceleration": np.full(nv, np.inf),
-            "torque": np.asarray(robot.torque_limits, dtype=float),
+            "lower": own.position_lower,
+            "upper": own.position_upper,
+            "velocity": own.velocity,
+            "acceleration": own.acceleration,
+            "torque": own.effort,
         }
     else:
         bounds = {k: np.asarray(v, dtype=float) for k, v in limits.items()}
@@ -236,6 +236,8 @@ def _excitation_figure(
         else f"period {trajectory.period:g} s"
     )
     which = "the limits it was designed within" if limits is not None else "the URDF's limits"
+    if limits is None and np.isfinite(bounds["acceleration"]).any():
+        which += " and the profile's accelerations"
     fig.suptitle(f"{robot.name}: excitation ({extra}) over one period; dashed: {which}")
     fix_margins(fig, EXCITATION_MARGINS)
     return fig
@@ -252,8 +254,9 @@ def save_excitation_figures(
     motion needs (rigid body, :func:`twolink_pin.feasibility.check_torques`, or ``check``)
     over one period, the limits dashed: ``limits`` as
     :meth:`~twolink_pin.identification.excitation.ExcitationLimits.resolve` gives them (the
-    bounds an excitation was designed within), else the URDF's position, velocity and effort
-    limits. A limit more than 3 × the peak is noted, not drawn."""
+    bounds an excitation was designed within), else the robot's own
+    (:func:`twolink_pin.limits.joint_limits`: the URDF's position, velocity and effort limits,
+    the profile's acceleration limits). A limit more than 3 × the peak is noted, not drawn."""
     if check is None:
         from twolink_pin.feasibility import check_torques
 

@@ -17,7 +17,7 @@ from __future__ import annotations
 import inspect
 import os
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from dataclasses import asdict
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -27,20 +27,20 @@ import numpy as np
 from twolink_pin import interrupts
 from twolink_pin.errors import (
     ControllerError,
-    InvalidParameterError,
     InvalidURDFError,
     SimulationDivergedError,
 )
 from twolink_pin.feasibility import check_torques
 from twolink_pin.files import output_directory
+from twolink_pin.law_variant import Variant, file_stem, parse_variants
 from twolink_pin.metrics import Metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report import facts
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
-from twolink_pin.run_spec import gains_used, plant_description
-from twolink_pin.scenario import builtin_laws, law_class
+from twolink_pin.run_spec import Row, build_rows, gains_used, plant_description
+from twolink_pin.scenario import builtin_laws
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.comparison import ComparisonTable
@@ -54,16 +54,18 @@ Progress = Callable[[str, int, int], None]
 __all__ = ["MARKER", "MAX_WORKERS", "ReportOptions", "build_report", "laws_to_run"]
 
 
-def laws_to_run(options: ReportOptions, robot: Any) -> tuple[str, ...]:
-    """The laws the report runs (see :class:`ReportOptions`): those asked for, else the
-    robot profile's report laws, else every built-in law."""
+def laws_to_run(options: ReportOptions, robot: Any) -> tuple[Variant, ...]:
+    """The rows the report runs (see :class:`ReportOptions`): the laws or variants asked for
+    (``LAW@KEY=VALUE…``, :mod:`twolink_pin.law_variant`), else the robot profile's report
+    laws, else every built-in law.
+
+    Raises:
+        InvalidParameterError: a bad variant, or the same one twice.
+    """
     if options.controllers is not None:
-        names = tuple(law_class(spec).name for spec in options.controllers)
-        if len(set(names)) != len(names):
-            raise InvalidParameterError("controllers", list(options.controllers), "each law at most once")
-        return tuple(options.controllers)
+        return parse_variants(options.controllers)
     laws = robot.profile.report.laws
-    return tuple(laws) if laws is not None else builtin_laws()
+    return parse_variants(tuple(laws) if laws is not None else builtin_laws())
 
 
 def build_report(
@@ -84,10 +86,12 @@ def build_report(
     started = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
     sections = robot.profile.report.sections  # the robot's own sections (the twolink's course report)
-    specs = laws_to_run(options, robot)
-    options.run.check_law_gains(specs)
-    options.run.check_effective(robot, specs)
-    steps = 4 + len(specs) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
+    variants = laws_to_run(options, robot)
+    laws = [v.law for v in variants]
+    options.run.check_law_gains(laws)
+    options.run.check_effective(robot, laws)
+    rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
+    steps = 4 + len(rows) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
     done = 0
     heard = len(interrupts.received)
 
@@ -99,7 +103,7 @@ def build_report(
             progress(what, done, steps)
 
     with output_directory(out_dir, MARKER, "written by twolink-pin report\n") as stage:
-        results = _build(stage, robot, specs, options, tick)
+        results = _build(stage, robot, rows, options, tick)
         results["total_seconds"] = time.perf_counter() - started
         results["command_line"] = command_line
         from twolink_pin.report.pages import write_pages
@@ -112,7 +116,7 @@ def build_report(
 def _build(
     stage: Path,
     robot: Any,
-    specs: Sequence[str],
+    rows: dict[str, Row],
     options: ReportOptions,
     tick: Callable[[str], None],
 ) -> dict[str, Any]:
@@ -121,30 +125,27 @@ def _build(
     via = default_via_points(robot) if not options.trajectory else None
     check = check_torques(robot, trajectory)
     sections = robot.profile.report.sections
-    names = [law_class(spec).name for spec in specs]
-    by_name = dict(zip(names, specs))
-    ran = _run_all(stage, robot, trajectory, via, by_name, options, tick)
+    names = list(rows)
+    ran = _run_all(stage, robot, trajectory, via, rows, options, tick)
     runs = {n: ran.runs[n] for n in names if n in ran.runs}  # the order asked for
     cfg = options.run.simulation
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
-    scenarios = {n: options.run.for_law(by_name[n]).build(robot) for n in names}  # what each ran with
-    task = {  # the task-space laws' end-effector errors (their class declares task_space)
-        n: task_metrics(r[0], robot) for n, r in runs.items() if law_class(by_name[n]).task_space
-    }
+    task = {n: task_metrics(r[0], robot) for n, r in runs.items()}  # every law moves the end effector
     table = ComparisonTable(
         {n: r[1] for n, r in runs.items()},
         {n: r[3] for n, r in runs.items()},
         cfg.duration,
         {n: ran.failed[n] for n in names if n in ran.failed},
-        plants={n: plant_description(scenarios[n]) for n in names},
-        gains={n: gains_used(scenarios[n].controller) for n in names},
+        plants={n: plant_description(rows[n].scenario) for n in names},
+        gains={n: gains_used(rows[n].scenario.controller) for n in names},
         task=task,
     )
-    controllers, lams = _law_entries(runs, by_name, scenarios, task)
+    controllers, lams = _law_entries(runs, rows, task)
     errata: list[dict[str, Any]] = []
     if sections:
         done_runs = {n: r[0] for n, r in runs.items()}
-        errata = sections.errata(robot, trajectory, done_runs, by_name, options, q0_offset, lams)
+        laws = {n: row.variant.law for n, row in rows.items()}
+        errata = sections.errata(robot, trajectory, done_runs, laws, options, q0_offset, lams)
     tick("errata")
     return {
         "robot": ran.model,
@@ -156,6 +157,7 @@ def _build(
             "q0_offset": q0_offset.tolist(),
             "lambda": lams,
             "saturate": options.run.plant.saturate,
+            "joint_stops": options.run.plant.position_stops,
             "friction_smoothing": options.run.friction_smoothing,
         },
         "run": options.run.as_dict(),
@@ -164,8 +166,14 @@ def _build(
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),
         "comparison_csv": table.csv(),
+        "overlays": ran.overlays,
         "animation": ran.animation,
-        "warnings": ran.warnings,
+        "warnings": ran.warnings
+        + [  # a run that passed a position range says so (the CLI prints them)
+            f"{name}: {sentence}"
+            for name, (result, metrics, *_) in runs.items()
+            for sentence in metrics.crossings.sentences(result.joint_limits, ("position",))
+        ],
         "animated": ran.animated,
         "errata": errata,
         "identification": ran.identification,
@@ -194,6 +202,8 @@ class _Ran(NamedTuple):
     """The robot's facts."""
     own_facts: Any
     """The robot's own sections' facts (None without)."""
+    overlays: dict[str, str]
+    """Each law run as several variants: the figure of their runs overlaid (file name)."""
 
 
 def _run_all(
@@ -201,7 +211,7 @@ def _run_all(
     robot: Any,
     trajectory: Any,
     via: Any,
-    by_name: dict[str, str],
+    rows: dict[str, Row],
     options: ReportOptions,
     tick: Callable[[str], None],
 ) -> _Ran:
@@ -213,7 +223,7 @@ def _run_all(
     declared = robot.profile.report
     sections = declared.sections
     numbers = {k: dict(v) for k, v in declared.figure_numbers.items()}
-    names = list(by_name)
+    names = list(rows)
     animated = declared.animated_law if declared.animated_law in names else names[0]
     order = [animated, *(n for n in names if n != animated)]
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]] = {}
@@ -226,7 +236,9 @@ def _run_all(
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
         pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
-        futures = {n: pool.submit(run_law, by_name[n], options, str(fig_dir), numbers.get(n)) for n in order}
+        futures = {
+            n: pool.submit(run_law, rows[n].variant, options, str(fig_dir), numbers.get(n)) for n in order
+        }
         traj_future = pool.submit(trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
         model = facts.model_facts(robot)
         own_facts = sections.facts(robot, via) if sections else None
@@ -245,12 +257,41 @@ def _run_all(
             tick("animation")  # every law failed: nothing to animate
         traj_figs = traj_future.result()
         tick("trajectory figures")
+        overlays = _write_overlays(fig_dir, rows, runs, options)
         identification = None
         if sections and pending is not None:
             done_runs = {n: r[0] for n, r in runs.items()}
             identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
             tick("identification")
-    return _Ran(runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts)
+    return _Ran(
+        runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays
+    )
+
+
+def _write_overlays(
+    fig_dir: Path,
+    rows: dict[str, Row],
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
+    options: ReportOptions,
+) -> dict[str, str]:
+    """``<law>_variants.png`` for each law run as several variants that finished: their runs
+    overlaid (:func:`~twolink_pin.plotting.overlay.save_overlay_figure`); law → file name."""
+    from twolink_pin.plotting.overlay import save_overlay_figure
+    from twolink_pin.plotting.run import wrench_spans
+
+    by_law: dict[str, dict[str, SimulationResult]] = {}
+    for key, row in rows.items():
+        if key in runs:
+            by_law.setdefault(row.variant.name, {})[key] = runs[key][0]
+    written = {}
+    for law, results in by_law.items():
+        if len(results) > 1:
+            path = fig_dir / f"{file_stem(law)}_variants.png"
+            title = f"{law}: {len(results)} runs overlaid"
+            written[law] = save_overlay_figure(
+                results, path, title, wrench_spans(options.run.plant.wrench)
+            ).name
+    return written
 
 
 def _write_animation(
@@ -287,22 +328,23 @@ def _write_animation(
 
 def _law_entries(
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
-    by_name: dict[str, str],
-    scenarios: dict[str, Any],
+    rows: dict[str, Row],
     task: dict[str, Any],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
-    """Each law that ran as ``results.json`` shows it (its law, gains, metrics, figures,
+    """Each row that ran as ``results.json`` shows it (its law, gains, metrics, figures,
     estimates, limits), and the λ [1/s] of those that have one."""
     controllers = {}
     lams: dict[str, float] = {}
     for name, (result, metrics, figures, seconds) in runs.items():
-        cls = law_class(by_name[name])
-        controller = scenarios[name].controller  # the gains it ran with
+        row = rows[name]
+        cls = row.variant.law_class()
+        controller = row.scenario.controller  # the gains it ran with
         if cls.takes("lam"):
             lams[name] = float(np.max(controller.gains.lam))
         controllers[name] = {
             "title": cls.title,
             "law": inspect.getdoc(cls) or "",
+            "variant": dict(row.variant.settings) if row.variant.settings else None,
             "gains": controller.gains.describe(),
             "metrics": metrics.as_dict(),
             "task_metrics": task[name].as_dict() if name in task else None,
@@ -313,6 +355,8 @@ def _law_entries(
             "parameter_names": list(result.parameter_names),
             "limit_exceeded": result.limit_exceeded.tolist(),
             "limit_exceeded_at": result.first_exceeded_at,
+            "crossings": metrics.crossings.summary(),
+            "crossed": metrics.crossings.sentences(result.joint_limits),
         }
     return controllers, lams
 

@@ -9,10 +9,10 @@ from typing import Any
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.feasibility import check_torques
+from twolink_pin.law_variant import Variant, file_stem
 from twolink_pin.metrics import Metrics, compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report.options import ReportOptions
-from twolink_pin.scenario import law_class
 from twolink_pin.simulation import SimulationResult, simulate
 from twolink_pin.trajectory import default_trajectory
 
@@ -35,30 +35,33 @@ def reference_trajectory(robot: Any, options: ReportOptions) -> Any:
 
 
 def run_law(
-    spec: str,
+    variant: Variant,
     options: ReportOptions,
     fig_dir: str,
     figure_numbers: dict[str, int] | None,
 ) -> tuple[SimulationResult, Metrics, list[str], float]:
-    """Worker: one law's run, metrics and figures (picklable arguments only)."""
+    """Worker: one row's run (a law, or a variant of it), metrics and figures (picklable
+    arguments only); its figures are prefixed by the row's name
+    (:func:`~twolink_pin.law_variant.file_stem`)."""
     from twolink_pin.plotting import save_simulation_figures
     from twolink_pin.plotting.run import wrench_spans
 
     start = time.perf_counter()
     robot = load_robot(options.robot, payload=options.payload)
-    cls = law_class(spec)
-    controller, plant = options.run.for_law(spec).build(robot)
+    cls, key = variant.law_class(), variant.key
+    prefix, title = file_stem(key), cls.title if key == cls.name else f"{cls.title}, {key}"
+    controller, plant = options.run.for_law(variant).build(robot)
     result = simulate(controller, plant, reference_trajectory(robot, options), options.run.simulation)
     metrics = compute_metrics(result)
     spans = wrench_spans(options.run.plant.wrench)  # a push shaded where it acts
     paths = save_simulation_figures(
-        result, Path(fig_dir), prefix=cls.name, figure_numbers=figure_numbers, title=cls.title, spans=spans
+        result, Path(fig_dir), prefix=prefix, figure_numbers=figure_numbers, title=title, spans=spans
     )
     if cls.task_space:  # the law's class declares it: its task errors beside the joint figures
         from twolink_pin.plotting import save_task_error_figure
 
-        path = Path(fig_dir) / f"{cls.name}_task_error.png"
-        paths.append(save_task_error_figure(robot, result, path, cls.title, spans))
+        path = Path(fig_dir) / f"{prefix}_task_error.png"
+        paths.append(save_task_error_figure(robot, result, path, title, spans))
     return result, metrics, [Path(p).name for p in paths], time.perf_counter() - start
 
 

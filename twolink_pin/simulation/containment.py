@@ -1,4 +1,4 @@
-"""The one door through which the engine calls a law's ``compute``: user code contained.
+"""The one door through which the engine calls a law's ``compute`` (and ``update``): user code contained.
 
 :func:`contained` wraps ``controller.compute`` so that what a law does wrong is an error
 naming the law, never a changed simulation or a silent exit:
@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
-from twolink_pin.errors import ControllerError
+from twolink_pin.errors import ControllerError, InvalidParameterError
 from twolink_pin.user_code import restore_baseline
 
 READ_ONLY_HINT = (
@@ -51,13 +51,15 @@ def read_only(a: np.ndarray) -> np.ndarray:
     return view
 
 
-def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
-    """``controller.compute`` behind read-only inputs, with ``SystemExit`` and
-    ``MemoryError`` turned into :class:`ControllerError` naming the law (see module doc).
+def contained(controller: Controller, method: str = "compute") -> Callable[[LawInput, Any], Any]:
+    """``controller.compute`` (or the law's ``update``, ``method="update"``) behind
+    read-only inputs, with ``SystemExit`` and ``MemoryError`` turned into
+    :class:`ControllerError` naming the law (see module doc).
 
-    The returned function has the law's signature ``(x, terms) -> LawOutput``."""
+    The returned function has the method's signature ``(x, terms) -> LawOutput`` (``update``:
+    ``-> z``)."""
     restore_baseline()  # each run starts from the command's working directory and NumPy state
-    compute = controller.compute
+    compute = getattr(controller, method)
     name = controller.name
 
     def call(x: LawInput, terms: Any) -> LawOutput:
@@ -74,13 +76,13 @@ def contained(controller: Controller) -> Callable[[LawInput, Any], LawOutput]:
             return compute(x, terms)
         except SystemExit as exc:
             raise ControllerError(
-                name, float(t), f"compute called sys.exit({exc.code!r}); a law must return or raise"
+                name, float(t), f"{method} called sys.exit({exc.code!r}); a law must return or raise"
             ) from None
         except MemoryError as exc:
             raise ControllerError(
                 name,
                 float(t),
-                f"compute ran out of memory (MemoryError{': ' + str(exc) if str(exc) else ''})",
+                f"{method} ran out of memory (MemoryError{': ' + str(exc) if str(exc) else ''})",
             ) from None
         except ValueError as exc:
             if "read-only" in str(exc):
@@ -115,4 +117,69 @@ def check_output(controller: Controller, out: object, runs: int, nv: int, nz: in
             )
 
 
-__all__ = ["check_output", "contained", "read_only"]
+def check_state(controller: Controller, z: object, runs: int, nz: int, t: float) -> np.ndarray:
+    """``z`` (the law's :meth:`~twolink_pin.controllers.Controller.update` at ``t`` [s]) as a
+    float array of shape (runs, nz), or :class:`ControllerError` naming the law."""
+    shape = getattr(z, "shape", None)
+    if not isinstance(z, np.ndarray) or shape != (runs, nz) or z.dtype.kind not in "fiu":
+        got = f"shape {shape} of {z.dtype}" if isinstance(z, np.ndarray) else type(z).__name__
+        raise ControllerError(
+            controller.name,
+            t,
+            f"update must return the new state z, real numbers of shape ({runs}, {nz}); got {got}",
+        )
+    return np.array(z, dtype=float)
+
+
+def law_call(
+    controller: Controller, noise: list[np.ndarray] | None, method: str = "compute"
+) -> Callable[[Any, Any], Any]:
+    """The law's ``method`` as the loop calls it: contained (read-only inputs; ``sys.exit``
+    and ``MemoryError`` name it) and, with sensor noise, measuring the state plus ``noise``
+    (the list the loop fills with the current step's offsets)."""
+    law = contained(controller, method)
+    if noise is None:
+        return law
+    new = tuple.__new__
+
+    def compute(x: LawInput, terms: Any) -> Any:  # the law measures the state + noise
+        t, q, v, z, *reference = x
+        return law(new(LawInput, (t, q + noise[0], v + noise[1], z, *reference)), terms)
+
+    return compute
+
+
+def update_steps(controller: Controller, dt: float) -> int | None:
+    """Steps between the law's state updates (its :meth:`~twolink_pin.controllers.Controller.update_period`
+    over the step ``dt`` [s]), None for a law without.
+
+    Raises:
+        InvalidParameterError: the period is not finite, shorter than the step or not a
+            multiple of it (to 1e-9 relative), naming the law.
+    """
+    period = controller.update_period()
+    if period is None:
+        return None
+    value = float(period)
+    steps = round(value / dt) if np.isfinite(value) and value > 0 else 0
+    if steps < 1 or abs(steps * dt - value) > 1e-9 * value:
+        raise InvalidParameterError(
+            f"{controller.name}: update period",
+            period,
+            f"a multiple of the simulation step dt = {dt:g} s (at least one step)",
+        )
+    return int(steps)
+
+
+def raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
+    """Whether ``exc`` was raised inside the law (its ``compute`` is on the traceback)."""
+    code = getattr(getattr(compute, "__func__", compute), "__code__", None)
+    tb = exc.__traceback__
+    while tb is not None:
+        if tb.tb_frame.f_code is code:
+            return True
+        tb = tb.tb_next
+    return isinstance(exc, ControllerError)
+
+
+__all__ = ["check_output", "check_state", "contained", "law_call", "raised_by", "read_only", "update_steps"]

@@ -10,11 +10,19 @@ State ``x = (q, q̇, z)`` per run (``z``: the law's internal state), arrays ``(N
   step. This is what a digital controller does; it differs from the per-stage law by
   O(control_period).
 
+* **A law that plans** (:meth:`~twolink_pin.controllers.Controller.update_period`: a model-
+  predictive law's replanning period, a multiple of the step): at every multiple of that
+  period, before the law's evaluation at that instant, the engine replaces ``z`` by the law's
+  :meth:`~twolink_pin.controllers.Controller.update` from the measured state (its new plan);
+  in between the law follows the plan in ``z``.
+
 A plant that pushes back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
 sensor noise, a delay) runs in the same loop: :class:`~twolink_pin.simulation.events.PlantEvents`
 gives each step's dynamics and the noise on what the law measures, and with a delay the law is
 sampled every step (or control period) and a :class:`~twolink_pin.simulation.events.DelayLine`
-applies its torque ``delay`` steps late (details in :mod:`twolink_pin.simulation.events`).
+applies its torque ``delay`` steps late (details in :mod:`twolink_pin.simulation.events`); with
+joint stops the state after each step is put back within the position ranges
+(:mod:`twolink_pin.simulation.stops`).
 
 The law gets its Pinocchio terms from :func:`~twolink_pin.simulation.terms.terms_for`
 and the plant's accelerations come from :func:`~twolink_pin.simulation.forward.dynamics_for`
@@ -38,11 +46,18 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
-from twolink_pin.controllers import Controller, LawInput, LawOutput
+from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.errors import ControllerError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import SimulationConfig
-from twolink_pin.simulation.containment import check_output, contained, read_only
+from twolink_pin.simulation.containment import (
+    check_output,
+    check_state,
+    law_call,
+    raised_by,
+    read_only,
+    update_steps,
+)
 from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
 from twolink_pin.simulation.divergence import flag_block, late_divergence
 from twolink_pin.simulation.events import DelayLine, PlantEvents
@@ -229,10 +244,17 @@ class _Run:
         # choose the dynamics of each step, offset what the law measures, delay its torque.
         self.events = events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
         self.line = line = DelayLine(plant.delay) if plant.delay > 0 else None
+        self.stop = events.stop if events is not None and events.stops is not None else None
         self.accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
         noisy = events is not None and events.noise is not None
         self.noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
-        self.compute = _law_call(controller, self.noise if noisy else None)
+        self.compute = law_call(controller, self.noise if noisy else None)
+        self.update_every = update_steps(controller, dt)
+        self.update = (
+            None
+            if self.update_every is None
+            else law_call(controller, self.noise if noisy else None, "update")
+        )
         self.sampled = hold is not None or line is not None  # the law evaluated once per step or period
         self.every = hold if hold is not None else 1
         self.total = total = n + 1
@@ -243,6 +265,8 @@ class _Run:
         self.alive = np.ones(runs, dtype=bool)
         self.z_start = np.array(z0, dtype=float)
         self.q, self.v, self.z = np.array(q0, dtype=float), np.array(v0, dtype=float), self.z_start.copy()
+        if self.stop is not None:  # a joint that starts beyond its stop starts on it
+            self.q, self.v = self.stop(0.0, self.q, self.v)
         self.steps = _Steps.of(dt, nv, nz)
         self.no_state = np.zeros((runs, 0))
         # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
@@ -259,7 +283,7 @@ class _Run:
     def advance(self, k0: int, k1: int, ref: Any) -> None:
         """Steps ``k0 … k1 − 1``: write each sample, evaluate the law where the run samples it
         (``ref[i]``: the law's reference rows of the block's half-step i), advance the state."""
-        controller, compute, terms, clock, events, line, noise = (
+        controller, compute, terms, clock, events, line, noise, stop = (
             self.controller,
             self.compute,
             self.terms,
@@ -267,6 +291,7 @@ class _Run:
             self.events,
             self.line,
             self.noise,
+            self.stop,
         )
         runs, nv, nz, n, dt, every, sampled, steps, no_state = (
             self.runs,
@@ -281,6 +306,7 @@ class _Run:
         )
         Q, V, T, Z, MQ, MV = self.out.Q, self.out.V, self.out.T, self.out.Z, self.out.MQ, self.out.MV
         q, v, z, accel, tau1, dz1, first = self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first
+        update, update_every = self.update, self.update_every or 1
         # LawInput(...) through tuple.__new__: the NamedTuple's own __new__ is a Python
         # function that costs twice as much, four times a step.
         new = tuple.__new__
@@ -294,6 +320,11 @@ class _Run:
                     accel = events.accel_at(t)
                     if events.noise is not None:
                         noise[:] = events.noise_at(k)
+                if update is not None and k % update_every == 0:  # a planning law replans
+                    clock.now = t
+                    z = check_state(
+                        controller, update(new(LawInput, (t, q, v, z, *ref[i])), terms), runs, nz, t
+                    )
                 if not sampled or k % every == 0:
                     clock.now = t
                     out = compute(new(LawInput, (t, q, v, z, *ref[i])), terms)
@@ -319,18 +350,29 @@ class _Run:
                     q, v, z = _stage_step(
                         compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
                     )
+                if stop is not None:  # joint stops: back within the ranges
+                    q, v = stop(t, q, v)
         except (KeyboardInterrupt, SystemExit, MemoryError):
             raise
         except Exception as exc:
-            if not _raised_by(exc, compute):
-                raise
-            # A law may raise on a state that had already diverged: report the divergence.
-            self.flag(k0 - off, filled, off, True)
-            if isinstance(exc, ControllerError):
-                raise
-            what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
-            raise ControllerError(controller.name, clock.now, what + raised_at(exc, controller)) from exc
+            self.failed(exc, k0 - off, filled, off)
+            raise
         self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first = q, v, z, accel, tau1, dz1, first
+
+    def failed(self, exc: Exception, start: int, filled: int, off: int) -> None:
+        """An exception raised inside the law (its ``compute`` or ``update``) as a
+        :class:`ControllerError` naming it and the time, after flagging the runs that had
+        already diverged in buffer rows ``start:filled`` (a law may raise on a diverged state:
+        the divergence is reported). Returns for any other exception: the caller re-raises it."""
+        update = self.update
+        if not (raised_by(exc, self.compute) or (update is not None and raised_by(exc, update))):
+            return
+        self.flag(start, filled, off, True)
+        if isinstance(exc, ControllerError):
+            return
+        what = str(exc) if isinstance(exc, TwolinkPinError) else f"{type(exc).__name__}: {exc}"
+        controller = self.controller
+        raise ControllerError(controller.name, self.clock.now, what + raised_at(exc, controller)) from exc
 
     def flag(self, start: int, stop: int, off: int, raise_now: bool) -> np.ndarray:
         """Flag the live runs that diverged within buffer rows ``start:stop`` (the first is
@@ -467,30 +509,3 @@ def _held_step(
     if nz:
         z = z + hz * dz
     return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z
-
-
-def _law_call(controller: Controller, noise: list[np.ndarray] | None) -> Callable[[Any, Any], Any]:
-    """The law as the loop calls it: contained (read-only inputs; ``sys.exit`` and
-    ``MemoryError`` name it) and, with sensor noise, measuring the state plus ``noise``
-    (the list the loop fills with the current step's offsets)."""
-    law = contained(controller)
-    if noise is None:
-        return law
-    new = tuple.__new__
-
-    def compute(x: LawInput, terms: Any) -> LawOutput:  # the law measures the state + noise
-        t, q, v, z, *reference = x
-        return law(new(LawInput, (t, q + noise[0], v + noise[1], z, *reference)), terms)
-
-    return compute
-
-
-def _raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
-    """Whether ``exc`` was raised inside the law (its ``compute`` is on the traceback)."""
-    code = getattr(getattr(compute, "__func__", compute), "__code__", None)
-    tb = exc.__traceback__
-    while tb is not None:
-        if tb.tb_frame.f_code is code:
-            return True
-        tb = tb.tb_next
-    return isinstance(exc, ControllerError)

@@ -10,6 +10,9 @@ events it asks :class:`PlantEvents` (built once per run) at each step k (``t_k =
 * :meth:`PlantEvents.noise_at` — the law's measurement offset ``(q, q̇) + noise_k`` (one
   noise sample per step and run, from the run's own generator, drawn block by block so that
   a run's noise does not depend on its batch; :meth:`PlantEvents.draw` per block);
+* :meth:`PlantEvents.stop` — with ``position_stops``, after step k: each joint beyond its
+  range put back at the bound and its velocity into the stop removed by an inelastic impact
+  (:mod:`twolink_pin.simulation.stops`, on the model of step k);
 * :class:`DelayLine` — with ``delay = d`` the law is sampled (every step, or every control
   period) and step k applies the torque computed at the latest sample ``<= k − d`` (before
   the first such sample: the first torque computed); ``z`` advances by ``dt ż`` with the
@@ -29,6 +32,7 @@ import numpy as np
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.rigid_terms import RigidBodyTerms
+from twolink_pin.simulation.stops import JointStops
 
 Accel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 """``(q, v, tau) -> q̈`` for N runs."""
@@ -62,6 +66,15 @@ class PlantEvents:
         self._k0 = 0
         self.delay = plant.delay
         self._nv = nv
+        self.stops = None
+        if plant.position_stops:
+            after = payload_plant(plant).model if plant.payload_step is not None else plant.model
+            self.stops = (JointStops(plant.joint_limits, plant.model), JointStops(plant.joint_limits, after))
+
+    def stop(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The state after the step that starts at ``t`` [s] with the joint stops applied."""
+        assert self.stops is not None
+        return self.stops[t >= self._payload_time](q, v)
 
     def accel_at(self, t: float) -> Accel:
         """The plant's ``q̈`` over the step that starts at ``t`` [s]."""

@@ -3,8 +3,11 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
+
+from twolink_pin.limits import Crossings, JointLimits, Motion, motion_crossings
 
 
 @dataclass(frozen=True)
@@ -66,6 +69,15 @@ class SimulationResult:
     where the law measures ``q``. A saved run keeps it, so that it reads as a real log."""
     v_measured: np.ndarray | None = field(repr=False, default=None)
     """Joint velocities the law measured [rad/s], as ``q_measured``."""
+    position_limits: np.ndarray | None = field(repr=False, default=None)
+    """Each joint's position range [rad], shape (2, nv): lower, upper (``∓inf``: none); None
+    in a result saved before it was recorded (no position crossings then)."""
+    velocity_limits: np.ndarray | None = field(repr=False, default=None)
+    """Each joint's velocity limit [rad/s], shape (nv,) (``inf``: none); None as above."""
+    joint_names: tuple[str, ...] = ()
+    """The joints, in the order of ``q`` (empty in an older saved result)."""
+    position_stops: bool = False
+    """Whether the plant made each position range a hard stop (``--joint-stops``)."""
 
     @property
     def duration(self) -> float:
@@ -93,17 +105,34 @@ class SimulationResult:
         return None if self.p_hat is None or self.p_true is None else self.p_hat - self.p_true
 
     @property
+    def joint_limits(self) -> JointLimits:
+        """The limits the run is checked against: the position range and velocity limits it
+        records (none where it records none) and ``torque_limits``."""
+        nv = self.nv
+        none = np.full(nv, np.inf)
+        lower, upper = (-none, none) if self.position_limits is None else self.position_limits
+        names = self.joint_names if len(self.joint_names) == nv else tuple(f"joint{j + 1}" for j in range(nv))
+        velocity = none if self.velocity_limits is None else self.velocity_limits
+        return JointLimits(names, lower, upper, velocity, none, self.torque_limits)
+
+    @cached_property
+    def crossings(self) -> Crossings:
+        """Where the run went past its position range, velocity and effort limits (the
+        commanded torque's): :func:`~twolink_pin.limits.motion_crossings` of its samples."""
+        motion = Motion(self.t, self.q, self.v, None, self.tau_command)
+        return motion_crossings(motion, self.joint_limits)
+
+    @property
     def limit_excess(self) -> np.ndarray:
         """Largest ``|τ_command| − limit`` per joint [N·m], 0 where never exceeded."""
-        return np.maximum(np.abs(self.tau_command) - self.torque_limits, 0.0).max(axis=0)
+        return self.crossings.effort.excess
 
     @property
     def limit_exceeded(self) -> np.ndarray:
         """Whether the commanded torque ever exceeded each joint's limit, shape (nv,)."""
-        return self.limit_excess > 0
+        return self.crossings.effort.crossed
 
     @property
     def first_exceeded_at(self) -> list[float | None]:
         """First time [s] each joint's commanded torque exceeded its limit, or None."""
-        over = np.abs(self.tau_command) > self.torque_limits
-        return [float(self.t[np.argmax(col)]) if col.any() else None for col in over.T]
+        return [None if np.isnan(x) else float(x) for x in self.crossings.effort.first_time]

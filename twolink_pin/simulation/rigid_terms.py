@@ -12,6 +12,8 @@ parameters, built the first time a law asks):
 ``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
 ``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
                 LU with pivoting: no inverse is formed)
+``inverse_dynamics_derivatives``  ``pin.computeRNEADerivatives`` at K states per run (τ, ∂τ/∂q,
+                ∂τ/∂q̇, M̂: what a planning law linearises its plan's torque with)
 ``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
                 then ``getFrameJacobian`` and ``getFrameClassicalAcceleration`` in
                 ``LOCAL_WORLD_ALIGNED`` (kinematics: the robot's own model); the
@@ -44,6 +46,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.controllers.base import FrameTerms
+from twolink_pin.dynamics import InverseDynamicsDerivatives, inverse_dynamics_derivatives
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.model.parameters import model_with_parameters
@@ -203,6 +206,27 @@ class RigidBodyTerms:
             return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
         return frozen(np.linalg.solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
 
+    def inverse_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray
+    ) -> InverseDynamicsDerivatives:
+        q, v, a = (np.asarray(x, dtype=float) for x in (q, v, a))
+        if q.ndim != 3 or q.shape[2] != self._nv or v.shape != q.shape or a.shape != q.shape:
+            raise InvalidParameterError(
+                "q, v, a",
+                f"shapes {q.shape}, {v.shape}, {a.shape}",
+                f"(N, K, {self._nv}) each: K states of each of N runs",
+            )
+        models, data = self._dynamics()
+        n = q.shape[0]
+        if len(models) > 1 and n != len(models):
+            raise InvalidParameterError(
+                "q", f"shape {q.shape}", f"one block of states per run ({len(models)})"
+            )
+        parts = [
+            inverse_dynamics_derivatives(models[i % len(models)], data, q[i], v[i], a[i]) for i in range(n)
+        ]
+        return InverseDynamicsDerivatives(*(frozen(np.stack(x)) for x in zip(*parts, strict=True)))
+
     def frame_id(self, frame: str | None) -> int:
         """Index of ``frame`` in the model (None: the end effector)."""
         fid = self._frames.get(frame)
@@ -304,7 +328,7 @@ def _frame_terms(placement: np.ndarray, jacobian: np.ndarray, drift: np.ndarray)
 
 
 class RigidBodyTermsMixin:
-    """The five rigid-body methods of :class:`~twolink_pin.controllers.Terms`, delegated
+    """The rigid-body methods of :class:`~twolink_pin.controllers.Terms`, delegated
     to ``self._rigid`` (a :class:`RigidBodyTerms`)."""
 
     _rigid: RigidBodyTerms
@@ -323,3 +347,8 @@ class RigidBodyTermsMixin:
 
     def frame(self, q: np.ndarray, v: np.ndarray, frame: str | None = None) -> FrameTerms:
         return self._rigid.frame(q, v, frame)
+
+    def inverse_dynamics_derivatives(
+        self, q: np.ndarray, v: np.ndarray, a: np.ndarray
+    ) -> InverseDynamicsDerivatives:
+        return self._rigid.inverse_dynamics_derivatives(q, v, a)

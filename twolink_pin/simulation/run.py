@@ -129,7 +129,11 @@ def _recorded_run(
         return samples
     if plant.has_events:
         raise InvalidParameterError(
-            "method", config.method, "'rk4' with a wrench, payload step, sensor noise or delay"
+            "method", config.method, "'rk4' with a wrench, payload step, sensor noise, delay or joint stops"
+        )
+    if controller.update_period() is not None:
+        raise InvalidParameterError(
+            "method", config.method, f"'rk4' for '{controller.name}', a law that replans (its state jumps)"
         )
     friction = plant.friction
     if friction is not None and friction.smoothing == 0 and any(friction.coulomb):
@@ -151,6 +155,7 @@ def _single_result(
     names, units = state_labels(controller, z.shape[1])
     columns = controller.estimate_columns if estimates else None
     p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
+    limits = plant.joint_limits
     return SimulationResult(
         controller=controller.name,
         method=config.method,
@@ -180,4 +185,8 @@ def _single_result(
         state_units=units,
         q_measured=None if samples.q_measured is None else readonly(samples.q_measured[:, 0, :]),
         v_measured=None if samples.v_measured is None else readonly(samples.v_measured[:, 0, :]),
+        position_limits=readonly(np.stack([limits.position_lower, limits.position_upper])),
+        velocity_limits=readonly(limits.velocity),
+        joint_names=limits.joint_names,
+        position_stops=plant.position_stops,
     )

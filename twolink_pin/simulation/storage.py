@@ -128,7 +128,7 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
                 kwargs[key] = str(value)
             elif key in ("dt", "reference_period", "control_period"):
                 kwargs[key] = float(value)
-            elif key == "saturate":
+            elif key in ("saturate", "position_stops"):
                 kwargs[key] = bool(value)
             elif key in (
                 "parameter_names",
@@ -136,6 +136,7 @@ def load_result(path: str | os.PathLike[str]) -> SimulationResult:
                 "parameter_kinds",
                 "state_names",
                 "state_units",
+                "joint_names",
             ):
                 kwargs[key] = tuple(str(x) for x in value)
             else:

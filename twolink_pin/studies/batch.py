@@ -87,8 +87,8 @@ class BatchResult:
     state_units: tuple[str, ...] = ()
     """SI unit of each state entry."""
     task_metrics: TaskMetrics | None = field(repr=False, default=None)
-    """Each run's task-space metrics (position error [mm], angle [deg]; arrays (N,), NaN for
-    diverged runs) for a law whose class declares ``task_space = True``, else None."""
+    """Each run's task-space metrics (position error [mm], angle [deg] of the end effector; arrays
+    (N,), NaN for diverged runs), whatever the law (None only in a result built by hand)."""
     trajectory: Trajectory | None = field(repr=False, default=None)
     """The reference every run tracked (``trajectory.sample(t)`` gives ``q_d``, ``q̇_d``,
     ``q̈_d`` at the output times ``t``)."""
@@ -193,15 +193,10 @@ def simulate_batch(
     if record:
         check_recorded_size(config.steps, nv, controller.state_size, n)
     used = threads_for(n, threads) if n > 1 else 1
-    steps = config.steps
-    dt = config.duration / steps
-    observer = RunningMetrics(n, nv, dt, steps + 1, trajectory.period, plant.limits, plant.applied_torque)
-    # A task-space law (its class declares it): its rows carry the task errors too.
-    task = (
-        RunningTaskMetrics(plant.robot, n, dt, steps + 1, trajectory.period)
-        if controller.task_space
-        else None
-    )
+    samples, dt = config.steps + 1, config.duration / config.steps
+    observer = RunningMetrics(n, nv, dt, samples, trajectory.period, plant.joint_limits, plant.applied_torque)
+    # Every law moves the end effector: its rows carry the task errors too.
+    task = RunningTaskMetrics(plant.robot, n, dt, samples, trajectory.period)
     with progress_callback(progress, n) as shown:
         run = integrate(
             controller,
@@ -212,12 +207,12 @@ def simulate_batch(
             ref0.v + v0_off,
             z0,
             record=record,
-            observer=observer if task is None else _Both(observer, task),
+            observer=_Both(observer, task),
             threads=used,
             progress=shown,
         )
     dead = ~np.isnan(run.diverged_at)
-    metrics, task_metrics = observer.result(dead), None if task is None else task.result(dead)
+    metrics, task_metrics = observer.result(dead), task.result(dead)
     return _batch_result(
         controller, plant, trajectory, config, run, q0_off, v0_off, metrics, task_metrics, used
     )

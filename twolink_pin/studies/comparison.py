@@ -97,7 +97,17 @@ class ComparisonTable:
             "plants": dict(self.plants),
             "gains": dict(self.gains),
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
+            "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
         }
+
+    def crossing_rows(self) -> list[tuple[str, str, int, float, float, str]]:
+        """Every law's position and velocity crossings: ``(law, kind, joint from 1, first time
+        [s], largest excess, unit)`` (:mod:`twolink_pin.limits.crossings`)."""
+        rows = []
+        for name, m in self.metrics.items():
+            for kind, j, first, excess in m.crossings.events():
+                rows.append((name, kind, j + 1, first, excess, getattr(m.crossings, kind).kind.unit))
+        return rows
 
     def csv(self) -> str:
         """One row per (law, norm), then the last-period max |e| row per law."""
@@ -120,6 +130,11 @@ class ComparisonTable:
             writer.writerow(["controller", "task_metric", *TASK_COLUMNS])
             for name, t in self.task.items():
                 writer.writerow([name, "task", *(f"{x:.6g}" for x in t)])
+        crossings = self.crossing_rows()
+        if crossings:
+            writer.writerow(["controller", "crossed", "joint", "first_time_s", "largest_excess", "unit"])
+            for name, kind, j, first, excess, unit in crossings:
+                writer.writerow([name, kind, j, f"{first:.6g}", f"{excess:.6g}", unit])
         return buffer.getvalue()
 
     def markdown(self) -> str:
@@ -144,6 +159,13 @@ class ComparisonTable:
             out.append("|---|" + "---:|" * len(TASK_HEADERS))
             for name, t in self.task.items():
                 out.append(f"| {name} | " + " | ".join(t.text()) + " |")
+        crossings = self.crossing_rows()
+        if crossings:
+            out.append("\n### position and velocity limits crossed by the motion\n")
+            out.append("| controller | limit | joint | first at [s] | largest excess |")
+            out.append("|---|---|---:|---:|---:|")
+            for name, kind, j, first, excess, unit in crossings:
+                out.append(f"| {name} | {kind} | {j} | {first:.4g} | {excess:.3g} {unit} |")
         if self.plants or self.failed or self.gains:
             out.append("\n### the runs\n")
             out.append("| controller | gains | plant | outcome |")

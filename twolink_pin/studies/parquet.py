@@ -29,7 +29,7 @@ METADATA_KEY = b"twolink_pin.sweep"
 """Schema-metadata key of the sweep's configuration (JSON) in every Parquet file."""
 RUNS_FOLDER = "runs"
 """The dataset's folder in a sweep's output folder."""
-FLAGS = ("limit_exceeded", "diverged")
+FLAGS = ("limit_exceeded", "diverged", "position_crossed", "velocity_crossed")
 """The boolean columns."""
 RUN = "run"
 """The int64 column: the run's index."""

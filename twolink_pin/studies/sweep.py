@@ -12,7 +12,8 @@ and metrics) as each chunk arrives:
   one table;
 * ``runs.csv`` and ``runs.json`` — the same rows in run order (NaN as ``nan`` / null);
 * ``summary.json`` — the median and the 5th / 95th percentiles of every metric over the runs
-  that did not diverge, and the counts of runs that diverged or exceeded a torque limit,
+  that did not diverge, and the counts of runs that diverged, exceeded a torque limit, crossed
+  a joint's position range or a velocity limit (and, per joint, in how many runs it crossed),
   computed from the Parquet dataset column by column, as is ``distributions.png``.
 
 What is drawn for run ``i``, from its own generator
@@ -64,6 +65,7 @@ from typing import Any
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import ControllerError, InvalidParameterError
 from twolink_pin.files import atomic_write, check_output_directory, output_directory, write_json
+from twolink_pin.limits import joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.simulation.deadline import run_limit
 from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError, TaskTimeout
@@ -313,7 +315,8 @@ def _conclude(
     """After the runs: ``summary.json`` from the dataset in ``stage`` and ``distributions.png``
     (if ``plot`` and some run did not diverge); returns the summary and every file written."""
     config, cls = prepared.config, prepared.cls
-    summary = _summary(config, robot, cls, summarize_dataset(stage / RUNS_FOLDER, prepared.metric_columns))
+    found = summarize_dataset(stage / RUNS_FOLDER, prepared.metric_columns, robot.nv)
+    summary = _summary(config, robot, cls, found)
     write_json(stage / "summary.json", summary)
     files = [stage / "runs.csv", stage / "runs.json", stage / RUNS_FOLDER, stage / "summary.json"]
     files += sink.kept
@@ -345,8 +348,10 @@ def _summary(
         "method": config.run.simulation.method,
         "lam": config.run.lam,
         "saturate": config.run.plant.saturate,
+        "joint_stops": config.run.plant.position_stops,
         "friction_smoothing": config.run.friction_smoothing,
         "torque_limits": [x if math.isfinite(x) else None for x in robot.torque_limits.tolist()],
+        "limits": joint_limits(robot).as_dict(),
         **found,
     }
 

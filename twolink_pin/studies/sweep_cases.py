@@ -219,6 +219,43 @@ class Cases:
                 self.wrench_scale[r] = rng.uniform(*config.wrench_scale)
 
 
+CHECK_CHUNK = 1000
+"""Runs whose drawn gains :func:`check_draws` checks at once."""
+
+
+def check_draws(config: SweepConfig, robot: RobotModel, base: Controller) -> None:
+    """Refuse a study with a drawn gain ``simulate`` would refuse, before any run: every run's
+    draws (the same draws the runs make: each run's stream is its own) build the law through
+    :func:`chunk_law`, the runs' own path, so with the checks of a value given to ``simulate``
+    (``--gain kp=0:1e-300`` on ``osc``: ``kp ≈ 1e-301 I`` is refused here, not run). A
+    ``positive`` gain's range from 0 passes while no draw falls below 1e-12.
+
+    Raises:
+        InvalidParameterError: ``--gain NAME=LO:HI``, the first run with a refused draw, its
+            drawn values and what the law refused.
+    """
+    if not config.gains:
+        return
+    for start in range(0, config.samples, CHECK_CHUNK):
+        stop = min(start + CHECK_CHUNK, config.samples)
+        try:
+            chunk_law(config, robot, Cases(config, robot, start, stop), base)
+        except InvalidParameterError:
+            for run in range(start, stop):  # name the first run refused
+                cases = Cases(config, robot, run, run + 1)
+                try:
+                    chunk_law(config, robot, cases, base)
+                except InvalidParameterError as exc:
+                    ranges = " ".join(f"{g.name}={g.low:g}:{g.high:g}" for g in config.gains)
+                    drawn = ", ".join(f"{name} = {value[0]:g}" for name, value in cases.gains.items())
+                    raise InvalidParameterError(
+                        f"--gain {ranges}",
+                        f"run {run}: {drawn}",
+                        f"draws '{type(base).name}' takes, as simulate checks a value ({exc})",
+                    ) from None
+            raise
+
+
 def _matrix_draws(config: SweepConfig, cases: Cases, base: Controller) -> dict[str, np.ndarray]:
     """The drawn matrix gains of the chunk's runs, shape (n, k, k) each.
 

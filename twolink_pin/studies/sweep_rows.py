@@ -17,7 +17,7 @@ from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
-from twolink_pin.studies.sweep_cases import Cases, SweepConfig, chunk_law, gain_target
+from twolink_pin.studies.sweep_cases import Cases, SweepConfig, check_draws, chunk_law, gain_target
 from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
 
@@ -41,18 +41,17 @@ METRIC_UNITS = metric_units()
 
 
 TASK_COLUMNS = {f"task_{name}": unit for name, unit in TASK_UNITS.items()}
-"""The task-space metric columns of a task-space law's row (:data:`twolink_pin.task_metrics.TASK_UNITS`,
-the one definition), with their units."""
+"""The task-space metric columns of every row (:data:`twolink_pin.task_metrics.TASK_UNITS`, the
+one definition: the end effector's errors, whatever the law), with their units."""
 
 
-def metric_columns(nv: int, parameter_names: Sequence[str] = (), task: bool = False) -> list[str]:
+def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
     """Names of the metric columns of a row, in order: the per-joint metrics, the task metrics
-    of a task-space law (``task``), the final estimates."""
+    (every law moves the end effector), the final estimates."""
     columns: list[str] = []
     for stem in METRIC_UNITS:
         columns += joint_columns(stem, nv)
-    if task:
-        columns += list(TASK_COLUMNS)
+    columns += list(TASK_COLUMNS)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
     return columns
 
@@ -69,6 +68,40 @@ def input_columns(config: SweepConfig, nv: int, parameter_names: Sequence[str]) 
 
 FLAG_COLUMNS = ("limit_exceeded", "diverged", "diverged_at")
 """Per-run outcome columns after the inputs."""
+CROSSED_FLAGS = ("position_crossed", "velocity_crossed")
+"""Whether a run (that did not diverge) crossed a joint's position range, a velocity limit
+(:mod:`twolink_pin.limits.crossings`), after :data:`FLAG_COLUMNS`."""
+CROSSING_UNITS = {
+    "position_crossed_at": "s",
+    "position_excess": "rad",
+    "velocity_crossed_at": "s",
+    "velocity_excess": "rad/s",
+}
+"""Per-joint crossing columns (the joint's 1-based index added) after :data:`CROSSED_FLAGS`: the
+first time [s] each joint crossed (null: never) and its largest excess (0: never)."""
+
+
+def outcome_columns(nv: int) -> list[str]:
+    """The per-run outcome columns, in order: :data:`FLAG_COLUMNS`, :data:`CROSSED_FLAGS`, the
+    per-joint crossing columns (:data:`CROSSING_UNITS`)."""
+    columns = [*FLAG_COLUMNS, *CROSSED_FLAGS]
+    for stem in CROSSING_UNITS:
+        columns += joint_columns(stem, nv)
+    return columns
+
+
+def _outcomes(result: BatchResult) -> tuple[np.ndarray, np.ndarray]:
+    """The outcome columns of a chunk's runs (:func:`outcome_columns`) as floats, and its
+    limit-exceeded mask."""
+    alive = ~result.diverged
+    crossings = result.metrics.crossings
+    exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & alive
+    flags = [exceeded, result.diverged, result.diverged_at]
+    flags += [crossings.position.crossed.any(axis=1) & alive, crossings.velocity.crossed.any(axis=1) & alive]
+    columns = [np.column_stack(flags).astype(float)]
+    for kind in (crossings.position, crossings.velocity):
+        columns += [kind.first_time, kind.excess]
+    return np.hstack(columns), exceeded
 
 
 def _chunk_rows(
@@ -81,11 +114,10 @@ def _chunk_rows(
     inputs += [cases.gains[g.name][:, None] for g in config.gains]
     if config.wrench_scale is not None:
         inputs.append(cases.wrench_scale[:, None])
-    exceeded = np.asarray(result.limit_exceeded.any(axis=1)) & ~result.diverged
-    flags = np.column_stack([exceeded, result.diverged, result.diverged_at]).astype(float)
+    flags, exceeded = _outcomes(result)
     parts = [metric_array(m, stem) for stem in METRIC_UNITS]
-    if result.task_metrics is not None:
-        parts.append(np.column_stack(list(result.task_metrics)))
+    assert result.task_metrics is not None  # simulate_batch gives every law its task errors
+    parts.append(np.column_stack(list(result.task_metrics)))
     if result.p_hat_final is not None:
         parts.append(result.p_hat_final)
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
@@ -98,10 +130,28 @@ def percentile_stats(column: np.ndarray) -> dict[str, float | None]:
     return {"median": float(p50), "p5": float(p5), "p95": float(p95)}
 
 
+def crossing_counts(crossed: dict[str, np.ndarray], first_times: dict[str, np.ndarray]) -> dict[str, Any]:
+    """The summary's crossing counts: ``position_crossed`` and ``velocity_crossed`` (runs, of the
+    flags ``crossed[kind]`` (N,) that are set) and ``crossed_joints`` (per kind, how many runs
+    each joint crossed in, from the first-time columns ``first_times[kind]`` (N, nv), null
+    where never)."""
+    return {
+        **{f"{kind}_crossed": int(flags.sum()) for kind, flags in crossed.items()},
+        "crossed_joints": {
+            kind: (~np.isnan(times)).sum(axis=0).astype(int).tolist() for kind, times in first_times.items()
+        },
+    }
+
+
 def summarize(
-    metrics: np.ndarray, names: Sequence[str], diverged: np.ndarray, exceeded: np.ndarray
+    metrics: np.ndarray,
+    names: Sequence[str],
+    diverged: np.ndarray,
+    exceeded: np.ndarray,
+    crossings: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Summary statistics of the metric table ``metrics`` (N, len(names)).
+    """Summary statistics of the metric table ``metrics`` (N, len(names)), with the
+    :func:`crossing_counts` ``crossings`` when given.
 
     Percentiles are ``numpy.percentile`` (linear interpolation) over the runs that did not
     diverge; a metric with no such run gets None.
@@ -111,6 +161,7 @@ def summarize(
         "runs": int(diverged.size),
         "diverged": int(diverged.sum()),
         "limit_exceeded": int((exceeded & keep).sum()),
+        **(crossings or {}),
         "metrics": {name: percentile_stats(metrics[keep, j]) for j, name in enumerate(names)},
     }
 
@@ -140,7 +191,9 @@ class ChunkRows:
     inputs: np.ndarray
     """Input columns (the run index as a float first), shape (n, inputs)."""
     flags: np.ndarray
-    """``limit_exceeded``, ``diverged`` (0/1) and ``diverged_at`` [s], shape (n, 3)."""
+    """The outcome columns (:func:`outcome_columns`): ``limit_exceeded``, ``diverged`` (0/1),
+    ``diverged_at`` [s], ``position_crossed``, ``velocity_crossed`` (0/1), then each joint's
+    crossing times [s] and largest excesses, shape (n, 5 + 4 nv)."""
     metrics: np.ndarray
     """Metric columns, shape (n, metrics)."""
     environment: tuple[tuple[str, str], ...]
@@ -173,6 +226,7 @@ class PreparedSweep:
             record,
         )
         self.base: Scenario = dataclasses.replace(config.run, law=cls).build(robot)
+        check_draws(config, robot, self.base.controller)  # every draw a value simulate takes, first
         nv = robot.nv
         if record:
             kept = config.samples * (config.run.simulation.steps + 1) * 3 * nv
@@ -188,9 +242,10 @@ class PreparedSweep:
         law = self.base.controller
         estimated = law.parameter_names if law.estimates else ()
         self.input_columns = input_columns(config, nv, self.parameter_names)
-        self.task = bool(cls.task_space)  # the law's class declares it
-        self.metric_columns = metric_columns(nv, estimated, self.task)
-        self.header = [*self.input_columns, *FLAG_COLUMNS, *self.metric_columns]
+        self.task = bool(cls.task_space)  # the law's class declares it: its figure shows them first
+        self.metric_columns = metric_columns(nv, estimated)
+        self.outcome_columns = outcome_columns(nv)
+        self.header = [*self.input_columns, *self.outcome_columns, *self.metric_columns]
         units = {"run": "", **{c: "rad" for c in joint_columns("q0_offset", nv)}}
         units.update({f"param_factor_{n}": "" for n in self.parameter_names})
         for g in config.gains:
@@ -198,11 +253,14 @@ class PreparedSweep:
             units[f"gain_{g.name}"] = spec_of(cls.Gains, key).unit
         if config.wrench_scale is not None:
             units["wrench_scale"] = ""
-        units.update(limit_exceeded="", diverged="", diverged_at="s")
+        units.update(
+            limit_exceeded="", diverged="", diverged_at="s", position_crossed="", velocity_crossed=""
+        )
+        for stem, unit in CROSSING_UNITS.items():
+            units.update({c: unit for c in joint_columns(stem, nv)})
         for stem, unit in METRIC_UNITS.items():
             units.update({c: unit for c in joint_columns(stem, nv)})
-        if self.task:
-            units.update(TASK_COLUMNS)
+        units.update(TASK_COLUMNS)
         if law.estimates:
             units.update(
                 {f"p_hat_final_{n}": u for n, u in zip(law.parameter_names, law.parameter_units, strict=True)}

@@ -27,10 +27,12 @@ from twolink_pin.studies.parquet import (
 )
 from twolink_pin.studies.sweep_cases import SweepConfig, law_reference
 from twolink_pin.studies.sweep_rows import (
+    CROSSED_FLAGS,
     METRIC_UNITS,
     TASK_COLUMNS,
     ChunkRows,
     PreparedSweep,
+    crossing_counts,
     joint_columns,
     percentile_stats,
 )
@@ -112,12 +114,23 @@ FIGURE_MAX_RUNS = 1_000_000
 """Most runs the histograms show (every k-th run beyond: the runs are independent draws)."""
 
 
-def summarize_dataset(folder: str | Path, names: Sequence[str]) -> dict[str, Any]:
+def summarize_dataset(folder: str | Path, names: Sequence[str], nv: int | None = None) -> dict[str, Any]:
     """:func:`summarize` of the Parquet dataset in ``folder``: the metric columns are read a
     few at a time (:data:`SUMMARY_MEMORY`), so memory is O(N) for N runs (8 bytes per run and
-    column held), whatever the number of metrics."""
+    column held), whatever the number of metrics; with ``nv``, the crossing counts
+    (:func:`~twolink_pin.studies.sweep_rows.crossing_counts`) from the flag and first-time
+    columns (8 nv bytes per run held)."""
     flags = read_columns(folder, FLAGS)
     diverged, exceeded = flags["diverged"], flags["limit_exceeded"]
+    crossings: dict[str, Any] = {}
+    if nv is not None:
+        kinds = [flag.removesuffix("_crossed") for flag in CROSSED_FLAGS]
+        times = {}
+        for kind in kinds:
+            stems = joint_columns(f"{kind}_crossed_at", nv)
+            read = read_columns(folder, stems)
+            times[kind] = np.column_stack([read[c] for c in stems])
+        crossings = crossing_counts({kind: flags[f"{kind}_crossed"] for kind in kinds}, times)
     keep = ~diverged
     per_pass = max(1, SUMMARY_MEMORY // (8 * max(1, diverged.size)))
     stats = {}
@@ -130,6 +143,7 @@ def summarize_dataset(folder: str | Path, names: Sequence[str]) -> dict[str, Any
         "runs": int(diverged.size),
         "diverged": int(diverged.sum()),
         "limit_exceeded": int((exceeded & keep).sum()),
+        **crossings,
         "metrics": {name: stats[name] for name in names},
     }
 

@@ -6,6 +6,7 @@ import numpy as np
 
 from twolink_pin.errors import require_type
 from twolink_pin.kinematics import inverse_kinematics
+from twolink_pin.limits import joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.cartesian import ViaPoints, cartesian_trajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
@@ -55,8 +56,8 @@ def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
     which the peak speed reaches the URDF's velocity limit)`` (a velocity limit of 0, as
     in a URDF that gives none, is no limit).
     """
-    model = robot.model
-    lower, upper = np.array(model.lowerPositionLimit), np.array(model.upperPositionLimit)
+    limits = joint_limits(robot)
+    lower, upper = np.array(limits.position_lower), np.array(limits.position_upper)
     home = home_configuration(robot)
     with np.errstate(invalid="ignore"):
         span = np.where(np.isfinite(upper - lower), upper - lower, np.inf)
@@ -67,7 +68,7 @@ def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
     unit_sample = unit.sample(np.linspace(0.0, period, 801))
     unit_peak = float(np.abs(unit_sample.q).max())  # the polynomial overshoots its via points: rad per rad
     unit_speed = float(np.abs(unit_sample.v).max())  # rad/s per rad
-    speed_limit = np.where(model.velocityLimit > 0, model.velocityLimit, np.inf)
+    speed_limit = limits.velocity
     amplitude = np.minimum.reduce(
         [
             np.full(robot.nv, NEUTRAL_AMPLITUDE),

@@ -63,6 +63,8 @@ import pinocchio as pin
 from twolink_pin.documents import load_json, load_toml
 from twolink_pin.errors import InputFileError, InvalidParameterError, InverseKinematicsError, require_type
 from twolink_pin.files import read_input_file
+from twolink_pin.limits import POSITION, joint_limits
+from twolink_pin.limits.check import check_grid
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
@@ -77,8 +79,6 @@ MAX_TRAJECTORY_BYTES = 16 << 20
 MAX_VIA_POINTS = 24
 """Most via points of one file: the polynomial through n points has degree n + 5, and
 beyond about two dozen points its normal equations lose the digits the fit needs."""
-LIMIT_SAMPLES = 2001
-"""Samples over one period at which the trajectory is checked against the joint limits."""
 
 MAX_TIME = 1e6
 """Largest via-point time [s] (the longest simulation): larger times overflow the polynomial."""
@@ -148,7 +148,8 @@ def parse_numbers(
 
 def check_within_limits(robot: RobotModel, values: np.ndarray, what: str) -> None:
     """Raise unless every row of ``values`` [rad] (shape (n, nv)) is within the joint limits."""
-    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
+    limits = joint_limits(robot)
+    lower, upper = limits.position_lower, limits.position_upper
     for k, row in enumerate(values):
         for j, x in enumerate(row):
             if not lower[j] <= x <= upper[j]:
@@ -161,11 +162,13 @@ def check_within_limits(robot: RobotModel, values: np.ndarray, what: str) -> Non
 
 
 def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str = "trajectory") -> None:
-    """Raise unless the trajectory stays within the joint limits over a period (sampled)."""
-    t = trajectory.t0 + np.linspace(0.0, trajectory.period, LIMIT_SAMPLES)
+    """Raise unless the trajectory stays within the joint limits over a period (on the limits' check
+    grid, :func:`twolink_pin.limits.check.check_grid`: 1 ms apart)."""
+    t = check_grid(trajectory.t0, trajectory.period)
     q = trajectory.sample(t).q
-    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
-    over = (q < lower) | (q > upper)
+    limits = joint_limits(robot)
+    lower, upper = limits.position_lower, limits.position_upper
+    over = limits.excess(POSITION, q) > 0
     if over.any():
         k, j = (int(i) for i in np.argwhere(over)[0])
         raise InvalidParameterError(
@@ -421,10 +424,11 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
             f"the number of coefficients per row of a and b ({a.shape[1]})",
         )
     trajectory = FourierTrajectory(float(period), a, b, offset)
-    t = np.linspace(0.0, trajectory.period, LIMIT_SAMPLES)
+    t = check_grid(0.0, trajectory.period)
     q = trajectory.sample(t).q
-    lower, upper = robot.model.lowerPositionLimit, robot.model.upperPositionLimit
-    over = (q < lower) | (q > upper)
+    limits = joint_limits(robot)
+    lower, upper = limits.position_lower, limits.position_upper
+    over = limits.excess(POSITION, q) > 0
     if over.any():
         k, j = (int(i) for i in np.argwhere(over)[0])
         raise InvalidParameterError(

@@ -58,6 +58,8 @@ def nice_step(value: float) -> float:
 
 
 def _range(value: float, spec: GainSpec) -> tuple[float, float, float]:
+    if spec.bound == "fraction":  # 0 < value <= 1: the whole range
+        return 0.0, 1.0, min(nice_step(value), 0.01)
     step = nice_step(value)
     top = SPAN * abs(value) if value else 1.0
     top = math.ceil(top / step) * step

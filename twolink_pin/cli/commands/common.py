@@ -44,35 +44,41 @@ def _config(args: argparse.Namespace) -> SimulationConfig:
     )
 
 
-def _gain_values(texts: list[str]) -> dict[str, Any]:
-    """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}``."""
-    from twolink_pin.cli.arguments import finite
+def _gain_values(texts: list[str], law: str = "") -> dict[str, Any]:
+    """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}`` (each value read by
+    :func:`~twolink_pin.law_variant.gain_value`); a gain given twice is refused, naming it
+    (as ``LAW.NAME`` with the ``law`` of ``--gain LAW.NAME=VALUE``)."""
+    from twolink_pin.law_variant import gain_value
 
     gains: dict[str, Any] = {}
+    given: dict[str, str] = {}
     for text in texts:
         name, sep, value = text.partition("=")
         if not sep or not name.strip() or not value.strip():
-            raise InvalidParameterError("--gain", text, "NAME=VALUE, e.g. kp=200 or kd=30,40")
-        try:
-            numbers = tuple(finite(x) for x in value.split(","))
-        except argparse.ArgumentTypeError as exc:
+            raise InvalidParameterError("--gain", law + text, "NAME=VALUE, e.g. kp=200 or kd=30,40")
+        name = name.strip()
+        if name in given:
             raise InvalidParameterError(
-                f"--gain {name.strip()}", value, str(exc).removeprefix("expected ")
-            ) from None
-        gains[name.strip()] = numbers[0] if len(numbers) == 1 else numbers
+                f"--gain {law}{name}",
+                value,
+                f"each gain once ({law}{name} is given twice: {law + given[name]!r} and {law + text!r})",
+            )
+        given[name] = text
+        gains[name] = gain_value(law + name, value)
     return gains
 
 
 def _law_gains(texts: list[str]) -> tuple[tuple[str, tuple[tuple[str, Any], ...]], ...]:
-    """compare/report ``--gain LAW.NAME=VALUE`` → per-law gains; a text without ``LAW.`` is refused."""
-    per_law: dict[str, dict[str, Any]] = {}
+    """compare/report ``--gain LAW.NAME=VALUE`` → per-law gains; a text without ``LAW.`` is
+    refused, and so is a law's gain given twice."""
+    per_law: dict[str, list[str]] = {}
     for text in texts:
-        name, sep, _ = text.partition("=")
+        name, sep, value = text.partition("=")
         law, dot, gain = name.strip().rpartition(".")
         if not (sep and dot and law and gain):
             raise InvalidParameterError("--gain", text, "LAW.NAME=VALUE with several laws, e.g. pd.kp=200")
-        per_law.setdefault(law, {}).update(_gain_values([f"{gain}={text.partition('=')[2]}"]))
-    return tuple((law, tuple(g.items())) for law, g in per_law.items())
+        per_law.setdefault(law, []).append(f"{gain}={value}")
+    return tuple((law, tuple(_gain_values(own, f"{law}.").items())) for law, own in per_law.items())
 
 
 def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool = True) -> RunSpec:
@@ -94,6 +100,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
             friction=getattr(args, "plant_friction", None) or "law",
             saturate=args.saturate,
             friction_smoothing=args.friction_smoothing,
+            position_stops=args.joint_stops,
             **plant_events(args),
         ),
         parameters=getattr(args, mode) if mode else None,

@@ -121,7 +121,8 @@ def _physical_and_urdf(
         document["urdf_written"] = args.write_urdf
         physical_lines.append(
             f"  URDF with the identified inertias{' and friction (<dynamics>)' if options.friction else ''} "
-            f"written to {args.write_urdf} (use with --robot/--urdf)"
+            f"written to {args.write_urdf} (as the model a law believes: --model {args.write_urdf}; as the "
+            f"plant: --robot {args.write_urdf})"
         )
     return physical_lines
 

@@ -11,17 +11,20 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from twolink_pin.cli.commands.common import robot_from_args, trajectory_from_args
-from twolink_pin.cli.output import emit, fmt, pose_lines
+from twolink_pin.cli.output import emit, fmt, limits_check_lines, pose_lines
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
+    from twolink_pin.limits import JointLimits
     from twolink_pin.model import RobotModel
 
 
 def cmd_info(args: argparse.Namespace) -> int:
+    from twolink_pin.limits import joint_limits
     from twolink_pin.model.base_parameters import BaseParameterMap
 
     robot = robot_from_args(args)
+    limits = joint_limits(robot)
     base = (
         robot.parameter_map
         if isinstance(robot.parameter_map, BaseParameterMap)
@@ -36,6 +39,8 @@ def cmd_info(args: argparse.Namespace) -> int:
         "gravity": robot.model.gravity.linear.tolist(),
         "link_lengths": robot.link_lengths.tolist(),
         "torque_limits": robot.torque_limits.tolist(),
+        "joint_names": list(limits.joint_names),
+        "limits": limits.as_dict(),
         "home": robot.home.tolist(),
         "home_pose": home_pose,
         "parameter_names": list(robot.parameter_map.names),
@@ -58,15 +63,14 @@ def cmd_info(args: argparse.Namespace) -> int:
         if len(names) <= 6
         else f"{len(names)} values"
     )
-    limits = ", ".join("no limit" if not np.isfinite(x) else f"{x:g}" for x in robot.torque_limits)
     text = "\n".join(
         [
             f"robot      {robot.name}: {robot.model.name} ({robot.urdf_path})",
             f"joints     nq = {robot.nq}, nv = {robot.nv}; end effector '{robot.ee_frame}'",
             f"gravity    {fmt(robot.model.gravity.linear, 3)} m/s²",
             f"links      {fmt(robot.link_lengths, 3)} m",
-            f"limits     ({limits}) N·m",
-            f"home       q = [{', '.join(f'{x:.9g}' for x in robot.home)}] rad, end effector at",
+            *limits_table(limits),
+            f"home       q = [{', '.join(_exact(x) for x in robot.home)}] rad, end effector at",
             *home_lines,
             f"payload    {robot.payload:g} kg",
             f"parameters {p_text}",
@@ -76,9 +80,44 @@ def cmd_info(args: argparse.Namespace) -> int:
     )
     if args.write_urdf:
         payload["urdf_written"] = str(_write_payload_variant(robot, args.write_urdf))
-        text += f"\nwrote      {payload['urdf_written']}"
+        written = payload["urdf_written"]
+        text += (
+            f"\nwrote      {written}: the arm with its {robot.payload:g}-kg payload, as the plant with "
+            f"--robot {written}, or as the model a law believes with --model {written}"
+        )
     emit(args, payload, text)
     return 0
+
+
+def _exact(x: float) -> str:
+    """``x`` as the shortest text that reads back to it (``1.5707963267948966``, ``0``): the
+    home is printed as the profile defines it, not rounded to a number of digits."""
+    text = repr(float(x))
+    return text[:-2] if text.endswith(".0") else text
+
+
+def limits_table(limits: JointLimits) -> list[str]:
+    """``info``'s table of each joint's limits: position range, velocity, acceleration, effort
+    ("none" where the URDF or the profile gives none)."""
+
+    def value(x: float) -> str:
+        return f"{x:.6g}" if np.isfinite(x) else "none"
+
+    names = limits.joint_names
+    width = max(5, *(len(n) for n in names))
+    lines = [
+        "limits     position and velocity from the URDF, acceleration from the robot's profile, effort from the URDF",
+        f"  {'joint':{width}s}  {'position [rad]':>26s}  {'velocity [rad/s]':>16s}  "
+        f"{'acceleration [rad/s²]':>21s}  {'effort [N·m]':>12s}",
+    ]
+    for j, name in enumerate(names):
+        lo, hi = float(limits.position_lower[j]), float(limits.position_upper[j])
+        span = f"[{value(lo)}, {value(hi)}]" if np.isfinite(lo) or np.isfinite(hi) else "none"
+        lines.append(
+            f"  {name:{width}s}  {span:>26s}  {value(limits.velocity[j]):>16s}  "
+            f"{value(limits.acceleration[j]):>21s}  {value(limits.effort[j]):>12s}"
+        )
+    return lines
 
 
 def _write_payload_variant(robot: RobotModel, target_name: str) -> Path:
@@ -100,6 +139,7 @@ def _write_payload_variant(robot: RobotModel, target_name: str) -> Path:
 
 
 def cmd_robots(args: argparse.Namespace) -> int:
+    from twolink_pin.limits import joint_limits
     from twolink_pin.model import catalog, load_robot
 
     rows = []
@@ -113,6 +153,7 @@ def cmd_robots(args: argparse.Namespace) -> int:
                 "nv": robot.nv,
                 "gravity": model.gravity.linear.tolist(),
                 "torque_limits": robot.torque_limits.tolist(),
+                "limits": joint_limits(robot).as_dict(),
                 "end_effector": robot.ee_frame,
                 "unlimited_joints": [
                     str(model.names[int(j) + 1]) for j in np.flatnonzero(np.isinf(model.lowerPositionLimit))
@@ -252,7 +293,8 @@ def cmd_ik(args: argparse.Namespace) -> int:
 
 
 def cmd_trajectory(args: argparse.Namespace) -> int:
-    from twolink_pin.feasibility import check_torques
+    from twolink_pin.feasibility import TorqueCheck
+    from twolink_pin.limits import check_limits
     from twolink_pin.trajectory import (
         FourierTrajectory,
         JointTrajectory,
@@ -273,7 +315,7 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
                 flag, "given", "--time-optimal beside it (it sets the retiming's limits)"
             )
     via = default_via_points(robot) if not args.trajectory else None
-    check = check_torques(robot, traj)
+    check = TorqueCheck(check_limits(robot, traj))  # every limit; the figures show its effort kind
     if args.save:
         from twolink_pin.trajectory.file import write_trajectory_file
 
@@ -307,6 +349,7 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         "via_q": traj.via_q.tolist(),
         "coefficients": traj.coefficients.tolist(),
         **check.summary(),
+        **limits_payload(check),
         "figures": figures,
     }
     lines = ["via points (t [s], q [rad]" + (", end effector (x, y) [m])" if via is not None else ")") + ":"]
@@ -317,9 +360,20 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         lines.append(f"q{j + 1}(t) coefficients, ascending powers of t: {terms}")
     lines.append(f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s")
     lines.append(check.verdict())
+    lines += limits_check_lines(check.limits_check)
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))
     return 0
+
+
+def limits_payload(check: Any) -> dict[str, Any]:
+    """``trajectory --json``'s limit fields of a :class:`~twolink_pin.feasibility.TorqueCheck`:
+    ``limits_check`` (:meth:`~twolink_pin.limits.LimitsCheck.summary`) and its grid."""
+    t = check.limits_check.motion.t
+    return {
+        "limits_check": check.limits_check.summary(),
+        "limits_check_grid": {"instants": len(t), "step": float(t[1] - t[0])},
+    }
 
 
 def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:
@@ -342,6 +396,7 @@ def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, 
         "condition_number": measures.condition_number,
         "gram_min_eigenvalue_per_s": measures.gram_min_eigenvalue_per_s,
         **check.summary(),
+        **limits_payload(check),
         "figures": figures,
     }
     lines = [
@@ -351,6 +406,7 @@ def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, 
         f"cond(W) of the base parameters and friction over a period: {measures.condition_number:.4g}",
         f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s",
         check.verdict(),
+        *limits_check_lines(check.limits_check),
     ]
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))

@@ -209,7 +209,9 @@ def _optimize_text(robot: RobotModel, result: Any, scale: float, source: str, fi
 
 
 def sampled_trajectory_command(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:
-    """``trajectory`` for a ``samples`` file: its samples, period, via times and torque check."""
+    """``trajectory`` for a ``samples`` file: its samples, period, via times and every limit."""
+    from twolink_pin.cli.commands.model import limits_check_lines, limits_payload
+
     figures: list[str] = []
     if args.plot:
         from twolink_pin.files import removed_on_failure
@@ -223,6 +225,7 @@ def sampled_trajectory_command(args: argparse.Namespace, robot: RobotModel, traj
         "via_times": traj.via_times.tolist(),
         "feedforward": traj.tau is not None,
         **check.summary(),
+        **limits_payload(check),
         "figures": figures,
     }
     lines = [
@@ -231,6 +234,7 @@ def sampled_trajectory_command(args: argparse.Namespace, robot: RobotModel, traj
         f"via points at t = {fmt(traj.via_times, 4)} s" if traj.via_times.size else "no via points marked",
         f"peak |tau| {fmt(check.peak, 2)} N·m at t = {fmt(check.peak_time, 3)} s",
         check.verdict(),
+        *limits_check_lines(check.limits_check),
     ]
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))

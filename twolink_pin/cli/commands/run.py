@@ -44,6 +44,9 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "torque_limits": result.torque_limits.tolist(),
         "limit_exceeded": result.limit_exceeded.tolist(),
         "limit_exceeded_at": result.first_exceeded_at,
+        "limits": result.joint_limits.as_dict(),
+        "crossings": metrics.crossings.summary(),
+        "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
         "p_true": None if result.p_true is None else result.p_true.tolist(),
         "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
@@ -62,10 +65,11 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     scenario = spec.build(robot, identified_parameters(spec, robot))
     result = simulate(*scenario, trajectory_from_args(args, robot), spec.simulation)
     metrics = compute_metrics(result)
+    for warning in position_warnings(result.controller, result):
+        print(warning, file=sys.stderr)
     payload = _result_payload(result, metrics)
-    task = task_summary(scenario.controller, result, robot)  # None unless a task-space law
-    if task is not None:
-        payload["task_metrics"] = task.as_dict()
+    task = task_summary(result, robot)  # every law: the end effector's errors
+    payload["task_metrics"] = task.as_dict()
     q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
     gains, gains_text = gains_echo(scenario.controller)
     payload |= {
@@ -85,7 +89,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         spans = wrench_spans(spec.plant.wrench)  # a push shaded where it acts
         with removed_on_failure(args.plot) as folder:
             figures = [str(p) for p in save_simulation_figures(result, folder, spans=spans)]
-            if task is not None:
+            if is_task_space(scenario.controller):
                 figures.append(str(save_task_figure(robot, result, folder, result.controller, spans=spans)))
     if args.save:
         from twolink_pin.simulation.storage import save_result
@@ -107,7 +111,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         ),
         *task_lines(task),
     ]
-    lines += _limit_and_estimate_lines(result)
+    lines += _limit_and_estimate_lines(result, metrics)
     lines += [f"  figure {f}" for f in figures]
     if args.save:
         lines.append(f"  saved {args.save}")
@@ -115,10 +119,22 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
-def _limit_and_estimate_lines(result: Any) -> list[str]:
-    """The summary's lines on torque limits (exceeded, clipped, absent) and, for an adaptive
-    law, its estimates at the end against the truth."""
-    out: list[str] = []
+def position_warnings(name: str, result: SimulationResult) -> list[str]:
+    """One warning per joint of the run of law ``name`` that passed its position range (joint,
+    first time, largest excess), for stderr: a plant never lets it pass silently."""
+    return [
+        f"twolink-pin: warning: {name}: {sentence} (the plant has no stop there: --joint-stops makes "
+        "the range a hard stop)"
+        for sentence in result.crossings.sentences(result.joint_limits, ("position",))
+    ]
+
+
+def _limit_and_estimate_lines(result: Any, metrics: Metrics) -> list[str]:
+    """The summary's lines on the limits (position range and velocity crossed; torque exceeded,
+    clipped, absent) and, for an adaptive law, its estimates at the end against the truth."""
+    out: list[str] = [f"  {s}" for s in metrics.crossings.sentences(result.joint_limits)]
+    if result.position_stops:
+        out.append("  joint stops: each position range a hard stop (--joint-stops)")
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
         if over:
             out.append(
@@ -161,32 +177,37 @@ def _believed_text(spec: RunSpec, robot: str) -> str:
 
 def cmd_compare(args: argparse.Namespace) -> int:
     from twolink_pin.files import output_directory
-    from twolink_pin.scenario import builtin_laws, law_class
+    from twolink_pin.law_variant import parse_variants
+    from twolink_pin.run_spec import build_rows, gains_used, plant_description
+    from twolink_pin.scenario import builtin_laws
     from twolink_pin.studies.comparison import run_comparison
 
     robot = robot_from_args(args)
-    specs = args.controllers or list(builtin_laws())
-    names = [law_class(s).name for s in specs]
-    if len(set(names)) != len(names):
-        raise InvalidParameterError("CONTROLLER", specs, "each law at most once")
-    by_name = dict(zip(names, specs))
+    variants = parse_variants(args.controllers or list(builtin_laws()))  # LAW or LAW@KEY=VALUE…
+    laws = [v.law for v in variants]
     shared = run_spec(args)
-    shared.check_law_gains(specs)
-    shared.check_effective(robot, specs)
-    identified = identified_parameters(shared, robot)
+    shared.check_law_gains(laws)
+    shared.check_effective(robot, laws)
+    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     reference = trajectory_from_args(args, robot)
+    warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
-        bar = progress_bar(len(names), "run", "compare")
+        bar = progress_bar(len(rows), "run", "compare")
+        figures = _ComparisonFigures(args, shared, rows, robot, stage / "figures")
+        tasks: dict[str, TaskMetrics] = {}
 
-        def on_result(name: str, result: SimulationResult) -> None:
-            if not args.no_plot:
-                from twolink_pin.plotting import save_simulation_figures
-                from twolink_pin.plotting.run import wrench_spans
+        def run(key: str) -> SimulationResult:
+            from twolink_pin.simulation import simulate
+            from twolink_pin.task_metrics import task_metrics
 
-                spans, title = wrench_spans(shared.plant.wrench), law_class(by_name[name]).title
-                save_simulation_figures(result, stage / "figures", prefix=name, title=title, spans=spans)
-                if is_task_space(law_class(by_name[name])):
-                    save_task_figure(robot, result, stage / "figures", name, title, spans)
+            row = rows[key]
+            result = simulate(*row.scenario, reference, row.spec.simulation)
+            tasks[key] = task_metrics(result, robot)  # every law moves the same end effector
+            return result
+
+        def on_result(key: str, result: SimulationResult) -> None:
+            warnings.extend(position_warnings(key, result))
+            figures.add(key, result)
 
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
@@ -194,28 +215,19 @@ def cmd_compare(args: argparse.Namespace) -> int:
             else:
                 bar.set_postfix_str(name)
 
-        plants: dict[str, str] = {}
-        gains: dict[str, dict[str, Any]] = {}
-        tasks: dict[str, TaskMetrics] = {}
-
-        def run(name: str) -> SimulationResult:
-            from twolink_pin.run_spec import gains_used, plant_description
-            from twolink_pin.simulation import simulate
-
-            spec = shared.for_law(by_name[name])
-            scenario = spec.build(robot, identified)
-            plants[name], gains[name] = plant_description(scenario), gains_used(scenario.controller)
-            result = simulate(*scenario, reference, spec.simulation)
-            task = task_summary(scenario.controller, result, robot)
-            if task is not None:
-                tasks[name] = task
-            return result
-
         try:
-            table = run_comparison(run, names, progress, on_result)
+            table = run_comparison(run, list(rows), progress, on_result)
+            figures.overlay()
         finally:
             bar.close()
-        table = replace(table, plants=plants, gains=gains, task=tasks)
+            for warning in warnings:
+                print(warning, file=sys.stderr)
+        table = replace(
+            table,
+            plants={k: plant_description(r.scenario) for k, r in rows.items()},
+            gains={k: gains_used(r.scenario.controller) for k, r in rows.items()},
+            task=tasks,
+        )
         files = [Path(args.out) / p.name for p in table.write(stage)]
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
         _say_failed(table.failed, f"the other laws' results are in {args.out}")
@@ -224,6 +236,53 @@ def cmd_compare(args: argparse.Namespace) -> int:
     said = [] if shared.parameters is None else [_believed_text(shared, robot.name)]
     emit(args, payload, table.markdown() + "\n" + "\n".join([*said, *(f"wrote {f}" for f in files)]))
     return 0
+
+
+class _ComparisonFigures:
+    """``compare``'s figures: each row's (prefixed by its name, :func:`~twolink_pin.law_variant.file_stem`)
+    as it finishes, then the variants of each law overlaid (``<law>_variants.png``) once all ran.
+    Nothing with ``--no-plot``."""
+
+    def __init__(
+        self, args: argparse.Namespace, shared: RunSpec, rows: dict[str, Any], robot: Any, folder: Path
+    ):
+        from twolink_pin.plotting.run import wrench_spans
+
+        self.on = not args.no_plot
+        self.rows, self.robot, self.folder = rows, robot, folder
+        self.spans = wrench_spans(shared.plant.wrench)
+        laws = [row.variant.name for row in rows.values()]
+        self.shared_laws = {law for law in laws if laws.count(law) > 1}  # laws run more than once
+        self.kept: dict[str, SimulationResult] = {}
+
+    def add(self, key: str, result: SimulationResult) -> None:
+        """Write the figures of row ``key``'s run (and keep it for the overlay, if its law has variants)."""
+        if not self.on:
+            return
+        from twolink_pin.law_variant import file_stem
+        from twolink_pin.plotting import save_simulation_figures
+
+        row = self.rows[key]
+        cls, prefix = row.variant.law_class(), file_stem(key)
+        title = cls.title if key == row.variant.name else f"{cls.title}, {key}"
+        save_simulation_figures(result, self.folder, prefix=prefix, title=title, spans=self.spans)
+        if is_task_space(cls):
+            save_task_figure(self.robot, result, self.folder, prefix, title, self.spans)
+        if row.variant.name in self.shared_laws:
+            self.kept[key] = result
+
+    def overlay(self) -> None:
+        """``<law>_variants.png`` for each law with several rows that finished."""
+        from twolink_pin.law_variant import file_stem
+        from twolink_pin.plotting.overlay import save_overlay_figure
+
+        for law in sorted(self.shared_laws):
+            runs = {k: r for k, r in self.kept.items() if self.rows[k].variant.name == law}
+            if len(runs) > 1:
+                path = self.folder / f"{file_stem(law)}_variants.png"
+                save_overlay_figure(runs, path, f"{law}: {len(runs)} runs overlaid", self.spans)
+            for key in runs:
+                del self.kept[key]
 
 
 def _say_failed(failed: dict[str, str], where: str) -> None:

@@ -91,7 +91,8 @@ def _sweep_lines(
     percentiles of every metric and the files written."""
     lines = [
         f"sweep {summary['controller']} on {summary['robot']}: {summary['runs']} runs in {output.seconds:.1f} s "
-        f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit)",
+        f"({summary['diverged']} diverged, {summary['limit_exceeded']} exceeded a torque limit, "
+        f"{summary['position_crossed']} crossed a position range, {summary['velocity_crossed']} a velocity limit)",
         f"  ran {'' if output.engine == 'in-process' else 'on '}{output.engine}, in chunks of {output.chunk} runs",
         f"  gains {gains_text}"
         + "".join(f"; {name} drawn per run from U({lo:g}, {hi:g})" for name, (lo, hi) in drawn.items()),
