@@ -17,9 +17,9 @@ and ``limits/``.
 ==========================  ================================================================
 
 The robot's dynamics reach the core through one callable,
-:data:`~twolink_pin.dynamics.derivatives.InverseDynamics` (``(q, q̇, q̈) -> (τ, ∂τ/∂q, ∂τ/∂q̇, M)``,
+:data:`~twolink_pin.dynamics.derivatives.InverseDynamics` (``(q, q̇, q̈) -> (tau, dtau_dq, dtau_dv, mass)``,
 batched): Pinocchio's offline (:class:`~twolink_pin.dynamics.RneaDerivatives`), a law's own
-through its ``Terms``.
+through its ``Terms.inverse_dynamics_derivatives``.
 """
 
 from twolink_pin.optimal.layout import Points, SplineLayout
