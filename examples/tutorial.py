@@ -122,6 +122,28 @@ fig.tight_layout()
 plt.show()
 
 # %% [markdown]
+# ### The reference within the limits
+#
+# The report designed this polynomial "with the motor torques in mind"; the toolkit designs
+# within every limit the arm has. `time_optimal` keeps the path and times it as fast as the
+# velocity and effort limits allow (TOPP-RA); `optimize` finds the trajectory through the same
+# via points, at the same times, with the least $\int \tau^\top \tau\,dt$, with the via points
+# as hard constraints ([trajectories within limits](../docs/within_limits.md)).
+
+# %%
+from twolink_pin import optimize, time_optimal
+
+retimed = time_optimal(robot, trajectory)
+print(f"time-optimal: {retimed.duration:.3f} s instead of {trajectory.period:g} s; active limits:")
+for stretch in retimed.active:
+    print("  ", stretch.describe())
+least = optimize(robot, trajectory, "effort")
+print(
+    f"least effort: ∫τᵀτ dt = {least.effort:.2f} N²·m²·s (the polynomial: {least.reference_effort:.2f}), "
+    f"via points met to {least.via_error:.1e} rad"
+)
+
+# %% [markdown]
 # ## 4. Two controllers
 #
 # Both laws use the tracking error $e = q - q_d$. The PD law with model feedforward

@@ -80,13 +80,18 @@ from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (
     FourierTrajectory,
     JointTrajectory,
+    OptimalTrajectory,
+    SampledTrajectory,
+    TimeOptimal,
     Trajectory,
     TrajectorySample,
     ViaPoints,
     build_trajectory,
     cartesian_trajectory,
     default_trajectory,
+    optimize,
     read_trajectory_file,
+    time_optimal,
 )
 from twolink_pin.twolink import excitation as _twolink_excitation  # noqa: F401  # registers its stored excitation
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
@@ -116,6 +121,7 @@ __all__ = [
     "LawInput",
     "LawOutput",
     "Metrics",
+    "OptimalTrajectory",
     "OptimizationError",
     "OutputError",
     "PDFeedforward",
@@ -126,6 +132,7 @@ __all__ = [
     "RunLog",
     "RunSpec",
     "RunningMetrics",
+    "SampledTrajectory",
     "Scenario",
     "SimulationConfig",
     "SimulationDivergedError",
@@ -133,6 +140,7 @@ __all__ = [
     "SlotineLiGains",
     "StateVariable",
     "Terms",
+    "TimeOptimal",
     "Trajectory",
     "TrajectorySample",
     "TwolinkPinError",
@@ -157,6 +165,7 @@ __all__ = [
     "mass_matrix",
     "model_torque",
     "optimise_excitation",
+    "optimize",
     "read_log",
     "read_trajectory_file",
     "regressor",
@@ -164,5 +173,6 @@ __all__ = [
     "simulate_batch",
     "simulate_log",
     "terms_for",
+    "time_optimal",
     "twolink_urdf_path",
 ]

@@ -45,7 +45,7 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "optimal",
         "Optimisation",
-        "The one optimisation core: QP solves, transcriptions on Pinocchio's derivatives.",
+        "The one optimisation core: QP solves, B-splines, transcriptions on Pinocchio's derivatives, SQP.",
         ("optimal",),
     ),
     ("controllers", "Controllers", "The law contract, the gains and the built-in laws.", ("controllers",)),

@@ -84,6 +84,7 @@ MAX_OFFSET = _bound("twolink_pin.cli.parser", "MAX_OFFSET", 100.0)
 MAX_PAYLOAD = _bound("twolink_pin.cli.common_options", "MAX_PAYLOAD", 1e4)
 MAX_DURATION = _bound("twolink_pin.cli.parser", "MAX_DURATION", 1e6)
 MAX_VIA_POINTS = int(_bound("twolink_pin.trajectory.file", "MAX_VIA_POINTS", 24))
+MAX_TRAJECTORY_BYTES = int(_bound("twolink_pin.trajectory.file", "MAX_TRAJECTORY_BYTES", 1 << 20))
 GiB = 2**30
 
 
@@ -369,7 +370,7 @@ HANG = [
     C("hang-simulate-trajectory-file-fifo", f"simulate pd {SIM} --trajectory via.json", 2, err=("via.json", NOT_REGULAR), setup=(fifo("via.json"),), run="proc", timeout=20),
     C("hang-trajectory-file-dev-zero", "trajectory --trajectory /dev/zero", 2, err=("/dev/zero", NOT_REGULAR), run="proc", memory=3 * GiB, timeout=20),
     C("hang-trajectory-file-stdin-pipe", "trajectory --trajectory /dev/stdin", 2, err=("/dev/stdin", NOT_REGULAR), run="stdin-pipe", timeout=20),
-    C("hang-trajectory-file-oversize", "trajectory --trajectory via.json", 2, err=("via.json", "bytes|MB|MiB"), setup=(via("via.json", VIA_JSON[:-2] + " " * (2 * 2**20) + "}\n"),)),
+    C("hang-trajectory-file-oversize", "trajectory --trajectory via.json", 2, err=("via.json", "bytes|MB|MiB"), setup=(via("via.json", VIA_JSON[:-2] + " " * (MAX_TRAJECTORY_BYTES + 2**20) + "}\n"),)),
     C("hang-trajectory-file-many-via-points", "trajectory --trajectory via.json", 2, err=("times", f"{MAX_VIA_POINTS}|too many"), setup=(via("via.json", json_file({"times": list(range(200)), "joints": [[0.0, 0.0]] * 200})),))
 ]
 

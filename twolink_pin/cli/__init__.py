@@ -1,7 +1,8 @@
 """``twolink-pin``: the command-line shell over the library.
 
 =====================  ====================================================================================
-``parser.py``          commands and options (``identify_parser.py``: those of ``identify`` and ``excite``)
+``parser.py``          commands and options (``identify_parser.py``: those of ``identify`` and ``excite``;
+                       ``optimal_parser.py``: ``optimize`` and ``trajectory --time-optimal``)
 ``common_options.py``  the options every family shares: the robot, the payload, the trajectory
 ``arguments.py``       the argument types that check numbers against their bounds
 ``commands/``          one module per family of commands, each command a thin shell over the library

@@ -15,6 +15,7 @@ from twolink_pin.cli.common_options import (
 from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
+from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -254,8 +255,10 @@ def _add_model_commands(sub: Any, c: Any) -> None:
         help="write the reference as a trajectory file (.json or .toml) that --trajectory and --reference read",
     )
     add_trajectory_option(p)
+    add_within_limits_options(p, retime=True)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_trajectory)
+    add_optimize_command(sub, c)
 
 
 def _add_run_commands(sub: Any, c: Any) -> None:

@@ -4,11 +4,17 @@
 ``rigid_body.py``      M (CRBA), C (Christoffel), g, RNEA, ABA, the polarised regressor
 ``polarisation.py``    the two-copy pair and forest: ``M a + C(q, v) w + g`` in one RNEA
 ``friction.py``        viscous + Coulomb friction and its regressor
-``derivatives.py``     τ and its analytical derivatives ∂τ/∂q, ∂τ/∂q̇, M at K states
+``derivatives.py``     τ and its analytical derivatives ∂τ/∂q, ∂τ/∂q̇, M at K states; the
+                       optimisation core's one dynamics callable (:class:`RneaDerivatives`)
 =====================  ==================================================================
 """
 
-from twolink_pin.dynamics.derivatives import InverseDynamicsDerivatives, inverse_dynamics_derivatives
+from twolink_pin.dynamics.derivatives import (
+    InverseDynamics,
+    InverseDynamicsDerivatives,
+    RneaDerivatives,
+    inverse_dynamics_derivatives,
+)
 from twolink_pin.dynamics.friction import Friction, friction_regressor, smooth_sign
 from twolink_pin.dynamics.polarisation import polarisation_forest, polarisation_pair
 from twolink_pin.dynamics.rigid_body import (
@@ -26,7 +32,9 @@ from twolink_pin.dynamics.rigid_body import (
 __all__ = [
     "ABA_CONVENTION",
     "Friction",
+    "InverseDynamics",
     "InverseDynamicsDerivatives",
+    "RneaDerivatives",
     "coriolis_matrix",
     "forward_dynamics",
     "friction_regressor",

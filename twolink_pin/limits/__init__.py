@@ -6,9 +6,11 @@ the checks of a reference, the crossings of a run, retiming, optimisation and co
 ``joint_limits.py``         :class:`JointLimits`, :func:`joint_limits` (read from a robot)
 ``check.py``                :func:`check_limits`: a reference against every limit over a period
 ``crossings.py``            :class:`Crossings`: where a run's motion went past a limit (joint, when, excess)
+``active.py``               :func:`active_limits`: where a motion rides each limit (a time-optimal one)
 ==========================  ==========================================================================
 """
 
+from twolink_pin.limits.active import ActiveLimit, active_limits
 from twolink_pin.limits.check import KindCheck, LimitsCheck, check_limits, check_motion, reference_motion
 from twolink_pin.limits.crossings import (
     CROSSED_KINDS,
@@ -36,6 +38,7 @@ __all__ = [
     "KINDS",
     "POSITION",
     "VELOCITY",
+    "ActiveLimit",
     "Crossings",
     "JointLimits",
     "KindCheck",
@@ -44,6 +47,7 @@ __all__ = [
     "LimitsCheck",
     "Motion",
     "RunningCrossings",
+    "active_limits",
     "check_limits",
     "check_motion",
     "joint_limits",

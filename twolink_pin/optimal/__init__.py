@@ -7,9 +7,46 @@ and ``limits/``.
 ==========================  ================================================================
 ``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP; the unconstrained
                             minimiser first on request), :func:`kkt_residual`
+``spline.py``               :class:`BSplineBasis`: values and derivatives of a B-spline as matrices
+``layout.py``               :class:`SplineLayout`: a trajectory in spline segments, its variables
+                            and Jacobians; :class:`Points` where it is evaluated
+``transcription.py``        :class:`TrajectoryProblem`: costs (:class:`Cost`), equalities
+                            (:class:`Pin`), limits, linearised on the dynamics' derivatives
+``sqp.py``                  :func:`solve_sqp` (to convergence), :func:`sqp_step` (one real-time iteration)
+``refinement.py``           :func:`solve_within_limits`: the limits between the check points too
 ==========================  ================================================================
+
+The robot's dynamics reach the core through one callable,
+:data:`~twolink_pin.dynamics.derivatives.InverseDynamics` (``(q, q̇, q̈) -> (tau, dtau_dq, dtau_dv, mass)``,
+batched): Pinocchio's offline (:class:`~twolink_pin.dynamics.RneaDerivatives`), a law's own
+through its ``Terms.inverse_dynamics_derivatives``.
 """
 
+from twolink_pin.optimal.layout import Points, SplineLayout
 from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp, unconstrained_minimiser
+from twolink_pin.optimal.refinement import WithinLimits, solve_within_limits
+from twolink_pin.optimal.spline import BSplineBasis
+from twolink_pin.optimal.sqp import SQPOptions, SQPResult, StepResult, solve_sqp, sqp_step
+from twolink_pin.optimal.transcription import Cost, Evaluation, Pin, TrajectoryProblem
 
-__all__ = ["QP", "QPSolution", "kkt_residual", "solve_qp", "unconstrained_minimiser"]
+__all__ = [
+    "QP",
+    "BSplineBasis",
+    "Cost",
+    "Evaluation",
+    "Pin",
+    "Points",
+    "QPSolution",
+    "SQPOptions",
+    "SQPResult",
+    "SplineLayout",
+    "StepResult",
+    "TrajectoryProblem",
+    "WithinLimits",
+    "kkt_residual",
+    "solve_qp",
+    "solve_sqp",
+    "solve_within_limits",
+    "sqp_step",
+    "unconstrained_minimiser",
+]

@@ -19,7 +19,8 @@ independently of the solver's own report.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from collections.abc import Sequence
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -48,8 +49,9 @@ class QP(NamedTuple):
     """Lower bounds of ``C x`` (``-inf``: none), shape (n_in,)."""
     u: np.ndarray | None = None
     """Upper bounds of ``C x`` (``inf``: none), shape (n_in,)."""
-    labels: tuple[str, ...] | None = None
-    """What each inequality row is, for messages (one per row of ``C``)."""
+    labels: Sequence[str] | None = None
+    """What each inequality row is, for messages (one per row of ``C``; any sequence: a long
+    one may make its labels when one is read)."""
 
 
 class QPSolution(NamedTuple):
@@ -102,6 +104,10 @@ def solve_qp(
     max_iter: int = DEFAULT_MAX_ITER,
     what: str = "QP",
     unconstrained_first: bool = False,
+    accept: float | None = None,
+    explain: bool = True,
+    rho: float | None = None,
+    infeasibility_eps: float | None = None,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -114,6 +120,15 @@ def solve_qp(
         unconstrained_first: First try the minimiser of the cost under the equalities alone
             (:func:`unconstrained_minimiser`): when it satisfies every inequality it is
             returned (0 iterations, zero inequality multipliers), else ProxQP solves the QP.
+        accept: When ProxQP stops at ``max_iter`` with both residuals below this, its point
+            is the answer (an SQP step needs no more than a descent direction; None: never).
+        explain: Whether a failure names the constraint that cannot hold (a second solve;
+            False where the failure is an answer in itself, a feasibility probe's).
+        rho: ProxQP's proximal step on the primal variables (None: its default, 1e-6; the
+            trajectory optimiser's steps take 1e-8: 200 iterations where 1e-6 took 1635).
+        infeasibility_eps: ProxQP's primal and dual infeasibility tolerances (None: its
+            default, 1e-4, which declared the trajectory optimiser's feasible steps
+            infeasible; it takes 1e-9, a problem that cannot hold still told apart below).
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
@@ -128,20 +143,22 @@ def solve_qp(
 
     proxqp = proxsuite.proxqp
     n = qp.g.shape[0]
-    kwargs = {}
-    if warm is not None:
-        kwargs = {"x": warm.x, "y": warm.y, "z": warm.z, "initial_guess": proxqp.InitialGuess.WARM_START}
-    # the duality gap checked too: without it ProxQP may stop with an active bound 1e-5 away
-    result = proxqp.dense.solve(
-        qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, eps_abs=eps, eps_rel=0.0, max_iter=max_iter,
-        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=0.0, **kwargs,
-    )  # fmt: skip
+    if rho is not None or infeasibility_eps is not None:
+        result = _solve_set(qp, warm, eps, max_iter, rho, infeasibility_eps)
+    else:
+        result = _solve_default(qp, warm, eps, max_iter)
     info = result.info
     status = info.status
-    if status != proxqp.PROXQP_SOLVED:
+    near = (
+        accept is not None
+        and status == proxqp.PROXQP_MAX_ITER_REACHED
+        and max(info.pri_res, info.dua_res) <= accept
+    )
+    if status != proxqp.PROXQP_SOLVED and not near:
         # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
         # the closest feasible point tells a problem that cannot hold from a slow one
-        infeasible = _infeasible_reason(qp, eps, max_iter, status == proxqp.PROXQP_PRIMAL_INFEASIBLE)
+        flagged = status == proxqp.PROXQP_PRIMAL_INFEASIBLE
+        infeasible = _infeasible_reason(qp, eps, max_iter, flagged) if explain else None
         reason = infeasible or (
             f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
             f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
@@ -158,6 +175,49 @@ def solve_qp(
         float(info.pri_res),
         float(info.dua_res),
     )
+
+
+def _solve_default(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -> Any:
+    """ProxQP's functional dense solve with its default settings, the duality gap checked
+    (without it ProxQP may stop with an active bound 1e-5 away); its results."""
+    import proxsuite
+
+    proxqp = proxsuite.proxqp
+    kwargs = {}
+    if warm is not None:
+        kwargs = {"x": warm.x, "y": warm.y, "z": warm.z, "initial_guess": proxqp.InitialGuess.WARM_START}
+    return proxqp.dense.solve(
+        qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, eps_abs=eps, eps_rel=0.0, max_iter=max_iter,
+        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=0.0, **kwargs,
+    )  # fmt: skip
+
+
+def _solve_set(
+    qp: QP, warm: QPSolution | None, eps: float, max_iter: int, rho: float | None, infeasibility: float | None
+) -> Any:
+    """ProxQP's dense solver object with ``rho`` and the infeasibility tolerances set (the
+    functional ``dense.solve`` takes neither), the duality gap checked; its results."""
+    import proxsuite
+
+    proxqp = proxsuite.proxqp
+    m = 0 if qp.A is None else qp.A.shape[0]
+    k = 0 if qp.C is None else qp.C.shape[0]
+    solver = proxqp.dense.QP(qp.g.shape[0], m, k)
+    settings = solver.settings
+    settings.eps_abs, settings.eps_rel, settings.max_iter = eps, 0.0, max_iter
+    settings.check_duality_gap = True
+    settings.eps_duality_gap_abs, settings.eps_duality_gap_rel = eps, 0.0
+    if infeasibility is not None:
+        settings.eps_primal_inf = settings.eps_dual_inf = infeasibility
+    if rho is not None:
+        settings.default_rho = rho
+    solver.init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
+    if warm is not None:
+        settings.initial_guess = proxqp.InitialGuess.WARM_START
+        solver.solve(warm.x, warm.y, warm.z)
+    else:
+        solver.solve()
+    return solver.results
 
 
 def unconstrained_minimiser(qp: QP) -> QPSolution | None:

@@ -8,7 +8,11 @@
 ``fourier.py``              :class:`FourierTrajectory`: a periodic finite Fourier series (excitations)
 ``se3.py``                  :class:`PoseTrajectory`: the end-effector frame through via poses on SE(3), its joint path
 ``pose_ik.py``              :func:`solve_pose`: 6-D (position and orientation) damped least-squares IK
+``sampled.py``              :class:`SampledTrajectory`: samples of q, q̇, q̈ (and τ), quintic Hermite between
+``retiming.py``             :func:`time_optimal`: a path retimed to its shortest duration within the limits (TOPP-RA)
+``optimal.py``              :func:`optimize`: the least effort or the shortest duration through via points (the core in ``optimal/``)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
+``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)
 ==========================  ================================================================
 """
 
@@ -32,16 +36,22 @@ from twolink_pin.trajectory.file import (
     write_trajectory_file,
 )
 from twolink_pin.trajectory.fourier import FourierTrajectory
+from twolink_pin.trajectory.optimal import OptimalTrajectory, effort_integral, optimize
 from twolink_pin.trajectory.polynomial import JointTrajectory
 from twolink_pin.trajectory.pose_ik import solve_pose
+from twolink_pin.trajectory.retiming import TimeOptimal, time_optimal
+from twolink_pin.trajectory.sampled import SampledTrajectory
 from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory, pose_trajectory
 
 __all__ = [
     "NEUTRAL_AMPLITUDE",
     "FourierTrajectory",
     "JointTrajectory",
+    "OptimalTrajectory",
     "PoseSample",
     "PoseTrajectory",
+    "SampledTrajectory",
+    "TimeOptimal",
     "Trajectory",
     "TrajectorySample",
     "ViaPoints",
@@ -51,10 +61,13 @@ __all__ = [
     "check_trajectory_limits",
     "default_trajectory",
     "default_via_points",
+    "effort_integral",
     "home_configuration",
     "neutral_motion",
+    "optimize",
     "pose_trajectory",
     "read_trajectory_file",
     "solve_pose",
+    "time_optimal",
     "write_trajectory_file",
 ]

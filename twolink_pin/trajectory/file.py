@@ -28,6 +28,9 @@ one-axis rotations between the via poses, continuous velocity and acceleration; 
 6 joints or more), whose desired pose, twist and acceleration task-space laws see, its joint
 path solved by a 6-D inverse kinematics;
 
+or samples of a motion (a ``samples`` table: :mod:`~twolink_pin.trajectory.samples_file`,
+what a time-optimal retiming and an optimised trajectory save);
+
 or a periodic finite Fourier series (:class:`~twolink_pin.trajectory.fourier.FourierTrajectory`,
 Swevers et al. 1997; what ``twolink-pin excite`` writes), a table of its own::
 
@@ -67,10 +70,12 @@ from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
+from twolink_pin.trajectory.sampled import SampledTrajectory
 from twolink_pin.trajectory.se3 import MAX_POSITION, PoseTrajectory, pose_trajectory
 
-MAX_TRAJECTORY_BYTES = 1 << 20
-"""Largest trajectory file read (1 MiB)."""
+MAX_TRAJECTORY_BYTES = 16 << 20
+"""Largest trajectory file read (16 MiB: a ``samples`` table of a retimed UR5 path is about
+1 MiB; via points need far less)."""
 MAX_VIA_POINTS = 24
 """Most via points of one file: the polynomial through n points has degree n + 5, and
 beyond about two dozen points its normal equations lose the digits the fit needs."""
@@ -118,7 +123,7 @@ def _only_numbers(value: Any) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool)
 
 
-def _numbers(
+def parse_numbers(
     path: Path, key: str, value: Any, shape: str, bound: float | None = None, unit: str = ""
 ) -> np.ndarray:
     """``value`` as a float array; a number that is not finite or beyond ``±bound`` [unit] is
@@ -176,7 +181,7 @@ def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str
 
 def read_trajectory_file(
     path: str | os.PathLike[str], robot: RobotModel
-) -> JointTrajectory | FourierTrajectory | PoseTrajectory:
+) -> JointTrajectory | FourierTrajectory | PoseTrajectory | SampledTrajectory:
     """The trajectory a TOML or JSON file describes for ``robot`` (see the module docstring).
 
     Raises:
@@ -190,6 +195,10 @@ def read_trajectory_file(
     document = _load(file)
     if "fourier" in document:
         return _fourier_trajectory(file, document, robot)
+    if "samples" in document:
+        from twolink_pin.trajectory.samples_file import read_samples
+
+        return read_samples(file, document, robot)
     unknown = sorted(set(document) - KEYS)
     if unknown:
         raise InvalidParameterError(
@@ -249,7 +258,7 @@ def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:
     ±:data:`MAX_TIME`, strictly increasing by at least :data:`MIN_TIME_STEP`."""
     if "times" not in document:
         raise InvalidParameterError(f"{file}: times", None, "a list of via-point times [s]")
-    times = _numbers(file, "times", document["times"], "a list of times [s]")
+    times = parse_numbers(file, "times", document["times"], "a list of times [s]")
     if times.ndim != 1 or not 2 <= times.size <= MAX_VIA_POINTS:
         raise InvalidParameterError(
             f"{file}: times", document["times"], f"a list of 2 to {MAX_VIA_POINTS} times [s]"
@@ -288,9 +297,9 @@ def _joint_rows(file: Path, rows: Sequence[Any], robot: RobotModel) -> np.ndarra
                 row,
                 f"{robot.nv} joint positions [rad] for {robot.name} (nv = {robot.nv})",
             )
-    via_q = _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
+    via_q = parse_numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]")
     check_within_limits(robot, via_q, f"{file}: joints")  # the URDF's limits first: the better message
-    _numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
+    parse_numbers(file, "joints", rows, f"rows of {robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
     return via_q
 
 
@@ -306,10 +315,12 @@ def _position_rows(
             rows,
             "rows of 3 coordinates (x, y, z) [m], or 2 (x, y) for a planar arm, all alike",
         )
-    points = _numbers(file, "positions", rows, "end-effector positions [m]", MAX_POSITION, "m")
+    points = parse_numbers(file, "positions", rows, "end-effector positions [m]", MAX_POSITION, "m")
     seed = None
     if "seed" in document:
-        seed = _numbers(file, "seed", document["seed"], f"{robot.nv} joint positions [rad]", MAX_ANGLE, "rad")
+        seed = parse_numbers(
+            file, "seed", document["seed"], f"{robot.nv} joint positions [rad]", MAX_ANGLE, "rad"
+        )
         if seed.shape != (robot.nv,):
             raise InvalidParameterError(
                 f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
@@ -337,7 +348,7 @@ def _pose_file(
         raise InvalidParameterError(
             f"{file}: rpy", rows, f"one row (roll, pitch, yaw) [rad] per time ({times.size})"
         )
-    rpy = _numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]", MAX_ANGLE, "rad")
+    rpy = parse_numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]", MAX_ANGLE, "rad")
     if points.shape[1] != 3:
         raise InvalidParameterError(
             f"{file}: positions", document["positions"], "3 coordinates (x, y, z) [m] per row beside 'rpy'"
@@ -388,17 +399,17 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
         raise InvalidParameterError(
             f"{file}: fourier.period", period, f"a period from {MIN_PERIOD:g} to {MAX_PERIOD:g} s"
         )
-    a = _numbers(file, "fourier.a", table["a"], f"{robot.nv} rows of N sine coefficients [rad/s]")
+    a = parse_numbers(file, "fourier.a", table["a"], f"{robot.nv} rows of N sine coefficients [rad/s]")
     if a.ndim != 2 or a.shape[0] != robot.nv or not 1 <= a.shape[1] <= MAX_HARMONICS:
         raise InvalidParameterError(
             f"{file}: fourier.a",
             f"shape {a.shape}",
             f"{robot.nv} rows (one per joint of {robot.name}) of 1 to {MAX_HARMONICS} coefficients [rad/s]",
         )
-    b = _numbers(file, "fourier.b", table["b"], f"{robot.nv} rows of N cosine coefficients [rad/s]")
+    b = parse_numbers(file, "fourier.b", table["b"], f"{robot.nv} rows of N cosine coefficients [rad/s]")
     if b.shape != a.shape:
         raise InvalidParameterError(f"{file}: fourier.b", f"shape {b.shape}", f"shape {a.shape} like a")
-    offset = _numbers(
+    offset = parse_numbers(
         file, "fourier.offset", table["offset"], f"{robot.nv} mean positions [rad]", MAX_ANGLE, "rad"
     )
     if offset.shape != (robot.nv,):
@@ -430,12 +441,19 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
 
 
 def write_trajectory_file(
-    path: str | os.PathLike[str], trajectory: JointTrajectory | FourierTrajectory | PoseTrajectory
+    path: str | os.PathLike[str],
+    trajectory: JointTrajectory | FourierTrajectory | PoseTrajectory | SampledTrajectory,
 ) -> Path:
     """Write ``trajectory`` as a trajectory file (atomically): its joint via points, an SE(3)
-    reference's via poses (positions, rpy, and its first configuration as the seed), or a
-    Fourier trajectory's ``fourier`` table; TOML if ``path`` ends in ``.toml``, else JSON."""
+    reference's via poses (positions, rpy, and its first configuration as the seed), a
+    Fourier trajectory's ``fourier`` table, or a sampled one's ``samples`` table
+    (:mod:`~twolink_pin.trajectory.samples_file`); TOML if ``path`` ends in ``.toml``, else JSON."""
     from twolink_pin.files import atomic_write, write_json
+
+    if isinstance(trajectory, SampledTrajectory):
+        from twolink_pin.trajectory.samples_file import write_samples
+
+        return write_samples(path, trajectory)
 
     toml = Path(os.fspath(path)).suffix.lower() == ".toml"
     if isinstance(trajectory, PoseTrajectory):

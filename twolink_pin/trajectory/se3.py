@@ -140,6 +140,12 @@ class PoseTrajectory(Trajectory):
     def nv(self) -> int:
         return int(self.via_q.shape[1])
 
+    def segment_path(self, k: int, s: np.ndarray, order: int = 0) -> np.ndarray:
+        """Segment ``k``'s geometric joint path ``Q_k^{(order)}(s)`` at ``s ∈ [0, 1]`` (module
+        docstring: its own parameter, whose time scaling the reference then applies), shape
+        (len(s), nv): what a retiming keeps while it chooses the timing anew."""
+        return np.asarray(self._paths[k](np.clip(np.asarray(s, dtype=float), 0.0, 1.0), order))
+
     @property
     def via_times(self) -> np.ndarray:
         return np.asarray(self.times)

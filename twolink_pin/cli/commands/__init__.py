@@ -4,6 +4,7 @@
 ``common.py``     what they share: the robot, the reference, the settings, one run
 ``model.py``      ``info``, ``robots``, ``controllers``, ``fk``, ``ik``, ``trajectory``
 ``identify.py``   ``identify``, ``excite``
+``optimal.py``    ``optimize``, ``trajectory --time-optimal``
 ``run.py``        ``simulate``, ``compare``, ``animate``, ``report``
 ``sweep.py``      ``sweep``
 ``tune.py``       ``tune``
@@ -24,6 +25,7 @@ from twolink_pin.cli.commands.model import (
     cmd_robots,
     cmd_trajectory,
 )
+from twolink_pin.cli.commands.optimal import cmd_optimize
 from twolink_pin.cli.commands.run import cmd_animate, cmd_compare, cmd_report, cmd_simulate
 from twolink_pin.cli.commands.sweep import cmd_sweep
 from twolink_pin.cli.commands.tune import cmd_tune
@@ -37,6 +39,7 @@ __all__ = [
     "cmd_identify",
     "cmd_ik",
     "cmd_info",
+    "cmd_optimize",
     "cmd_report",
     "cmd_robots",
     "cmd_simulate",

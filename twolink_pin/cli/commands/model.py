@@ -295,10 +295,25 @@ def cmd_ik(args: argparse.Namespace) -> int:
 def cmd_trajectory(args: argparse.Namespace) -> int:
     from twolink_pin.feasibility import TorqueCheck
     from twolink_pin.limits import check_limits
-    from twolink_pin.trajectory import FourierTrajectory, JointTrajectory, PoseTrajectory, default_via_points
+    from twolink_pin.trajectory import (
+        FourierTrajectory,
+        JointTrajectory,
+        PoseTrajectory,
+        SampledTrajectory,
+        default_via_points,
+    )
 
     robot = robot_from_args(args)
     traj = trajectory_from_args(args, robot)
+    if args.time_optimal:
+        from twolink_pin.cli.commands.optimal import time_optimal_command
+
+        return time_optimal_command(args, robot, traj)
+    for flag, given in (("--limit-scale", args.limit_scale is not None), ("--friction", args.friction)):
+        if given:
+            raise InvalidParameterError(
+                flag, "given", "--time-optimal beside it (it sets the retiming's limits)"
+            )
     via = default_via_points(robot) if not args.trajectory else None
     check = TorqueCheck(check_limits(robot, traj))  # every limit; the figures show its effort kind
     if args.save:
@@ -316,6 +331,10 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
         from twolink_pin.cli.task_space import pose_trajectory_command
 
         return pose_trajectory_command(args, robot, traj, check)
+    if isinstance(traj, SampledTrajectory):  # samples (a retimed or optimised reference)
+        from twolink_pin.cli.commands.optimal import sampled_trajectory_command
+
+        return sampled_trajectory_command(args, robot, traj, check)
     assert isinstance(traj, JointTrajectory)  # the only other kind a file or a profile gives
     figures: list[str] = []
     if args.plot:
