@@ -1051,7 +1051,7 @@ def test_figures_are_freed_after_saving(
 
 def test_no_pyplot_and_only_the_public_names() -> None:
     """Building and saving figures never imports pyplot (checked in a fresh interpreter),
-    and the package exports exactly its five save functions (no report tables)."""
+    and the package exports exactly its six save functions (no report tables)."""
     code = (
         "import sys, tempfile, numpy as np\n"
         "import twolink_pin.plotting as p\n"
@@ -1063,6 +1063,7 @@ def test_no_pyplot_and_only_the_public_names() -> None:
     assert sorted(plotting.__all__) == [
         "save_distribution_figure",
         "save_end_effector_figure",
+        "save_limits_figure",
         "save_simulation_figures",
         "save_task_error_figure",
         "save_trajectory_figures",
