@@ -19,6 +19,10 @@ from twolink_pin.cli import output
 DEFAULT_TIMEOUT = 86_400.0
 """Default ``--timeout`` [s] per simulation: one day, far beyond any run the bounds allow on
 one machine (the longest single simulation, 10^7 steps, takes minutes), short of "forever"."""
+TUNE_TIMEOUT = 60.0
+"""``tune``'s default ``--timeout`` [s]: a run still going after it is left behind and shown as
+failed (:class:`~twolink_pin.tuning.latest.LatestWins`), so that a law that never returns does
+not hold the page."""
 
 
 @contextlib.contextmanager
@@ -39,7 +43,7 @@ def results_only_on_stdout(active: bool) -> Iterator[None]:
         output.RESULT_STREAM = None
 
 
-__all__ = ["DEFAULT_TIMEOUT", "results_only_on_stdout"]
+__all__ = ["DEFAULT_TIMEOUT", "TUNE_TIMEOUT", "results_only_on_stdout"]
 
 
 OUTPUT_OPTIONS = ("save", "save_data", "out", "html", "write_urdf", "plot")

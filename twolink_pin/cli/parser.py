@@ -13,7 +13,7 @@ from twolink_pin.cli.common_options import (
     run_option_strings,
 )
 from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
-from twolink_pin.cli.guard import DEFAULT_TIMEOUT
+from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
 
@@ -328,14 +328,34 @@ def _add_animate(sub: Any, c: Any) -> None:
     p.set_defaults(func=c.cmd_animate, run_options=run_option_strings(p))
 
 
+def _set_help(parser: argparse.ArgumentParser, dest: str, text: str) -> None:
+    """Give the option ``dest`` of ``parser`` its own help (a default that differs by command)."""
+    for action in parser._actions:  # argparse has no public way to reach an added option
+        if action.dest == dest:
+            action.help = text
+
+
 def _add_tune(sub: Any, c: Any) -> None:
     """``tune``: a law's gains live in the browser."""
     p = sub.add_parser(
-        "tune", help="tune a law live in the browser: move a gain, the run is simulated again and shown"
+        "tune",
+        help="tune a law live in the browser: move a gain, the run is simulated again and shown",
+        description="Serve a page (Viser) with the law's gains as sliders and the run's settings: each change "
+        "re-simulates the run in the background (the newest change wins) and shows the arm, the plots, the "
+        "metrics beside the previous run and the defaults, and the `twolink-pin simulate` line that reproduces "
+        "it. The page saves the run (.npz) and its animation (.html) inside the folder tune runs in, and "
+        "offers them as downloads. Ctrl-C stops it.",
     )
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
     add_sim_options(p)
-    p.set_defaults(duration=None)  # one period of the reference: a run to tune is short
+    p.set_defaults(duration=None, timeout=TUNE_TIMEOUT)  # a few periods; a stuck run is left behind
+    _set_help(p, "duration", "simulated time [s] (default: 3 periods of the reference, 12 s on the twolink)")
+    _set_help(
+        p,
+        "timeout",
+        f"a run still going after S s of wall-clock time is left behind and shown as failed (0: no bound; default "
+        f"{TUNE_TIMEOUT:g}); a run superseded by a change is left behind 2 s after the change",
+    )
     add_gain_option(p)
     add_identified_options(p)
     p.add_argument(

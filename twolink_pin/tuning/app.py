@@ -4,6 +4,7 @@ with ``watch``, the law's file is saved."""
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import io
 import os
@@ -12,9 +13,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.errors import InvalidParameterError, TwolinkPinError, raised_at
-from twolink_pin.tuning.knobs import knobs_of
-from twolink_pin.tuning.latest import LatestWins
+from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
+from twolink_pin.tuning.address import check_listen
+from twolink_pin.tuning.knobs import Knob, knobs_of
+from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
+from twolink_pin.tuning.outputs import page_path
 from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
 
 if TYPE_CHECKING:
@@ -78,14 +81,41 @@ def run_line(done: Finished, command: str, generation: int) -> dict[str, Any]:
 
 
 def error_text(exc: BaseException) -> str:
-    """A failed run in one line; a law file that did not load: with the file and line."""
+    """A failed run in one line; a law file that did not load: with the file and line (its
+    message names the user's file and line, :func:`~twolink_pin.user_code.guarded`: never
+    importlib's frames)."""
     text = str(exc)
     cause = exc.__context__ or exc.__cause__
-    if cause is not None and not isinstance(exc, InvalidParameterError):
+    if cause is not None and not isinstance(exc, (InvalidParameterError, ControllerSpecError)):
         where = raised_at(cause)
         if where and where.strip(" ()") not in text:
             text += where
     return text
+
+
+def knob_changes(old: list[Knob], new: list[Knob]) -> list[str]:
+    """What differs between two sets of controls (names, defaults, units): ``[]`` when the
+    page's controls still fit the law's ``Gains`` declaration."""
+    before = {k.label: k for k in old}
+    after = {k.label: k for k in new}
+    changes = [f"new control {label!r}" for label in after if label not in before]
+    changes += [f"control {label!r} gone" for label in before if label not in after]
+    changes += [
+        f"{label!r} default {after[label].value:g} (was {before[label].value:g})"
+        for label in after
+        if label in before and after[label].value != before[label].value
+    ]
+    return changes
+
+
+def _stop_quietly(server: Any) -> None:
+    """Stop a Viser server without its "(viser) Server stopped" line on stdout (printed by its
+    thread as it ends: stdout is redirected until that thread has ended)."""
+    thread = getattr(getattr(server, "_websock_server", None), "_server_thread", None)
+    with contextlib.redirect_stdout(io.StringIO()):
+        server.stop()
+        if isinstance(thread, threading.Thread):
+            thread.join(10.0)
 
 
 class Tuner:
@@ -99,8 +129,14 @@ class Tuner:
         record_of: ``(spec, payload)`` → what a saved run records (``simulate --save``).
         report: Called with each run's line (:func:`run_line`) or a failure's
             (``{"error": ..., "command": ...}``), on the worker thread.
-        host, port: Where the page is served (port 0: a free one).
+        host, port: Where the page is served (port 0: a free one): checked first
+            (:func:`~twolink_pin.tuning.address.check_listen`).
         watch: Re-read the law's file when it changes.
+        folder: Where the page's "run file" and "animation file" boxes write (names inside it
+            only, :func:`~twolink_pin.tuning.outputs.page_path`); default: the working directory.
+        limit: A run still going after this long is left behind and shown as failed [s]
+            (None: no limit); a superseded run that has not stopped ``stuck_after`` s after
+            the change is left behind too (:class:`~twolink_pin.tuning.latest.LatestWins`).
     """
 
     def __init__(
@@ -114,21 +150,22 @@ class Tuner:
         host: str = "127.0.0.1",
         port: int = 0,
         watch: bool = False,
+        folder: Path | None = None,
+        limit: float | None = None,
+        stuck_after: float = STUCK_AFTER,
     ) -> None:
-        import viser
-
         from twolink_pin.run_spec import gains_used
 
         self._command_of, self._record_of, self._report = command_of, record_of, report
+        self.folder = (folder or Path.cwd()).resolve()
+        self.address = check_listen(host, port)  # a refused host or port: exit 2 before serving
+        self._limit = limit
         self._runner = Runner(arm, lambda: self._session.superseded(), self._partial)
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         knobs = knobs_of(type(controller).Gains, gains_used(controller))
-        with contextlib.redirect_stdout(io.StringIO()):  # its banner: the command prints the URL itself
-            self.server = viser.ViserServer(host=host, port=port, verbose=False)
-        if port and self.server.get_port() != port:
-            self.server.stop()
-            raise InvalidParameterError("--port", port, "a free port (it is in use)")
+        self._knobs = knobs
+        self.server = self._start_server(host, port)
         self.server.gui.configure_theme(control_width="large")
         gui = self.server.gui
         gui.add_markdown(f"**twolink-pin tune** · {controller.title} (`{controller.name}`) on {robot.name}")
@@ -146,18 +183,23 @@ class Tuner:
             self.plots = Plots(self.server)
         with gui.add_folder("as a command"):
             self.command = gui.add_markdown("")
-            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz")
-            gui.add_button("save run").on_click(lambda _: self._save())
-            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html")
-            gui.add_button("export animation").on_click(lambda _: self._export())
-            self.saved = gui.add_markdown("")
+            hint = f"a file name inside {self.folder} (also offered as a download)"
+            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz", hint=hint)
+            gui.add_button("save run").on_click(lambda event: self._save(event.client))
+            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html", hint=hint)
+            gui.add_button("export animation").on_click(lambda event: self._export(event.client))
+            self.saved = gui.add_markdown(f"files are written in `{self.folder}`")
         self._lock = threading.Lock()
         self._latest: Finished | None = None
         self._previous: Finished | None = None
         self._defaults: Finished | None = None
         self._law_version = 0
+        self._knobs_version = 0  # the law version the controls were last checked against
+        self._base = base
         self._closed = threading.Event()
-        self._session: LatestWins[Request, Finished] = LatestWins(self._runner, self._deliver)
+        self._session: LatestWins[Request, Finished] = LatestWins(
+            self._runner, self._deliver, stuck_after=stuck_after, limit=limit, on_abandoned=self._abandoned
+        )
         self._watcher = None
         law = base.law if isinstance(base.law, str) else ""
         if watch and ".py:" in law:
@@ -169,6 +211,22 @@ class Tuner:
             )
             self._watcher.start()
         self.changed()
+
+    def _start_server(self, host: str, port: int) -> Any:
+        """The Viser server on ``host``:``port``, stopped quietly at exit."""
+        import viser
+
+        with contextlib.redirect_stdout(io.StringIO()):  # its banner: the command prints the URL itself
+            self.server = viser.ViserServer(host=host, port=port, verbose=False)
+        self._stopped = False
+        websock = getattr(self.server, "_websock_server", None)
+        if websock is not None:  # at exit (an error or a signal while the page is built): quietly
+            atexit.unregister(websock.stop)
+        atexit.register(self._stop_server)
+        if port and self.server.get_port() != port:  # taken since the check
+            self._stop_server()
+            raise InvalidParameterError("--port", port, f"a free port on {host} (it is in use)")
+        return self.server
 
     @property
     def url(self) -> str:
@@ -187,15 +245,35 @@ class Tuner:
         except TwolinkPinError as exc:
             self.panel.show_error(None, str(exc))
             return
-        self.status.content = "running…"
+        bound = f" (given up after {self._limit:g} s: --timeout)" if self._limit else ""
+        self.status.content = f"running…{bound}"
         self._session.submit(Request(spec, payload, self._law_version))
 
     def close(self) -> None:
-        """Stop the runs, the playback and the server."""
+        """Stop the runs, the playback and the server (quietly: no line of Viser's)."""
         self._closed.set()
         self._session.close()
         self.scene.close()
-        self.server.stop()
+        self._stop_server()
+
+    def _stop_server(self) -> None:
+        """Stop the server once, quietly (also at exit if :meth:`close` was never reached)."""
+        atexit.unregister(self._stop_server)
+        if not self._stopped:
+            self._stopped = True
+            _stop_quietly(self.server)
+
+    def _abandoned(self, generation: int, seconds: float) -> None:
+        """A run left behind (a law that does not return): say so in the page."""
+        self.status.content = (
+            f"**run {generation} cannot be stopped**: the law's compute has not returned for {seconds:.1f} s; "
+            "it is left running in the background and "
+            + (
+                "the newer change runs now"
+                if self._session.generation > generation
+                else "its run is given up"
+            )
+        )
 
     def _partial(self, part: Partial) -> None:
         """Show the part of the run in flight simulated so far (on the worker thread)."""
@@ -220,6 +298,7 @@ class Tuner:
             self._report({"run": generation, "error": text, "command": command})
             return
         self.panel.show_error(None, "")
+        kept = self._check_controls(request) if request.law_version != self._knobs_version else ""
         with self._lock:
             self._previous, self._latest = self._latest, outcome
             if self._defaults is None:
@@ -230,22 +309,51 @@ class Tuner:
         self.plots.show(outcome)
         self.metrics.content = metrics_table(outcome, previous, defaults)
         self.command.content = f"```\n{command}\n```"
-        self.status.content = f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s"
+        self.status.content = (
+            f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s" + kept
+        )
         self._report(run_line(outcome, command, generation))
 
-    def _save(self) -> None:
+    def _check_controls(self, request: Request) -> str:
+        """After ``--watch`` reloaded the law: whether its ``Gains`` declaration still gives the
+        page's controls; if not, the page keeps them and the status says what changed."""
+        from twolink_pin.run_spec import gains_used
+
+        self._knobs_version = request.law_version
+        base = self._base
+        try:
+            robot, _ = self._runner.arm(request.payload)
+            controller = base.build(robot, base.read_parameters(robot)).controller
+            changes = knob_changes(self._knobs, knobs_of(type(controller).Gains, gains_used(controller)))
+        except TwolinkPinError as exc:
+            changes = [str(exc)]
+        if not changes:
+            return ""
+        return (
+            f" · **the law's Gains changed** ({'; '.join(changes)}): the page kept its old controls (the run and "
+            "its command line use their values); restart tune for the new ones"
+        )
+
+    def _offer(self, client: Any, path: Path) -> None:
+        """Offer the file just written as a download in the page of ``client`` (None: every page)."""
+        target = client if client is not None else self.server
+        target.send_file_download(path.name, path.read_bytes())
+
+    def _save(self, client: Any = None) -> None:
         from twolink_pin.simulation.storage import save_result
 
         done = self._latest
         if done is None:
             return
         try:
-            path = save_result(done.result, self.save_path.value, record=self._record_of(*done.request[:2]))
-            self.saved.content = f"saved `{path}`"
+            path = page_path(self.folder, str(self.save_path.value), ".npz", "run file")
+            save_result(done.result, path, record=self._record_of(*done.request[:2]))
+            self._offer(client, path)
+            self.saved.content = f"saved `{path}` (and offered as a download)"
         except (TwolinkPinError, OSError) as exc:
             self.saved.content = f"**not saved**: {exc}"
 
-    def _export(self) -> None:
+    def _export(self, client: Any = None) -> None:
         from twolink_pin.kinematics import joint_positions
         from twolink_pin.visualization import write_html
         from twolink_pin.visualization.overlays import run_overlays
@@ -258,16 +366,18 @@ class Tuner:
         via_q = getattr(reference, "via_q", None)
         points = None if via_q is None else joint_positions(done.robot, via_q)[:, -1, :]
         try:
-            path = write_html(
+            path = page_path(self.folder, str(self.html_path.value), ".html", "animation file")
+            write_html(
                 done.robot,
                 result.t,
                 result.q,
                 result.q_des,
-                path=self.html_path.value,
+                path=path,
                 via_points=points,
                 **run_overlays(done.request.spec.plant.wrench, result.t),
             )
-            self.saved.content = f"animation written to `{path}`"
+            self._offer(client, path)
+            self.saved.content = f"animation written to `{path}` (and offered as a download)"
         except (TwolinkPinError, OSError) as exc:
             self.saved.content = f"**not written**: {exc}"
 

@@ -11,19 +11,64 @@ The run in flight is cancelled, not waited for: ``work`` may ask :meth:`LatestWi
 (the tuner asks it after every block of samples the engine writes,
 :func:`~twolink_pin.simulation.deadline.watched`) and stop by raising
 :class:`~twolink_pin.simulation.deadline.RunCancelled`; a cancelled run is never delivered.
+
+A run that does not stop — a law whose ``compute`` sleeps or loops, so that no block ends —
+would hold every later change back. Two bounds keep the page live: a superseded run that has
+not stopped ``stuck_after`` seconds after the newer request, and a run still going after
+``limit`` seconds (``tune --timeout``), is **left behind**: a new worker thread takes the next
+request at once, the old thread's outcome is never delivered, and :class:`RunAbandoned` is
+raised in it asynchronously (which stops a loop in Python at its next bytecode, or a sleep
+when it returns; code looping inside C cannot be stopped that way and goes on in the
+background). ``on_abandoned`` says so (the page shows it); a run left behind at its limit is
+delivered as :class:`RunTooLong`.
 """
 
 from __future__ import annotations
 
+import ctypes
 import sys
 import threading
+import time
 from collections.abc import Callable
 from typing import Generic, TypeVar
 
+from twolink_pin.errors import TwolinkPinError
 from twolink_pin.simulation.deadline import RunCancelled
 
 In = TypeVar("In")
 Out = TypeVar("Out")
+
+STUCK_AFTER = 2.0
+"""A superseded run that has not stopped this long after the newer request is left behind [s]."""
+
+
+class RunAbandoned(BaseException):
+    """Raised asynchronously in a run left behind (a ``BaseException``: a law's
+    ``except Exception`` does not swallow it)."""
+
+
+class RunTooLong(TwolinkPinError):
+    """A run still going after the session's limit (left behind, not stopped).
+
+    Attributes:
+        generation: The run's number.
+        seconds: The limit [s].
+    """
+
+    def __init__(self, generation: int, seconds: float) -> None:
+        self.generation, self.seconds = generation, seconds
+        super().__init__(
+            f"run {generation} did not finish within --timeout {seconds:g} s of wall-clock time (the law's "
+            "compute may never return): it was left behind, and a change of a control starts a new run"
+        )
+
+
+def _raise_in(thread: threading.Thread) -> None:
+    """Raise :class:`RunAbandoned` in ``thread`` at its next Python bytecode (CPython)."""
+    ident = thread.ident
+    set_async = getattr(getattr(ctypes, "pythonapi", None), "PyThreadState_SetAsyncExc", None)
+    if ident is not None and set_async is not None and thread.is_alive():
+        set_async(ctypes.c_ulong(ident), ctypes.py_object(RunAbandoned))
 
 
 class LatestWins(Generic[In, Out]):
@@ -33,26 +78,47 @@ class LatestWins(Generic[In, Out]):
         work: The job (a simulation); what it raises is its outcome too.
         deliver: Called on the worker thread with ``(generation, request, outcome)`` for the
             newest request's run (``outcome`` the value or the exception raised).
+        stuck_after: A superseded run still in flight this long after the newer request is
+            left behind [s] (module doc).
+        limit: A run still in flight after this long is left behind and delivered as
+            :class:`RunTooLong` [s] (None: no limit).
+        on_abandoned: Called with ``(generation, seconds it ran)`` when a run is left behind.
     """
 
     def __init__(
         self,
         work: Callable[[In], Out],
         deliver: Callable[[int, In, Out | Exception], None],
+        stuck_after: float = STUCK_AFTER,
+        limit: float | None = None,
+        on_abandoned: Callable[[int, float], None] | None = None,
     ) -> None:
         self._work = work
         self._deliver = deliver
+        self._stuck_after, self._limit, self._on_abandoned = stuck_after, limit, on_abandoned
         self._lock = threading.Condition()
         self._waiting: tuple[int, In] | None = None
+        self._flight: tuple[int, In] | None = None  # the run in flight
         self._generation = 0
         self._closed = False
-        self._running = 0
+        self._running: dict[threading.Thread, int] = {}  # the worker's generation in flight
+        self._started = 0.0  # when the run in flight started (time.monotonic)
+        self._superseded_at: float | None = None  # when a newer request came while it ran
         self.runs = 0
         """Runs started (a superseded request never starts)."""
         self.cancelled = 0
         """Runs that stopped with :class:`RunCancelled` (superseded while in flight)."""
-        self._thread = threading.Thread(target=self._loop, name="twolink-pin-tune-runs", daemon=True)
-        self._thread.start()
+        self.abandoned = 0
+        """Runs left behind (stuck after a newer request, or past the limit)."""
+        self._worker = self._start_worker()
+        self._watchdog = threading.Thread(target=self._watch, name="twolink-pin-tune-watchdog", daemon=True)
+        self._watchdog.start()
+
+    def _start_worker(self) -> threading.Thread:
+        thread = threading.Thread(target=self._loop, name="twolink-pin-tune-runs", daemon=True)
+        self._worker = thread
+        thread.start()
+        return thread
 
     @property
     def generation(self) -> int:
@@ -65,61 +131,132 @@ class LatestWins(Generic[In, Out]):
         with self._lock:
             self._generation += 1
             self._waiting = (self._generation, request)
-            self._lock.notify()
+            if self._busy and self._superseded_at is None:
+                self._superseded_at = time.monotonic()
+            self._lock.notify_all()
             return self._generation
 
     def superseded(self) -> bool:
-        """Whether the run in flight is no longer wanted (a newer request, or closed)."""
-        return self._closed or self._running != self._generation
+        """Whether the run in flight on this thread is no longer wanted (a newer request,
+        closed, or left behind)."""
+        me = threading.current_thread()
+        return self._closed or me is not self._worker or self._running.get(me) != self._generation
 
     def close(self) -> None:
         """Stop: no further request starts, and the run in flight is superseded."""
         with self._lock:
             self._closed = True
             self._waiting = None
-            self._lock.notify()
+            self._lock.notify_all()
 
     def idle(self, timeout: float | None = None) -> bool:
         """Wait until no request is waiting or running; False on timeout."""
         with self._lock:
             return self._lock.wait_for(lambda: self._waiting is None and not self._busy, timeout)
 
-    _busy = False
+    @property
+    def _busy(self) -> bool:
+        return self._worker in self._running
+
+    def _watch(self) -> None:
+        """Leave a stuck run behind (module doc)."""
+        with self._lock:
+            while not self._closed:
+                now = time.monotonic()
+                due: list[float] = []
+                if self._busy and self._superseded_at is not None:
+                    due.append(self._superseded_at + self._stuck_after)
+                if self._busy and self._limit:
+                    due.append(self._started + self._limit)
+                if not due:
+                    self._lock.wait()
+                    continue
+                if min(due) > now:
+                    self._lock.wait(min(due) - now)
+                    continue
+                self._abandon(now)
+
+    def _abandon(self, now: float) -> None:
+        """(Lock held.) Leave the worker's run behind and start a new worker."""
+        old = self._worker
+        self._running.pop(old)
+        assert self._flight is not None
+        generation, request = self._flight
+        seconds = now - self._started
+        too_long = self._superseded_at is None  # at the limit, not superseded
+        self.abandoned += 1
+        self._superseded_at = None
+        self._start_worker()
+        _raise_in(old)
+        if too_long:
+            threading.Thread(
+                target=self._say_too_long,
+                args=(generation, request, seconds),
+                name="twolink-pin-tune-limit",
+                daemon=True,
+            ).start()
+        elif self._on_abandoned is not None:
+            threading.Thread(
+                target=self._on_abandoned,
+                args=(generation, seconds),
+                name="twolink-pin-tune-stuck",
+                daemon=True,
+            ).start()
+        self._lock.notify_all()
+
+    def _say_too_long(self, generation: int, request: In, seconds: float) -> None:
+        if self._on_abandoned is not None:
+            self._on_abandoned(generation, seconds)
+        with self._lock:
+            current = generation == self._generation and not self._closed
+        if current:
+            self._deliver(generation, request, RunTooLong(generation, self._limit or seconds))
 
     def _loop(self) -> None:
+        me = threading.current_thread()
+        try:
+            self._serve(me)
+        except RunAbandoned:  # left behind (raised asynchronously): this thread ends
+            pass
+
+    def _serve(self, me: threading.Thread) -> None:
         while True:
             with self._lock:
-                self._lock.wait_for(lambda: self._waiting is not None or self._closed)
-                if self._closed:
+                self._lock.wait_for(
+                    lambda: self._waiting is not None or self._closed or me is not self._worker
+                )
+                if self._closed or me is not self._worker:
                     return
                 assert self._waiting is not None
                 generation, request = self._waiting
                 self._waiting = None
-                self._busy = True
-                self._running = generation
+                self._running[me] = generation
+                self._flight = (generation, request)
+                self._started, self._superseded_at = time.monotonic(), None
                 self.runs += 1
+                self._lock.notify_all()
             outcome: Out | Exception
             try:
                 outcome = self._work(request)
             except RunCancelled:
                 with self._lock:
-                    self.cancelled += 1
-                    self._busy = False
+                    if self._running.pop(me, None) is not None:
+                        self.cancelled += 1
                     self._lock.notify_all()
                 continue
             except Exception as exc:  # the run's failure is its outcome (shown, the server stays up)
                 outcome = exc
             try:
                 with self._lock:
-                    current = generation == self._generation and not self._closed
+                    current = me is self._worker and generation == self._generation and not self._closed
                 if current:
                     self._deliver(generation, request, outcome)
             except Exception as exc:  # showing a run failed (stdout closed): say so, keep serving
                 print(f"twolink-pin: run {generation} could not be shown: {exc}", file=sys.stderr, flush=True)
             finally:
                 with self._lock:
-                    self._busy = False
+                    self._running.pop(me, None)
                     self._lock.notify_all()
 
 
-__all__ = ["LatestWins"]
+__all__ = ["STUCK_AFTER", "LatestWins", "RunAbandoned", "RunTooLong"]

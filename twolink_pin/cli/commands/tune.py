@@ -14,6 +14,9 @@ from twolink_pin.cli.commands.common import (
     trajectory_from_args,
 )
 from twolink_pin.cli.output import emit
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.interrupts import Terminated
+from twolink_pin.readiness import ready
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
@@ -21,11 +24,28 @@ if TYPE_CHECKING:
     from twolink_pin.trajectory import Trajectory
 
 
+PERIODS = 3
+"""Periods of the reference a run holds when ``--duration`` is not given: more than one, so
+that the last period's error tells what the first period's transient hides."""
+
+
 def _duration(args: argparse.Namespace) -> None:
-    """No ``--duration``: one period of the reference (a tuning run is short)."""
+    """No ``--duration``: :data:`PERIODS` periods of the reference."""
     if args.duration is None:
         robot = robot_from_args(args)
-        args.duration = float(trajectory_from_args(args, robot).period)
+        args.duration = PERIODS * float(trajectory_from_args(args, robot).period)
+
+
+def _check_watch(args: argparse.Namespace) -> None:
+    """``--watch`` watches a law's file: refused for a registered law (nothing to watch)."""
+    law = str(args.controller)
+    if args.watch and not law.partition(":")[0].endswith(".py"):
+        raise InvalidParameterError(
+            "--watch",
+            law,
+            "a law given as a file (path/to/law.py:Class) to reload when it is saved; "
+            f"{law!r} is no file (leave --watch out)",
+        )
 
 
 def cmd_tune(args: argparse.Namespace) -> int:
@@ -33,6 +53,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
     from twolink_pin.cli.simulate_line import command_line, simulate_argv
     from twolink_pin.tuning import Tuner
 
+    _check_watch(args)
     _duration(args)
     spec = run_spec(args, args.controller)
     identified_parameters(spec, robot_from_args(args))  # the parameter file's notes, once
@@ -65,16 +86,24 @@ def cmd_tune(args: argparse.Namespace) -> int:
         host=args.host,
         port=args.port or 0,
         watch=args.watch,
+        limit=args.timeout or None,
     )
     try:
         emit(args, {"url": tuner.url}, f"tuning {args.controller} at {tuner.url}")
+        if not tuner.address.loopback:
+            from twolink_pin.tuning.address import exposure_note
+
+            print(exposure_note(tuner.address, tuner.server.get_port()), file=sys.stderr, flush=True)
+        ready("serving")
         if not args.no_browser:
             import webbrowser
 
             webbrowser.open(tuner.url)
         print("press Ctrl-C to stop", file=sys.stderr, flush=True)
         threading.Event().wait()
-    except KeyboardInterrupt:
+    except Terminated:  # SIGTERM: exit 143 "terminated", as every command
+        raise
+    except KeyboardInterrupt:  # Ctrl-C: the way to stop the tuner
         print("stopping the tuner", file=sys.stderr, flush=True)
     finally:
         tuner.close()
