@@ -1,10 +1,10 @@
 """Stage markers: where a running command has got to, for tests and supervisors.
 
 When the environment variable :data:`READY_FILE` names a file, :func:`ready` appends one
-line per stage reached (``started``, ``parsed``, ``running``, ``writing``), so that a test
-can send Ctrl-C at a known stage instead of after a guessed delay (which a busy machine
-breaks). Without the variable it does nothing. A failure to write the marker is ignored: it
-never changes what the command does.
+line per stage reached (``started``, ``parsed``, ``running``, ``writing``; ``serving``:
+``tune``'s page is up), so that a test can send Ctrl-C at a known stage instead of after a
+guessed delay (which a busy machine breaks). Without the variable it does nothing. A failure
+to write the marker is ignored: it never changes what the command does.
 """
 
 from __future__ import annotations

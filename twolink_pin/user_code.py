@@ -109,7 +109,17 @@ def location(exc: BaseException) -> str:
     return found
 
 
+def location_of(exc: BaseException) -> str:
+    """``file:line`` in the user's code where ``exc`` arose: a syntax error's own file and line
+    (its traceback holds only importlib's frames), else :func:`location`."""
+    if isinstance(exc, SyntaxError) and exc.filename and exc.lineno:
+        return f"{exc.filename}:{exc.lineno}"
+    return location(exc)
+
+
 def _raised(exc: BaseException) -> str:
+    if isinstance(exc, SyntaxError):  # its place is the file's line, not a frame (location_of)
+        return f"raised {type(exc).__name__}: {exc.msg}"
     if isinstance(exc, SystemExit):
         return f"called sys.exit({exc.code!r})"
     if isinstance(exc, MemoryError):
@@ -146,10 +156,10 @@ def guarded(reference: str, what: str, *, timed: bool = True) -> Iterator[None]:
         except BaseException as exc:
             if type(exc).__name__ in ("Terminated", "RunTimeout"):  # a signal, an enclosing bound
                 raise
-            where = location(exc)
+            where = location_of(exc)
             raise ControllerSpecError(
                 reference, f"{what} {_raised(exc)}" + (f" at {where}" if where else "")
             ) from exc
 
 
-__all__ = ["baseline", "guarded", "location", "process_state", "restore_baseline"]
+__all__ = ["baseline", "guarded", "location", "location_of", "process_state", "restore_baseline"]

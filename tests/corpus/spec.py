@@ -93,7 +93,7 @@ class Case:
         run: How to run it (:data:`RUNNERS`).
         signal: ``(signum, stage, "group" | "parent")`` for the ``signal`` runner: the signal
             goes out as soon as the program reports ``stage`` (``started``, ``parsed``,
-            ``running``, ``writing``: :mod:`twolink_pin.readiness`), never after a delay.
+            ``running``, ``writing``, ``serving``: :mod:`twolink_pin.readiness`), never after a delay.
         nonfinite_ok: A successful run may print ``nan`` / ``inf``.
         warns: Words a successful run's stderr must hold (a warning, a law's own prints); a
             success may then print on stderr.
@@ -507,5 +507,5 @@ def json_file(obj: Any) -> str:
 
 
 SIGINT, SIGTERM = int(signal.SIGINT), int(signal.SIGTERM)
-STAGES = ("started", "parsed", "running", "writing")
+STAGES = ("started", "parsed", "running", "writing", "serving")
 """The stages the program reports (:mod:`twolink_pin.readiness`), in order."""

@@ -81,8 +81,8 @@ def exposure_note(address: Address, port: int) -> str:
     """The line that says a page served beyond this machine is reachable from the network."""
     where = ", ".join(address.addresses)
     return (
-        f"twolink-pin: note: --host {address.host} serves the page to the network ({where}, port {port}): "
-        "anyone who reaches it can run laws and download the runs; --host 127.0.0.1 keeps it on this machine"
+        f"twolink-pin: note: with --host {address.host} the page is reachable from the network ({where}, port "
+        f"{port}): anyone who reaches it can run laws and download the runs; --host 127.0.0.1 keeps it on this machine"
     )
 
 

@@ -89,7 +89,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         limit=args.timeout or None,
     )
     try:
-        emit(args, {"url": tuner.url}, f"tuning {args.controller} at {tuner.url}")
+        emit(args, {"url": tuner.url}, f"tuning {args.controller} at {tuner.url} (Ctrl-C stops it)")
         if not tuner.address.loopback:
             from twolink_pin.tuning.address import exposure_note
 
@@ -99,12 +99,11 @@ def cmd_tune(args: argparse.Namespace) -> int:
             import webbrowser
 
             webbrowser.open(tuner.url)
-        print("press Ctrl-C to stop", file=sys.stderr, flush=True)
         threading.Event().wait()
     except Terminated:  # SIGTERM: exit 143 "terminated", as every command
         raise
-    except KeyboardInterrupt:  # Ctrl-C: the way to stop the tuner
-        print("stopping the tuner", file=sys.stderr, flush=True)
+    except KeyboardInterrupt:  # Ctrl-C: the way to stop the tuner (exit 0)
+        pass
     finally:
         tuner.close()
     return 0
