@@ -264,7 +264,7 @@ def test_ctrl_c_ends_the_server_cleanly(pd: Tune) -> None:
     code, err = pd.interrupt()
     assert code == 0, err
     assert "Traceback" not in err
-    assert "stopping the tuner" in err
+    assert "(viser)" not in err  # Viser's "Server stopped" line is not ours to print
 
 
 @pytest.fixture(scope="module")

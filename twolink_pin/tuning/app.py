@@ -264,16 +264,15 @@ class Tuner:
             _stop_quietly(self.server)
 
     def _abandoned(self, generation: int, seconds: float) -> None:
-        """A run left behind (a law that does not return): say so in the page."""
-        self.status.content = (
-            f"**run {generation} cannot be stopped**: the law's compute has not returned for {seconds:.1f} s; "
-            "it is left running in the background and "
-            + (
-                "the newer change runs now"
-                if self._session.generation > generation
-                else "its run is given up"
-            )
+        """A run left behind (a law that does not return): say so in the page, now and beside
+        the next run shown."""
+        self._left_behind = (
+            f"**run {generation} cannot be stopped**: the law's compute had not returned after {seconds:.1f} s; "
+            "it was left running in the background"
         )
+        self.status.content = self._left_behind
+
+    _left_behind = ""
 
     def _partial(self, part: Partial) -> None:
         """Show the part of the run in flight simulated so far (on the worker thread)."""
@@ -309,8 +308,11 @@ class Tuner:
         self.plots.show(outcome)
         self.metrics.content = metrics_table(outcome, previous, defaults)
         self.command.content = f"```\n{command}\n```"
+        left, self._left_behind = self._left_behind, ""
         self.status.content = (
-            f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s" + kept
+            f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s"
+            + kept
+            + (f" · {left}" if left else "")
         )
         self._report(run_line(outcome, command, generation))
 

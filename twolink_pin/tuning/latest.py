@@ -82,7 +82,8 @@ class LatestWins(Generic[In, Out]):
             left behind [s] (module doc).
         limit: A run still in flight after this long is left behind and delivered as
             :class:`RunTooLong` [s] (None: no limit).
-        on_abandoned: Called with ``(generation, seconds it ran)`` when a run is left behind.
+        on_abandoned: Called with ``(generation, seconds it ran)`` when a run is left behind,
+            before the next run starts (with the session's lock held: it must not call back).
     """
 
     def __init__(
@@ -186,31 +187,24 @@ class LatestWins(Generic[In, Out]):
         too_long = self._superseded_at is None  # at the limit, not superseded
         self.abandoned += 1
         self._superseded_at = None
+        if self._on_abandoned is not None:  # before the next run starts: its page says so
+            self._on_abandoned(generation, seconds)
         self._start_worker()
         _raise_in(old)
         if too_long:
             threading.Thread(
                 target=self._say_too_long,
-                args=(generation, request, seconds),
+                args=(generation, request),
                 name="twolink-pin-tune-limit",
-                daemon=True,
-            ).start()
-        elif self._on_abandoned is not None:
-            threading.Thread(
-                target=self._on_abandoned,
-                args=(generation, seconds),
-                name="twolink-pin-tune-stuck",
                 daemon=True,
             ).start()
         self._lock.notify_all()
 
-    def _say_too_long(self, generation: int, request: In, seconds: float) -> None:
-        if self._on_abandoned is not None:
-            self._on_abandoned(generation, seconds)
+    def _say_too_long(self, generation: int, request: In) -> None:
         with self._lock:
             current = generation == self._generation and not self._closed
         if current:
-            self._deliver(generation, request, RunTooLong(generation, self._limit or seconds))
+            self._deliver(generation, request, RunTooLong(generation, self._limit or 0.0))
 
     def _loop(self) -> None:
         me = threading.current_thread()
