@@ -136,13 +136,37 @@ def test_a_run_past_the_limit_is_delivered_as_too_long_and_the_next_one_runs() -
         session.submit(1)
         generation, outcome = delivered.get(timeout=WAIT)
         assert generation == 1 and isinstance(outcome, RunTooLong)
-        assert "within --timeout 0.2 s" in str(outcome)
+        assert "no progress for --timeout 0.2 s" in str(outcome)
         session.submit(2)
         assert delivered.get(timeout=WAIT) == (2, 20)
     finally:
         release.set()
         session.close()
     assert delivered.empty()  # run 1, released at last, is never delivered
+
+
+def test_a_run_that_makes_progress_is_not_cut_by_the_limit() -> None:
+    """The limit counts from the last sign of progress: a run of 0.6 s that reports progress
+    every 0.05 s under a 0.2-s limit is delivered whole."""
+    import time
+
+    delivered: queue.Queue[tuple[int, object]] = queue.Queue()
+    session: LatestWins[int, int] | None = None
+
+    def work(x: int) -> int:
+        for _ in range(12):
+            time.sleep(0.05)  # a block of samples
+            assert session is not None
+            session.alive()
+        return 10 * x
+
+    session = LatestWins(work, lambda g, r, out: delivered.put((g, out)), limit=0.2)
+    try:
+        session.submit(1)
+        assert delivered.get(timeout=WAIT) == (1, 10)
+        assert session.abandoned == 0
+    finally:
+        session.close()
 
 
 def _tuner(

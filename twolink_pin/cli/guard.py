@@ -19,10 +19,10 @@ from twolink_pin.cli import output
 DEFAULT_TIMEOUT = 86_400.0
 """Default ``--timeout`` [s] per simulation: one day, far beyond any run the bounds allow on
 one machine (the longest single simulation, 10^7 steps, takes minutes), short of "forever"."""
-TUNE_TIMEOUT = 60.0
-"""``tune``'s default ``--timeout`` [s]: a run still going after it is left behind and shown as
-failed (:class:`~twolink_pin.tuning.latest.LatestWins`), so that a law that never returns does
-not hold the page."""
+TUNE_TIMEOUT = 30.0
+"""``tune``'s default ``--timeout`` [s]: a run that shows no progress (no block of samples) for
+that long is left behind and shown as failed (:class:`~twolink_pin.tuning.latest.LatestWins`),
+so that a law that never returns does not hold the page."""
 
 
 @contextlib.contextmanager

@@ -353,8 +353,9 @@ def _add_tune(sub: Any, c: Any) -> None:
     _set_help(
         p,
         "timeout",
-        f"a run still going after S s of wall-clock time is left behind and shown as failed (0: no bound; default "
-        f"{TUNE_TIMEOUT:g}); a run superseded by a change is left behind 2 s after the change",
+        f"a run that simulates no block of 128 steps for S s of wall-clock time (a law that never returns) is left "
+        f"behind and shown as failed (0: no bound; default {TUNE_TIMEOUT:g}); a run superseded by a change is left "
+        "behind if it has not stopped 2 s after the change",
     )
     add_gain_option(p)
     add_identified_options(p)

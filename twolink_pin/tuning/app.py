@@ -160,7 +160,9 @@ class Tuner:
         self.folder = (folder or Path.cwd()).resolve()
         self.address = check_listen(host, port)  # a refused host or port: exit 2 before serving
         self._limit = limit
-        self._runner = Runner(arm, lambda: self._session.superseded(), self._partial)
+        self._runner = Runner(
+            arm, lambda: self._session.superseded(), self._partial, alive=lambda: self._session.alive()
+        )
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         knobs = knobs_of(type(controller).Gains, gains_used(controller))
@@ -245,7 +247,7 @@ class Tuner:
         except TwolinkPinError as exc:
             self.panel.show_error(None, str(exc))
             return
-        bound = f" (given up after {self._limit:g} s: --timeout)" if self._limit else ""
+        bound = f" (given up after {self._limit:g} s without progress: --timeout)" if self._limit else ""
         self.status.content = f"running…{bound}"
         self._session.submit(Request(spec, payload, self._law_version))
 
@@ -293,7 +295,10 @@ class Tuner:
                 self.panel.show_error(gain, text)
             else:
                 self.panel.show_error(None, "")
-            self.status.content = f"**run {generation} failed** (the last good run stays on screen): {text}"
+            kept = self._check_controls(request) if request.law_version != self._knobs_version else ""
+            self.status.content = (
+                f"**run {generation} failed** (the last good run stays on screen): {text}{kept}"
+            )
             self._report({"run": generation, "error": text, "command": command})
             return
         self.panel.show_error(None, "")
@@ -321,14 +326,14 @@ class Tuner:
         page's controls; if not, the page keeps them and the status says what changed."""
         from twolink_pin.run_spec import gains_used
 
-        self._knobs_version = request.law_version
         base = self._base
         try:
             robot, _ = self._runner.arm(request.payload)
             controller = base.build(robot, base.read_parameters(robot)).controller
-            changes = knob_changes(self._knobs, knobs_of(type(controller).Gains, gains_used(controller)))
-        except TwolinkPinError as exc:
-            changes = [str(exc)]
+        except TwolinkPinError:  # the file does not load: the run's own error says so
+            return ""
+        self._knobs_version = request.law_version
+        changes = knob_changes(self._knobs, knobs_of(type(controller).Gains, gains_used(controller)))
         if not changes:
             return ""
         return (

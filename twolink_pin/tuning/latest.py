@@ -14,8 +14,10 @@ The run in flight is cancelled, not waited for: ``work`` may ask :meth:`LatestWi
 
 A run that does not stop — a law whose ``compute`` sleeps or loops, so that no block ends —
 would hold every later change back. Two bounds keep the page live: a superseded run that has
-not stopped ``stuck_after`` seconds after the newer request, and a run still going after
-``limit`` seconds (``tune --timeout``), is **left behind**: a new worker thread takes the next
+not stopped ``stuck_after`` seconds after the newer request, and a run that has shown no
+progress for ``limit`` seconds (``tune --timeout``: ``work`` calls :meth:`LatestWins.alive`
+after each block of samples; a run that never does, an adaptive-step one, counts from its
+start), is **left behind**: a new worker thread takes the next
 request at once, the old thread's outcome is never delivered, and :class:`RunAbandoned` is
 raised in it asynchronously (which stops a loop in Python at its next bytecode, or a sleep
 when it returns; code looping inside C cannot be stopped that way and goes on in the
@@ -48,7 +50,7 @@ class RunAbandoned(BaseException):
 
 
 class RunTooLong(TwolinkPinError):
-    """A run still going after the session's limit (left behind, not stopped).
+    """A run that showed no progress for the session's limit (left behind, not stopped).
 
     Attributes:
         generation: The run's number.
@@ -58,7 +60,7 @@ class RunTooLong(TwolinkPinError):
     def __init__(self, generation: int, seconds: float) -> None:
         self.generation, self.seconds = generation, seconds
         super().__init__(
-            f"run {generation} did not finish within --timeout {seconds:g} s of wall-clock time (the law's "
+            f"run {generation} made no progress for --timeout {seconds:g} s of wall-clock time (the law's "
             "compute may never return): it was left behind, and a change of a control starts a new run"
         )
 
@@ -80,8 +82,8 @@ class LatestWins(Generic[In, Out]):
             newest request's run (``outcome`` the value or the exception raised).
         stuck_after: A superseded run still in flight this long after the newer request is
             left behind [s] (module doc).
-        limit: A run still in flight after this long is left behind and delivered as
-            :class:`RunTooLong` [s] (None: no limit).
+        limit: A run that showed no progress (:meth:`alive`) for this long is left behind
+            and delivered as :class:`RunTooLong` [s] (None: no limit).
         on_abandoned: Called with ``(generation, seconds it ran)`` when a run is left behind,
             before the next run starts (with the session's lock held: it must not call back).
     """
@@ -103,7 +105,7 @@ class LatestWins(Generic[In, Out]):
         self._generation = 0
         self._closed = False
         self._running: dict[threading.Thread, int] = {}  # the worker's generation in flight
-        self._started = 0.0  # when the run in flight started (time.monotonic)
+        self._started = 0.0  # when the run in flight started or last progressed (time.monotonic)
         self._superseded_at: float | None = None  # when a newer request came while it ran
         self.runs = 0
         """Runs started (a superseded request never starts)."""
@@ -142,6 +144,12 @@ class LatestWins(Generic[In, Out]):
         closed, or left behind)."""
         me = threading.current_thread()
         return self._closed or me is not self._worker or self._running.get(me) != self._generation
+
+    def alive(self) -> None:
+        """The run in flight on this thread made progress (a block of samples): its limit
+        counts from now."""
+        if threading.current_thread() is self._worker:
+            self._started = time.monotonic()
 
     def close(self) -> None:
         """Stop: no further request starts, and the run in flight is superseded."""

@@ -85,6 +85,7 @@ class _Stream:
 
     def __call__(self, block: Any) -> None:
         runner = self.runner
+        runner.alive()
         if runner.cancelled():
             raise RunCancelled(f"run of {self.request.spec.law} superseded")
         if runner.partial is None:
@@ -111,6 +112,7 @@ class Runner:
         partial: Called with the part simulated so far (:class:`Partial`), on the run's thread.
         stream_after: A run publishes partial results once it has taken this long [s].
         stream_period: At most one partial result per this many seconds [s].
+        alive: Called after every block: the run makes progress.
     """
 
     def __init__(
@@ -120,9 +122,10 @@ class Runner:
         partial: Callable[[Partial], None] | None = None,
         stream_after: float = 1.0,
         stream_period: float = 0.5,
+        alive: Callable[[], None] = lambda: None,
     ) -> None:
         self._arm = arm
-        self.cancelled, self.partial = cancelled, partial
+        self.cancelled, self.partial, self.alive = cancelled, partial, alive
         self.stream_after, self.stream_period = stream_after, stream_period
         self._arms: dict[float, tuple[RobotModel, Trajectory]] = {}
         self._law_version = 0
