@@ -326,3 +326,21 @@ def test_watch_says_when_the_gains_declaration_changed_and_the_line_still_reprod
     robot = load_robot("twolink")
     result = simulate(*spec.build(robot), default_trajectory(robot), spec.simulation)
     assert jsonable(compute_metrics(result).as_dict()) == jsonable(line["metrics"])
+
+
+def test_the_default_run_holds_three_periods_as_help_says(capsys: pytest.CaptureFixture[str]) -> None:
+    """No ``--duration``: three periods of the robot's reference (the last period's error then
+    differs from the whole run's), and ``--help`` says so, not simulate's 30 s."""
+    from twolink_pin.cli.commands.tune import PERIODS, _duration
+    from twolink_pin.cli.parser import build_parser
+    from twolink_pin.model import load_robot
+    from twolink_pin.trajectory import default_trajectory
+
+    parser = build_parser()
+    args = parser.parse_args(["tune", "pd"])
+    _duration(args)
+    assert PERIODS == 3 and args.duration == 3 * default_trajectory(load_robot("twolink")).period
+    with pytest.raises(SystemExit):
+        parser.parse_args(["tune", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "default: 3 periods of the reference" in text and "(default 30)" not in text
