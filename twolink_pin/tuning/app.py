@@ -233,7 +233,8 @@ class Tuner:
     @property
     def url(self) -> str:
         """The page's address."""
-        return f"http://{self.server.get_host()}:{self.server.get_port()}/"
+        host = str(self.server.get_host())
+        return f"http://{f'[{host}]' if ':' in host else host}:{self.server.get_port()}/"
 
     @property
     def session(self) -> LatestWins[Request, Finished]:

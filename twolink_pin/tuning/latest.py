@@ -173,9 +173,10 @@ class LatestWins(Generic[In, Out]):
             while not self._closed:
                 now = time.monotonic()
                 due: list[float] = []
-                if self._busy and self._superseded_at is not None:
+                working = self._busy and self._flight is not None  # not yet delivering its outcome
+                if working and self._superseded_at is not None:
                     due.append(self._superseded_at + self._stuck_after)
-                if self._busy and self._limit:
+                if working and self._limit:
                     due.append(self._started + self._limit)
                 if not due:
                     self._lock.wait()
@@ -242,6 +243,8 @@ class LatestWins(Generic[In, Out]):
                 outcome = self._work(request)
             except RunCancelled:
                 with self._lock:
+                    if me is self._worker:
+                        self._flight = None
                     if self._running.pop(me, None) is not None:
                         self.cancelled += 1
                     self._lock.notify_all()
@@ -251,6 +254,8 @@ class LatestWins(Generic[In, Out]):
             try:
                 with self._lock:
                     current = me is self._worker and generation == self._generation and not self._closed
+                    if me is self._worker:
+                        self._flight = None  # its work is done: never left behind while delivering
                 if current:
                     self._deliver(generation, request, outcome)
             except Exception as exc:  # showing a run failed (stdout closed): say so, keep serving
