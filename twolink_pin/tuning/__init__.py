@@ -6,12 +6,14 @@ page shows the new run: the arm, its ghost and trail, the plots, the metrics bes
 previous run and the defaults, and the ``twolink-pin simulate …`` line that reproduces it.
 
 ================  ===================================================================
-``latest.py``     :class:`LatestWins`: one worker thread, one waiting request
+``latest.py``     :class:`LatestWins`: one worker, one waiting request, stuck runs left behind
 ``knobs.py``      the controls of a law's gains, from its ``Gains`` declaration
 ``runner.py``     one run: simulated, measured, its gains and plant
 ``panel.py``      the controls in the page and the ``RunSpec`` they describe
 ``scene.py``      the arm (Pinocchio's ``ViserVisualizer``), ghost, trail, playback
 ``plots.py``      joint errors, torques against limits, task errors, the law's state
+``address.py``    ``--host`` and ``--port`` checked before the server starts
+``outputs.py``    the page's file names kept inside the tuner's folder
 ``app.py``        :class:`Tuner`: the server, the metrics table, save and export, watch
 ================  ===================================================================
 
