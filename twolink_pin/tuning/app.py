@@ -134,9 +134,10 @@ class Tuner:
         watch: Re-read the law's file when it changes.
         folder: Where the page's "run file" and "animation file" boxes write (names inside it
             only, :func:`~twolink_pin.tuning.outputs.page_path`); default: the working directory.
-        limit: A run still going after this long is left behind and shown as failed [s]
-            (None: no limit); a superseded run that has not stopped ``stuck_after`` s after
-            the change is left behind too (:class:`~twolink_pin.tuning.latest.LatestWins`).
+        limit: A run that simulates no block of samples for this long is left behind and
+            shown as failed [s] (None: no limit).
+        stuck_after: A superseded run that has not stopped this long after the change is left
+            behind [s] (:class:`~twolink_pin.tuning.latest.LatestWins`).
     """
 
     def __init__(
