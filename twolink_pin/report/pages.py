@@ -126,6 +126,21 @@ RATIO_SYMBOLS = {"velocity": "q̇", "acceleration": "q̈", "effort": "τ"}
 """The symbol of each kind whose peak ratio the section's reference table gives."""
 
 
+def _crossed(crossings: dict[str, Any]) -> str:
+    """A run's crossings in a few symbols: ``q̇2 +0.361 rad/s (t = 0.076 s); τ1 +32.8 N·m
+    (t = 0.001 s)`` — the limit, by how much at most, first when."""
+    symbols = {"position": "q", "velocity": "q̇", "effort": "τ"}
+    parts = []
+    for kind, entry in crossings.items():
+        for j, crossed in enumerate(entry["crossed"]):
+            if crossed:
+                excess, first = entry["excess"][j], entry["first_time"][j]
+                parts.append(
+                    f"{symbols.get(kind, kind)}{j + 1} +{fmt(excess, 3)} {entry['unit']} (t = {fmt(first, 3)} s)"
+                )
+    return "; ".join(parts)
+
+
 def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
     """The section "The reference within the limits": its references' table (one row per
     reference) and its tracking table (one row per law and reference); None without it."""
@@ -153,13 +168,13 @@ def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
     track_headers += [f"max |τ{j + 1}| [N·m]" for j in range(nv)] + ["limits crossed"]
     track_rows = []
     for row in section["tracking"]:
-        head = [row["law"], refs[row["reference"]]["title"], fmt(row["duration_s"])]
+        head = [row["law"], refs[row["reference"]]["short"], fmt(row["duration_s"])]
         if not row["finished"]:
             track_rows.append(head + ["—"] * (3 * nv) + [f"did not finish: {row['failed']}"])
             continue
         m = row["metrics"]
         cells = [fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["max"]["tau"]]
-        track_rows.append(head + cells + ["; ".join(row["crossed"]) or "none"])
+        track_rows.append(head + cells + [_crossed(row["crossings"]) or "none"])
     return {
         "reference_headers": ref_headers,
         "reference_rows": ref_rows,

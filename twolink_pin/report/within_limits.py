@@ -55,11 +55,12 @@ from twolink_pin.simulation import simulate
 from twolink_pin.trajectory import Trajectory
 
 REFERENCES = {
-    "reference": "the report's reference",
-    "time_optimal": "its time-optimal retiming",
-    "minimum_effort": "the minimum-effort trajectory",
+    "reference": ("the report's reference", "reference"),
+    "time_optimal": ("its time-optimal retiming", "time-optimal"),
+    "minimum_effort": ("the minimum-effort trajectory", "minimum effort"),
 }
-"""The references' keys (file names under ``references/``) and titles, in table order."""
+"""The references' keys (file names under ``references/``), titles and short names (the
+tracking table's), in table order."""
 RATIO_KINDS = (VELOCITY, ACCELERATION, EFFORT)
 """The limits whose peak ratio a reference's row gives (a kind no joint limits is left out)."""
 FIGURE_PREFIX = "limits_references_"
@@ -86,6 +87,16 @@ def _design(robot: Any, reference: Any) -> tuple[dict[str, Any], list[str]]:
     except (InvalidParameterError, OptimizationError) as exc:
         notes.append(f"no minimum-effort trajectory: {exc}")
     return designed, notes
+
+
+def _titles(key: str, trajectory: Any) -> tuple[str, str]:
+    """The reference's title and short name: :data:`REFERENCES`', the report's a polynomial's
+    when it is one."""
+    from twolink_pin.trajectory.polynomial import JointTrajectory
+
+    if key == "reference" and isinstance(trajectory, JointTrajectory):
+        return "the polynomial through the via points", "polynomial"
+    return REFERENCES[key]
 
 
 def reference_row(robot: Any, trajectory: Trajectory) -> tuple[dict[str, Any], LimitsCheck]:
@@ -151,11 +162,11 @@ def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stag
     references, motions = {}, {}
     for key, trajectory in designed.items():
         row, _ = reference_row(robot, trajectory)
-        row["title"] = REFERENCES[key]
+        row["title"], row["short"] = _titles(key, trajectory)
         row["file"] = f"references/{key}.json"
         write_trajectory_file(folder / f"{key}.json", trajectory)
         references[key] = row
-        label = f"{REFERENCES[key]}, {row['duration_s']:.4g} s"
+        label = f"{row['title']}, {row['duration_s']:.4g} s"
         motions[label] = reference_motion(robot, trajectory, 2001)
     figures = save_references_figures(
         motions, joint_limits(robot), Path(stage) / "figures", FIGURE_PREFIX, f"{robot.name}: the references"
