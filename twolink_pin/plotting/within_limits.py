@@ -147,7 +147,8 @@ def _references_figure(
     motions: dict[str, Motion], limits: JointLimits, kind: LimitKind, symbol: str, title: str
 ) -> Figure:
     """One figure: ``kind``'s quantity of every motion per joint against ``t / duration``, the
-    limit dashed; a limit far beyond every motion's peak is not drawn, its panel's title says so."""
+    limit dashed (its value on the axis), one legend below the panels; a limit far beyond every
+    motion's peak is not drawn, its panel's title says so."""
     nv = limits.nv
     fig = new_figure(rows_figsize(TORQUE_FIGSIZE, nv, 0.55 * TORQUE_ROW_HEIGHT))
     axes = fig.subplots(nv, 1, sharex=True, squeeze=False)[:, 0]
@@ -162,9 +163,10 @@ def _references_figure(
             peak = max(peak, float(np.abs(values[:, j]).max()))
         limit = float(upper[j])
         if math.isfinite(limit) and limit <= OFF_SCALE * max(peak, 1e-300):
-            ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.0, label=f"±limit ({limit:.4g} {kind.unit})")
+            ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.0, label="±limit")
             ax.axhline(-limit, color=LIMIT_COLOR, ls="--", lw=1.0)
-            ax.set_ylim(-1.15 * limit, 1.6 * limit)  # room for the legend above the +limit line
+            ax.set_ylim(-1.15 * limit, 1.15 * limit)
+            ax.set_title(f"joint {j + 1}: limit ±{limit:.4g} {kind.unit}", fontsize=8)
         elif math.isfinite(limit):
             ax.set_title(
                 f"joint {j + 1}: the ±{limit:.4g} {kind.unit} limit is off scale (largest peak "
@@ -175,7 +177,9 @@ def _references_figure(
             ax.set_title(f"joint {j + 1}: no {kind.name} limit given", fontsize=8)
         ax.set_ylabel(f"{symbol}{j + 1} [{kind.unit}]")
         ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=7, ncol=2)
+    # one legend for every panel, below them: it never covers a curve
+    handles, labels = max((ax.get_legend_handles_labels() for ax in axes), key=lambda hl: len(hl[1]))
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=7.5, frameon=False)
     axes[-1].set_xlabel("t / duration (each reference on its own time scale)")
     what = "torque" if kind is EFFORT else kind.name
     fig.suptitle(f"{title}: {what} against the limits", fontsize=10)
