@@ -191,3 +191,28 @@ def test_the_section_in_chromium(report: Path) -> None:
             " document.querySelectorAll('nav a[href=\"#limits\"]').length];"
         )
         assert rows == [3, 3 * len(LAWS), 1]
+
+
+def test_a_robot_without_velocity_limits_gets_a_note_instead_of_a_retiming(tmp_path: Path) -> None:
+    """The double pendulum's URDF gives no velocity limit: no time-optimal retiming (a note
+    naming the missing limit), the reference and the minimum-effort trajectory with their
+    rows, no ratio columns and no figure (no joint has a limit to draw)."""
+    from twolink_pin.law_variant import parse_variants
+    from twolink_pin.model import example_robot_urdf
+    from twolink_pin.report.within_limits import limits_section
+
+    urdf = str(example_robot_urdf("double_pendulum_description/urdf/double_pendulum.urdf"))
+    (tmp_path / "figures").mkdir()
+    options = ReportOptions(robot=urdf, **{k: v for k, v in OPTIONS.items() if k != "controllers"})
+    section = limits_section([("pd", parse_variants(("pd",))[0])], options, str(tmp_path))
+    assert list(section["references"]) == ["reference", "minimum_effort"]
+    assert len(section["notes"]) == 1 and "no time-optimal retiming" in section["notes"][0]
+    assert "velocity limit" in section["notes"][0]
+    assert all(ref["peak_ratio"] == {} for ref in section["references"].values())
+    assert section["figures"] == [] and [r["reference"] for r in section["tracking"]] == [
+        "reference",
+        "minimum_effort",
+    ]
+    assert (
+        read_trajectory_file(tmp_path / "references" / "minimum_effort.json", load_robot(urdf)).period == 4.0
+    )
