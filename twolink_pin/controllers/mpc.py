@@ -1,0 +1,221 @@
+"""Model-predictive control: a finite-horizon plan within the joint limits, replanned every period."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, cast
+
+import numpy as np
+
+from twolink_pin.controllers.base import Controller, LawInput, LawOutput, StateVariable, Terms
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.dynamics import joint_inertia
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.limits import joint_limits
+from twolink_pin.model import RobotModel
+from twolink_pin.optimal import QP, solve_qp
+from twolink_pin.optimal.horizon import Horizon, check_memory, knots_of
+
+TRACKING_RATE = 20.0
+"""ω [rad/s] of the default weights: ``W_q = ω² diag M̂(q₀)``, ``W_v = 2 ω diag M̂(q₀)`` — each
+error weighed as the torque a critically damped PD at ω would ask for it."""
+MAX_ITER = 200
+"""Most ProxQP iterations of one replan: a QP this small (tens of variables) is solved in tens;
+one that cannot hold is told apart at once instead of iterating for minutes."""
+INFEASIBILITY_EPS = 1e-9
+"""ProxQP's infeasibility tolerances: its default, 1e-4, declared feasible replans infeasible
+after 10 iterations (a problem that cannot hold is still told apart by the closest feasible point)."""
+
+
+@dataclass(frozen=True, eq=False)
+class MPCGains(Gains):
+    r"""Gains of :class:`ModelPredictive`.
+
+    Attributes:
+        horizon: $T$ [s], the length of the plan; default 0.2 s.
+        knot_interval: $h$ [s] between the plan's knots ($K = T/h$ pieces of constant
+            acceleration); default 0.025 s.
+        replan_period: [s] between replans, a multiple of the simulation step; default 0.01 s.
+        weight_q: $W_q$ per joint [N·m/rad]; default $\omega^2 \operatorname{diag} \hat M(q_0)$, ω = 20 rad/s.
+        weight_v: $W_v$ per joint [N·m·s/rad]; default $2\omega \operatorname{diag} \hat M(q_0)$.
+        weight_tau: $w_\tau$ (no unit), the weight of the torque's deviation from the reference's; default 1.
+        kp, kd: the local feedback toward the plan between replans [1/s², 1/s]; default 400, 40.
+        limit_scale: $f$, the fraction of the velocity, acceleration and effort limits the plan may
+            use (headroom for the feedback; the position range is kept); default 0.95.
+    """
+
+    horizon: Any = gain(0.2, unit="s", doc="length T of the plan")
+    knot_interval: Any = gain(0.025, unit="s", doc="time h between the plan's knots")
+    replan_period: Any = gain(0.01, unit="s", doc="time between replans (a multiple of the step)")
+    weight_q: Any = gain(None, per="joint", unit="N·m/rad", doc="weight W_q of the position error")
+    weight_v: Any = gain(None, per="joint", unit="N·m·s/rad", doc="weight W_v of the velocity error")
+    weight_tau: Any = gain(1.0, doc="weight w_τ of the torque's deviation from the reference's")
+    kp: Any = gain(400.0, per="joint", unit="1/s²", doc="stiffness of the feedback toward the plan")
+    kd: Any = gain(40.0, per="joint", unit="1/s", doc="damping of the feedback toward the plan")
+    limit_scale: Any = gain(
+        0.95, bound="fraction", doc="fraction f of the velocity, acceleration and effort limits planned with"
+    )
+
+
+ONE_VALUE = ("horizon", "knot_interval", "replan_period", "limit_scale")
+"""Gains that shape the QP or the replanning instants: one value for every run."""
+
+
+class ModelPredictive(Controller[MPCGains]):
+    r"""Model-predictive control within the joint limits (real-time iteration).
+
+    **Every replanning period** (at $t_r$) it plans the next $T$ seconds from the measured state
+    on its **believed** model (``--model``): $K = T/h$ pieces of constant acceleration $a_k$,
+    solving one QP (:mod:`twolink_pin.optimal.horizon`)
+
+    $$\min_{a}\ h\sum_{k=1}^{K} \|W_q (q_k - q_{r,k})\|^2 + \|W_v(\dot q_k - \dot q_{r,k})\|^2
+    + h\, w_\tau \sum_{k=0}^{K-1} \|\tau_k - \tau_{r,k}\|^2$$
+
+    subject to $|\tau_k| \le f\tau_{max}$, $|a_k| \le f \ddot q_{max}$, $|\dot q_k| \le f \dot q_{max}$
+    and $q_{min} \le q_k \le q_{max}$ (the state bounds from the first knot on), with
+    $\tau_k = \hat{\mathrm{RNEA}}(q_k, \dot q_k, a_k)$ linearised on Pinocchio's RNEA derivatives
+    at the previous plan shifted to $t_r$ (one QP per replan, not solved to convergence of the
+    nonlinear problem: Diehl's real-time iteration). The shifted plan is also the QP's start:
+    its unconstrained minimiser first (one Cholesky solve; when it meets every row it is the
+    solution), else ProxQP, at most :data:`MAX_ITER` iterations.
+
+    **The reference over the horizon** is extrapolated from the sample at $t_r$ at constant
+    acceleration, $q_r(t_r + s) = q_d + \dot q_d s + \tfrac12 \ddot q_d s^2$: a law sees the
+    reference at its own instant only (the contract gives no preview). A short horizon keeps that
+    close.
+
+    **Between replans** it follows the plan $(q_p, \dot q_p, a_p)(t)$ with computed torque on the
+    believed model, clipped to the effort limits:
+    $\tau = \operatorname{clip}(\hat M (a_p + K_p (q_p - q) + K_d(\dot q_p - \dot q)) + \hat C \dot q + \hat g,
+    \pm\tau_{max})$ ($f < 1$ leaves it the headroom).
+
+    **State** $z$: the plan — its time $t_r$, the count of replans, the measured state it starts
+    from and its $K \cdot n_v$ accelerations — recorded like any state; a batch of N runs takes
+    one derivatives call for all N plans and solves the N QPs one after the other, so a batch
+    equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
+    the run at that time naming the row (:class:`~twolink_pin.errors.OptimizationError`; exit 1).
+    """
+
+    name = "mpc"
+    title = "model-predictive control within the joint limits"
+    Gains = MPCGains
+
+    def __init__(self, robot: RobotModel, gains: MPCGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        g = cast(MPCGains, self.gains)
+        for name in ONE_VALUE:
+            if not isinstance(getattr(g, name), float):
+                raise InvalidParameterError(
+                    f"gains.{name}",
+                    "one value per run",
+                    f"one value of {name} for every run (it shapes the plan)",
+                )
+        self.limits = joint_limits(robot)
+        """The robot's limits (unscaled: ``limit_scale`` scales them in the QP)."""
+        self.horizon = Horizon(
+            knots_of(g.horizon, g.knot_interval), g.knot_interval, self.limits, g.limit_scale
+        )
+        """The QP's structure: knots, integration matrices, labelled rows."""
+        check_memory(self.horizon, self.runs or 1, "gains.horizon")
+        self._effort = np.where(np.isfinite(self.limits.effort), self.limits.effort, np.inf)
+        """``τ_max`` [N·m] per joint (inf where none): where :meth:`compute` clips."""
+
+    def scaled_gains(self) -> dict[str, Any]:
+        inertia = joint_inertia(self.robot.model, self.robot.home)
+        return {"weight_q": TRACKING_RATE**2 * inertia, "weight_v": 2 * TRACKING_RATE * inertia}
+
+    # -- the state: the plan -------------------------------------------------------------
+
+    def state_variables(self) -> tuple[StateVariable, ...]:
+        nv, K = self.robot.nv, self.horizon.knots
+        return (
+            super().state_variables()
+            + (StateVariable("t_plan", "s", "plan"), StateVariable("replans", "", "plan"))
+            + tuple(StateVariable(f"q0_{j + 1}", "rad", "plan") for j in range(nv))
+            + tuple(StateVariable(f"v0_{j + 1}", "rad/s", "plan") for j in range(nv))
+            + tuple(StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for k in range(K) for j in range(nv))
+        )
+
+    def update_period(self) -> float | None:
+        return float(cast(MPCGains, self.gains).replan_period)
+
+    def _split(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        nv, K = self.robot.nv, self.horizon.knots
+        u = z[:, 2 + 2 * nv :].reshape(-1, K, nv)
+        return z[:, 0], z[:, 1], z[:, 2 : 2 + nv], z[:, 2 + nv : 2 + 2 * nv], u
+
+    # -- the replan ----------------------------------------------------------------------
+
+    def update(self, x: LawInput, terms: Terms) -> np.ndarray:
+        problems, u_bar = self._problems(x, terms)
+        step = np.empty_like(u_bar)
+        at = f"the MPC replan at t = {x.t:.6g} s"
+        for i, qp in enumerate(problems):
+            what = at if len(problems) == 1 else f"{at} (run {i})"
+            step[i] = solve_qp(
+                qp,
+                what=what,
+                unconstrained_first=True,
+                max_iter=MAX_ITER,
+                infeasibility_eps=INFEASIBILITY_EPS,
+            ).x.reshape(u_bar.shape[1:])
+        t_plan, replans, _, _, _ = self._split(x.z)
+        runs = x.q.shape[0]
+        return np.concatenate(
+            (
+                np.full((runs, 1), x.t),
+                (replans + 1).reshape(-1, 1),
+                x.q,
+                x.v,
+                (u_bar + step).reshape(runs, -1),
+            ),
+            axis=1,
+        )
+
+    def problems(self, x: LawInput, terms: Terms) -> list[QP]:
+        """The QP of each run at a replan (what :meth:`update` solves; e.g. to check its KKT
+        conditions): over the step ``u − ū`` [rad/s²] from the shifted plan ``ū``, its rows
+        labelled in ``self.horizon.labels``."""
+        return self._problems(x, terms)[0]
+
+    def _problems(self, x: LawInput, terms: Terms) -> tuple[list[QP], np.ndarray]:
+        g = cast(MPCGains, self.gains)
+        hz = self.horizon
+        K, h = hz.knots, hz.interval
+        runs = x.q.shape[0]
+        t_plan, replans, _, _, u_prev = self._split(np.broadcast_to(x.z, (runs, x.z.shape[1])))
+        # the previous plan shifted to now: knot k of the new plan starts in piece idx of the old
+        shifted = np.floor((x.t - t_plan[:, None] + h * np.arange(K)) / h + 1e-9).astype(int)
+        shifted = np.clip(shifted, 0, K - 1)
+        u_bar = np.take_along_axis(u_prev, shifted[:, :, None], axis=1)
+        fresh = replans < 0.5
+        u_bar[fresh] = x.a_des[0]
+        s = h * np.arange(K + 1)[None, :, None]
+        reference = (
+            x.q_des[:, None] + x.v_des[:, None] * s + 0.5 * x.a_des[:, None] * s * s,
+            x.v_des[:, None] + x.a_des[:, None] * s,
+            np.broadcast_to(x.a_des[:, None], (1, K + 1, self.robot.nv)),
+        )
+        qb, vb = hz.rollout(x.q, x.v, u_bar)
+        d = terms.inverse_dynamics_derivatives(qb[:, :K], vb[:, :K], u_bar)
+        weight_tau = np.asarray(g.weight_tau, dtype=float).reshape(-1, 1)
+        return hz.problems(x.q, x.v, u_bar, d, reference, g.weight_q, g.weight_v, weight_tau), u_bar
+
+    # -- between replans: follow the plan ------------------------------------------------
+
+    def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        g, hz = cast(MPCGains, self.gains), self.horizon
+        h, K = hz.interval, hz.knots
+        t_plan, _, q0, v0, u = self._split(x.z)
+        s = np.maximum(x.t - t_plan, 0.0)
+        k = np.minimum((s / h + 1e-9).astype(int), K - 1)
+        rows = np.arange(u.shape[0])
+        a = u[rows, k]
+        # the plan's knot k: q0 + k h v0 + Σ_j sq[k, j] a_j, v0 + Σ_j sv[k, j] a_j
+        qk = q0 + (k * h)[:, None] * v0 + np.einsum("nj,njv->nv", hz.sq[k], u)
+        vk = v0 + np.einsum("nj,njv->nv", hz.sv[k], u)
+        r = (s - k * h)[:, None]
+        q_plan, v_plan = qk + vk * r + 0.5 * a * r * r, vk + a * r
+        accel = a + g.kp * (q_plan - x.q) + g.kd * (v_plan - x.v)
+        tau = terms.model(x.q, x.v, x.v, accel)
+        return LawOutput(np.clip(tau, -self._effort, self._effort), np.zeros_like(x.z))

@@ -1,0 +1,252 @@
+"""The finite-horizon QP of a model-predictive law: the plan's knot accelerations, the believed
+dynamics linearised on Pinocchio's RNEA derivatives, the joint limits as hard rows.
+
+**Decision.** The plan over the horizon ``[t, t + K h]`` is piecewise-constant acceleration:
+``a_k`` [rad/s²] on ``[t + k h, t + (k + 1) h)``, ``k = 0 … K − 1``, from the measured state
+``(q_0, q̇_0)``. Its states at the knots are linear in ``u = (a_0, …, a_{K−1})`` (knot-major,
+``K nv`` values)::
+
+    q̇_k = q̇_0 + h Σ_{j<k} a_j,      q_k = q_0 + k h q̇_0 + h² Σ_{j<k} (k − j − ½) a_j
+
+(exact for that acceleration: the velocity is linear between knots, so a velocity bound at the
+knots holds between them too).
+
+**Dynamics.** ``τ_k = RNEA(q_k, q̇_k, a_k)`` on the believed model, linearised at a plan
+``ū`` (real-time iteration: the previous plan, shifted; its states rolled out from the measured
+state the same way)::
+
+    τ_k ≈ τ̄_k + ∂τ/∂q (q_k − q̄_k) + ∂τ/∂q̇ (q̇_k − q̄̇_k) + M̂ (a_k − ā_k) = τ̄_k + T_k (u − ū)
+
+``T`` is block lower-triangular with ``M̂(q̄_k)`` on its diagonal, so it is invertible.
+
+**Cost** [(N·m)²·s] (each error weighed as the torque it is worth; the QP holds it divided by
+its Hessian's largest diagonal entry, which changes no minimiser)::
+
+    h Σ_{k=1..K} (‖W_q (q_k − q_ref,k)‖² + ‖W_v (q̇_k − q̇_ref,k)‖²)
+      + h w_τ Σ_{k=0..K−1} ‖τ_k − τ_ref,k‖²
+
+with ``W_q = diag(weight_q)`` [N·m/rad], ``W_v = diag(weight_v)`` [N·m·s/rad], ``w_τ`` (no unit)
+and ``τ_k − τ_ref,k ≈ ∂τ/∂q (q_k − q_ref,k) + ∂τ/∂q̇ (q̇_k − q̇_ref,k) + M̂ (a_k − a_ref,k)`` on
+the same linearisation (the reference's torque needs no further RNEA). With ``w_τ > 0`` the
+Hessian is positive definite.
+
+**Rows** (hard; ``f``: ``limit_scale``): ``|τ_k| ≤ f τ_max`` at knots 0 … K−1, ``|a_k| ≤ f
+q̈_max`` (where the arm has one), ``|q̇_k| ≤ f q̇_max`` and ``q_min ≤ q_k ≤ q_max`` at knots
+1 … K — the state bounds from the first knot on, not at the measured state (which the plan
+cannot change). A joint without a kind of limit has no row for it. Each row is labelled.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+import numpy as np
+
+from twolink_pin.dynamics import InverseDynamicsDerivatives
+from twolink_pin.errors import InvalidParameterError
+from twolink_pin.limits import ACCELERATION, EFFORT, POSITION, VELOCITY, JointLimits
+from twolink_pin.memory import available_memory
+from twolink_pin.optimal.qp import QP
+
+KINDS_IN_ROWS = (EFFORT, ACCELERATION, VELOCITY, POSITION)
+"""The limits the QP's inequality rows bound, in the rows' order."""
+
+
+class Horizon:
+    """The horizon's fixed structure: ``K`` knots ``h`` [s] apart for a robot of ``nv`` joints
+    and its limits, the integration matrices and the rows' labels (built once per law).
+
+    Args:
+        knots: ``K ≥ 1``, the number of knot intervals.
+        interval: ``h`` [s] > 0.
+        limits: The robot's joint limits (unscaled).
+        limit_scale: ``f``, the fraction of the velocity, acceleration and effort limits used
+            (one value for every run; the position range is kept).
+    """
+
+    def __init__(self, knots: int, interval: float, limits: JointLimits, limit_scale: float) -> None:
+        self.knots, self.interval, self.limits, self.nv = int(knots), float(interval), limits, limits.nv
+        K, h, nv = self.knots, self.interval, self.nv
+        k = np.arange(K + 1)[:, None]
+        j = np.arange(K)[None, :]
+        self.sq = np.where(j < k, h * h * (k - j - 0.5), 0.0)
+        """``q_k − q_0 − k h q̇_0 = Σ_j sq[k, j] a_j``, shape (K + 1, K) [s²]."""
+        self.sv = np.where(j < k, h, 0.0)
+        """``q̇_k − q̇_0 = Σ_j sv[k, j] a_j``, shape (K + 1, K) [s]."""
+        eye = np.eye(nv)
+        self.Q = np.kron(self.sq, eye)  # ((K+1) nv, K nv)
+        self.V = np.kron(self.sv, eye)
+        self._Qk = self.Q.reshape(K + 1, nv, K * nv)
+        self._Vk = self.V.reshape(K + 1, nv, K * nv)
+        f = float(limit_scale)
+        rows: list[tuple[str, int, int, float, float]] = []  # kind, knot, joint, lower, upper
+        for kind in KINDS_IN_ROWS:
+            given = np.flatnonzero(limits.given(kind))
+            first = 0 if kind in (EFFORT, ACCELERATION) else 1
+            last = K - 1 if kind in (EFFORT, ACCELERATION) else K
+            for kn in range(first, last + 1):
+                for jj in given:
+                    if kind is POSITION:
+                        lo, hi = limits.position_lower[jj], limits.position_upper[jj]
+                    else:
+                        hi = f * float(getattr(limits, kind.name)[jj])
+                        lo = -hi
+                    rows.append((kind.name, kn, int(jj), float(lo), float(hi)))
+        self.rows = rows
+        """Per inequality row: the kind's name, the knot, the joint (0-based), its bounds."""
+        self.labels: Sequence[str] = tuple(self._label(r) for r in rows)
+        """What each row bounds, in words."""
+        kind_of = np.array([r[0] for r in rows], dtype=object)
+        knot = np.array([r[1] for r in rows], dtype=int)
+        joint = np.array([r[2] for r in rows], dtype=int)
+        self._lower = np.array([r[3] for r in rows])
+        self._upper = np.array([r[4] for r in rows])
+        self._effort = np.flatnonzero(kind_of == EFFORT.name)
+        self._effort_index = knot[self._effort] * nv + joint[self._effort]
+        state = np.flatnonzero(kind_of != EFFORT.name)
+        self._state = state
+        C = np.zeros((len(rows), K * nv))
+        for i in state:
+            kn, jj = knot[i], joint[i]
+            if kind_of[i] == ACCELERATION.name:
+                C[i, kn * nv + jj] = 1.0
+            elif kind_of[i] == VELOCITY.name:
+                C[i] = self._Vk[kn, jj]
+            else:
+                C[i] = self._Qk[kn, jj]
+        self._C_state = C[state]
+        self._position = np.flatnonzero(kind_of[state] == POSITION.name)
+        self._velocity = np.flatnonzero(kind_of[state] == VELOCITY.name)
+        self._pos_knot, self._pos_joint = knot[state][self._position], joint[state][self._position]
+        self._vel_joint = joint[state][self._velocity]
+
+    def _label(self, row: tuple[str, int, int, float, float]) -> str:
+        name, kn, jj, lo, hi = row
+        joint = f"joint {jj + 1} ({self.limits.joint_names[jj]})"
+        when = f"at knot {kn} (t + {kn * self.interval:.6g} s)"
+        kind = {k.name: k for k in KINDS_IN_ROWS}[name]
+        if kind is POSITION:
+            return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when}"
+        return f"the {name} limit |{kind.symbol}| <= {hi:.6g} {kind.unit} of {joint} {when}"
+
+    @property
+    def variables(self) -> int:
+        """``K nv``: the QP's variables."""
+        return self.knots * self.nv
+
+    def rollout(self, q0: np.ndarray, v0: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The knot states ``q_k``, ``q̇_k`` [rad, rad/s], each (N, K + 1, nv), of the plan ``u``
+        (N, K, nv) [rad/s²] from ``(q0, v0)`` (N, nv)."""
+        K, h = self.knots, self.interval
+        k = np.arange(K + 1)[None, :, None]
+        q = q0[:, None] + k * h * v0[:, None] + np.einsum("kj,njv->nkv", self.sq, u)
+        v = v0[:, None] + np.einsum("kj,njv->nkv", self.sv, u)
+        return q, v
+
+    def problems(
+        self,
+        q0: np.ndarray,
+        v0: np.ndarray,
+        u_bar: np.ndarray,
+        d: InverseDynamicsDerivatives,
+        reference: tuple[np.ndarray, np.ndarray, np.ndarray],
+        weight_q: np.ndarray,
+        weight_v: np.ndarray,
+        weight_tau: np.ndarray,
+    ) -> list[QP]:
+        """The QP of each of the N runs, over ``u − ū`` (the step from the linearisation plan:
+        the plan is ``ū + x``).
+
+        Args:
+            q0, v0: The measured state [rad, rad/s], (N, nv).
+            u_bar: The plan linearised at [rad/s²], (N, K, nv).
+            d: τ and its derivatives at ``ū``'s states, knots 0 … K−1, (N, K, nv[, nv]).
+            reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv).
+            weight_q, weight_v: ``W_q`` [N·m/rad], ``W_v`` [N·m·s/rad], (1 or N, nv).
+            weight_tau: ``w_τ``, (1 or N, 1).
+        """
+        N, K, nv, h = q0.shape[0], self.knots, self.nv, self.interval
+        n = K * nv
+        qb, vb = self.rollout(q0, v0, u_bar)
+        qr, vr, ar = reference
+        # T u: the torque's Jacobian over u, (N, K, nv, K nv)
+        T = np.einsum("nkij,kjm->nkim", d.dtau_dq, self._Qk[:K]) + np.einsum(
+            "nkij,kjm->nkim", d.dtau_dv, self._Vk[:K]
+        )
+        for k in range(K):
+            T[:, k, :, k * nv : (k + 1) * nv] += d.mass[:, k]
+        T = T.reshape(N, n, n)
+        # errors as affine maps of x = u − ū: e = A x + c
+        eq = (qb - qr)[:, 1:].reshape(N, n)  # q_k − q_ref,k at ū, knots 1..K
+        ev = (vb - vr)[:, 1:].reshape(N, n)
+        et = (
+            np.einsum("nkij,nkj->nki", d.dtau_dq, (qb - qr)[:, :K])
+            + np.einsum("nkij,nkj->nki", d.dtau_dv, (vb - vr)[:, :K])
+            + np.einsum("nkij,nkj->nki", d.mass, u_bar - ar[:, :K])
+        ).reshape(N, n)
+        Qs, Vs = self.Q[nv:], self.V[nv:]
+        wq2 = np.tile(np.asarray(weight_q, dtype=float) ** 2, (1, K))  # (1 or N, n)
+        wv2 = np.tile(np.asarray(weight_v, dtype=float) ** 2, (1, K))
+        wt = np.asarray(weight_tau, dtype=float).reshape(-1, 1, 1)
+        H = (
+            np.einsum("im,ni,ip->nmp", Qs, np.broadcast_to(wq2, (N, n)), Qs)
+            + np.einsum("im,ni,ip->nmp", Vs, np.broadcast_to(wv2, (N, n)), Vs)
+            + wt * np.matmul(T.transpose(0, 2, 1), T)
+        )
+        g = (
+            np.einsum("im,ni->nm", Qs, wq2 * eq)
+            + np.einsum("im,ni->nm", Vs, wv2 * ev)
+            + wt[:, :, 0] * np.matvec(T.transpose(0, 2, 1), et)
+        )
+        # the cost in units of its largest curvature (the minimiser is the same; the solver's
+        # absolute tolerances then mean the same on every arm and weight)
+        scale = np.einsum("nii->ni", H).max(axis=1)[:, None, None]
+        H, g = H / scale, g / scale[:, :, 0]
+        rows = len(self.rows)
+        C = np.empty((N, rows, n))
+        lower = np.broadcast_to(self._lower, (N, rows)).copy()
+        upper = np.broadcast_to(self._upper, (N, rows)).copy()
+        C[:, self._effort] = T[:, self._effort_index]
+        tau_bar = d.tau.reshape(N, n)[:, self._effort_index]
+        lower[:, self._effort] -= tau_bar
+        upper[:, self._effort] -= tau_bar
+        C[:, self._state] = self._C_state
+        # state rows at ū's value: the bounds minus the row's value at ū
+        at_bar = np.einsum("rm,nm->nr", self._C_state, u_bar.reshape(N, n))
+        base = np.zeros((N, self._state.size))
+        base[:, self._position] = q0[:, self._pos_joint] + self._pos_knot * h * v0[:, self._pos_joint]
+        base[:, self._velocity] = v0[:, self._vel_joint]
+        lower[:, self._state] -= at_bar + base
+        upper[:, self._state] -= at_bar + base
+        return [QP(H[i], g[i], None, None, C[i], lower[i], upper[i], self.labels) for i in range(N)]
+
+    def memory_need(self, runs: int) -> int:
+        """Bytes the QPs of ``runs`` runs take: ``8 (2 (n + m)² + N (n² + m n))`` for ``n`` variables
+        and ``m`` rows (the solver's KKT matrix and its factor, and each run's ``H`` and ``C``)."""
+        n, m = self.variables, len(self.rows)
+        return 8 * (2 * (n + m) ** 2 + runs * (n * n + m * n))
+
+
+def knots_of(horizon: float, interval: float) -> int:
+    """``K = round(horizon / interval)`` knot intervals, at least 1: the horizon [s] in
+    intervals of ``interval`` [s] (a horizon shorter than one interval is refused)."""
+    if not horizon >= interval:
+        raise InvalidParameterError(
+            "horizon", horizon, f"a horizon [s] of at least one knot interval ({interval:g} s)"
+        )
+    return max(1, round(horizon / interval))
+
+
+def check_memory(horizon: Horizon, runs: int, what: str = "horizon") -> None:
+    """Refuse a horizon whose QPs would not fit in the memory available (:func:`available_memory`).
+
+    Raises:
+        InvalidParameterError: naming the horizon's knots, the bytes needed and available.
+    """
+    need, have = horizon.memory_need(runs), available_memory()
+    if have is not None and need > have:
+        raise InvalidParameterError(
+            what,
+            f"{horizon.knots * horizon.interval:g} s ({horizon.knots} knots of {horizon.interval:g} s)",
+            f"a horizon whose QPs fit in memory: {need / 1e6:.4g} MB needed for {runs} run(s), "
+            f"{have / 1e6:.4g} MB available",
+        )
