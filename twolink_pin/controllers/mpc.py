@@ -128,13 +128,11 @@ class ModelPredictive(Controller[MPCGains]):
 
     def state_variables(self) -> tuple[StateVariable, ...]:
         nv, K = self.robot.nv, self.horizon.knots
-        return (
-            super().state_variables()
-            + (StateVariable("t_plan", "s", "plan"), StateVariable("replans", "", "plan"))
-            + tuple(StateVariable(f"q0_{j + 1}", "rad", "plan") for j in range(nv))
-            + tuple(StateVariable(f"v0_{j + 1}", "rad/s", "plan") for j in range(nv))
-            + tuple(StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for k in range(K) for j in range(nv))
-        )
+        plan = [StateVariable("t_plan", "s", "plan"), StateVariable("replans", "", "plan")]
+        plan += [StateVariable(f"q0_{j + 1}", "rad", "plan") for j in range(nv)]
+        plan += [StateVariable(f"v0_{j + 1}", "rad/s", "plan") for j in range(nv)]
+        plan += [StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for k in range(K) for j in range(nv)]
+        return (*super().state_variables(), *plan)
 
     def update_period(self) -> float | None:
         return float(cast(MPCGains, self.gains).replan_period)
@@ -159,7 +157,7 @@ class ModelPredictive(Controller[MPCGains]):
                 max_iter=MAX_ITER,
                 infeasibility_eps=INFEASIBILITY_EPS,
             ).x.reshape(u_bar.shape[1:])
-        t_plan, replans, _, _, _ = self._split(x.z)
+        replans = self._split(x.z)[1]
         runs = x.q.shape[0]
         return np.concatenate(
             (

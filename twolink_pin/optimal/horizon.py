@@ -39,6 +39,7 @@ cannot change). A joint without a kind of limit has no row for it. Each row is l
 from __future__ import annotations
 
 from collections.abc import Sequence
+
 import numpy as np
 
 from twolink_pin.dynamics import InverseDynamicsDerivatives
