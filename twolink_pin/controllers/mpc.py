@@ -13,8 +13,8 @@ from twolink_pin.dynamics import joint_inertia
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import joint_limits
 from twolink_pin.model import RobotModel
-from twolink_pin.optimal import QP, solve_qp
-from twolink_pin.optimal.horizon import Horizon, check_memory, knots_of
+from twolink_pin.optimal import solve_qp
+from twolink_pin.optimal.horizon import Horizon, HorizonQPs, check_memory, knots_of
 
 TRACKING_RATE = 20.0
 """ω [rad/s] of the default weights: ``W_q = ω² diag M̂(q₀)``, ``W_v = 2 ω diag M̂(q₀)`` — each
@@ -89,8 +89,8 @@ class ModelPredictive(Controller[MPCGains]):
     $\tau = \operatorname{clip}(\hat M (a_p + K_p (q_p - q) + K_d(\dot q_p - \dot q)) + \hat C \dot q + \hat g,
     \pm\tau_{max})$ ($f < 1$ leaves it the headroom).
 
-    **State** $z$: the plan — its time $t_r$, the count of replans, the measured state it starts
-    from and its $K \cdot n_v$ accelerations — recorded like any state; a batch of N runs takes
+    **State** $z$: the plan — its time $t_r$, the count of replans and, per knot $k < K$, its
+    state and acceleration $(q_k, \dot q_k, a_k)$ ($2 + 3 K n_v$ numbers) — recorded like any state; a batch of N runs takes
     one derivatives call for all N plans and solves the N QPs one after the other, so a batch
     equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
     the run at that time naming the row (:class:`~twolink_pin.errors.OptimizationError`; exit 1).
@@ -117,8 +117,11 @@ class ModelPredictive(Controller[MPCGains]):
         )
         """The QP's structure: knots, integration matrices, labelled rows."""
         check_memory(self.horizon, self.runs or 1, "gains.horizon")
+        self._weights = self.horizon.weights(g.weight_q, g.weight_v, g.weight_tau)
         self._effort = np.where(np.isfinite(self.limits.effort), self.limits.effort, np.inf)
         """``τ_max`` [N·m] per joint (inf where none): where :meth:`compute` clips."""
+        self._kp, self._kd = np.asarray(g.kp, dtype=float), np.asarray(g.kd, dtype=float)
+        self._zeros: dict[tuple[int, ...], np.ndarray] = {}
 
     def scaled_gains(self) -> dict[str, Any]:
         inertia = joint_inertia(self.robot.model, self.robot.home)
@@ -129,64 +132,53 @@ class ModelPredictive(Controller[MPCGains]):
     def state_variables(self) -> tuple[StateVariable, ...]:
         nv, K = self.robot.nv, self.horizon.knots
         plan = [StateVariable("t_plan", "s", "plan"), StateVariable("replans", "", "plan")]
-        plan += [StateVariable(f"q0_{j + 1}", "rad", "plan") for j in range(nv)]
-        plan += [StateVariable(f"v0_{j + 1}", "rad/s", "plan") for j in range(nv)]
-        plan += [StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for k in range(K) for j in range(nv)]
+        for k in range(K):
+            plan += [StateVariable(f"q{k}_{j + 1}", "rad", "plan") for j in range(nv)]
+            plan += [StateVariable(f"v{k}_{j + 1}", "rad/s", "plan") for j in range(nv)]
+            plan += [StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for j in range(nv)]
         return (*super().state_variables(), *plan)
 
     def update_period(self) -> float | None:
         return float(cast(MPCGains, self.gains).replan_period)
 
-    def _split(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    def _split(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``t_plan`` (N,), ``replans`` (N,) and the plan's knots (N, K, 3, nv): ``q_k``, ``q̇_k``, ``a_k``."""
         nv, K = self.robot.nv, self.horizon.knots
-        u = z[:, 2 + 2 * nv :].reshape(-1, K, nv)
-        return z[:, 0], z[:, 1], z[:, 2 : 2 + nv], z[:, 2 + nv : 2 + 2 * nv], u
+        return z[:, 0], z[:, 1], z[:, 2:].reshape(-1, K, 3, nv)
 
     # -- the replan ----------------------------------------------------------------------
 
     def update(self, x: LawInput, terms: Terms) -> np.ndarray:
-        problems, u_bar = self._problems(x, terms)
-        step = np.empty_like(u_bar)
+        qps, u_bar = self._problems(x, terms)
+        step, inside = qps.unconstrained()
         at = f"the MPC replan at t = {x.t:.6g} s"
-        for i, qp in enumerate(problems):
-            what = at if len(problems) == 1 else f"{at} (run {i})"
-            step[i] = solve_qp(
-                qp,
-                what=what,
-                unconstrained_first=True,
-                max_iter=MAX_ITER,
-                infeasibility_eps=INFEASIBILITY_EPS,
-            ).x.reshape(u_bar.shape[1:])
+        for i in np.flatnonzero(~inside):  # a row binds: ProxQP, one run after the other
+            what = at if len(inside) == 1 else f"{at} (run {i})"
+            solution = solve_qp(qps.qp(i), what=what, max_iter=MAX_ITER, infeasibility_eps=INFEASIBILITY_EPS)
+            step[i] = solution.x
+        u = u_bar + step.reshape(u_bar.shape)
         replans = self._split(x.z)[1]
-        runs = x.q.shape[0]
-        return np.concatenate(
-            (
-                np.full((runs, 1), x.t),
-                (replans + 1).reshape(-1, 1),
-                x.q,
-                x.v,
-                (u_bar + step).reshape(runs, -1),
-            ),
-            axis=1,
-        )
+        runs, K = x.q.shape[0], self.horizon.knots
+        q, v = self.horizon.rollout(x.q, x.v, u)
+        knots = np.stack((q[:, :K], v[:, :K], u), axis=2).reshape(runs, -1)
+        return np.concatenate((np.full((runs, 1), x.t), (replans + 1).reshape(-1, 1), knots), axis=1)
 
-    def problems(self, x: LawInput, terms: Terms) -> list[QP]:
-        """The QP of each run at a replan (what :meth:`update` solves; e.g. to check its KKT
+    def problems(self, x: LawInput, terms: Terms) -> HorizonQPs:
+        """The QPs of the runs at a replan (what :meth:`update` solves; e.g. to check its KKT
         conditions): over the step ``u − ū`` [rad/s²] from the shifted plan ``ū``, its rows
         labelled in ``self.horizon.labels``."""
         return self._problems(x, terms)[0]
 
-    def _problems(self, x: LawInput, terms: Terms) -> tuple[list[QP], np.ndarray]:
-        g = cast(MPCGains, self.gains)
+    def _problems(self, x: LawInput, terms: Terms) -> tuple[HorizonQPs, np.ndarray]:
         hz = self.horizon
         K, h = hz.knots, hz.interval
-        runs = x.q.shape[0]
-        t_plan, replans, _, _, u_prev = self._split(np.broadcast_to(x.z, (runs, x.z.shape[1])))
-        # the previous plan shifted to now: knot k of the new plan starts in piece idx of the old
-        shifted = np.floor((x.t - t_plan[:, None] + h * np.arange(K)) / h + 1e-9).astype(int)
-        shifted = np.clip(shifted, 0, K - 1)
-        u_bar = np.take_along_axis(u_prev, shifted[:, :, None], axis=1)
-        fresh = replans < 0.5
+        _, replans, plan = self._split(x.z)
+        # the previous plan shifted to now (every run replans at the same instants): knot k of
+        # the new plan starts in piece shifted[k] of the old one, the last one held
+        since = x.t - float(x.z[:, 0].max())
+        shifted = np.minimum(((since + h * np.arange(K)) / h + 1e-9).astype(int), K - 1)
+        u_bar = plan[:, shifted, 2]
+        fresh = replans < 0.5  # no plan yet: the reference's acceleration
         u_bar[fresh] = x.a_des[0]
         s = h * np.arange(K + 1)[None, :, None]
         reference = (
@@ -196,24 +188,27 @@ class ModelPredictive(Controller[MPCGains]):
         )
         qb, vb = hz.rollout(x.q, x.v, u_bar)
         d = terms.inverse_dynamics_derivatives(qb[:, :K], vb[:, :K], u_bar)
-        weight_tau = np.asarray(g.weight_tau, dtype=float).reshape(-1, 1)
-        return hz.problems(x.q, x.v, u_bar, d, reference, g.weight_q, g.weight_v, weight_tau), u_bar
+        return hz.problems(x.q, x.v, u_bar, (qb, vb), d, reference, self._weights), u_bar
 
     # -- between replans: follow the plan ------------------------------------------------
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        g, hz = cast(MPCGains, self.gains), self.horizon
-        h, K = hz.interval, hz.knots
-        t_plan, _, q0, v0, u = self._split(x.z)
-        s = np.maximum(x.t - t_plan, 0.0)
-        k = np.minimum((s / h + 1e-9).astype(int), K - 1)
-        rows = np.arange(u.shape[0])
-        a = u[rows, k]
-        # the plan's knot k: q0 + k h v0 + Σ_j sq[k, j] a_j, v0 + Σ_j sv[k, j] a_j
-        qk = q0 + (k * h)[:, None] * v0 + np.einsum("nj,njv->nv", hz.sq[k], u)
-        vk = v0 + np.einsum("nj,njv->nv", hz.sv[k], u)
-        r = (s - k * h)[:, None]
-        q_plan, v_plan = qk + vk * r + 0.5 * a * r * r, vk + a * r
-        accel = a + g.kp * (q_plan - x.q) + g.kd * (v_plan - x.v)
-        tau = terms.model(x.q, x.v, x.v, accel)
-        return LawOutput(np.clip(tau, -self._effort, self._effort), np.zeros_like(x.z))
+        z = x.z
+        nv, h = self.robot.nv, self.horizon.interval
+        s = max(x.t - float(z[:, 0].max()), 0.0)  # every run replans at the same instants
+        k = min(int(s / h + 1e-9), self.horizon.knots - 1)
+        r = s - k * h
+        start = 2 + 3 * nv * k
+        qk, vk, a = (
+            z[:, start : start + nv],
+            z[:, start + nv : start + 2 * nv],
+            z[:, start + 2 * nv : start + 3 * nv],
+        )
+        accel = a + self._kp * (qk + (vk + 0.5 * r * a) * r - x.q) + self._kd * (vk + a * r - x.v)
+        tau = np.minimum(terms.model(x.q, x.v, x.v, accel), self._effort)
+        np.maximum(tau, -self._effort, out=tau)
+        zeros = self._zeros.get(z.shape)
+        if zeros is None:
+            zeros = self._zeros[z.shape] = np.zeros(z.shape)
+            zeros.setflags(write=False)
+        return LawOutput(tau, zeros)

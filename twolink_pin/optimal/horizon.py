@@ -39,6 +39,7 @@ cannot change). A joint without a kind of limit has no row for it. Each row is l
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 import numpy as np
 
@@ -50,6 +51,49 @@ from twolink_pin.optimal.qp import QP
 
 KINDS_IN_ROWS = (EFFORT, ACCELERATION, VELOCITY, POSITION)
 """The limits the QP's inequality rows bound, in the rows' order."""
+
+
+class CostWeights(NamedTuple):
+    """The cost's weights over the knots (:meth:`Horizon.weights`)."""
+
+    q2: np.ndarray
+    """``W_q²`` per knot and joint, (1 or N, K nv) [(N·m/rad)²]."""
+    v2: np.ndarray
+    """``W_v²`` per knot and joint, (1 or N, K nv) [(N·m·s/rad)²]."""
+    tau: np.ndarray
+    """``w_τ``, (1 or N, 1, 1)."""
+    tracking: np.ndarray
+    """``Qᵀ W_q² Q + Vᵀ W_v² V``, the Hessian's part that does not change, (1 or N, K nv, K nv)."""
+
+
+class HorizonQPs(NamedTuple):
+    """The QPs of N runs over the step ``x = u − ū`` [rad/s²], as batched arrays (one
+    factorisation call solves all N unconstrained minimisers: :meth:`unconstrained`)."""
+
+    H: np.ndarray
+    """Hessians, (N, n, n), positive definite (the cost over its largest curvature)."""
+    g: np.ndarray
+    """Linear costs, (N, n)."""
+    C: np.ndarray
+    """Inequality rows, (N, m, n)."""
+    l: np.ndarray  # noqa: E741  (the solver's name)
+    """Lower bounds, (N, m)."""
+    u: np.ndarray
+    """Upper bounds, (N, m)."""
+    labels: Sequence[str]
+    """What each row bounds (:attr:`Horizon.labels`)."""
+
+    def qp(self, i: int) -> QP:
+        """Run ``i``'s QP for :func:`~twolink_pin.optimal.solve_qp`."""
+        return QP(self.H[i], self.g[i], None, None, self.C[i], self.l[i], self.u[i], self.labels)
+
+    def unconstrained(self) -> tuple[np.ndarray, np.ndarray]:
+        """Every run's unconstrained minimiser ``−H⁻¹ g`` (N, n) (one batched LAPACK call) and
+        whether it meets every row, exactly (N,) bool: where it does it is the QP's solution
+        (the KKT conditions hold with zero multipliers)."""
+        x = np.linalg.solve(self.H, -self.g[..., None])[..., 0]
+        cx = np.matvec(self.C, x)
+        return x, ((cx >= self.l) & (cx <= self.u)).all(axis=1)
 
 
 class Horizon:
@@ -74,6 +118,7 @@ class Horizon:
         self.sv = np.where(j < k, h, 0.0)
         """``q̇_k − q̇_0 = Σ_j sv[k, j] a_j``, shape (K + 1, K) [s]."""
         eye = np.eye(nv)
+        self._kh = (h * np.arange(K + 1))[:, None]
         self.Q = np.kron(self.sq, eye)  # ((K+1) nv, K nv)
         self.V = np.kron(self.sv, eye)
         self._Qk = self.Q.reshape(K + 1, nv, K * nv)
@@ -137,71 +182,76 @@ class Horizon:
     def rollout(self, q0: np.ndarray, v0: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The knot states ``q_k``, ``q̇_k`` [rad, rad/s], each (N, K + 1, nv), of the plan ``u``
         (N, K, nv) [rad/s²] from ``(q0, v0)`` (N, nv)."""
-        K, h = self.knots, self.interval
-        k = np.arange(K + 1)[None, :, None]
-        q = q0[:, None] + k * h * v0[:, None] + np.einsum("kj,njv->nkv", self.sq, u)
-        v = v0[:, None] + np.einsum("kj,njv->nkv", self.sv, u)
+        q = q0[:, None] + self._kh * v0[:, None] + np.matmul(self.sq, u)
+        v = v0[:, None] + np.matmul(self.sv, u)
         return q, v
+
+    def weights(self, weight_q: np.ndarray, weight_v: np.ndarray, weight_tau: np.ndarray) -> CostWeights:
+        """The cost's weights laid out over the knots, and its tracking Hessian (made once per law).
+
+        Args:
+            weight_q, weight_v: ``W_q`` [N·m/rad], ``W_v`` [N·m·s/rad], (1 or N, nv) or scalars.
+            weight_tau: ``w_τ`` (no unit), a scalar or (N, 1).
+        """
+        K, nv = self.knots, self.nv
+        wq2 = np.tile(np.broadcast_to(np.asarray(weight_q, dtype=float), (1, nv)) ** 2, (1, K))
+        wv2 = np.tile(np.broadcast_to(np.asarray(weight_v, dtype=float), (1, nv)) ** 2, (1, K))
+        Qs, Vs = self.Q[nv:], self.V[nv:]
+        tracking = np.matmul(Qs.T * wq2[:, None, :], Qs) + np.matmul(Vs.T * wv2[:, None, :], Vs)
+        wt = np.asarray(weight_tau, dtype=float).reshape(-1, 1, 1)
+        return CostWeights(wq2, wv2, wt, tracking)
 
     def problems(
         self,
         q0: np.ndarray,
         v0: np.ndarray,
         u_bar: np.ndarray,
+        states: tuple[np.ndarray, np.ndarray],
         d: InverseDynamicsDerivatives,
         reference: tuple[np.ndarray, np.ndarray, np.ndarray],
-        weight_q: np.ndarray,
-        weight_v: np.ndarray,
-        weight_tau: np.ndarray,
-    ) -> list[QP]:
-        """The QP of each of the N runs, over ``u − ū`` (the step from the linearisation plan:
+        weights: CostWeights,
+    ) -> HorizonQPs:
+        """The QPs of the N runs, over ``x = u − ū`` (the step from the linearisation plan:
         the plan is ``ū + x``).
 
         Args:
             q0, v0: The measured state [rad, rad/s], (N, nv).
             u_bar: The plan linearised at [rad/s²], (N, K, nv).
+            states: ``ū``'s knot states from ``(q0, v0)`` (:meth:`rollout`).
             d: τ and its derivatives at ``ū``'s states, knots 0 … K−1, (N, K, nv[, nv]).
             reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv).
-            weight_q, weight_v: ``W_q`` [N·m/rad], ``W_v`` [N·m·s/rad], (1 or N, nv).
-            weight_tau: ``w_τ``, (1 or N, 1).
+            weights: :meth:`weights`.
         """
         N, K, nv, h = q0.shape[0], self.knots, self.nv, self.interval
         n = K * nv
-        qb, vb = self.rollout(q0, v0, u_bar)
+        qb, vb = states
         qr, vr, ar = reference
-        # T u: the torque's Jacobian over u, (N, K, nv, K nv)
-        T = np.einsum("nkij,kjm->nkim", d.dtau_dq, self._Qk[:K]) + np.einsum(
-            "nkij,kjm->nkim", d.dtau_dv, self._Vk[:K]
-        )
-        for k in range(K):
-            T[:, k, :, k * nv : (k + 1) * nv] += d.mass[:, k]
+        # T: the torque's Jacobian over u, (N, K, nv, K nv); block lower-triangular, M̂ on the diagonal
+        T = np.matmul(d.dtau_dq, self._Qk[:K]) + np.matmul(d.dtau_dv, self._Vk[:K])
+        Tb = T.reshape(N, K, nv, K, nv)
+        diagonal = np.arange(K)
+        Tb[:, diagonal, :, diagonal] += d.mass.transpose(1, 0, 2, 3)
         T = T.reshape(N, n, n)
-        # errors as affine maps of x = u − ū: e = A x + c
-        eq = (qb - qr)[:, 1:].reshape(N, n)  # q_k − q_ref,k at ū, knots 1..K
-        ev = (vb - vr)[:, 1:].reshape(N, n)
+        # errors at ū (x = 0): e = A x + e(ū)
+        dq, dv = qb - qr, vb - vr
+        eq = dq[:, 1:].reshape(N, n)  # q_k − q_ref,k, knots 1..K
+        ev = dv[:, 1:].reshape(N, n)
         et = (
-            np.einsum("nkij,nkj->nki", d.dtau_dq, (qb - qr)[:, :K])
-            + np.einsum("nkij,nkj->nki", d.dtau_dv, (vb - vr)[:, :K])
-            + np.einsum("nkij,nkj->nki", d.mass, u_bar - ar[:, :K])
+            np.matmul(d.dtau_dq, dq[:, :K, :, None])
+            + np.matmul(d.dtau_dv, dv[:, :K, :, None])
+            + np.matmul(d.mass, (u_bar - ar[:, :K])[..., None])
         ).reshape(N, n)
-        Qs, Vs = self.Q[nv:], self.V[nv:]
-        wq2 = np.tile(np.asarray(weight_q, dtype=float) ** 2, (1, K))  # (1 or N, n)
-        wv2 = np.tile(np.asarray(weight_v, dtype=float) ** 2, (1, K))
-        wt = np.asarray(weight_tau, dtype=float).reshape(-1, 1, 1)
-        H = (
-            np.einsum("im,ni,ip->nmp", Qs, np.broadcast_to(wq2, (N, n)), Qs)
-            + np.einsum("im,ni,ip->nmp", Vs, np.broadcast_to(wv2, (N, n)), Vs)
-            + wt * np.matmul(T.transpose(0, 2, 1), T)
-        )
+        Tt = T.transpose(0, 2, 1)
+        H = weights.tracking + weights.tau * np.matmul(Tt, T)
         g = (
-            np.einsum("im,ni->nm", Qs, wq2 * eq)
-            + np.einsum("im,ni->nm", Vs, wv2 * ev)
-            + wt[:, :, 0] * np.matvec(T.transpose(0, 2, 1), et)
+            np.matmul(weights.q2 * eq, self.Q[nv:])
+            + np.matmul(weights.v2 * ev, self.V[nv:])
+            + weights.tau[:, :, 0] * np.matvec(Tt, et)
         )
         # the cost in units of its largest curvature (the minimiser is the same; the solver's
         # absolute tolerances then mean the same on every arm and weight)
-        scale = np.einsum("nii->ni", H).max(axis=1)[:, None, None]
-        H, g = H / scale, g / scale[:, :, 0]
+        scale = H.reshape(N, n * n)[:, :: n + 1].max(axis=1)
+        H, g = H / scale[:, None, None], g / scale[:, None]
         rows = len(self.rows)
         C = np.empty((N, rows, n))
         lower = np.broadcast_to(self._lower, (N, rows)).copy()
@@ -212,13 +262,13 @@ class Horizon:
         upper[:, self._effort] -= tau_bar
         C[:, self._state] = self._C_state
         # state rows at ū's value: the bounds minus the row's value at ū
-        at_bar = np.einsum("rm,nm->nr", self._C_state, u_bar.reshape(N, n))
+        at_bar = np.matmul(u_bar.reshape(N, n), self._C_state.T)
         base = np.zeros((N, self._state.size))
         base[:, self._position] = q0[:, self._pos_joint] + self._pos_knot * h * v0[:, self._pos_joint]
         base[:, self._velocity] = v0[:, self._vel_joint]
         lower[:, self._state] -= at_bar + base
         upper[:, self._state] -= at_bar + base
-        return [QP(H[i], g[i], None, None, C[i], lower[i], upper[i], self.labels) for i in range(N)]
+        return HorizonQPs(H, g, C, lower, upper, self.labels)
 
     def memory_need(self, runs: int) -> int:
         """Bytes the QPs of ``runs`` runs take: ``8 (2 (n + m)² + N (n² + m n))`` for ``n`` variables
