@@ -122,6 +122,16 @@ class ModelPredictive(Controller[MPCGains]):
         """``τ_max`` [N·m] per joint (inf where none): where :meth:`compute` clips."""
         self._kp, self._kd = np.asarray(g.kp, dtype=float), np.asarray(g.kd, dtype=float)
         self._zeros: dict[tuple[int, ...], np.ndarray] = {}
+        nv, K = robot.nv, self.horizon.knots
+        self._slices = [
+            tuple(slice(2 + 3 * nv * k + i * nv, 2 + 3 * nv * k + (i + 1) * nv) for i in range(3))
+            for k in range(K)
+        ]  # the columns of q_k, q̇_k, a_k in z
+        self._interval, self._per_interval, self._last = (
+            self.horizon.interval,
+            1 / self.horizon.interval,
+            K - 1,
+        )
 
     def scaled_gains(self) -> dict[str, Any]:
         inertia = joint_inertia(self.robot.model, self.robot.home)
@@ -194,17 +204,12 @@ class ModelPredictive(Controller[MPCGains]):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         z = x.z
-        nv, h = self.robot.nv, self.horizon.interval
-        s = max(x.t - float(z[:, 0].max()), 0.0)  # every run replans at the same instants
-        k = min(int(s / h + 1e-9), self.horizon.knots - 1)
-        r = s - k * h
-        start = 2 + 3 * nv * k
-        qk, vk, a = (
-            z[:, start : start + nv],
-            z[:, start + nv : start + 2 * nv],
-            z[:, start + 2 * nv : start + 3 * nv],
-        )
-        accel = a + self._kp * (qk + (vk + 0.5 * r * a) * r - x.q) + self._kd * (vk + a * r - x.v)
+        since = x.t - z[:, 0].max()  # every run replans at the same instants
+        k = min(int(since * self._per_interval + 1e-9), self._last) if since > 0 else 0
+        r = since - k * self._interval if since > 0 else 0.0
+        q, v, a = self._slices[k]
+        vk, ak = z[:, v], z[:, a]
+        accel = ak + self._kp * (z[:, q] + (vk + (0.5 * r) * ak) * r - x.q) + self._kd * (vk + ak * r - x.v)
         tau = np.minimum(terms.model(x.q, x.v, x.v, accel), self._effort)
         np.maximum(tau, -self._effort, out=tau)
         zeros = self._zeros.get(z.shape)
