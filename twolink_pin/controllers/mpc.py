@@ -112,11 +112,10 @@ class ModelPredictive(Controller[MPCGains]):
                 )
         self.limits = joint_limits(robot)
         """The robot's limits (unscaled: ``limit_scale`` scales them in the QP)."""
-        self.horizon = Horizon(
-            knots_of(g.horizon, g.knot_interval), g.knot_interval, self.limits, g.limit_scale
-        )
+        knots = knots_of(g.horizon, g.knot_interval)
+        check_memory(knots, g.knot_interval, self.limits, self.runs or 1, "horizon")
+        self.horizon = Horizon(knots, g.knot_interval, self.limits, g.limit_scale)
         """The QP's structure: knots, integration matrices, labelled rows."""
-        check_memory(self.horizon, self.runs or 1, "gains.horizon")
         self._weights = self.horizon.weights(g.weight_q, g.weight_v, g.weight_tau)
         self._effort = np.where(np.isfinite(self.limits.effort), self.limits.effort, np.inf)
         """``τ_max`` [N·m] per joint (inf where none): where :meth:`compute` clips."""

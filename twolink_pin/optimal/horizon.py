@@ -270,12 +270,6 @@ class Horizon:
         upper[:, self._state] -= at_bar + base
         return HorizonQPs(H, g, C, lower, upper, self.labels)
 
-    def memory_need(self, runs: int) -> int:
-        """Bytes the QPs of ``runs`` runs take: ``8 (2 (n + m)² + N (n² + m n))`` for ``n`` variables
-        and ``m`` rows (the solver's KKT matrix and its factor, and each run's ``H`` and ``C``)."""
-        n, m = self.variables, len(self.rows)
-        return 8 * (2 * (n + m) ** 2 + runs * (n * n + m * n))
-
 
 def knots_of(horizon: float, interval: float) -> int:
     """``K = round(horizon / interval)`` knot intervals, at least 1: the horizon [s] in
@@ -287,17 +281,23 @@ def knots_of(horizon: float, interval: float) -> int:
     return max(1, round(horizon / interval))
 
 
-def check_memory(horizon: Horizon, runs: int, what: str = "horizon") -> None:
-    """Refuse a horizon whose QPs would not fit in the memory available (:func:`available_memory`).
+def check_memory(knots: int, interval: float, limits: JointLimits, runs: int, what: str = "horizon") -> None:
+    """Refuse a horizon whose QPs would not fit in the memory available
+    (:func:`~twolink_pin.memory.available_memory`), before anything of its size is made: ``n = K nv``
+    variables and ``m`` rows (one per knot and limit the robot has) take
+    ``8 (2 (n + m)² + N (n² + m n))`` bytes (the solver's KKT matrix and its factor, and each
+    run's ``H`` and ``C``).
 
     Raises:
         InvalidParameterError: naming the horizon's knots, the bytes needed and available.
     """
-    need, have = horizon.memory_need(runs), available_memory()
+    n = knots * limits.nv
+    m = knots * sum(int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS)
+    need, have = 8 * (2 * (n + m) ** 2 + runs * (n * n + m * n)), available_memory()
     if have is not None and need > have:
         raise InvalidParameterError(
             what,
-            f"{horizon.knots * horizon.interval:g} s ({horizon.knots} knots of {horizon.interval:g} s)",
-            f"a horizon whose QPs fit in memory: {need / 1e6:.4g} MB needed for {runs} run(s), "
-            f"{have / 1e6:.4g} MB available",
+            f"{knots * interval:g} s ({knots} knots of {interval:g} s)",
+            f"a horizon whose QPs fit in memory: {need / 1e6:.4g} MB needed for {runs} run(s) "
+            f"(8 B × (2 (n + m)² + N (n² + m n)), n = {n} variables, m = {m} rows), {have / 1e6:.4g} MB available",
         )
