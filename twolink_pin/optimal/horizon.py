@@ -194,8 +194,9 @@ class Horizon:
             weight_tau: ``w_τ`` (no unit), a scalar or (N, 1).
         """
         K, nv = self.knots, self.nv
-        wq2 = np.tile(np.broadcast_to(np.asarray(weight_q, dtype=float), (1, nv)) ** 2, (1, K))
-        wv2 = np.tile(np.broadcast_to(np.asarray(weight_v, dtype=float), (1, nv)) ** 2, (1, K))
+        wq, wv = (np.atleast_2d(np.asarray(w, dtype=float)) for w in (weight_q, weight_v))
+        wq2 = np.tile(np.broadcast_to(wq, (wq.shape[0], nv)) ** 2, (1, K))
+        wv2 = np.tile(np.broadcast_to(wv, (wv.shape[0], nv)) ** 2, (1, K))
         Qs, Vs = self.Q[nv:], self.V[nv:]
         tracking = np.matmul(Qs.T * wq2[:, None, :], Qs) + np.matmul(Vs.T * wv2[:, None, :], Vs)
         wt = np.asarray(weight_tau, dtype=float).reshape(-1, 1, 1)
