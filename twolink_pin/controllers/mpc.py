@@ -163,7 +163,9 @@ class ModelPredictive(Controller[MPCGains]):
         at = f"the MPC replan at t = {x.t:.6g} s"
         for i in np.flatnonzero(~inside):  # a row binds: ProxQP, one run after the other
             what = at if len(inside) == 1 else f"{at} (run {i})"
-            solution = solve_qp(qps.qp(i), what=what, max_iter=MAX_ITER, infeasibility_eps=INFEASIBILITY_EPS)
+            solution = solve_qp(
+                qps.qp(int(i)), what=what, max_iter=MAX_ITER, infeasibility_eps=INFEASIBILITY_EPS
+            )
             step[i] = solution.x
         u = u_bar + step.reshape(u_bar.shape)
         replans = self._split(x.z)[1]
