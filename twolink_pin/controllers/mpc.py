@@ -117,11 +117,17 @@ class ModelPredictive(Controller[MPCGains]):
         self.horizon = Horizon(knots, g.knot_interval, self.limits, g.limit_scale)
         """The QP's structure: knots, integration matrices, labelled rows."""
         self._weights = self.horizon.weights(g.weight_q, g.weight_v, g.weight_tau)
-        self._effort = np.where(np.isfinite(self.limits.effort), self.limits.effort, np.inf)
-        """``τ_max`` [N·m] per joint (inf where none): where :meth:`compute` clips."""
-        self._kp, self._kd = np.asarray(g.kp, dtype=float), np.asarray(g.kd, dtype=float)
+        self._effort = np.where(np.isfinite(self.limits.effort), self.limits.effort, np.inf).reshape(1, -1)
+        """``τ_max`` [N·m] per joint (inf where none), (1, nv): where :meth:`compute` clips
+        (every constant of :meth:`compute` is (1, nv): numpy broadcasts (1, nv) against (N, nv)
+        at a quarter of the cost of (nv,))."""
+        self._lowest = -self._effort
+        nv = robot.nv
+        self._kp, self._kd = (
+            np.broadcast_to(np.atleast_2d(k), (np.atleast_2d(k).shape[0], nv)).copy() for k in (g.kp, g.kd)
+        )
         self._zeros: dict[tuple[int, ...], np.ndarray] = {}
-        nv, K = robot.nv, self.horizon.knots
+        K = self.horizon.knots
         self._slices = [
             tuple(slice(2 + 3 * nv * k + i * nv, 2 + 3 * nv * k + (i + 1) * nv) for i in range(3))
             for k in range(K)
@@ -205,14 +211,16 @@ class ModelPredictive(Controller[MPCGains]):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         z = x.z
-        since = x.t - z[:, 0].max()  # every run replans at the same instants
+        since = x.t - (
+            z[0, 0] if z.shape[0] == 1 else z[:, 0].max()
+        )  # every run replans at the same instants
         k = min(int(since * self._per_interval + 1e-9), self._last) if since > 0 else 0
         r = since - k * self._interval if since > 0 else 0.0
         q, v, a = self._slices[k]
         vk, ak = z[:, v], z[:, a]
         accel = ak + self._kp * (z[:, q] + (vk + (0.5 * r) * ak) * r - x.q) + self._kd * (vk + ak * r - x.v)
         tau = np.minimum(terms.model(x.q, x.v, x.v, accel), self._effort)
-        np.maximum(tau, -self._effort, out=tau)
+        np.maximum(tau, self._lowest, out=tau)
         zeros = self._zeros.get(z.shape)
         if zeros is None:
             zeros = self._zeros[z.shape] = np.zeros(z.shape)
