@@ -146,10 +146,8 @@ class Horizon:
         joint = np.array([r[2] for r in rows], dtype=int)
         self._lower = np.array([r[3] for r in rows])
         self._upper = np.array([r[4] for r in rows])
-        self._effort = np.flatnonzero(kind_of == EFFORT.name)
-        self._effort_index = knot[self._effort] * nv + joint[self._effort]
+        effort = np.flatnonzero(kind_of == EFFORT.name)
         state = np.flatnonzero(kind_of != EFFORT.name)
-        self._state = state
         C = np.zeros((len(rows), K * nv))
         for i in state:
             kn, jj = knot[i], joint[i]
@@ -160,10 +158,23 @@ class Horizon:
             else:
                 C[i] = self._Qk[kn, jj]
         self._C_state = C[state]
-        self._position = np.flatnonzero(kind_of[state] == POSITION.name)
-        self._velocity = np.flatnonzero(kind_of[state] == VELOCITY.name)
-        self._pos_knot, self._pos_joint = knot[state][self._position], joint[state][self._position]
-        self._vel_joint = joint[state][self._velocity]
+        # the state rows' value at the measured state: q0_j + k h q̇0_j (position), q̇0_j (velocity)
+        B = np.zeros((state.size, 2 * nv))
+        for r, i in enumerate(state):
+            if kind_of[i] == POSITION.name:
+                B[r, joint[i]], B[r, nv + joint[i]] = 1.0, float(knot[i]) * h
+            elif kind_of[i] == VELOCITY.name:
+                B[r, nv + joint[i]] = 1.0
+        self._state_map = np.concatenate((self._C_state, B), axis=1).T.copy()  # (K nv + 2 nv, rows)
+        # the rows of each kind and the variables of the effort rows' torques: slices where contiguous
+        self._effort = _contiguous(effort)
+        self._effort_index = _contiguous(knot[effort] * nv + joint[effort])
+        self._state = _contiguous(state)
+        select = np.zeros((K, nv, K * nv))
+        for block in range(K):
+            select[block, :, block * nv : (block + 1) * nv] = eye
+        self._QVE = np.concatenate((self._Qk[:K], self._Vk[:K], select), axis=1)  # (K, 3 nv, K nv)
+        self._QVs = np.concatenate((self.Q[nv:], self.V[nv:]), axis=0)  # (2 K nv, K nv)
 
     def _label(self, row: tuple[str, int, int, float, float]) -> str:
         name, kn, jj, lo, hi = row
@@ -223,53 +234,49 @@ class Horizon:
             reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv).
             weights: :meth:`weights`.
         """
-        N, K, nv, h = q0.shape[0], self.knots, self.nv, self.interval
+        N, K, nv = q0.shape[0], self.knots, self.nv
         n = K * nv
         qb, vb = states
         qr, vr, ar = reference
         # T: the torque's Jacobian over u, (N, K, nv, K nv); block lower-triangular, M̂ on the diagonal
-        T = np.matmul(d.dtau_dq, self._Qk[:K]) + np.matmul(d.dtau_dv, self._Vk[:K])
-        Tb = T.reshape(N, K, nv, K, nv)
-        diagonal = np.arange(K)
-        Tb[:, diagonal, :, diagonal] += d.mass.transpose(1, 0, 2, 3)
-        T = T.reshape(N, n, n)
+        # T: the torque's Jacobian over u, (N, K nv, K nv): [∂τ/∂q, ∂τ/∂q̇, M̂] at knot k times
+        # [∂q_k/∂u; ∂q̇_k/∂u; ∂a_k/∂u] — block lower-triangular, M̂ on its diagonal
+        D = np.concatenate((d.dtau_dq, d.dtau_dv, d.mass), axis=-1)  # (N, K, nv, 3 nv)
+        T = np.matmul(D, self._QVE).reshape(N, n, n)
         # errors at ū (x = 0): e = A x + e(ū)
         dq, dv = qb - qr, vb - vr
         eq = dq[:, 1:].reshape(N, n)  # q_k − q_ref,k, knots 1..K
         ev = dv[:, 1:].reshape(N, n)
-        et = (
-            np.matmul(d.dtau_dq, dq[:, :K, :, None])
-            + np.matmul(d.dtau_dv, dv[:, :K, :, None])
-            + np.matmul(d.mass, (u_bar - ar[:, :K])[..., None])
+        et = np.matmul(
+            D, np.concatenate((dq[:, :K], dv[:, :K], u_bar - ar[:, :K]), axis=-1)[..., None]
         ).reshape(N, n)
         Tt = T.transpose(0, 2, 1)
         H = weights.tracking + weights.tau * np.matmul(Tt, T)
-        g = (
-            np.matmul(weights.q2 * eq, self.Q[nv:])
-            + np.matmul(weights.v2 * ev, self.V[nv:])
-            + weights.tau[:, :, 0] * np.matvec(Tt, et)
-        )
+        g = np.matmul(np.concatenate((weights.q2 * eq, weights.v2 * ev), axis=1), self._QVs) + weights.tau[
+            :, :, 0
+        ] * np.matvec(Tt, et)
         # the cost in units of its largest curvature (the minimiser is the same; the solver's
         # absolute tolerances then mean the same on every arm and weight)
-        scale = H.reshape(N, n * n)[:, :: n + 1].max(axis=1)
-        H, g = H / scale[:, None, None], g / scale[:, None]
-        rows = len(self.rows)
-        C = np.empty((N, rows, n))
-        lower = np.broadcast_to(self._lower, (N, rows)).copy()
-        upper = np.broadcast_to(self._upper, (N, rows)).copy()
+        scale = H.reshape(N, n * n)[:, :: n + 1].max(axis=1)[:, None]
+        H, g = H / scale[..., None], g / scale
+        C = np.empty((N, len(self.rows), n))
         C[:, self._effort] = T[:, self._effort_index]
-        tau_bar = d.tau.reshape(N, n)[:, self._effort_index]
-        lower[:, self._effort] -= tau_bar
-        upper[:, self._effort] -= tau_bar
         C[:, self._state] = self._C_state
-        # state rows at ū's value: the bounds minus the row's value at ū
-        at_bar = np.matmul(u_bar.reshape(N, n), self._C_state.T)
-        base = np.zeros((N, self._state.size))
-        base[:, self._position] = q0[:, self._pos_joint] + self._pos_knot * h * v0[:, self._pos_joint]
-        base[:, self._velocity] = v0[:, self._vel_joint]
-        lower[:, self._state] -= at_bar + base
-        upper[:, self._state] -= at_bar + base
+        # each row's value at x = 0: the effort rows' τ̄, the state rows' (u, q0, q̇0) at ū
+        at_bar = np.empty((N, len(self.rows)))
+        at_bar[:, self._effort] = d.tau.reshape(N, n)[:, self._effort_index]
+        at_bar[:, self._state] = np.matmul(
+            np.concatenate((u_bar.reshape(N, n), q0, v0), axis=1), self._state_map
+        )
+        lower, upper = self._lower - at_bar, self._upper - at_bar
         return HorizonQPs(H, g, C, lower, upper, self.labels)
+
+
+def _contiguous(index: np.ndarray) -> slice | np.ndarray:
+    """``index`` as a slice when it is a run of consecutive integers (a view, not a copy)."""
+    if index.size and (np.diff(index) == 1).all():
+        return slice(int(index[0]), int(index[-1]) + 1)
+    return index
 
 
 def knots_of(horizon: float, interval: float) -> int:
