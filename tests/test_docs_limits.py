@@ -159,7 +159,7 @@ def _check_saved_mpc_run(run: Any) -> None:
     assert run.controller == "mpc" and run.t.size == 2113  # every 1-ms step of 2.112 s
     assert limits.excess(EFFORT, run.tau_command).max() <= 0
     assert limits.excess(VELOCITY, run.v).max() < 0
-    assert run.state.shape[1] == 2 + 3 * 8 * 2  # t_plan, replans, (q, q̇, a) at 8 knots
+    assert run.state.shape[1] == 2 + 2 * 2 + 8 * 2  # t_plan, replans, q0, q̇0, a_k at 8 knots
 
 
 def _check_demo(runs: dict[str, Any]) -> None:

@@ -89,8 +89,8 @@ class ModelPredictive(Controller[MPCGains]):
     $\tau = \operatorname{clip}(\hat M (a_p + K_p (q_p - q) + K_d(\dot q_p - \dot q)) + \hat C \dot q + \hat g,
     \pm\tau_{max})$ ($f < 1$ leaves it the headroom).
 
-    **State** $z$: the plan — its time $t_r$, the count of replans and, per knot $k < K$, its
-    state and acceleration $(q_k, \dot q_k, a_k)$ ($2 + 3 K n_v$ numbers) — recorded like any state; a batch of N runs takes
+    **State** $z$: the plan — its time $t_r$, the count of replans, the measured state it starts
+    from and its accelerations $a_k$ ($2 + (2 + K) n_v$ numbers) — recorded like any state; a batch of N runs takes
     one derivatives call for all N plans and solves the N QPs one after the other, so a batch
     equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
     the run at that time naming the row (:class:`~twolink_pin.errors.OptimizationError`; exit 1).
@@ -127,11 +127,14 @@ class ModelPredictive(Controller[MPCGains]):
             np.broadcast_to(np.atleast_2d(k), (np.atleast_2d(k).shape[0], nv)).copy() for k in (g.kp, g.kd)
         )
         self._zeros: dict[tuple[int, ...], np.ndarray] = {}
+        s = self.horizon.interval * np.arange(self.horizon.knots + 1)[None, :, None]
+        self._knot_times = (s, 0.5 * s * s)  # s and s²/2 [s, s²] at the knots, (1, K + 1, 1)
         K = self.horizon.knots
-        self._slices = [
-            tuple(slice(2 + 3 * nv * k + i * nv, 2 + 3 * nv * k + (i + 1) * nv) for i in range(3))
-            for k in range(K)
-        ]  # the columns of q_k, q̇_k, a_k in z
+        self._columns = (
+            slice(2, 2 + nv),
+            slice(2 + nv, 2 + 2 * nv),
+            [slice(2 + (2 + k) * nv, 2 + (3 + k) * nv) for k in range(K)],
+        )  # the columns of q_0, q̇_0 and each a_k in z
         self._interval, self._per_interval, self._last = (
             self.horizon.interval,
             1 / self.horizon.interval,
@@ -147,19 +150,18 @@ class ModelPredictive(Controller[MPCGains]):
     def state_variables(self) -> tuple[StateVariable, ...]:
         nv, K = self.robot.nv, self.horizon.knots
         plan = [StateVariable("t_plan", "s", "plan"), StateVariable("replans", "", "plan")]
-        for k in range(K):
-            plan += [StateVariable(f"q{k}_{j + 1}", "rad", "plan") for j in range(nv)]
-            plan += [StateVariable(f"v{k}_{j + 1}", "rad/s", "plan") for j in range(nv)]
-            plan += [StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for j in range(nv)]
+        plan += [StateVariable(f"q0_{j + 1}", "rad", "plan") for j in range(nv)]
+        plan += [StateVariable(f"v0_{j + 1}", "rad/s", "plan") for j in range(nv)]
+        plan += [StateVariable(f"a{k}_{j + 1}", "rad/s²", "plan") for k in range(K) for j in range(nv)]
         return (*super().state_variables(), *plan)
 
     def update_period(self) -> float | None:
         return float(cast(MPCGains, self.gains).replan_period)
 
     def _split(self, z: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``t_plan`` (N,), ``replans`` (N,) and the plan's knots (N, K, 3, nv): ``q_k``, ``q̇_k``, ``a_k``."""
-        nv, K = self.robot.nv, self.horizon.knots
-        return z[:, 0], z[:, 1], z[:, 2:].reshape(-1, K, 3, nv)
+        """``t_plan`` (N,), ``replans`` (N,) and the plan's accelerations ``a_k`` (N, K, nv)."""
+        nv = self.robot.nv
+        return z[:, 0], z[:, 1], z[:, 2 + 2 * nv :].reshape(z.shape[0], self.horizon.knots, nv)
 
     # -- the replan ----------------------------------------------------------------------
 
@@ -174,11 +176,11 @@ class ModelPredictive(Controller[MPCGains]):
             )
             step[i] = solution.x
         u = u_bar + step.reshape(u_bar.shape)
-        replans = self._split(x.z)[1]
-        runs, K = x.q.shape[0], self.horizon.knots
-        q, v = self.horizon.rollout(x.q, x.v, u)
-        knots = np.stack((q[:, :K], v[:, :K], u), axis=2).reshape(runs, -1)
-        return np.concatenate((np.full((runs, 1), x.t), (replans + 1).reshape(-1, 1), knots), axis=1)
+        nv = x.q.shape[1]
+        z = np.empty(x.z.shape)
+        z[:, 0], z[:, 1] = x.t, x.z[:, 1] + 1
+        z[:, 2 : 2 + nv], z[:, 2 + nv : 2 + 2 * nv], z[:, 2 + 2 * nv :] = x.q, x.v, u.reshape(u.shape[0], -1)
+        return z
 
     def problems(self, x: LawInput, terms: Terms) -> HorizonQPs:
         """The QPs of the runs at a replan (what :meth:`update` solves; e.g. to check its KKT
@@ -194,14 +196,15 @@ class ModelPredictive(Controller[MPCGains]):
         # the new plan starts in piece shifted[k] of the old one, the last one held
         since = x.t - float(x.z[:, 0].max())
         shifted = np.minimum(((since + h * np.arange(K)) / h + 1e-9).astype(int), K - 1)
-        u_bar = plan[:, shifted, 2]
+        u_bar = plan[:, shifted]
         fresh = replans < 0.5  # no plan yet: the reference's acceleration
         u_bar[fresh] = x.a_des[0]
-        s = h * np.arange(K + 1)[None, :, None]
+        s, half_s2 = self._knot_times
+        a_des = x.a_des[:, None]
         reference = (
-            x.q_des[:, None] + x.v_des[:, None] * s + 0.5 * x.a_des[:, None] * s * s,
-            x.v_des[:, None] + x.a_des[:, None] * s,
-            np.broadcast_to(x.a_des[:, None], (1, K + 1, self.robot.nv)),
+            x.q_des[:, None] + x.v_des[:, None] * s + a_des * half_s2,
+            x.v_des[:, None] + a_des * s,
+            a_des,
         )
         qb, vb = hz.rollout(x.q, x.v, u_bar)
         d = terms.inverse_dynamics_derivatives(qb[:, :K], vb[:, :K], u_bar)
@@ -216,9 +219,13 @@ class ModelPredictive(Controller[MPCGains]):
         )  # every run replans at the same instants
         k = min(int(since * self._per_interval + 1e-9), self._last) if since > 0 else 0
         r = since - k * self._interval if since > 0 else 0.0
-        q, v, a = self._slices[k]
-        vk, ak = z[:, v], z[:, a]
-        accel = ak + self._kp * (z[:, q] + (vk + (0.5 * r) * ak) * r - x.q) + self._kd * (vk + ak * r - x.v)
+        q0, v0, a = self._columns
+        qk, vk, ak = z[:, q0], z[:, v0], z[:, a[k]]
+        if k:  # past the first piece (a replan period longer than a knot interval): knot k's state
+            u = self._split(z)[2]
+            qk = qk + (k * self._interval) * vk + np.matmul(self.horizon.sq[k], u)
+            vk = vk + np.matmul(self.horizon.sv[k], u)
+        accel = ak + self._kp * (qk + (vk + (0.5 * r) * ak) * r - x.q) + self._kd * (vk + ak * r - x.v)
         tau = np.minimum(terms.model(x.q, x.v, x.v, accel), self._effort)
         np.maximum(tau, self._lowest, out=tau)
         zeros = self._zeros.get(z.shape)

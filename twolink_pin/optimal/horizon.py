@@ -231,7 +231,8 @@ class Horizon:
             u_bar: The plan linearised at [rad/s²], (N, K, nv).
             states: ``ū``'s knot states from ``(q0, v0)`` (:meth:`rollout`).
             d: τ and its derivatives at ``ū``'s states, knots 0 … K−1, (N, K, nv[, nv]).
-            reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv).
+            reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv)
+                or broadcastable to it (a constant acceleration: (1, 1, nv)).
             weights: :meth:`weights`.
         """
         N, K, nv = q0.shape[0], self.knots, self.nv
