@@ -75,9 +75,9 @@ class ModelPredictive(Controller[MPCGains]):
     and $q_{min} \le q_k \le q_{max}$ (the state bounds from the first knot on), with
     $\tau_k = \hat{\mathrm{RNEA}}(q_k, \dot q_k, a_k)$ linearised on Pinocchio's RNEA derivatives
     at the previous plan shifted to $t_r$ (one QP per replan, not solved to convergence of the
-    nonlinear problem: Diehl's real-time iteration). The shifted plan is also the QP's start:
-    its unconstrained minimiser first (one Cholesky solve; when it meets every row it is the
-    solution), else ProxQP, at most :data:`MAX_ITER` iterations.
+    nonlinear problem: Diehl's real-time iteration); the QP's variable is the step from that plan.
+    Every run's unconstrained minimiser first (one batched LAPACK solve for the N runs; where it
+    meets every row it is the solution), else ProxQP, cold, at most :data:`MAX_ITER` iterations.
 
     **The reference over the horizon** is extrapolated from the sample at $t_r$ at constant
     acceleration, $q_r(t_r + s) = q_d + \dot q_d s + \tfrac12 \ddot q_d s^2$: a law sees the
@@ -90,9 +90,10 @@ class ModelPredictive(Controller[MPCGains]):
     \pm\tau_{max})$ ($f < 1$ leaves it the headroom).
 
     **State** $z$: the plan — its time $t_r$, the count of replans, the measured state it starts
-    from and its accelerations $a_k$ ($2 + (2 + K) n_v$ numbers) — recorded like any state; a batch of N runs takes
-    one derivatives call for all N plans and solves the N QPs one after the other, so a batch
-    equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
+    from and its accelerations $a_k$ ($2 + (2 + K) n_v$ numbers) — recorded like any state.
+    **A batch of N runs** takes one derivatives call for all N plans, builds the N QPs as batched
+    arrays and solves their unconstrained minimisers in one call; the runs where a row binds go
+    to ProxQP one after the other. The runs never mix, so a batch equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
     the run at that time naming the row (:class:`~twolink_pin.errors.OptimizationError`; exit 1).
     """
 
