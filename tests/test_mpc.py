@@ -187,3 +187,61 @@ def test_a_replan_that_cannot_hold_fails_at_once_naming_the_row() -> None:
     assert "the position range [-3.14159, 3.14159] rad of joint 1 (joint1) at knot 1" in message
     iterations = int(message.split("failed after ")[1].split(" iterations")[0])
     assert iterations <= 200
+
+
+def test_a_solver_that_stops_mid_run_fails_the_run_at_that_time(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """ProxQP allowed no iteration from t = 0.02 s on, while the effort limit binds (a 0.8-rad
+    start): the replan it cannot finish fails the run there — exit status 1, one line naming
+    the law, the time and what stopped — not a traceback and not a plan held from before."""
+    from typing import Any
+
+    import twolink_pin.controllers.mpc as law_module
+    import twolink_pin.optimal.qp as qp_module
+    from twolink_pin.cli import main
+
+    real = law_module.solve_qp
+
+    def starved(qp: Any, **kwargs: Any) -> Any:
+        if float(kwargs["what"].split("t = ")[1].split(" s")[0]) >= 0.02:
+            kwargs["max_iter"] = 0
+        return real(qp, **kwargs)
+
+    monkeypatch.setattr(law_module, "solve_qp", starved)
+    monkeypatch.setattr(
+        qp_module, "_infeasible_reason", lambda *args: None
+    )  # a slow solve, not infeasibility
+    assert main(["simulate", "mpc", "--duration", "0.1", "--q0-offset", "0.8", "-0.8"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "Traceback" not in err[0], err
+    assert "controller 'mpc' failed at t = 0.02 s" in err[0] and "ProxQP stopped with status" in err[0], err[
+        0
+    ]
+
+
+def test_controllers_and_tune_list_its_gains_with_units(capsys: pytest.CaptureFixture[str]) -> None:
+    """``twolink-pin controllers`` lists mpc's gains with their units; ``tune mpc`` has a control
+    per gain (per joint for the weights and the feedback), limit_scale ranging over (0, 1]."""
+    from twolink_pin.cli import main
+    from twolink_pin.run_spec import gains_used
+    from twolink_pin.tuning.knobs import knobs_of
+
+    assert main(["controllers"]) == 0
+    listed = next(line for line in capsys.readouterr().out.splitlines() if "knot_interval" in line)
+    for shown in (
+        "horizon [s]",
+        "replan_period [s]",
+        "weight_q [N·m/rad]",
+        "weight_v [N·m·s/rad]",
+        "kp [1/s²]",
+    ):
+        assert shown in listed
+    law = ModelPredictive(ROBOT)
+    knobs = {k.label: k for k in knobs_of(MPCGains, gains_used(law))}
+    assert {"horizon [s]", "replan_period [s]", "weight_tau", "weight_q joint 2 [N·m/rad]"} <= set(knobs)
+    assert (knobs["limit_scale"].low, knobs["limit_scale"].high, knobs["limit_scale"].value) == (
+        0.0,
+        1.0,
+        0.95,
+    )
