@@ -140,7 +140,8 @@ class Horizon:
         self.rows = rows
         """Per inequality row: the kind's name, the knot, the joint (0-based), its bounds."""
         self.labels: Sequence[str] = tuple(self._label(r) for r in rows)
-        """What each row bounds, in words."""
+        """What each row bounds, in words (a message's bounds and value are the row's: the
+        quantity less its value on the plan the QP steps from)."""
         kind_of = np.array([r[0] for r in rows], dtype=object)
         knot = np.array([r[1] for r in rows], dtype=int)
         joint = np.array([r[2] for r in rows], dtype=int)
@@ -181,9 +182,10 @@ class Horizon:
         joint = f"joint {jj + 1} ({self.limits.joint_names[jj]})"
         when = f"at knot {kn} (t + {kn * self.interval:.6g} s)"
         kind = {k.name: k for k in KINDS_IN_ROWS}[name]
+        row = f"(row: {kind.symbol} less its value on the shifted plan [{kind.unit}])"
         if kind is POSITION:
-            return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when}"
-        return f"the {name} limit |{kind.symbol}| <= {hi:.6g} {kind.unit} of {joint} {when}"
+            return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when} {row}"
+        return f"the {name} limit |{kind.symbol}| <= {hi:.6g} {kind.unit} of {joint} {when} {row}"
 
     @property
     def variables(self) -> int:
