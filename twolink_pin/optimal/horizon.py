@@ -182,10 +182,10 @@ class Horizon:
         joint = f"joint {jj + 1} ({self.limits.joint_names[jj]})"
         when = f"at knot {kn} (t + {kn * self.interval:.6g} s)"
         kind = {k.name: k for k in KINDS_IN_ROWS}[name]
-        row = f"(row: {kind.symbol} less its value on the shifted plan [{kind.unit}])"
+        held = f"(row: {kind.symbol} less its value on the shifted plan [{kind.unit}])"
         if kind is POSITION:
-            return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when} {row}"
-        return f"the {name} limit |{kind.symbol}| <= {hi:.6g} {kind.unit} of {joint} {when} {row}"
+            return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when} {held}"
+        return f"the {name} limit |{kind.symbol}| <= {hi:.6g} {kind.unit} of {joint} {when} {held}"
 
     @property
     def variables(self) -> int:
