@@ -85,9 +85,10 @@ class ModelPredictive(Controller[MPCGains]):
     close.
 
     **Between replans** it follows the plan $(q_p, \dot q_p, a_p)(t)$ with computed torque on the
-    believed model, clipped to the effort limits:
-    $\tau = \operatorname{clip}(\hat M (a_p + K_p (q_p - q) + K_d(\dot q_p - \dot q)) + \hat C \dot q + \hat g,
-    \pm\tau_{max})$ ($f < 1$ leaves it the headroom).
+    believed model, clipped to the effort limits ($f < 1$ leaves it the headroom):
+
+    $$\tau = \operatorname{clip}\big(\hat M (a_p + K_p (q_p - q) + K_d(\dot q_p - \dot q))
+    + \hat C \dot q + \hat g,\ \pm\tau_{max}\big)$$
 
     **State** $z$: the plan — its time $t_r$, the count of replans, the measured state it starts
     from and its accelerations $a_k$ ($2 + (2 + K) n_v$ numbers) — recorded like any state.
