@@ -37,6 +37,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --tune-only [--quick]    # tune: from a change to updated results
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
+    .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -69,6 +70,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin import (  # first, before pinocchio loads: OpenMP's passive wait policy (twolink_pin.openmp)
+    Plant,
     SimulationConfig,
     default_trajectory,
     load_robot,
@@ -866,6 +868,108 @@ def qp_osc_section(quick: bool, repeats: int) -> dict[str, Any]:
     }
 
 
+MPC_TARGETS = {"twolink": 3.0, "ur5": 30.0}
+"""Issue 37's goals for ``mpc``: seconds per 30-s run (the twolink 10× faster than real time)."""
+
+
+def _mpc_split(law: Any, plant: Any, reference: Any, config: SimulationConfig) -> dict[str, float]:
+    """One run of ``law`` with its replans timed apart: total (wall and this process's CPU),
+    replans (building the QPs and solving them; the rest is the plant and the law between
+    replans), in seconds, and the number of replans."""
+    spent = {"update": 0.0, "replans": 0, "proxqp": 0}
+    update = law.update
+
+    def timed_update(x: Any, terms: Any) -> Any:
+        start = time.perf_counter()
+        try:
+            return update(x, terms)
+        finally:
+            spent["update"] += time.perf_counter() - start
+            spent["replans"] += 1
+
+    law.update = timed_update
+    cpu = time.process_time()
+    try:
+        total = _timed(lambda: simulate(law, plant, reference, config))
+    finally:
+        del law.update
+    return {
+        "total": total,
+        "cpu": time.process_time() - cpu,
+        "update": spent["update"],
+        "replans": spent["replans"],
+    }
+
+
+def mpc_section(quick: bool, repeats: int) -> dict[str, Any]:
+    """Issue 37's goals for ``mpc``: a 30-s run on the twolink (<= 3 s) and on the UR5 (<= 30 s),
+    the default reference 0.1 / 0.05 rad off, the law replanning every 10 ms (min of ``repeats``,
+    the replans' share beside); a batch of N runs per run (one derivatives call for the N plans,
+    the N QPs solved one after the other); and demo (a) of docs/control_within_limits.md — the
+    retimed twolink, the model 20 % light — with its limit violations counted (goal: none)."""
+    from twolink_pin.controllers import ModelPredictive
+    from twolink_pin.limits import EFFORT, VELOCITY, joint_limits
+    from twolink_pin.trajectory import time_optimal
+
+    durations = {"twolink": 0.5 if quick else 30.0, "ur5": 0.2 if quick else 30.0}
+    seconds, shares = {}, {}
+    print(
+        f"\nmpc (horizon 0.2 s, 8 knots, replans every 10 ms; min of {repeats}): seconds per 30-s run; "
+        f"load average {[round(x, 2) for x in os.getloadavg()]}"
+    )
+    for name, duration in durations.items():
+        robot = load_robot(name)
+        law, plant = ModelPredictive(robot), Plant(robot)
+        config = SimulationConfig(duration=duration, dt=DT)
+        runs = [_mpc_split(law, plant, default_trajectory(robot), config) for _ in range(repeats)]
+        best = min(runs, key=lambda r: r["total"])
+        seconds[name] = best["total"] * FULL / duration
+        cpu = best["cpu"] * FULL / duration
+        shares[name] = best["update"] / best["total"]
+        per_replan = 1e6 * best["update"] / max(best["replans"], 1)
+        met = "met" if seconds[name] <= MPC_TARGETS[name] else "NOT met"
+        print(
+            f"  {name:8s} {seconds[name]:8.3f} s per 30-s run (CPU {cpu:.3f} s; {FULL / seconds[name]:.1f}x real time; "
+            f"replans {100 * shares[name]:.0f} % of it, {per_replan:.0f} us each) (target <= {MPC_TARGETS[name]:g} s: {met})"
+        )
+    robot = load_robot()
+    n, batch_duration = (4, 0.2) if quick else (50, 2.0)
+    offsets = np.random.default_rng(0).uniform(-0.1, 0.1, (n, robot.nv))
+    law = ModelPredictive(robot)
+    elapsed = _timed(
+        lambda: simulate_batch(
+            law, Plant(robot), default_trajectory(robot), SimulationConfig(duration=batch_duration, dt=DT),
+            q0_offsets=offsets,
+        )
+    )  # fmt: skip
+    batch = elapsed * FULL / batch_duration / n
+    print(
+        f"  batch    {batch:8.3f} s per 30-s run, N = {n} ({batch_duration:g} s each; one derivatives call per replan)"
+    )
+    retimed = time_optimal(robot, default_trajectory(robot)).trajectory
+    light = ModelPredictive(robot, model_parameters=np.asarray(robot.p) * 0.8)
+    run = simulate(light, Plant(robot), retimed, SimulationConfig(duration=0.2 if quick else 2.112, dt=DT))
+    limits = joint_limits(robot)
+    violations = int(
+        (limits.excess(EFFORT, run.tau_command) > 0).sum() + (limits.excess(VELOCITY, run.v) > 0).sum()
+    )
+    rms = np.sqrt(np.mean(run.e**2, axis=0))
+    print(
+        f"  demo (a) retimed twolink, model 20 % light: {violations} limit violations over {run.t.size} samples "
+        f"(goal 0: {'met' if violations == 0 else 'NOT met'}), RMS e {np.round(rms, 4).tolist()} rad"
+    )
+    return {
+        "mpc": {
+            "seconds_per_30s": seconds,
+            "replan_share": shares,
+            "targets": MPC_TARGETS,
+            "batch_seconds_per_30s": batch,
+            "batch_n": n,
+            "demo_a_violations": violations,
+        }
+    }
+
+
 BIG_ARM_TARGETS = {"osc batch": 8.0, "adaptive batch": 5.0}
 """Issue 31's batch targets per run (× the baseline): osc on the Panda, adaptive on the UR5."""
 
@@ -1280,6 +1384,11 @@ def main(argv: list[str] | None = None) -> int:
         "--qp-osc-only", action="store_true", help="only qp-osc against osc on the Panda (issue 37's goal)"
     )
     parser.add_argument(
+        "--mpc-only",
+        action="store_true",
+        help="only mpc's goals: 30-s runs on the twolink and the UR5, demo (a)",
+    )
+    parser.add_argument(
         "--optimal-only",
         action="store_true",
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
@@ -1315,6 +1424,11 @@ def main(argv: list[str] | None = None) -> int:
     )
     if args.qp_osc_only:
         results.update(qp_osc_section(quick, args.repeats or (1 if quick else 5)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.mpc_only:
+        results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
         if args.json:
             print(json.dumps(results))
         return 0
@@ -1466,6 +1580,7 @@ def main(argv: list[str] | None = None) -> int:
     results.update(single_runs_section(baseline, scale, quick, repeats))
     results.update(osc_panda_section(baseline, scale, quick, repeats))
     results.update(qp_osc_section(quick, repeats))
+    results.update(mpc_section(quick, 1 if quick else 3))
     if not quick:  # the smoke test runs --big-arms-only --quick on its own
         results.update(big_arms_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))

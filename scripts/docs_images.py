@@ -23,6 +23,8 @@ tune           tune.png: ``twolink-pin tune pd`` in the browser, after one run  
 limits         limits_panda_fold.png, limits_qp_osc_task_error.png:             20 s
                docs/control_within_limits.md's demo (osc and qp-osc)
 within_limits  within_limits_*.png: the retimed and the least-effort twolink    5 s
+mpc            limits_mpc_twolink.png: docs/control_within_limits.md's demo (a)   5 s
+               (mpc and computed-torque --saturate on the retimed twolink)
 =============  ==============================================================  =========
 """
 
@@ -311,6 +313,52 @@ def within_limits() -> list[Path]:
     return out
 
 
+MPC_DEMO = "--trajectory {tmp}/twolink_time_optimal.toml --model examples/twolink_light.urdf --duration 2.112"
+"""docs/control_within_limits.md's demo (a): the retimed twolink, the law's model 20 % light."""
+
+
+def mpc() -> list[Path]:
+    """docs/control_within_limits.md, demo (a): mpc and computed-torque --saturate on the
+    twolink's time-optimal retiming, both believing links 20 % light; joint 2's velocity and
+    torque against its limits, from the runs the page's commands save; prints their numbers."""
+    import shlex
+
+    from twolink_pin.cli import main as cli
+    from twolink_pin.limits import EFFORT, VELOCITY, joint_limits
+    from twolink_pin.plotting import save_velocity_limits_figure
+    from twolink_pin.simulation.storage import load_result
+
+    bounds = joint_limits(load_robot("twolink"))
+    runs = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        cli(["trajectory", "--time-optimal", "--save", f"{tmp}/twolink_time_optimal.toml"])
+        for label, law in (("mpc", "mpc"), ("computed-torque --saturate", "computed-torque --saturate")):
+            argv = [
+                *shlex.split(law),
+                *shlex.split(MPC_DEMO.format(tmp=tmp)),
+                "--save",
+                f"{tmp}/{law.split()[0]}.npz",
+            ]
+            cli(["simulate", *argv])
+            runs[label] = load_result(f"{tmp}/{law.split()[0]}.npz")
+    for label, run in runs.items():
+        rms = np.sqrt(np.mean(run.e**2, axis=0))
+        print(
+            f"mpc: {label}: RMS e {np.round(rms, 4).tolist()} rad, peak |v| / limit "
+            f"{np.round(np.abs(run.v).max(axis=0) / bounds.velocity, 3).tolist()}, largest torque excess "
+            f"{bounds.excess(EFFORT, run.tau_command).max():.3g} N·m, velocity excess {bounds.excess(VELOCITY, run.v).max():.3g} rad/s"
+        )
+    return [
+        save_velocity_limits_figure(
+            runs,
+            bounds,
+            IMAGES / "limits_mpc_twolink.png",
+            joint=1,
+            title="twolink on its time-optimal retiming, the laws' links 20 % light",
+        )
+    ]
+
+
 MAKERS: dict[str, Callable[[], list[Path]]] = {
     "report": report,
     "animation": animation,
@@ -320,6 +368,7 @@ MAKERS: dict[str, Callable[[], list[Path]]] = {
     "tune": tune,
     "limits": limits,
     "within_limits": within_limits,
+    "mpc": mpc,
 }
 
 

@@ -31,6 +31,7 @@ GROUPS: dict[str, str] = {
     "test_tutorial.py": "docs",
     "test_cluster.py": "cluster",  # a dask scheduler with 2 workers, the in-process reference sweep
     "test_report.py": "report",  # a report build, checked in Chromium
+    "test_report_within_limits.py": "report_within_limits",  # a report build with the section
     "test_visualization.py": "visualization",  # Chromium, a live meshcat server, three pages
     "test_visualization_overlays.py": "visualization_overlays",  # Chromium on a page
     "test_bags.py": "bags",  # a 30-s log at 1 kHz and its identification
@@ -52,6 +53,7 @@ MARKS: dict[str, tuple[str, ...]] = {
     "test_docs_images.py": ("docs",),  # an image maker of scripts/docs_images.py
     "test_docs_limits.py": ("docs",),  # the page's commands: two 2.5-s Panda runs, one failing at 0.12 s
     "test_report.py": ("report",),  # report builds
+    "test_report_within_limits.py": ("report",),  # two short report builds, one with the section
     "test_benchmark_script.py": ("slow",),  # scripts/benchmark.py --quick: minutes
 }
 """Test file → markers added to each of its tests (``make check`` deselects them: pyproject's markers)."""

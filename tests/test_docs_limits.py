@@ -1,9 +1,11 @@
 """docs/control_within_limits.md, run: every command on the page is run here and every output
-line the page quotes must be in what it prints (stdout, or stderr for the run the page shows
-failing); the page's path is the example file; and demo (b) is checked from the runs its
+line the page quotes must be in what it prints (stdout, or stderr for the runs the page shows
+failing); the page's path is the example file; demo (b) is checked from the runs its
 ``compare`` made: qp-osc keeps every joint inside its range, every velocity, acceleration and
 commanded torque within its limit, where osc takes joint 4 past its range and asks joint 6 for
-more than its effort limit.
+more than its effort limit; demo (a) from its compare's runs (mpc within every torque and
+velocity limit and with the lower RMS error, computed-torque past joint 2's velocity limit)
+and from the run file its ``simulate --save`` wrote (every step within the limits).
 
 Slow-ish: two 2.5-s Panda runs (one with its limits binding for 0.7 s) and one that fails at
 0.12 s. ``compare`` runs with ``--no-plot``: what is checked here is what it prints and its runs
@@ -51,20 +53,44 @@ COMMANDS = _commands()
 def test_the_page_compares_osc_and_qp_osc_on_its_example_path() -> None:
     verbs = [shlex.split(c)[1:3] for c, _ in COMMANDS]
     assert ["compare", "osc"] in verbs and ["simulate", "qp-osc"] in verbs
-    assert all("--robot panda" in c and "examples/panda_fold_pose.toml" in c for c, _ in COMMANDS)
+    panda = [c for c, _ in COMMANDS if "--robot panda" in c]
+    assert len(panda) == 2 and all("examples/panda_fold_pose.toml" in c for c in panda)
     page = load_toml(next(text for kind, text in _blocks() if kind == "toml"), "page")
     assert page == load_toml((ROOT / "examples" / "panda_fold_pose.toml").read_text(), "file")
 
 
+def test_demo_a_compares_mpc_and_computed_torque_on_the_retimed_twolink() -> None:
+    """Demo (a)'s commands: the retimed reference saved, then read by a compare and a saved run
+    of mpc, both with the light model; that model is the twolink's with every link × 0.8
+    (CRBA on both URDFs)."""
+    verbs = [shlex.split(c)[1:3] for c, _ in COMMANDS]
+    assert ["trajectory", "--time-optimal"] in verbs and ["compare", "mpc"] in verbs
+    retimed = [c for c, _ in COMMANDS if "out/twolink_time_optimal.toml" in c]
+    assert len(retimed) == 3 and all("--model examples/twolink_light.urdf" in c for c in retimed[1:])
+    import pinocchio as pin
+
+    light, twolink = load_robot(str(ROOT / "examples" / "twolink_light.urdf")), load_robot()
+    for q in np.random.default_rng(0).uniform(-3, 3, (5, 2)):  # to the file's 12 digits
+        m_light = pin.crba(light.model, light.model.createData(), q)
+        np.testing.assert_allclose(
+            m_light, 0.8 * pin.crba(twolink.model, twolink.model.createData(), q), rtol=1e-10
+        )
+
+
+RETIMED = "out/twolink_time_optimal.toml"
+"""Demo (a)'s retimed reference, which its later commands read."""
+
+
 def _run(command: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[int, dict[str, Any]]:
-    """The page's command through ``main``, its output folder in ``tmp_path``, ``compare``
-    without figures; and the runs ``compare`` made (each law's result as it was tabulated)."""
+    """The page's command through ``main``, every ``out/`` path in ``tmp_path`` (the retimed
+    reference made there first when the command reads it), ``compare`` without figures; and
+    the runs ``compare`` made (each law's result as it was tabulated) or the run ``--save``d."""
     import twolink_pin.studies.comparison as comparison
 
     argv = shlex.split(command)[1:]
-    if "--out" in argv:
-        i = argv.index("--out") + 1
-        argv[i] = str(tmp_path / Path(argv[i]).name)
+    if RETIMED in argv and argv[0] != "trajectory":
+        assert main(["trajectory", "--time-optimal", "--save", str(tmp_path / Path(RETIMED).name)]) == 0
+    argv = [str(tmp_path / Path(a).name) if a.startswith("out/") else a for a in argv]
     if argv[0] == "compare":
         argv.append("--no-plot")
     runs: dict[str, Any] = {}
@@ -80,7 +106,12 @@ def _run(command: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple
 
     monkeypatch.setattr(comparison, "run_comparison", keeping)
     monkeypatch.chdir(ROOT)
-    return main(argv), runs
+    status = main(argv)
+    if "--save" in argv and argv[argv.index("--save") + 1].endswith(".npz") and status == 0:
+        from twolink_pin.simulation.storage import load_result
+
+        runs["saved"] = load_result(argv[argv.index("--save") + 1])
+    return status, runs
 
 
 @pytest.mark.slow
@@ -101,8 +132,34 @@ def test_every_command_prints_what_the_page_says(
         assert any(line in p for p in printed) if fails else line in printed, (
             f"{line!r} is not in the output of {command!r}:\n" + "\n".join(printed)
         )
-    if runs:
+    if "qp-osc" in runs:
         _check_demo(runs)
+    elif "mpc" in runs:
+        _check_demo_a(runs)
+    elif "saved" in runs:
+        _check_saved_mpc_run(runs["saved"])
+
+
+def _check_demo_a(runs: dict[str, Any]) -> None:
+    """Demo (a) from compare's runs: mpc keeps every commanded torque and velocity within its
+    limit and has the lower RMS error on both joints; computed-torque takes joint 2 past 10 rad/s."""
+    limits = joint_limits(load_robot())
+    mpc, ct = runs["mpc"], runs["computed-torque"]
+    assert limits.excess(EFFORT, mpc.tau_command).max() <= 0
+    assert limits.excess(VELOCITY, mpc.v).max() < 0
+    assert limits.excess(VELOCITY, ct.v)[:, 1].max() > 0.1
+    rms = {name: np.sqrt(np.mean(run.e**2, axis=0)) for name, run in runs.items()}
+    assert (rms["mpc"] < rms["computed-torque"]).all(), rms
+
+
+def _check_saved_mpc_run(run: Any) -> None:
+    """The saved file of demo (a)'s mpc run, every step of it: no commanded torque beyond its
+    effort limit, no velocity beyond its limit; and it is the mpc run (its plan is its state)."""
+    limits = joint_limits(load_robot())
+    assert run.controller == "mpc" and run.t.size == 2113  # every 1-ms step of 2.112 s
+    assert limits.excess(EFFORT, run.tau_command).max() <= 0
+    assert limits.excess(VELOCITY, run.v).max() < 0
+    assert run.state.shape[1] == 2 + 2 * 2 + 8 * 2  # t_plan, replans, q0, q̇0, a_k at 8 knots
 
 
 def _check_demo(runs: dict[str, Any]) -> None:

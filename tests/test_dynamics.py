@@ -18,6 +18,7 @@ from twolink_pin.dynamics import (
     forward_dynamics,
     friction_regressor,
     inverse_dynamics,
+    inverse_dynamics_rows,
     mass_matrix,
     model_torque,
     polarisation_pair,
@@ -263,3 +264,19 @@ def test_friction_regressor_of_a_batch_is_the_regressor_of_each_row() -> None:
     batch = friction_regressor(v, 1e-3)
     for i in range(3):
         np.testing.assert_array_equal(batch[i], friction_regressor(v[i], 1e-3))
+
+
+@pytest.mark.parametrize("name", ["twolink", "ur5"])
+def test_inverse_dynamics_rows_is_pinocchios_rnea_row_by_row(name: str) -> None:
+    """One ``rneaInParallel`` call over K rows gives ``pin.rnea`` of each row (a second call
+    path of Pinocchio) to rounding, and refuses a row of the wrong width naming it."""
+    robot = load_robot(name)
+    rng = np.random.default_rng(3)
+    q, v, a = (rng.uniform(-2.0, 2.0, (37, robot.nv)) for _ in range(3))
+    data = robot.model.createData()
+    expected = np.array([pin.rnea(robot.model, data, *row) for row in zip(q, v, a)])
+    np.testing.assert_allclose(inverse_dynamics_rows(robot.model, q, v, a), expected, rtol=0, atol=1e-10)
+    with pytest.raises(InvalidParameterError, match="v"):
+        inverse_dynamics_rows(robot.model, q, v[:, :-1], a)
+    with pytest.raises(InvalidParameterError, match="the same number of rows"):
+        inverse_dynamics_rows(robot.model, q, v[:-1], a)

@@ -662,6 +662,7 @@ def test_the_html_report_answers_figure_27(tmp_path: Path) -> None:
         run=RunSpec(simulation=SimulationConfig(duration=10.0)),
         workers=1,
         animation=False,
+        limits_section=False,
         controllers=("adaptive",),
     )
     results = build_report(tmp_path / "r", options)

@@ -130,6 +130,7 @@ def test_a_signal_some_library_swallowed_stops_the_report_at_its_next_step(tmp_p
         workers=2,
         animation=False,
         identification=False,
+        limits_section=False,
         controllers=("pd", "computed-torque"),
     )
     seen: list[str] = []

@@ -15,7 +15,7 @@ from twolink_pin.report import MARKER, ReportOptions, build_report
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
-SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1)
+SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False)
 
 
 @pytest.fixture(scope="module")
@@ -126,6 +126,7 @@ def test_a_sixth_law_gets_its_own_section_and_the_errata_use_the_runs_lambda(tmp
     options = ReportOptions(
         run=RunSpec(simulation=SimulationConfig(duration=1.0), lam=3.0),
         workers=1,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         animation=False,
         identification=False,  # its table is the test above's
         controllers=("pd", "adaptive", "examples/sliding_mode.py:SlidingMode"),
@@ -148,6 +149,7 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
         robot=urdf,
         run=RunSpec(simulation=SimulationConfig(duration=1.0)),
         workers=1,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         animation=False,
         controllers=("pd",),
     )
@@ -186,6 +188,7 @@ def test_what_the_report_shows_of_a_robot_is_its_profiles_declaration(
         robot="declared",
         run=RunSpec(simulation=SimulationConfig(duration=0.5), plant=PlantOptions(friction="on")),
         workers=1,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         animation=False,
     )
     results = build_report(tmp_path / "r", options)
@@ -204,6 +207,7 @@ def test_the_identification_section_can_be_left_out(tmp_path: Path, report_dir: 
     short = {
         "run": RunSpec(simulation=SimulationConfig(duration=1.0)),
         "workers": 1,
+        "limits_section": False,
         "animation": False,
         "controllers": ("pd",),
     }
@@ -247,6 +251,7 @@ def test_failure_midway_leaves_the_previous_report_whole(
     small = ReportOptions(  # the smallest report that still goes through every stage before the pages
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         animation=False,
         identification=False,
         controllers=("pd",),
@@ -263,6 +268,7 @@ def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp
     options = ReportOptions(
         run=RunSpec(simulation=SimulationConfig(duration=0.5), lam=1e6),
         workers=2,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         animation=False,
         identification=False,
     )
@@ -287,6 +293,7 @@ def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> No
         robot=str(urdf),
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
+        limits_section=False,  # its own tests: test_report_within_limits.py
         controllers=("pd",),
     )
     results = build_report(tmp_path / "r", options)

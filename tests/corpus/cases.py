@@ -96,7 +96,7 @@ def C(id: str, argv: str | tuple[str | bytes, ...], exit: int | tuple[int, ...],
 
 SIM = "--duration 0.5"
 """A short run: 500 steps."""
-REP = "--duration 1 --workers 1 --no-animation --controller pd"
+REP = "--duration 1 --workers 1 --no-animation --no-limits-section --controller pd"
 """A cheap report: one law, one second, in this process, no animation."""
 LAW = "{corpus}/laws"
 SAVED = cli("simulate", "pd", "--duration", "0.5", "--save", "run.npz")
@@ -255,8 +255,8 @@ WRONG = [
     C("wrong-ik-twolink-payload", "ik 0.48 -0.1 --payload 2 --json", 0, checks=(ik_reaches(None, 0.48, -0.1),)),
     # -- options that must be honoured, and recorded where the output records settings
     C("wrong-report-saturate", f"report {REP} --saturate --out r", 0, checks=(json_at("r/results.json", "simulation.saturate", "==", True),)),
-    C("wrong-report-friction-smoothing", "report --duration 1 --workers 1 --no-animation --controller adaptive-friction --friction-smoothing 0.01 --out r", 0, checks=(json_at("r/results.json", "simulation.friction_smoothing", "==", 0.01),)),
-    C("wrong-report-settings", "report --duration 1 --workers 1 --no-animation --controller computed-torque --lambda 7 --q0-offset 0.2 -0.3 --dt 0.002 --payload 2 --out r", 0, checks=(json_at("r/results.json", "simulation.lambda.computed-torque", "==", 7.0), json_at("r/results.json", "simulation.q0_offset", "close", [0.2, -0.3]), json_at("r/results.json", "simulation.dt", "close", 0.002), json_at("r/results.json", "simulation.duration", "close", 1.0), json_at("r/results.json", "robot.payload_kg", "==", 2.0))),
+    C("wrong-report-friction-smoothing", "report --no-limits-section --duration 1 --workers 1 --no-animation --controller adaptive-friction --friction-smoothing 0.01 --out r", 0, checks=(json_at("r/results.json", "simulation.friction_smoothing", "==", 0.01),)),
+    C("wrong-report-settings", "report --no-limits-section --duration 1 --workers 1 --no-animation --controller computed-torque --lambda 7 --q0-offset 0.2 -0.3 --dt 0.002 --payload 2 --out r", 0, checks=(json_at("r/results.json", "simulation.lambda.computed-torque", "==", 7.0), json_at("r/results.json", "simulation.q0_offset", "close", [0.2, -0.3]), json_at("r/results.json", "simulation.dt", "close", 0.002), json_at("r/results.json", "simulation.duration", "close", 1.0), json_at("r/results.json", "robot.payload_kg", "==", 2.0))),
     C("wrong-simulate-saturate", "simulate pd --duration 0.05 --gain kp=5000 --saturate --json", 0, checks=(peak_within_limits(),)),
     C("wrong-simulate-q0-offset", "simulate pd --duration 0.05 --q0-offset 0.2 --json", 0, checks=(json_at("stdout", "metrics.max.e", ">=", [0.2 - 1e-12, 0.2 - 1e-12]),)),
     C("wrong-simulate-dt", "simulate pd --duration 0.5 --dt 0.002 --json", 0, checks=(json_at("stdout", "dt", "close", 0.002),)),
@@ -364,7 +364,7 @@ HANG = [
     C("hang-simulate-adaptive-long", "simulate pd --method adaptive --duration 1e5 --dt 1", (0, 1, 2), timeout=60, note="a long adaptive run on a coarse output grid: it must end or be refused within the timeout"),
     C("hang-sweep-duration-max", f"sweep pd --samples 2 --duration {MAX_DURATION:g}", 2, err=(str(MAX_STEPS),)),
     C("hang-compare-duration-max", f"compare pd --duration {MAX_DURATION:g} --no-plot --out c", 2, err=(str(MAX_STEPS),), absent=("c",)),
-    C("hang-report-duration-max", f"report --duration {MAX_DURATION:g} --workers 1 --no-animation --out r", 2, err=(str(MAX_STEPS),), absent=("r",)),
+    C("hang-report-duration-max", f"report --no-limits-section --duration {MAX_DURATION:g} --workers 1 --no-animation --out r", 2, err=(str(MAX_STEPS),), absent=("r",)),
     C("hang-animate-duration-1e5", "animate pd --duration 1e5 --html a.html", 2, err=(str(MAX_STEPS),), absent=("a.html",)),
     C("hang-animate-port-70000", f"animate pd {SIM} --no-browser --port 70000", 2, err=("70000", "65535")),
     C("hang-simulate-trajectory-file-fifo", f"simulate pd {SIM} --trajectory via.json", 2, err=("via.json", NOT_REGULAR), setup=(fifo("via.json"),), run="proc", timeout=20),
@@ -434,8 +434,8 @@ TRACEBACK = [
     C("traceback-simulate-stderr-closed-argparse", "simulate pd --dt 0", 2, run="stderr-closed"),
     C("traceback-simulate-stderr-closed-diverged", f"simulate computed-torque {SIM} --lambda 1e6", 1, run="stderr-closed"),
     # -- runs that fail: exit 1 naming the law and the time
-    C("traceback-report-lambda-1e6", "report --duration 1 --workers 1 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("r/index.html",), note="the laws without λ finish: their results are written", timeout=240),
-    C("traceback-report-lambda-1e6-workers-2", "report --duration 1 --workers 2 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), run="proc", exists=("r/index.html",), timeout=240),
+    C("traceback-report-lambda-1e6", "report --no-limits-section --duration 1 --workers 1 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("r/index.html",), note="the laws without λ finish: their results are written", timeout=240),
+    C("traceback-report-lambda-1e6-workers-2", "report --no-limits-section --duration 1 --workers 2 --no-animation --lambda 1e6 --out r", 1, err=("t =", "computed-torque|robust|adaptive"), run="proc", exists=("r/index.html",), timeout=240),
     C("traceback-compare-lambda-1e6", f"compare {SIM} --no-plot --lambda 1e6 --out c", 1, err=("t =", "computed-torque|robust|adaptive"), exists=("c/comparison.csv",), note="pd finishes: its row is written"),
     C("traceback-sweep-lambda-1e6", f"sweep computed-torque --samples 3 {SIM} --lambda 1e6 --no-plot --out s", (0, 1), err=("t =", "computed-torque"), note="a sweep may count diverged runs (exit 0, '3 diverged') or fail; both are sound"),
     C("traceback-simulate-lambda-1e6", f"simulate computed-torque {SIM} --lambda 1e6", 1, err=("computed-torque", "t =")),
@@ -453,12 +453,12 @@ TRACEBACK = [
     C("traceback-simulate-law-no-such-module", f"simulate nosuchmodule_xyz:Law {SIM}", 2, err=("nosuchmodule_xyz",)),
     C("traceback-compare-law-raises", f"compare {LAW}/raiser.py:Raiser pd {SIM} --no-plot --out c", 1, err=("corpus-raiser", "t ="), exists=("c/comparison.csv",), note="pd's row is written"),
     C("traceback-sweep-law-raises", f"sweep {LAW}/raiser.py:Raiser --samples 2 {SIM} --no-plot --out s", 1, err=("corpus-raiser", "t ="), absent=("s",)),
-    C("traceback-report-law-raises", f"report --duration 1 --workers 1 --no-animation --controller {LAW}/raiser.py:Raiser --out r", 1, err=("corpus-raiser", "t ="), exists=("r/index.html",), note="the page says the law did not finish", timeout=240),
+    C("traceback-report-law-raises", f"report --no-limits-section --duration 1 --workers 1 --no-animation --controller {LAW}/raiser.py:Raiser --out r", 1, err=("corpus-raiser", "t ="), exists=("r/index.html",), note="the page says the law did not finish", timeout=240),
     C("traceback-animate-law-raises", f"animate {LAW}/raiser.py:Raiser {SIM} --html a.html", 1, err=("corpus-raiser", "t ="), absent=("a.html",)),
     # -- qp-osc: limits that cannot all hold (1 % of the effort cannot hold the Panda up within 1 % of its accelerations), a QP that stops mid-run
     C("traceback-simulate-qp-osc-limits-cannot-hold", f"simulate qp-osc --robot panda --gain limit_scale=0.01 {SIM}", 1, err=("qp-osc", "t =", "cannot all hold", "of joint")),
     C("traceback-compare-qp-osc-limits-cannot-hold", "compare osc qp-osc --robot panda --gain qp-osc.limit_scale=0.01 --duration 0.05 --no-plot --out c", 1, err=("qp-osc", "t =", "cannot all hold"), exists=("c/comparison.csv",), checks=(contains("c/comparison.md", "| osc |"),), note="osc's row is written"),
-    C("traceback-report-qp-osc-limits-cannot-hold", "report --robot panda --duration 0.2 --workers 1 --no-animation --no-identification --controller osc --controller qp-osc --gain qp-osc.limit_scale=0.01 --out r", 1, err=("qp-osc", "t =", "cannot all hold"), exists=("r/index.html",), checks=(contains("r/index.html", "cannot all hold"),), note="the page says qp-osc did not finish and why; osc's results are in it", timeout=240),
+    C("traceback-report-qp-osc-limits-cannot-hold", "report --no-limits-section --robot panda --duration 0.2 --workers 1 --no-animation --no-identification --controller osc --controller qp-osc --gain qp-osc.limit_scale=0.01 --out r", 1, err=("qp-osc", "t =", "cannot all hold"), exists=("r/index.html",), checks=(contains("r/index.html", "cannot all hold"),), note="the page says qp-osc did not finish and why; osc's results are in it", timeout=240),
     C("traceback-simulate-qp-osc-cannot-hold-mid-run", "simulate qp-osc --robot panda --payload 3 --trajectory fold.toml --q0-offset 1.5 0 0 0 0 0 0 --gain limit_scale=0.25 --duration 0.5", 1, err=("qp-osc", "t = 0.", "cannot all hold", "of joint"), setup=(via("fold.toml", PANDA_FOLD),), note="a quarter of the effort brakes the arm's swing too late: the limits stop being satisfiable partway"),
     # -- saved results that are not
     *(C(f"traceback-animate-from-{name}", "animate --from bad.npz --html a.html", 2, err=("bad.npz",), setup=(step,), absent=("a.html",)) for name, step in NPZ_BAD.items()),
@@ -716,7 +716,7 @@ UNCLEAR = [
     C("unclear-simulate-law-case", f"simulate PD {SIM}", 2, err=("PD", "pd")),
     C("unclear-simulate-law-empty", ("simulate", "", "--duration", "0.5"), 2, err=("law|controller",)),
     C("unclear-compare-law-twice", f"compare pd pd {SIM} --no-plot --out c", 2, err=("pd", "once"), absent=("c",)),
-    C("unclear-report-law-twice", "report --duration 1 --workers 1 --no-animation --controller pd --controller pd --out r", 2, err=("pd", "once"), absent=("r",)),
+    C("unclear-report-law-twice", "report --no-limits-section --duration 1 --workers 1 --no-animation --controller pd --controller pd --out r", 2, err=("pd", "once"), absent=("r",)),
     # -- options that need others
     C("unclear-info-write-urdf-no-payload", "info --write-urdf heavy.urdf", 2, err=("--payload",), absent=("heavy.urdf",)),
     C("unclear-animate-nothing-to-show", "animate --html a.html", 2, err=("--from", "controller|CONTROLLER"), absent=("a.html",)),
@@ -732,7 +732,7 @@ UNCLEAR = [
     C("unclear-simulate-help", "simulate --help", 0, out=("--duration",)),
     C("unclear-simulate-user-law-example", f"simulate examples/sliding_mode.py:SlidingMode {SIM}", 0, cwd="repo", setup=(symlink("repo", str(__import__("pathlib").Path(__file__).resolve().parents[2])),), note="the tutorial's law, run from the repository"),
     C("unclear-info-missing-mesh", "info --robot missing_mesh.urdf", 0, setup=(urdf("missing_mesh"),)),
-    C("unclear-report-animation-twolink", "report --duration 1 --workers 1 --controller pd --out r", 0, exists=("r/index.html", "r/animation.html"), checks=(contains("r/results.json", '"saturate": false'),)),
+    C("unclear-report-animation-twolink", "report --no-limits-section --duration 1 --workers 1 --controller pd --out r", 0, exists=("r/index.html", "r/animation.html"), checks=(contains("r/results.json", '"saturate": false'),)),
     # -- the catalog's other robots and the newer options
     C("unclear-info-friction", "info --friction --json", 0, checks=(strict_json(),)),
     C("unclear-info-friction-arm3", "info --friction --robot arm3.urdf", 0, setup=(urdf("arm3"),)),
@@ -762,13 +762,13 @@ def twolink_text_latin1() -> bytes:
 # as long as it cleans up), leaves no staging folder, no partial file, no worker process.
 TERM_EXITS = 143
 INTERRUPT = [
-    C("interrupt-report-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
-    C("interrupt-report-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
-    C("interrupt-report-sigint-parent-only", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "parent"), absent=("r",)),
-    C("interrupt-report-workers-1-sigterm", "report --workers 1 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
-    C("interrupt-report-workers-1-sigint", "report --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
-    C("interrupt-report-own-folder-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the previous report stays whole"),
-    C("interrupt-report-own-folder-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), err=("terminated",)),
+    C("interrupt-report-sigterm", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
+    C("interrupt-report-sigint", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
+    C("interrupt-report-sigint-parent-only", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "parent"), absent=("r",)),
+    C("interrupt-report-workers-1-sigterm", "report --no-limits-section --workers 1 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("r",), err=("terminated",)),
+    C("interrupt-report-workers-1-sigint", "report --no-limits-section --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("r",)),
+    C("interrupt-report-own-folder-sigint", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the previous report stays whole"),
+    C("interrupt-report-own-folder-sigterm", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), err=("terminated",)),
     C("interrupt-sweep-sigint", "sweep pd --samples 20000 --duration 30 --out s", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("s",)),
     C("interrupt-sweep-sigterm", "sweep pd --samples 20000 --duration 30 --out s", TERM_EXITS, run="signal", signal=(SIGTERM, "running", "parent"), absent=("s",), err=("terminated",)),
     C("interrupt-simulate-sigint", "simulate adaptive --duration 1000 --save run.npz", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("run.npz",)),
@@ -783,16 +783,16 @@ INTERRUPT = [
     C("interrupt-simulate-importing-sigint", "simulate adaptive --duration 1000 --save run.npz", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), absent=("run.npz",)),
     C("interrupt-simulate-importing-sigterm", "simulate adaptive --duration 1000 --save run.npz", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "started", "parent"), absent=("run.npz",)),
     C("interrupt-fk-importing-sigint", "fk 0 0 --json", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), note="a command that takes no time still says 'interrupted' if Ctrl-C comes while it loads"),
-    C("interrupt-report-importing-sigint", "report --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), absent=("r",)),
+    C("interrupt-report-importing-sigint", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "started", "group"), absent=("r",)),
     C("interrupt-sweep-importing-sigterm", "sweep pd --samples 20000 --duration 30 --out s", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "started", "parent"), absent=("s",)),
     C("interrupt-compare-parsed-sigint", "compare --duration 300 --out c", 130, err=("interrupted",), run="signal", signal=(SIGINT, "parsed", "group"), absent=("c",)),
     C("interrupt-sweep-parsed-sigint", "sweep pd --samples 20000 --duration 30 --out s", 130, err=("interrupted",), run="signal", signal=(SIGINT, "parsed", "group"), absent=("s",)),
-    C("interrupt-report-parsed-sigterm", "report --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "parsed", "parent"), absent=("r",)),
+    C("interrupt-report-parsed-sigterm", "report --no-limits-section --workers 2 --duration 30 --no-animation --out r", TERM_EXITS, err=("terminated",), run="signal", signal=(SIGTERM, "parsed", "parent"), absent=("r",)),
     C("interrupt-ik-parsed-sigterm", "ik 0.3 0.2 --json", (0, 143), run="signal", signal=(SIGTERM, "parsed", "parent"), note="ik may finish before the signal lands: its answer (exit 0) or 143, never a traceback"),
     # while writing: the signal comes when the output is being staged; the command may finish first
     C("interrupt-simulate-writing-sigint", "simulate pd --duration 20 --save run.npz", (0, 130), run="signal", signal=(SIGINT, "writing", "group"), checks=(whole_or_absent("run.npz"),)),
     C("interrupt-simulate-writing-sigterm", "simulate pd --duration 20 --save run.npz", (0, 143), run="signal", signal=(SIGTERM, "writing", "parent"), checks=(whole_or_absent("run.npz"),)),
-    C("interrupt-report-own-folder-writing-sigint", "report --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "writing", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the report stages its folder before its runs: the previous report stays whole"),
+    C("interrupt-report-own-folder-writing-sigint", "report --no-limits-section --workers 1 --duration 30 --no-animation --out r", 130, err=("interrupted",), run="signal", signal=(SIGINT, "writing", "group"), setup=(cli("report", *REP.split(), "--out", "r"),), exists=("r/index.html",), note="the report stages its folder before its runs: the previous report stays whole"),
 ]
 
 

@@ -401,6 +401,9 @@ def _add_report(sub: Any, c: Any) -> None:
         action="store_true",
         help="skip the twolink's identification section (beside Fig. 27; about a third of the report's CPU time)",
     )
+    p.add_argument(
+        "--no-limits-section", action="store_true", help="skip the section 'The reference within the limits'"
+    )
     add_robot_options(p)
     add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)

@@ -16,6 +16,7 @@
 ``osc.py``             ``osc`` — :class:`OperationalSpace` (Khatib)
 ``impedance.py``       ``impedance`` — :class:`Impedance` (Cartesian impedance + ĝ)
 ``qp_osc.py``          ``qp-osc`` — :class:`QPOperationalSpace` (``osc`` as a QP within the limits)
+``mpc.py``             ``mpc`` — :class:`ModelPredictive` (a plan within the limits, replanned)
 =====================  ============================================================
 """
 
@@ -43,6 +44,7 @@ from twolink_pin.controllers.pid import PID, PIDGains
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
 from twolink_pin.controllers.impedance import Impedance, ImpedanceGains
 from twolink_pin.controllers.qp_osc import QPOperationalSpace, QPOSCGains
+from twolink_pin.controllers.mpc import MPCGains, ModelPredictive
 from twolink_pin.controllers.loading import available_controllers, load_controller
 
 __all__ = [
@@ -61,6 +63,8 @@ __all__ = [
     "ImpedanceGains",
     "LawInput",
     "LawOutput",
+    "MPCGains",
+    "ModelPredictive",
     "OSCGains",
     "OperationalSpace",
     "PDFeedforward",

@@ -18,8 +18,8 @@ import math
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-import pinocchio as pin
 
+from twolink_pin.dynamics.rigid_body import inverse_dynamics_rows
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits.joint_limits import JointLimits, joint_limits
 from twolink_pin.limits.kinds import KINDS, LimitKind, Motion
@@ -58,8 +58,7 @@ def reference_motion(
     ``+ f(q̇)`` with ``friction``."""
     t = check_grid(trajectory.t0, trajectory.period, samples)
     ref = trajectory.sample(t)
-    model, data = robot.model, robot.create_data()
-    tau = np.array([pin.rnea(model, data, q, v, a) for q, v, a in zip(ref.q, ref.v, ref.a)])
+    tau = inverse_dynamics_rows(robot.model, ref.q, ref.v, ref.a)
     if friction is not None:
         tau = tau + friction.torque(ref.v)
     return Motion(t, ref.q, ref.v, ref.a, tau)

@@ -14,6 +14,8 @@ and ``limits/``.
                             (:class:`Pin`), limits, linearised on the dynamics' derivatives
 ``sqp.py``                  :func:`solve_sqp` (to convergence), :func:`sqp_step` (one real-time iteration)
 ``refinement.py``           :func:`solve_within_limits`: the limits between the check points too
+``horizon.py``              :class:`~twolink_pin.optimal.horizon.Horizon`: the model-predictive law's
+                            horizon QP (knot accelerations, RNEA linearised, limits as rows)
 ==========================  ================================================================
 
 The robot's dynamics reach the core through one callable,

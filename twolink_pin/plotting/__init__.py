@@ -30,6 +30,8 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
                      law's variants on the same axes (error envelope, torque)
 ``limits.py``        :func:`save_limits_figure`: several runs against one joint's range and
                      one joint's effort limit
+``velocity_limits``  :func:`save_velocity_limits_figure`: several runs against one joint's
+                     velocity and effort limits
 ===================  =====================================================================
 
 Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,
@@ -44,6 +46,7 @@ from twolink_pin.plotting.limits import save_limits_figure
 from twolink_pin.plotting.run import save_simulation_figures
 from twolink_pin.plotting.task import save_task_error_figure
 from twolink_pin.plotting.trajectory import save_trajectory_figures
+from twolink_pin.plotting.velocity_limits import save_velocity_limits_figure
 
 __all__ = [
     "save_distribution_figure",
@@ -52,4 +55,5 @@ __all__ = [
     "save_simulation_figures",
     "save_task_error_figure",
     "save_trajectory_figures",
+    "save_velocity_limits_figure",
 ]

@@ -6,6 +6,8 @@ joint, the limits dashed and the stretches where a limit is active shaded.
 draw); :func:`limit_figures` returns the figures keyed ``velocity``, ``acceleration``,
 ``torque``. A reference drawn beside it (the motion before retiming or optimisation) is a
 thin grey line on its own time axis, stretched to the motion's duration and labelled so.
+:func:`save_references_figures` draws several references overlaid, each on its own time
+axis scaled to its duration (the report's section "The reference within the limits").
 Time [s], rates [rad/s], accelerations [rad/s²], torques [N·m].
 """
 
@@ -137,4 +139,68 @@ def save_limit_figures(
     return save_figures(limit_figures(motion, limits, title, active, reference), out_dir, prefix)
 
 
-__all__ = ["limit_figures", "save_limit_figures"]
+REFERENCE_COLORS = ("0.2", "tab:blue", "tab:green", "tab:purple", "tab:brown")
+"""Colours of the references overlaid by :func:`save_references_figures`, in order."""
+
+
+def _references_figure(
+    motions: dict[str, Motion], limits: JointLimits, kind: LimitKind, symbol: str, title: str
+) -> Figure:
+    """One figure: ``kind``'s quantity of every motion per joint against ``t / duration``, the
+    limit dashed (its value on the axis), one legend below the panels; a limit far beyond every
+    motion's peak is not drawn, its panel's title says so."""
+    nv = limits.nv
+    fig = new_figure(rows_figsize(TORQUE_FIGSIZE, nv, 0.55 * TORQUE_ROW_HEIGHT))
+    axes = fig.subplots(nv, 1, sharex=True, squeeze=False)[:, 0]
+    _, upper = limits.bounds(kind)
+    for j, ax in enumerate(axes):
+        peak = 0.0
+        for (label, motion), color in zip(motions.items(), REFERENCE_COLORS, strict=False):
+            values = kind.of(motion)
+            assert values is not None
+            duration = float(motion.t[-1] - motion.t[0]) or 1.0
+            ax.plot((motion.t - motion.t[0]) / duration, values[:, j], color=color, lw=1.1, label=label)
+            peak = max(peak, float(np.abs(values[:, j]).max()))
+        limit = float(upper[j])
+        if math.isfinite(limit) and limit <= OFF_SCALE * max(peak, 1e-300):
+            ax.axhline(limit, color=LIMIT_COLOR, ls="--", lw=1.0, label="±limit")
+            ax.axhline(-limit, color=LIMIT_COLOR, ls="--", lw=1.0)
+            ax.set_ylim(-1.15 * limit, 1.15 * limit)
+            ax.set_title(f"joint {j + 1}: limit ±{limit:.4g} {kind.unit}", fontsize=8)
+        elif math.isfinite(limit):
+            ax.set_title(
+                f"joint {j + 1}: the ±{limit:.4g} {kind.unit} limit is off scale (largest peak "
+                f"{100 * peak / limit:.1f} % of it)",
+                fontsize=8, color=LIMIT_COLOR,
+            )  # fmt: skip
+        else:
+            ax.set_title(f"joint {j + 1}: no {kind.name} limit given", fontsize=8)
+        ax.set_ylabel(f"{symbol}{j + 1} [{kind.unit}]")
+        ax.grid(alpha=0.3)
+    # one legend for every panel, below them: it never covers a curve
+    handles, labels = max((ax.get_legend_handles_labels() for ax in axes), key=lambda hl: len(hl[1]))
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=7.5, frameon=False)
+    axes[-1].set_xlabel("t / duration (each reference on its own time scale)")
+    what = "torque" if kind is EFFORT else kind.name
+    fig.suptitle(f"{title}: {what} against the limits", fontsize=10)
+    return fig
+
+
+def save_references_figures(
+    motions: dict[str, Motion],
+    limits: JointLimits,
+    out_dir: str | os.PathLike[str],
+    prefix: str,
+    title: str,
+) -> list[Path]:
+    """The velocity, torque and (where some joint has one) acceleration of several references
+    overlaid against their limits (``motions``: label → one period of each, the labels saying
+    the durations), as ``out_dir/<prefix><key>.png``; a kind no joint limits is not drawn."""
+    figures = {}
+    for kind, key, symbol in PANELS:
+        if limits.given(kind).any() and all(kind.of(m) is not None for m in motions.values()):
+            figures[key] = _references_figure(motions, limits, kind, symbol, title)
+    return save_figures(figures, out_dir, prefix)
+
+
+__all__ = ["limit_figures", "save_limit_figures", "save_references_figures"]

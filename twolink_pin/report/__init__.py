@@ -6,6 +6,7 @@
 ``runs.py``             worker tasks: one law's run and figures, the trajectory's figures
 ``pool.py``             worker processes that never outlive the report (or in-process)
 ``facts.py``            the model, the torque check, the versions
+``within_limits.py``    the section "The reference within the limits": three references, the laws on each
 ``pages.py``            ``index.html`` (from ``templates/report.html``), ``report.md``, JSON
 ``templates/``          the page's Jinja2 template (package data)
 ======================  ===============================================================

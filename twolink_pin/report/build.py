@@ -39,6 +39,7 @@ from twolink_pin.report import facts
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
+from twolink_pin.report.within_limits import limits_section
 from twolink_pin.run_spec import Row, build_rows, gains_used, plant_description
 from twolink_pin.scenario import builtin_laws
 from twolink_pin.simulation import SimulationResult
@@ -91,7 +92,8 @@ def build_report(
     options.run.check_law_gains(laws)
     options.run.check_effective(robot, laws)
     rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
-    steps = 4 + len(rows) + (1 if options.animation else 0) + (sections.steps(options) if sections else 0)
+    steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
+    steps += sections.steps(options) if sections else 0
     done = 0
     heard = len(interrupts.received)
 
@@ -177,6 +179,7 @@ def _build(
         "animated": ran.animated,
         "errata": errata,
         "identification": ran.identification,
+        "within_limits": ran.within_limits,
         "versions": facts.versions(),
     }
 
@@ -204,6 +207,9 @@ class _Ran(NamedTuple):
     """The robot's own sections' facts (None without)."""
     overlays: dict[str, str]
     """Each law run as several variants: the figure of their runs overlaid (file name)."""
+    within_limits: dict[str, Any] | None
+    """The section "The reference within the limits" (:mod:`~twolink_pin.report.within_limits`),
+    None without it."""
 
 
 def _run_all(
@@ -236,6 +242,11 @@ def _run_all(
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
         pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
+        limits_future = (  # about as long as a law's run: before them, so the runs fill in around it
+            pool.submit(limits_section, [(n, rows[n].variant) for n in names], options, str(stage))
+            if options.limits_section
+            else None
+        )
         futures = {
             n: pool.submit(run_law, rows[n].variant, options, str(fig_dir), numbers.get(n)) for n in order
         }
@@ -258,14 +269,19 @@ def _run_all(
         traj_figs = traj_future.result()
         tick("trajectory figures")
         overlays = _write_overlays(fig_dir, rows, runs, options)
+        within_limits = None
+        if limits_future is not None:
+            within_limits = limits_future.result()
+            tick("the reference within the limits")
         identification = None
         if sections and pending is not None:
             done_runs = {n: r[0] for n, r in runs.items()}
             identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
             tick("identification")
     return _Ran(
-        runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays
-    )
+        runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays,
+        within_limits,
+    )  # fmt: skip
 
 
 def _write_overlays(

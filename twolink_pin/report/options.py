@@ -34,6 +34,10 @@ class ReportOptions:
         identification: Whether the twolink's report has its identification section (beside
             Fig. 27: the adaptive law along two excitations and an identification from a
             logged 2-kHz run; about a third of the report's CPU time, docs/performance.md).
+        limits_section: Whether the report has its section "The reference within the limits"
+            (:mod:`twolink_pin.report.within_limits`: the reference, its time-optimal
+            retiming and the minimum-effort trajectory, the laws tracking each; about
+            a tenth of the report's CPU time, docs/performance.md).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
@@ -47,6 +51,7 @@ class ReportOptions:
     workers: int | None = None
     animation: bool = True
     identification: bool = True
+    limits_section: bool = True
     trajectory: str | None = None
 
     def __post_init__(self) -> None:

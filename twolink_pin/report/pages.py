@@ -111,8 +111,76 @@ def html(r: dict[str, Any]) -> str:
     return (
         _environment()
         .get_template("report.html")
-        .render(r=r, tables=tables, task_table=_task_table(r), discussion=_discussion(r), nv=nv)
+        .render(
+            r=r,
+            tables=tables,
+            task_table=_task_table(r),
+            discussion=_discussion(r),
+            nv=nv,
+            limits=_limits_tables(r, nv),
+        )
     )
+
+
+RATIO_SYMBOLS = {"velocity": "q̇", "acceleration": "q̈", "effort": "τ"}
+"""The symbol of each kind whose peak ratio the section's reference table gives."""
+
+
+def _crossed(crossings: dict[str, Any]) -> str:
+    """A run's crossings in a few symbols: ``q̇2 +0.361 rad/s (t = 0.076 s); τ1 +32.8 N·m
+    (t = 0.001 s)`` — the limit, by how much at most, first when."""
+    symbols = {"position": "q", "velocity": "q̇", "effort": "τ"}
+    parts = []
+    for kind, entry in crossings.items():
+        for j, crossed in enumerate(entry["crossed"]):
+            if crossed:
+                excess, first = entry["excess"][j], entry["first_time"][j]
+                parts.append(
+                    f"{symbols.get(kind, kind)}{j + 1} +{fmt(excess, 3)} {entry['unit']} (t = {fmt(first, 3)} s)"
+                )
+    return "; ".join(parts)
+
+
+def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
+    """The section "The reference within the limits": its references' table (one row per
+    reference) and its tracking table (one row per law and reference); None without it."""
+    section = r.get("within_limits")
+    if not section:
+        return None
+    refs = section["references"]
+    kinds = [k for k in RATIO_SYMBOLS if any(k in ref["peak_ratio"] for ref in refs.values())]
+    ref_headers = ["reference", "duration [s]"]
+    ref_headers += [f"peak |{RATIO_SYMBOLS[k]}{j + 1}| / limit" for k in kinds for j in range(nv)]
+    ref_headers += ["∫τᵀτ dt [N²·m²·s]", "within every limit", "file"]
+    ref_rows = [
+        [
+            ref["title"],
+            fmt(ref["duration_s"]),
+            *(fmt(x) for k in kinds for x in ref["peak_ratio"].get(k, [None] * nv)),
+            fmt(ref["effort_integral"]),
+            fmt(ref["within_limits"]),
+            ref["file"],
+        ]
+        for ref in refs.values()
+    ]
+    track_headers = ["controller", "reference", "run [s]"]
+    track_headers += [f"RMS e{j + 1} [rad]" for j in range(nv)] + [f"max |e{j + 1}| [rad]" for j in range(nv)]
+    track_headers += [f"max |τ{j + 1}| [N·m]" for j in range(nv)] + ["limits crossed"]
+    track_rows = []
+    for row in section["tracking"]:
+        head = [row["law"], refs[row["reference"]]["short"], fmt(row["duration_s"])]
+        if not row["finished"]:
+            track_rows.append(head + ["—"] * (3 * nv) + [f"did not finish: {row['failed']}"])
+            continue
+        m = row["metrics"]
+        cells = [fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["max"]["tau"]]
+        track_rows.append(head + cells + [_crossed(row["crossings"]) or "none"])
+    return {
+        "reference_headers": ref_headers,
+        "reference_rows": ref_rows,
+        "tracking_headers": track_headers,
+        "tracking_rows": track_rows,
+    }
 
 
 def _task_table(r: dict[str, Any]) -> dict[str, Any] | None:
@@ -178,6 +246,7 @@ def markdown(r: dict[str, Any]) -> str:
             )
             lines.append(f"| {row['title']} | " + " | ".join(fmt(x) for x in cells) + " |")
         lines.append("")
+    lines += _limits_markdown(r)
     if r["errata"]:
         lines += ["## Errata", ""]
         for e in r["errata"]:
@@ -193,6 +262,22 @@ def markdown(r: dict[str, Any]) -> str:
                 "",
             ]
     return "\n".join(lines)
+
+
+def _limits_markdown(r: dict[str, Any]) -> list[str]:
+    """``report.md``'s lines of the section "The reference within the limits" (none without it)."""
+    tables = _limits_tables(r, r["robot"]["nv"])
+    if tables is None:
+        return []
+    lines = ["## The reference within the limits", ""]
+    for heads, rows in (
+        (tables["reference_headers"], tables["reference_rows"]),
+        (tables["tracking_headers"], tables["tracking_rows"]),
+    ):
+        escaped = [[cell.replace("|", "\\|") for cell in row] for row in [heads, *rows]]
+        lines += ["| " + " | ".join(escaped[0]) + " |", "|" + "---|" * len(heads)]
+        lines += ["| " + " | ".join(row) + " |" for row in escaped[1:]] + [""]
+    return lines + [f"- {note}" for note in r["within_limits"]["notes"]]
 
 
 def write_pages(stage: Path, r: dict[str, Any]) -> None:

@@ -40,6 +40,7 @@ import pinocchio as pin
 
 from twolink_pin import interrupts
 from twolink_pin.dynamics.derivatives import RneaDerivatives
+from twolink_pin.dynamics.rigid_body import inverse_dynamics_rows
 from twolink_pin.errors import InvalidParameterError, OptimizationError, require_type
 from twolink_pin.limits import (
     ACCELERATION,
@@ -348,8 +349,7 @@ def effort_integral(
     spaced instants, trapezoid."""
     t = trajectory.t0 + np.linspace(0.0, trajectory.period, samples)
     ref = trajectory.sample(t)
-    model, data = robot.model, robot.create_data()
-    tau = np.array([pin.rnea(model, data, q, v, a) for q, v, a in zip(ref.q, ref.v, ref.a)])
+    tau = inverse_dynamics_rows(robot.model, ref.q, ref.v, ref.a)
     if friction is not None:
         tau = tau + friction.torque(ref.v)
     return float(np.trapezoid((tau**2).sum(axis=1), t))

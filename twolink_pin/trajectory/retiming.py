@@ -54,9 +54,9 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-import pinocchio as pin
 
 from twolink_pin import interrupts
+from twolink_pin.dynamics.rigid_body import inverse_dynamics_rows
 from twolink_pin.errors import InvalidParameterError, OptimizationError, require_type
 from twolink_pin.limits import (
     ACCELERATION,
@@ -301,11 +301,10 @@ def _stage(robot: RobotModel, piece: _Piece, grid: np.ndarray, friction: Frictio
     theta = np.arange(SUBPOINTS) / SUBPOINTS
     s = np.append((grid[:-1, None] + np.diff(grid)[:, None] * theta).ravel(), grid[-1])
     q, dq, ddq = (piece.path(s, r) for r in range(3))
-    model, data = robot.model, robot.create_data()
-    zero = np.zeros(robot.nv)
-    c = np.array([pin.rnea(model, data, x, zero, zero) for x in q])
-    a = np.array([pin.rnea(model, data, x, zero, d1) for x, d1 in zip(q, dq)]) - c
-    b = np.array([pin.rnea(model, data, x, d1, d2) for x, d1, d2 in zip(q, dq, ddq)]) - c
+    zero = np.zeros_like(dq)
+    c = inverse_dynamics_rows(robot.model, q, zero, zero)
+    a = inverse_dynamics_rows(robot.model, q, zero, dq) - c
+    b = inverse_dynamics_rows(robot.model, q, dq, ddq) - c
     return _Stage(s, q, dq, ddq, a, b, c)
 
 
@@ -582,8 +581,7 @@ def _torque(
     robot: RobotModel, q: np.ndarray, v: np.ndarray, a: np.ndarray, friction: Friction | None
 ) -> np.ndarray:
     """``RNEA(q, q̇, q̈) (+ f(q̇))`` at each row [N·m]."""
-    model, data = robot.model, robot.create_data()
-    tau = np.array([pin.rnea(model, data, x, y, z) for x, y, z in zip(q, v, a)])
+    tau = inverse_dynamics_rows(robot.model, q, v, a)
     return tau if friction is None else tau + friction.torque(v)
 
 

@@ -410,6 +410,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         workers=args.workers,
         animation=not args.no_animation,
         identification=not args.no_identification,
+        limits_section=not args.no_limits_section,
         trajectory=args.trajectory,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))

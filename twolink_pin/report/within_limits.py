@@ -1,0 +1,185 @@
+"""The report's section "The reference within the limits": the report's reference, its
+time-optimal retiming and the minimum-effort trajectory through the same via points side by
+side, and the report's laws tracking each.
+
+**The references.** ``reference``: what the report's runs track (on the twolink the course's
+polynomial), as it is; ``time_optimal``: its path timed as fast as the velocity, acceleration
+and effort limits allow (:func:`~twolink_pin.trajectory.retiming.time_optimal`, TOPP-RA);
+``minimum_effort``: the least ``∫ τᵀτ dt`` through its via points at its via times, within
+every limit (:func:`~twolink_pin.trajectory.optimal.optimize`). All on the robot's model (its
+payload included), no friction, the whole limits (``limit_scale`` 1). A reference the robot
+cannot have (no velocity limit to retime against, a solver that fails) is a note instead of a
+row; the others are kept.
+
+**Each reference's row** uses the one definition of each number: its duration is its period
+[s]; peak ``|q̇|``, ``|q̈|`` (where a limit is given) and ``|τ|`` as a fraction of the limit per
+joint are :func:`~twolink_pin.limits.check_limits`'s peak over its limit (one period on the
+check grid, torque by RNEA); ``∫ τᵀτ dt`` [N²·m²·s] is
+:func:`~twolink_pin.trajectory.optimal.effort_integral`'s. Each is written to
+``references/<key>.json``, a trajectory file every ``--trajectory`` reads (``simulate``,
+``compare``, ``animate``; the report's own ``--trajectory`` wants via points).
+
+**The tracking rows**: every row of the report (law or variant) on every reference, with the
+report's simulation settings (step, initial offset, plant) over **one period** of that
+reference (short runs: the section costs what 3 periods of each law cost), its metrics
+(:func:`~twolink_pin.metrics.compute_metrics`: RMS and max of ``e``, ``ė``, ``τ``, the
+crossings of the position, velocity and effort limits). A run that diverges is a row saying so.
+
+:func:`limits_section` is one worker task (picklable arguments only): the design, the files,
+the figures and the runs; it returns the section as ``results.json`` holds it under
+``within_limits``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.errors import (
+    ControllerError,
+    InvalidParameterError,
+    OptimizationError,
+    SimulationDivergedError,
+)
+from twolink_pin.law_variant import Variant
+from twolink_pin.limits import ACCELERATION, EFFORT, VELOCITY, LimitsCheck, check_limits, joint_limits
+from twolink_pin.metrics import compute_metrics
+from twolink_pin.model import load_robot
+from twolink_pin.report.options import ReportOptions
+from twolink_pin.report.runs import reference_trajectory
+from twolink_pin.simulation import simulate
+from twolink_pin.trajectory import Trajectory
+
+REFERENCES = {
+    "reference": ("the report's reference", "reference"),
+    "time_optimal": ("its time-optimal retiming", "time-optimal"),
+    "minimum_effort": ("the minimum-effort trajectory", "minimum effort"),
+}
+"""The references' keys (file names under ``references/``), titles and short names (the
+tracking table's), in table order."""
+RATIO_KINDS = (VELOCITY, ACCELERATION, EFFORT)
+"""The limits whose peak ratio a reference's row gives (a kind no joint limits is left out)."""
+FIGURE_PREFIX = "limits_references_"
+"""The section's figures: ``figures/limits_references_<velocity|acceleration|torque>.png``."""
+CROSSED_KINDS = ("position", "velocity", "effort")
+"""The limits whose crossings a tracking row lists."""
+
+__all__ = ["FIGURE_PREFIX", "REFERENCES", "limits_section", "reference_row"]
+
+
+def _design(robot: Any, reference: Any) -> tuple[dict[str, Any], list[str]]:
+    """The three references (those the robot can have) and a note for each it cannot."""
+    from twolink_pin.trajectory.optimal import optimize
+    from twolink_pin.trajectory.retiming import time_optimal
+
+    designed: dict[str, Any] = {"reference": reference}  # a via-point reference, then two sampled
+    notes = []
+    try:
+        designed["time_optimal"] = time_optimal(robot, reference).trajectory
+    except (InvalidParameterError, OptimizationError) as exc:
+        notes.append(f"no time-optimal retiming: {exc}")
+    try:
+        designed["minimum_effort"] = optimize(robot, reference, "effort").trajectory
+    except (InvalidParameterError, OptimizationError) as exc:
+        notes.append(f"no minimum-effort trajectory: {exc}")
+    return designed, notes
+
+
+def _titles(key: str, trajectory: Any) -> tuple[str, str]:
+    """The reference's title and short name: :data:`REFERENCES`', the report's a polynomial's
+    when it is one."""
+    from twolink_pin.trajectory.polynomial import JointTrajectory
+
+    if key == "reference" and isinstance(trajectory, JointTrajectory):
+        return "the polynomial through the via points", "polynomial"
+    return REFERENCES[key]
+
+
+def reference_row(robot: Any, trajectory: Trajectory) -> tuple[dict[str, Any], LimitsCheck]:
+    """One reference's numbers (module docstring): ``duration_s`` [s], ``peak_ratio`` (kind →
+    per-joint peak / limit, None for a joint without that limit; only kinds some joint
+    limits), ``effort_integral`` [N²·m²·s], ``within_limits``; and the check they come from."""
+    from twolink_pin.trajectory.optimal import effort_integral
+
+    check = check_limits(robot, trajectory)
+    ratios = {}
+    for kind in RATIO_KINDS:
+        if not check.limits.given(kind).any():
+            continue
+        k = check.of(kind.name)
+        ratios[kind.name] = [
+            float(p / lim) if np.isfinite(lim) else None for p, lim in zip(k.peak, k.limit, strict=True)
+        ]
+    row = {
+        "duration_s": float(trajectory.period),
+        "peak_ratio": ratios,
+        "effort_integral": effort_integral(robot, trajectory),
+        "within_limits": check.within_limits,
+    }
+    return row, check
+
+
+def _track(robot: Any, variant: Variant, options: ReportOptions, trajectory: Trajectory) -> dict[str, Any]:
+    """One law on one reference for one period (module docstring): its metrics and crossings,
+    or what stopped it."""
+    cfg = options.run.simulation
+    duration = max(float(trajectory.period), cfg.control_period or 0.0, cfg.dt)
+    start = time.perf_counter()
+    controller, plant = options.run.for_law(variant).build(robot)
+    try:
+        result = simulate(controller, plant, trajectory, replace(cfg, duration=duration))
+    except (SimulationDivergedError, ControllerError) as exc:
+        return {"finished": False, "failed": str(exc), "duration_s": duration}
+    metrics = compute_metrics(result)
+    return {
+        "finished": True,
+        "duration_s": duration,
+        "metrics": metrics.as_dict(),
+        "peak_command": np.asarray(metrics.peak_command).tolist(),
+        "crossings": metrics.crossings.summary(),
+        "crossed": metrics.crossings.sentences(result.joint_limits, CROSSED_KINDS),
+        "seconds": time.perf_counter() - start,
+    }
+
+
+def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stage: str) -> dict[str, Any]:
+    """Worker: the section (module docstring) for the report's ``rows`` (name, variant), its
+    reference files under ``stage/references`` and figures under ``stage/figures``; returns
+    what ``results.json`` holds under ``within_limits``."""
+    from twolink_pin.limits import reference_motion
+    from twolink_pin.plotting.within_limits import save_references_figures
+    from twolink_pin.trajectory.file import write_trajectory_file
+
+    start = time.perf_counter()
+    robot = load_robot(options.robot, payload=options.payload)
+    designed, notes = _design(robot, reference_trajectory(robot, options))
+    folder = Path(stage) / "references"
+    folder.mkdir(exist_ok=True)
+    references, motions = {}, {}
+    for key, trajectory in designed.items():
+        row, _ = reference_row(robot, trajectory)
+        row["title"], row["short"] = _titles(key, trajectory)
+        row["file"] = f"references/{key}.json"
+        write_trajectory_file(folder / f"{key}.json", trajectory)
+        references[key] = row
+        label = f"{row['title']}, {row['duration_s']:.4g} s"
+        motions[label] = reference_motion(robot, trajectory, 2001)
+    figures = save_references_figures(
+        motions, joint_limits(robot), Path(stage) / "figures", FIGURE_PREFIX, f"{robot.name}: the references"
+    )
+    tracking = [
+        {"law": name, "reference": key} | _track(robot, variant, options, trajectory)
+        for key, trajectory in designed.items()
+        for name, variant in rows
+    ]
+    return {
+        "references": references,
+        "notes": notes,
+        "figures": [p.name for p in figures],
+        "tracking": tracking,
+        "seconds": time.perf_counter() - start,
+    }
