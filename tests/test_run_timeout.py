@@ -6,8 +6,10 @@ tests do not depend on the machine's speed.
 
 from __future__ import annotations
 
+import gc
 import json
 import signal
+import time
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +23,7 @@ from twolink_pin.errors import ControllerError
 from twolink_pin.plant import Plant
 from twolink_pin.run_spec import make_scenario
 from twolink_pin.simulation import SimulationConfig, simulate
-from twolink_pin.simulation.deadline import per_run_limit
+from twolink_pin.simulation.deadline import RunTimeout, bounded, per_run_limit
 
 SPINNER = Path(__file__).parent / "corpus" / "laws" / "misbehaving.py"
 
@@ -121,3 +123,29 @@ def test_a_bound_that_fires_while_it_is_armed_gives_the_same_error(seconds: floa
             simulate(controller, plant, TRAJECTORY, SimulationConfig(duration=60.0))
         assert signal.getsignal(signal.SIGALRM) is handler
         assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_an_alarm_swallowed_inside_a_gc_callback_still_ends_the_block() -> None:
+    """Python drops an exception raised inside a gc callback (hypothesis and distributed install
+    such callbacks): the alarm that fires there fires again, so the block still ends with the
+    bound's error instead of running on unbounded. The callback spins (Python code, so the
+    signal is handled inside it) for much longer than the bound."""
+
+    def spin(phase: str, info: dict) -> None:
+        if phase == "start":
+            end = time.monotonic() + 0.5
+            while time.monotonic() < end:
+                pass
+
+    gc.callbacks.append(spin)
+    try:
+        with pytest.raises(RunTimeout), per_run_limit(0.02), bounded():
+            gc.collect()  # the alarm fires inside spin and is dropped
+            gc.callbacks.remove(spin)
+            for _ in range(600_000):  # the only way out in time is the alarm firing again
+                time.sleep(1e-4)
+    finally:
+        if spin in gc.callbacks:
+            gc.callbacks.remove(spin)
+    assert signal.getitimer(signal.ITIMER_REAL) == (0.0, 0.0)

@@ -88,6 +88,11 @@ def run_limit() -> float | None:
     return _LIMIT.get()
 
 
+REFIRE = 0.01
+"""Seconds after an alarm that the alarm fires again while the block has not ended (an
+exception raised inside a gc callback or ``__del__`` is printed and dropped by Python)."""
+
+
 class bounded:
     """Raise :class:`RunTimeout` inside the block once it has run for the bound in force
     (:func:`per_run_limit`) — or ``error(seconds)`` in its place, e.g. :func:`timed_out`
@@ -108,7 +113,11 @@ class bounded:
 
     def _expire(self, signum: int, frame: object) -> None:
         if self.armed:
-            self.armed = False
+            # Python ignores an exception raised where it cannot propagate (a gc callback, as
+            # hypothesis and distributed install, or a __del__): fire again in 10 ms, so a
+            # swallowed alarm still ends the block; __exit__ disarms before anything re-fires
+            # outside it (the handler raises only while armed).
+            signal.setitimer(signal.ITIMER_REAL, REFIRE)
             raise RunTimeout(self.seconds or 0.0)
 
     def _disarm(self) -> None:
