@@ -1,6 +1,12 @@
 """The tuner's 3-D scene in Viser: the arm (its URDF meshes, through Pinocchio's
 ``ViserVisualizer``), its translucent ghost following the reference, the end effector's
-trail and desired path, and the playback (play/pause, a time scrubber, a speed)."""
+trail and desired path, and the playback (play/pause, a time scrubber, a speed).
+
+The playback is kept light so that the page answers a control at once: :data:`FPS` frames
+a second (each moves the arm and its ghost), the time scrubber's number updated
+:data:`SCRUBBER_HZ` times a second (each update re-renders the panel), and no frame at all
+while :meth:`ArmScene.hold` holds it (the tuner holds it from a control's move to the new
+run shown)."""
 
 from __future__ import annotations
 
@@ -16,8 +22,10 @@ from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visua
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
 
-FPS = 30.0
+FPS = 20.0
 """Playback frames per second."""
+SCRUBBER_HZ = 2.0
+"""Updates of the time scrubber per second while playing."""
 TRAIL_POINTS = 400
 """Largest number of points of the trail and the desired path."""
 TRAIL_RGB = (194, 37, 92)
@@ -76,6 +84,7 @@ class ArmScene:
         self._now = 0.0
         self._stop = threading.Event()
         self._framed = False
+        self._held = threading.Event()
         self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
         self._thread.start()
 
@@ -101,6 +110,13 @@ class ArmScene:
         self.time.max = float(t[-1])
         self._draw()
 
+    def hold(self, held: bool) -> None:
+        """Stop drawing frames (True) or go on (False) without touching play/pause."""
+        if held:
+            self._held.set()
+        else:
+            self._held.clear()
+
     def close(self) -> None:
         """Stop the playback thread."""
         self._stop.set()
@@ -124,17 +140,19 @@ class ArmScene:
             self.ghost.display(q_des)
 
     def _play(self) -> None:
-        last = time.monotonic()
+        last = scrubbed = time.monotonic()
         while not self._stop.wait(1.0 / FPS):
             now = time.monotonic()
             elapsed, last = now - last, now
-            if not self.playing.value:
+            if not self.playing.value or self._held.is_set():
                 continue
             with self._lock:
                 end = float(self._t[-1])
                 self._now = (self._now + elapsed * float(self.speed.value)) % end if end > 0 else 0.0
                 shown = self._now
-            self.time.value = round(shown, 2)
+            if now - scrubbed >= 1.0 / SCRUBBER_HZ:
+                scrubbed = now
+                self.time.value = round(shown, 2)
             self._draw()
 
 

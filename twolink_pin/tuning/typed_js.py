@@ -1,0 +1,73 @@
+"""Typed values run when they are complete: a few lines of script the page runs once.
+
+Viser's text and number boxes send every keystroke to the server (typing "120" would run
+1, then 12, then 120). The script, given to the page in a hidden HTML element (Viser has no
+other way to add behaviour to its page), holds a box's keystrokes back from Viser's client
+and lets the value go on Enter or when the box loses focus (the browser's ``change`` event):
+
+* a gain's box (its label ends with :data:`TYPED_SUFFIX`) and a number box of the run's
+  settings: sent on Enter or blur only;
+* the number box beside a gain's slider: read-only (typing goes to the gain's box, which
+  reads exponent notation as typed; the slider's box would read ``1e308`` as 1308).
+
+The script keys on what Viser's client renders (a ``label`` beside the input, Mantine's
+class names); ``tests/test_tune_browser.py`` types into a real page and checks that
+nothing runs before Enter.
+"""
+
+from __future__ import annotations
+
+import html
+
+TYPED_SUFFIX = " ="
+"""The end of a gain box's label (``kp =``): the script knows the box by it."""
+
+SCRIPT = r"""
+if (!window.twolinkTyped) {
+  window.twolinkTyped = true;
+  var suffix = %SUFFIX%;
+  var rowOf = function (el) {
+    var n = el;
+    for (var i = 0; i < 12 && n; i++) {
+      n = n.parentElement;
+      if (n && n.querySelector('label')) return n;
+    }
+    return null;
+  };
+  var kind = function (el) {
+    if (!(el instanceof HTMLInputElement) || el.type === 'checkbox') return null;
+    var row = rowOf(el);
+    if (!row) return null;
+    var text = row.querySelector('label').textContent || '';
+    if (text.slice(-suffix.length) === suffix) return 'typed';
+    if (row.querySelector('.mantine-Slider-root')) return 'slider';
+    if (el.closest('.mantine-NumberInput-root')) return 'number';
+    return null;
+  };
+  window.addEventListener('input', function (e) {
+    var k = kind(e.target);
+    if (k === 'typed' || k === 'number') e.stopImmediatePropagation();
+  }, true);
+  window.addEventListener('beforeinput', function (e) {
+    if (kind(e.target) === 'slider') e.preventDefault();
+  }, true);
+  window.addEventListener('keydown', function (e) {
+    var k = kind(e.target);
+    if (e.key === 'Enter' && (k === 'typed' || k === 'number')) {
+      e.target.dispatchEvent(new Event('change', { bubbles: true }));
+    }
+  }, true);
+}
+"""
+
+
+def typed_html() -> str:
+    """The hidden element that runs :data:`SCRIPT` once the page shows it."""
+    script = SCRIPT.replace("%SUFFIX%", repr(TYPED_SUFFIX)).strip()
+    return (
+        '<img alt="" style="display:none" src="data:image/gif;base64,AA==" '
+        f'onerror="{html.escape(script, quote=True)}">'
+    )
+
+
+__all__ = ["SCRIPT", "TYPED_SUFFIX", "typed_html"]
