@@ -208,6 +208,7 @@ class Panel:
             slider.value = x
         for i in scales:
             self.sliders[i].value = 1.0
+        self.typed[name].value = format_typed(self._shown(name))  # what runs, as the box shows it
         self.gain_errors[name].content = ""
         self._changed()
 
