@@ -42,6 +42,11 @@ Usage::
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
 of the reference: pd on the twolink (4 s; goal 0.5 s), pd on the UR5, osc on the Panda; the
 median and the largest of several changes, through the tuner's own server (no browser).
+Then as a person meets it (issue 38): ``tune`` started as a command, its page in headless
+Chromium (software WebGL), the arm playing; from one ArrowRight on the focused slider
+``kp joint 1`` to the page showing the new run's status line, which the tuner sends after
+the run's plots and with its metrics table (key → page), beside key → the JSON line and the
+simulation's own time: pd on the twolink (goal 0.5 s), osc on the Panda (goal 2 s).
 
 A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
 processes, at the default thread count, at 1 and at 2 threads, per simulation against the
@@ -1019,6 +1024,148 @@ def _tune_latency(robot_name: str, law: str, changes: int) -> list[float]:
         tuner.close()
 
 
+PAGE_GOALS = {("twolink", "pd"): 0.5, ("panda", "osc"): 2.0}
+"""Key press → updated page [s] (issue 38), headless Chromium, the arm playing."""
+SHOWN_JS = """
+window.twolinkShown = {};
+window.twolinkKeys = [];
+window.twolinkRunning = [];
+window.addEventListener('keydown', function () { window.twolinkKeys.push(Date.now()); }, true);
+new MutationObserver(function () {
+  var text = document.body.textContent;
+  var m = /run (\\d+): /.exec(text);
+  if (m && !(m[1] in window.twolinkShown)) window.twolinkShown[m[1]] = Date.now();
+  var running = text.indexOf('running…') >= 0;
+  if (running !== window.twolinkWasRunning) {
+    window.twolinkWasRunning = running;
+    if (running) window.twolinkRunning.push(Date.now());
+  }
+}).observe(document.body, {subtree: true, childList: true, characterData: true});
+"""
+"""Times (ms since the epoch) the page saw: each key press, each run's status line, each
+"running…" (the server's answer to a change)."""
+
+
+def _tune_page_latency(robot_name: str, law: str, changes: int) -> dict[str, list[float]]:
+    """Key → page, key → JSON line, and the run's own time [s] for ``changes`` ArrowRight
+    presses on ``kp joint 1`` (or the first gain's first slider), the arm playing."""
+    import json
+    import queue
+    import subprocess
+    import threading
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "tests"))
+    from browser import start_chromium  # the tests' headless Chromium (software WebGL)
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "twolink_pin_entry",
+            "tune",
+            law,
+            f"--robot={robot_name}",
+            "--json",
+            "--no-browser",
+        ],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    lines: queue.Queue[tuple[float, dict[str, Any]]] = queue.Queue()
+
+    def read() -> None:
+        assert proc.stdout is not None
+        for text in proc.stdout:
+            lines.put((time.time(), json.loads(text)))
+
+    threading.Thread(target=read, daemon=True).start()
+
+    def next_line(wanted: Any) -> tuple[float, dict[str, Any]]:
+        while True:
+            at, line = lines.get(timeout=600)
+            if wanted(line):
+                return at, line
+
+    out: dict[str, list[float]] = {"page": [], "json": [], "run": [], "key": [], "running": []}
+    try:
+        url = next_line(lambda line: "url" in line)[1]["url"]
+        next_line(lambda line: "metrics" in line)
+        with start_chromium(1400, 1000) as driver:
+            driver.get(url)
+            driver.execute_script(SHOWN_JS)
+            thumb = WebDriverWait(driver, 600).until(
+                lambda d: d.execute_script(
+                    "var l = Array.from(document.querySelectorAll('label')).find("
+                    "function (e) { return / joint 1 | axis x /.test(e.textContent + ' '); });"
+                    "return l ? document.getElementById(l.htmlFor).querySelector('[role=slider]') : null;"
+                )
+            )
+            WebDriverWait(driver, 600).until(
+                lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
+            )
+            time.sleep(2.0)  # the playback running as a person finds it
+            for _ in range(changes):
+                driver.execute_script("arguments[0].focus()", thumb)
+                pressed = time.time()
+                ActionChains(driver).send_keys(Keys.ARROW_RIGHT).perform()
+                at, line = next_line(lambda line: "metrics" in line or "error" in line)
+                run = str(line["run"])
+                shown = WebDriverWait(driver, 600).until(
+                    lambda d, run=run: d.execute_script("return window.twolinkShown[arguments[0]]", run)
+                )
+                out["page"].append(shown / 1e3 - pressed)
+                keys, running = driver.execute_script("return [window.twolinkKeys, window.twolinkRunning]")
+                out["key"].append(keys[-1] / 1e3 - pressed if keys else float("nan"))
+                out["running"].append(running[-1] / 1e3 - pressed if running else float("nan"))
+                out["json"].append(at - pressed)
+                out["run"].append(float(line.get("seconds", float("nan"))))
+                time.sleep(1.0)  # the arm plays again before the next press
+    finally:
+        proc.terminate()
+        proc.wait(timeout=60)
+    return out
+
+
+def tune_page_section(quick: bool) -> dict[str, Any]:
+    """``tune`` in Chromium: key press → updated page (see the module docstring)."""
+    import shutil
+
+    changes = 2 if quick else 5
+    if not (shutil.which("chromium") or Path("/usr/bin/chromium").exists()):
+        print("\ntune in Chromium: skipped (no /usr/bin/chromium: scripts/install_browser.sh)")
+        return {}
+    print(
+        f"\ntune in headless Chromium (software WebGL), the arm playing: one ArrowRight on the first gain's "
+        f"first slider → the page shows the new run (status line, metrics, plots); median and max of {changes}"
+    )
+    out: dict[str, Any] = {}
+    for (robot_name, law), goal in list(PAGE_GOALS.items())[:1] if quick else PAGE_GOALS.items():
+        got = _tune_page_latency(robot_name, law, changes)
+        page = statistics.median(got["page"])
+        print(
+            f"  {law + ' on the ' + robot_name:22s} key → page {page:6.3f} s (max {max(got['page']):6.3f} s), "
+            f"key → JSON {statistics.median(got['json']):6.3f} s, run {statistics.median(got['run']):6.3f} s, "
+            f"key → keydown in the page {statistics.median(got['key']):6.3f} s, "
+            f"→ 'running…' shown {statistics.median(got['running']):6.3f} s"
+            f"  (goal {goal:g} s: {'met' if page <= goal else 'NOT met'})"
+        )
+        out[f"{law}_{robot_name}"] = {
+            "page_median_seconds": page,
+            "page_max_seconds": max(got["page"]),
+            "json_median_seconds": statistics.median(got["json"]),
+            "run_median_seconds": statistics.median(got["run"]),
+            "keydown_median_seconds": statistics.median(got["key"]),
+            "running_shown_median_seconds": statistics.median(got["running"]),
+        }
+    return {"tune_page_latency": out}
+
+
 def tune_section(quick: bool) -> dict[str, Any]:
     """``tune``: the latency from a change to updated results (see the module docstring)."""
     changes = 2 if quick else 5
@@ -1325,6 +1472,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.tune_only:
         results.update(tune_section(quick))
+        results.update(tune_page_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0

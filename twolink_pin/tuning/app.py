@@ -270,11 +270,11 @@ class Tuner:
         columns: dict[str, Finished | None] = {"previous": previous, "defaults": defaults}
         if kept is not None:
             columns[kept[0]] = kept[1]
+        self.plots.show(done, columns)  # first: the status line below says all is shown
         with self.server.atomic():
             self.metrics.content = metrics_table(done, columns)
-            self.status.content = f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s"
             self.command.content = f"```\n{command}\n```"
-        self.plots.show(done, columns)
+            self.status.content = f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s"
         self.scene.show(result.t, result.q, result.q_des)
         self.scene.hold(False)
 
