@@ -1029,26 +1029,21 @@ PAGE_GOALS = {("twolink", "pd"): 0.5, ("panda", "osc"): 2.0}
 SHOWN_JS = """
 window.twolinkShown = {};
 window.twolinkKeys = [];
-window.twolinkRunning = [];
 window.addEventListener('keydown', function () { window.twolinkKeys.push(Date.now()); }, true);
 new MutationObserver(function () {
-  var text = document.body.textContent;
-  var m = /run (\\d+): /.exec(text);
+  var m = /run (\\d+): /.exec(document.body.textContent);
   if (m && !(m[1] in window.twolinkShown)) window.twolinkShown[m[1]] = Date.now();
-  var running = text.indexOf('running…') >= 0;
-  if (running !== window.twolinkWasRunning) {
-    window.twolinkWasRunning = running;
-    if (running) window.twolinkRunning.push(Date.now());
-  }
 }).observe(document.body, {subtree: true, childList: true, characterData: true});
 """
-"""Times (ms since the epoch) the page saw: each key press, each run's status line, each
-"running…" (the server's answer to a change)."""
+"""Times (ms since the epoch) the page saw: each key press, each run's status line."""
 
 
-def _tune_page_latency(robot_name: str, law: str, changes: int) -> dict[str, list[float]]:
-    """Key → page, key → JSON line, and the run's own time [s] for ``changes`` ArrowRight
-    presses on ``kp joint 1`` (or the first gain's first slider), the arm playing."""
+def _tune_page_latency(
+    robot_name: str, law: str, changes: int, playing: bool = True
+) -> dict[str, list[float]]:
+    """Key → page, key → the page's keydown, key → JSON line, and the run's own time [s]
+    for ``changes`` ArrowRight presses on ``kp joint 1`` (or the first gain's first
+    slider), the arm playing (or paused from the page's play box first)."""
     import json
     import queue
     import subprocess
@@ -1092,7 +1087,7 @@ def _tune_page_latency(robot_name: str, law: str, changes: int) -> dict[str, lis
             if wanted(line):
                 return at, line
 
-    out: dict[str, list[float]] = {"page": [], "json": [], "run": [], "key": [], "running": []}
+    out: dict[str, list[float]] = {"page": [], "json": [], "run": [], "key": []}
     try:
         url = next_line(lambda line: "url" in line)[1]["url"]
         next_line(lambda line: "metrics" in line)
@@ -1109,7 +1104,13 @@ def _tune_page_latency(robot_name: str, law: str, changes: int) -> dict[str, lis
             WebDriverWait(driver, 600).until(
                 lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
             )
-            time.sleep(2.0)  # the playback running as a person finds it
+            if not playing:
+                driver.execute_script(
+                    "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
+                    "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"
+                    " var c = n.querySelector('input[type=checkbox]'); if (c) { c.click(); return; } }"
+                )
+            time.sleep(2.0)  # the playback running (or paused) as a person finds it
             for _ in range(changes):
                 driver.execute_script("arguments[0].focus()", thumb)
                 pressed = time.time()
@@ -1120,9 +1121,8 @@ def _tune_page_latency(robot_name: str, law: str, changes: int) -> dict[str, lis
                     lambda d, run=run: d.execute_script("return window.twolinkShown[arguments[0]]", run)
                 )
                 out["page"].append(shown / 1e3 - pressed)
-                keys, running = driver.execute_script("return [window.twolinkKeys, window.twolinkRunning]")
+                keys = driver.execute_script("return window.twolinkKeys")
                 out["key"].append(keys[-1] / 1e3 - pressed if keys else float("nan"))
-                out["running"].append(running[-1] / 1e3 - pressed if running else float("nan"))
                 out["json"].append(at - pressed)
                 out["run"].append(float(line.get("seconds", float("nan"))))
                 time.sleep(1.0)  # the arm plays again before the next press
@@ -1146,23 +1146,23 @@ def tune_page_section(quick: bool) -> dict[str, Any]:
     )
     out: dict[str, Any] = {}
     for (robot_name, law), goal in list(PAGE_GOALS.items())[:1] if quick else PAGE_GOALS.items():
-        got = _tune_page_latency(robot_name, law, changes)
-        page = statistics.median(got["page"])
-        print(
-            f"  {law + ' on the ' + robot_name:22s} key → page {page:6.3f} s (max {max(got['page']):6.3f} s), "
-            f"key → JSON {statistics.median(got['json']):6.3f} s, run {statistics.median(got['run']):6.3f} s, "
-            f"key → keydown in the page {statistics.median(got['key']):6.3f} s, "
-            f"→ 'running…' shown {statistics.median(got['running']):6.3f} s"
-            f"  (goal {goal:g} s: {'met' if page <= goal else 'NOT met'})"
-        )
-        out[f"{law}_{robot_name}"] = {
-            "page_median_seconds": page,
-            "page_max_seconds": max(got["page"]),
-            "json_median_seconds": statistics.median(got["json"]),
-            "run_median_seconds": statistics.median(got["run"]),
-            "keydown_median_seconds": statistics.median(got["key"]),
-            "running_shown_median_seconds": statistics.median(got["running"]),
-        }
+        for playing in (True, False):
+            got = _tune_page_latency(robot_name, law, changes, playing)
+            page = statistics.median(got["page"])
+            how = "playing" if playing else "paused"
+            print(
+                f"  {law + ' on the ' + robot_name + ', ' + how:30s} key → page {page:6.3f} s "
+                f"(max {max(got['page']):6.3f} s), key → keydown in the page {statistics.median(got['key']):6.3f} s, "
+                f"key → JSON {statistics.median(got['json']):6.3f} s, run {statistics.median(got['run']):6.3f} s"
+                + (f"  (goal {goal:g} s: {'met' if page <= goal else 'NOT met'})" if playing else "")
+            )
+            out[f"{law}_{robot_name}_{how}"] = {
+                "page_median_seconds": page,
+                "page_max_seconds": max(got["page"]),
+                "keydown_median_seconds": statistics.median(got["key"]),
+                "json_median_seconds": statistics.median(got["json"]),
+                "run_median_seconds": statistics.median(got["run"]),
+            }
     return {"tune_page_latency": out}
 
 

@@ -22,7 +22,7 @@ from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visua
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
 
-FPS = 20.0
+FPS = 10.0
 """Playback frames per second."""
 SCRUBBER_HZ = 2.0
 """Updates of the time scrubber per second while playing."""
