@@ -1056,6 +1056,8 @@ def _tune_page_latency(
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 
+    from twolink_pin.tuning.scene import RESUME_AFTER
+
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -1125,7 +1127,7 @@ def _tune_page_latency(
                 out["key"].append(keys[-1] / 1e3 - pressed if keys else float("nan"))
                 out["json"].append(at - pressed)
                 out["run"].append(float(line.get("seconds", float("nan"))))
-                time.sleep(1.0)  # the arm plays again before the next press
+                time.sleep(RESUME_AFTER + 1.0)  # the arm plays again before the next press
     finally:
         proc.terminate()
         proc.wait(timeout=60)

@@ -137,3 +137,39 @@ def test_keep_this_run_names_its_column_as_compare_names_the_variant(pd: Tune, d
     for name, value in variant.gains:
         np.testing.assert_array_equal(np.ravel(value), np.ravel(last["gains"][name]))
     assert {name for name, _ in variant.gains} == {"kp", "kd"}  # both moved from their defaults
+
+
+FULL = [[150.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
+
+
+@pytest.fixture(scope="module")
+def panda() -> Iterator[Tune]:
+    tune = Tune("osc", "--robot", "panda", "--gain", "kp=150,20,0,20,150,0,0,0,80", "--duration", "0.5")
+    try:
+        yield tune
+    finally:
+        tune.stop()
+
+
+def test_a_full_matrix_gain_keeps_its_off_diagonals_in_the_page_the_runs_and_the_command(
+    panda: Tune, driver: Any
+) -> None:
+    """The first run and its command carry the whole matrix; the page shows it row by row;
+    moving the x diagonal slider changes that entry only; ``simulate`` with the command runs
+    the same gains."""
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+    from test_tune_browser import simulate_json
+
+    first = panda.next(ran)
+    assert first["gains"]["kp"] == FULL
+    assert "--gain=kp=150.0,20.0,0.0,20.0,150.0,0.0,0.0,0.0,80.0" in first["command"]
+    driver.get(panda.url)
+    assert box(driver, "kp =").get_attribute("value") == "150, 20, 0; 20, 150, 0; 0, 0, 80"
+    press(slider(driver, "kp axis x [1/s²]"), Keys.ARROW_RIGHT)
+    moved = panda.next(ran)
+    assert moved["gains"]["kp"] == [[151.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
+    WebDriverWait(driver, WAIT).until(
+        lambda d: box(d, "kp =").get_attribute("value") == "151, 20, 0; 20, 150, 0; 0, 0, 80"
+    )
+    assert simulate_json(moved["command"])["gains"] == moved["gains"]

@@ -18,6 +18,7 @@ from twolink_pin.errors import InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.knobs import knobs_of, matrices_of
 from twolink_pin.tuning.latest import LatestWins
 from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
+from twolink_pin.tuning.scene import RESUME_AFTER
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
@@ -245,7 +246,7 @@ class Tuner:
             else:
                 self.panel.show_error(None, "")
             self.status.content = f"**run {generation} failed** (the last good run stays on screen): {text}"
-            self.scene.hold(False)
+            self.scene.hold(False, RESUME_AFTER)
             self._report({"run": generation, "error": text, "command": command})
             return
         self.panel.show_error(None, "")
@@ -276,7 +277,7 @@ class Tuner:
             self.command.content = f"```\n{command}\n```"
             self.status.content = f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s"
         self.scene.show(result.t, result.q, result.q_des)
-        self.scene.hold(False)
+        self.scene.hold(False, RESUME_AFTER)
 
     def _keep_latest(self) -> None:
         """Pin the run shown as a reference, named as ``compare`` names a variant."""

@@ -97,9 +97,13 @@ class Panel:
                     box.on_update(lambda event, name=knob.gain: self._typed(event, name))
                     self.typed[knob.gain] = box
                     self.gain_errors[knob.gain] = gui.add_markdown("")
+        self._add_run_controls(gui, base, payload, order + 10)
+
+    def _add_run_controls(self, gui: Any, base: RunSpec, payload: float, order: float) -> None:
+        """The run's settings, in a folder at ``order``."""
         plant, sim = base.plant, base.simulation
         wrench = plant.wrench
-        with gui.add_folder("run", expand_by_default=False, order=order + 10):
+        with gui.add_folder("run", expand_by_default=False, order=order):
             self.duration = gui.add_number(  # bounded: a run in flight is not interrupted
                 "duration [s]", sim.duration, min=sim.dt, max=max(MAX_DURATION, sim.duration), step=0.1
             )

@@ -5,8 +5,10 @@ trail and desired path, and the playback (play/pause, a time scrubber, a speed).
 The playback is kept light so that the page answers a control at once: :data:`FPS` frames
 a second (each moves the arm and its ghost), the time scrubber's number updated
 :data:`SCRUBBER_HZ` times a second (each update re-renders the panel), and no frame at all
-while :meth:`ArmScene.hold` holds it (the tuner holds it from a control's move to the new
-run shown)."""
+while :meth:`ArmScene.hold` holds it: the tuner holds it from a control's move until
+:data:`RESUME_AFTER` seconds after the new run is shown, so a burst of key presses meets a
+still scene. (Viser's client renders on demand, each scene update opening a 250-ms window of
+continuous frames: with software WebGL a playing arm keeps the browser's main thread busy.)"""
 
 from __future__ import annotations
 
@@ -26,6 +28,8 @@ FPS = 10.0
 """Playback frames per second."""
 SCRUBBER_HZ = 2.0
 """Updates of the time scrubber per second while playing."""
+RESUME_AFTER = 2.0
+"""The playback goes on this long after a hold is released [s]."""
 TRAIL_POINTS = 400
 """Largest number of points of the trail and the desired path."""
 TRAIL_RGB = (194, 37, 92)
@@ -85,6 +89,7 @@ class ArmScene:
         self._stop = threading.Event()
         self._framed = False
         self._held = threading.Event()
+        self._resume_at = 0.0
         self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
         self._thread.start()
 
@@ -110,11 +115,13 @@ class ArmScene:
         self.time.max = float(t[-1])
         self._draw()
 
-    def hold(self, held: bool) -> None:
-        """Stop drawing frames (True) or go on (False) without touching play/pause."""
+    def hold(self, held: bool, resume_after: float = 0.0) -> None:
+        """Stop drawing frames (True), or go on ``resume_after`` seconds from now (False),
+        without touching play/pause."""
         if held:
             self._held.set()
         else:
+            self._resume_at = time.monotonic() + resume_after
             self._held.clear()
 
     def close(self) -> None:
@@ -144,7 +151,7 @@ class ArmScene:
         while not self._stop.wait(1.0 / FPS):
             now = time.monotonic()
             elapsed, last = now - last, now
-            if not self.playing.value or self._held.is_set():
+            if not self.playing.value or self._held.is_set() or now < self._resume_at:
                 continue
             with self._lock:
                 end = float(self._t[-1])
