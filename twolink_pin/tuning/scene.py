@@ -8,7 +8,10 @@ a second (each moves the arm and its ghost), the time scrubber's number updated
 while :meth:`ArmScene.hold` holds it: the tuner holds it from a control's move until
 :data:`RESUME_AFTER` seconds after the new run is shown, so a burst of key presses meets a
 still scene. (Viser's client renders on demand, each scene update opening a 250-ms window of
-continuous frames: with software WebGL a playing arm keeps the browser's main thread busy.)"""
+continuous frames: with software WebGL a playing arm keeps the browser's main thread busy.)
+An arm whose visual meshes are heavy (more than :data:`TRIANGLES` triangles: the UR5's and
+the Panda's hold about 10⁵) is drawn with its URDF's collision geometry, about 50 times
+lighter, when it has one (:func:`light_model`)."""
 
 from __future__ import annotations
 
@@ -18,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from twolink_pin.errors import TwolinkPinError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visual_model
 
@@ -32,6 +36,10 @@ RESUME_AFTER = 2.0
 """The playback goes on this long after a hold is released [s]."""
 TRAIL_POINTS = 400
 """Largest number of points of the trail and the desired path."""
+TRIANGLES = 20_000
+"""The most triangles of visual meshes the tuner draws (twice: the arm and its ghost)."""
+ARM_RGBA = (0.62, 0.66, 0.72, 1.0)
+"""The colour of an arm drawn with its collision geometry (which has none of its own)."""
 TRAIL_RGB = (194, 37, 92)
 DESIRED_RGB = (43, 138, 62)
 
@@ -41,6 +49,30 @@ def _segments(points: np.ndarray) -> np.ndarray:
     step = max(1, len(points) // TRAIL_POINTS)
     p = points[::step]
     return np.stack([p[:-1], p[1:]], axis=1).astype(np.float32)
+
+
+def _triangles(geometry: Any) -> int:
+    return sum(int(getattr(obj.geometry, "num_tris", 0)) for obj in geometry.geometryObjects)
+
+
+def light_model(robot: RobotModel) -> Any:
+    """The geometry the tuner draws: the visual meshes, or, when they hold more than
+    :data:`TRIANGLES` triangles, the collision geometry if it is lighter (coloured
+    :data:`ARM_RGBA`)."""
+    import pinocchio as pin
+
+    visual = visual_model(robot)
+    if _triangles(visual) <= TRIANGLES:
+        return visual
+    try:
+        collision = visual_model(robot, pin.GeometryType.COLLISION)
+    except TwolinkPinError:
+        return visual
+    if not collision.ngeoms or _triangles(collision) >= _triangles(visual):
+        return visual
+    for obj in collision.geometryObjects:
+        obj.meshColor = np.array(ARM_RGBA)
+    return collision
 
 
 def view_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -68,7 +100,7 @@ class ArmScene:
 
         self._server = server
         self._robot = robot
-        visual = visual_model(robot)
+        visual = light_model(robot)
         self.arm = ViserVisualizer(robot.model, pin.GeometryModel(), visual)
         self.arm.initViewer(viewer=server)
         self.arm.loadViewerModel("arm")
