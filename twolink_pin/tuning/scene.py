@@ -113,6 +113,12 @@ class ArmScene:
         self.time = server.gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0, hint="the instant shown")
         self.speed = server.gui.add_slider("speed", 0.1, 4.0, 0.1, 1.0, hint="× real time")
         self.time.on_update(self._on_scrub)
+        from twolink_pin.tuning.typed_js import FOCUS_LABEL
+
+        self.focus = server.gui.add_text(
+            FOCUS_LABEL, "0", hint="set by the page: a gain's control has the focus"
+        )
+        self.focus.on_update(lambda _: self.hold(self.focus.value == "1", RESUME_AFTER, why="focus"))
         self._lock = threading.Lock()
         self._t = np.zeros(1)
         self._q = np.array([robot.home])
@@ -122,6 +128,7 @@ class ArmScene:
         self._framed = False
         self._held = threading.Event()
         self._resume_at = 0.0
+        self._holds: set[str] = set()
         self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
         self._thread.start()
 
@@ -147,14 +154,20 @@ class ArmScene:
         self.time.max = float(t[-1])
         self._draw()
 
-    def hold(self, held: bool, resume_after: float = 0.0) -> None:
+    def hold(self, held: bool, resume_after: float = 0.0, why: str = "run") -> None:
         """Stop drawing frames (True), or go on ``resume_after`` seconds from now (False),
-        without touching play/pause."""
-        if held:
-            self._held.set()
-        else:
-            self._resume_at = time.monotonic() + resume_after
-            self._held.clear()
+        without touching play/pause; each reason ``why`` (a run in flight, a focused
+        control) holds until it is released."""
+        with self._lock:
+            if held:
+                self._holds.add(why)
+            else:
+                self._holds.discard(why)
+                self._resume_at = max(self._resume_at, time.monotonic() + resume_after)
+            if self._holds:
+                self._held.set()
+            else:
+                self._held.clear()
 
     def close(self) -> None:
         """Stop the playback thread."""

@@ -8,7 +8,10 @@ and lets the value go on Enter or when the box loses focus (the browser's ``chan
 * a gain's box (its label ends with :data:`TYPED_SUFFIX`) and a number box of the run's
   settings: sent on Enter or blur only;
 * the number box beside a gain's slider: read-only (typing goes to the gain's box, which
-  reads exponent notation as typed; the slider's box would read ``1e308`` as 1308).
+  reads exponent notation as typed; the slider's box would read ``1e308`` as 1308);
+* while a slider or a gain's box has the focus, the hidden box labelled :data:`FOCUS_LABEL`
+  holds ``1`` (else ``0``): the tuner holds the arm's playback still then, so a key press
+  on a control never waits behind the 3-D view.
 
 The script keys on what Viser's client renders (a ``label`` beside the input, Mantine's
 class names); ``tests/test_tune_browser.py`` types into a real page and checks that
@@ -21,11 +24,14 @@ import html
 
 TYPED_SUFFIX = " ="
 """The end of a gain box's label (``kp =``): the script knows the box by it."""
+FOCUS_LABEL = "(control focused)"
+"""The label of the hidden box the script tells whether a control has the focus."""
 
 SCRIPT = r"""
 if (!window.twolinkTyped) {
   window.twolinkTyped = true;
   var suffix = %SUFFIX%;
+  var focusLabel = %FOCUS%;
   var rowOf = function (el) {
     var n = el;
     for (var i = 0; i < 12 && n; i++) {
@@ -51,6 +57,25 @@ if (!window.twolinkTyped) {
   window.addEventListener('beforeinput', function (e) {
     if (kind(e.target) === 'slider') e.preventDefault();
   }, true);
+  var focusBox = function () {
+    var l = Array.from(document.querySelectorAll('label')).find(function (e) { return e.textContent === focusLabel; });
+    var n = l;
+    for (var i = 0; i < 12 && n && !n.querySelector('input'); i++) n = n.parentElement;
+    if (!n || !n.querySelector('input')) return null;
+    if (n.parentElement) n.parentElement.style.display = 'none';
+    return n.querySelector('input');
+  };
+  var tell = function (value) {
+    var input = focusBox();
+    if (!input || input.value === value) return;
+    Object.getOwnPropertyDescriptor(HTMLInputElement.prototype, 'value').set.call(input, value);
+    input.dispatchEvent(new Event('input', { bubbles: true }));
+  };
+  var control = function (el) {
+    return el && el.getAttribute && (el.getAttribute('role') === 'slider' || kind(el) === 'typed');
+  };
+  window.addEventListener('focusin', function (e) { if (control(e.target)) tell('1'); }, true);
+  window.addEventListener('focusout', function (e) { if (control(e.target)) tell('0'); }, true);
   window.addEventListener('keydown', function (e) {
     var k = kind(e.target);
     if (e.key === 'Enter' && (k === 'typed' || k === 'number')) {
@@ -63,11 +88,11 @@ if (!window.twolinkTyped) {
 
 def typed_html() -> str:
     """The hidden element that runs :data:`SCRIPT` once the page shows it."""
-    script = SCRIPT.replace("%SUFFIX%", repr(TYPED_SUFFIX)).strip()
+    script = SCRIPT.replace("%SUFFIX%", repr(TYPED_SUFFIX)).replace("%FOCUS%", repr(FOCUS_LABEL)).strip()
     return (
         '<img alt="" style="display:none" src="data:image/gif;base64,AA==" '
         f'onerror="{html.escape(script, quote=True)}">'
     )
 
 
-__all__ = ["SCRIPT", "TYPED_SUFFIX", "typed_html"]
+__all__ = ["FOCUS_LABEL", "SCRIPT", "TYPED_SUFFIX", "typed_html"]
