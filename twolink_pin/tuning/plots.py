@@ -160,16 +160,28 @@ class Plots:
         self._folder = folder
         self._handles: dict[str, Any] = {}
         self._orders: dict[str, int] = {}
+        self._cache: list[tuple[Finished, Panels]] = []
 
     def show(self, done: Finished, references: dict[str, Finished | None] | None = None) -> None:
         """Redraw every panel for ``done`` beside ``references`` (name → run; a panel this
         run has no data for is hidden)."""
-        theirs = {name: (None if run is None else panels(run)) for name, run in (references or {}).items()}
+        theirs = {
+            name: (None if run is None else self._panels(run)) for name, run in (references or {}).items()
+        }
         wanted = {
             title: compose(curves, {name: (p or {}).get(title) for name, p in theirs.items()})
-            for title, curves in panels(done).items()
+            for title, curves in self._panels(done).items()
         }
         self._draw(wanted, hide_others=True)
+
+    def _panels(self, run: Finished) -> Panels:
+        """:func:`panels` of ``run``, kept for the runs drawn again (previous, defaults, kept)."""
+        for seen, out in self._cache:
+            if seen is run:
+                return out
+        out = panels(run)
+        self._cache = [*self._cache[-5:], (run, out)]
+        return out
 
     def show_partial(self, part: Partial) -> None:
         """Redraw the joint-error and torque panels for the part of a run simulated so far."""
