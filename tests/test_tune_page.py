@@ -140,6 +140,28 @@ def test_keep_this_run_names_its_column_as_compare_names_the_variant(pd: Tune, d
     assert {name for name, _ in variant.gains} == {"kp", "kd"}  # both moved from their defaults
 
 
+def test_a_letter_in_a_run_settings_number_box_is_refused_next_to_it(pd: Tune, driver: Any) -> None:
+    """ "1e3" typed into ``payload [kg]``: the "e" is refused with the browser's bubble at the
+    box (Mantine's box would silently drop it: 13); "2" and Enter then run with 2 kg."""
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    from twolink_pin.tuning.typed_js import NUMBER_ONLY
+
+    driver.find_element("xpath", "//*[text()='run']").click()  # open the run's folder
+    payload = WebDriverWait(driver, WAIT).until(
+        lambda d: d.execute_script(
+            "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'payload [kg]');"
+            "return l ? document.getElementById(l.htmlFor) : null"
+        )
+    )
+    type_into(payload, "1e")
+    assert payload.get_attribute("validationMessage") == NUMBER_ONLY
+    type_into(payload, "2")
+    press(payload, Keys.ENTER)
+    assert pd.next(ran)["payload"] == 2.0
+
+
 FULL = [[150.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
 
 
