@@ -43,6 +43,11 @@ Usage::
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
 of the reference: pd on the twolink (4 s; goal 0.5 s), pd on the UR5, osc on the Panda; the
 median and the largest of several changes, through the tuner's own server (no browser).
+Then as a person meets it (issue 38): ``tune`` started as a command, its page in headless
+Chromium (software WebGL), the arm playing; from one ArrowRight on the focused slider
+``kp joint 1`` to the page showing the new run's status line, which the tuner sends after
+the run's plots and with its metrics table (key → page), beside key → the JSON line and the
+simulation's own time: pd on the twolink (goal 0.5 s), osc on the Panda (goal 2 s).
 
 A shared machine: two copies of the pd batch (N = 1000, 0.2 s) started together in two
 processes, at the default thread count, at 1 and at 2 threads, per simulation against the
@@ -1123,6 +1128,156 @@ def _tune_latency(robot_name: str, law: str, changes: int) -> list[float]:
         tuner.close()
 
 
+PAGE_GOALS = {("twolink", "pd"): 0.5, ("panda", "osc"): 2.0}
+"""Key press → updated page [s] (issue 38), headless Chromium, the arm playing."""
+SHOWN_JS = """
+window.twolinkShown = {};
+window.twolinkKeys = [];
+window.addEventListener('keydown', function () { window.twolinkKeys.push(Date.now()); }, true);
+new MutationObserver(function () {
+  var m = /run (\\d+): /.exec(document.body.textContent);
+  if (m && !(m[1] in window.twolinkShown)) window.twolinkShown[m[1]] = Date.now();
+}).observe(document.body, {subtree: true, childList: true, characterData: true});
+"""
+"""Times (ms since the epoch) the page saw: each key press, each run's status line."""
+
+
+def _tune_page_latency(
+    robot_name: str, law: str, changes: int, playing: bool = True, duration: float | None = None
+) -> dict[str, list[float]]:
+    """Key → page, key → the page's keydown, key → JSON line, and the run's own time [s]
+    for ``changes`` ArrowRight presses on ``kp joint 1`` (or the first gain's first
+    slider), the arm playing (or paused from the page's play box first); the tuner's
+    default duration (three periods) or ``duration`` [s]."""
+    import json
+    import queue
+    import subprocess
+    import threading
+
+    root = Path(__file__).resolve().parents[1]
+    sys.path.insert(0, str(root / "tests"))
+    from browser import start_chromium  # the tests' headless Chromium (software WebGL)
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    from twolink_pin.tuning.scene import RESUME_AFTER
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "twolink_pin_entry",
+            "tune",
+            law,
+            f"--robot={robot_name}",
+            "--json",
+            "--no-browser",
+            *([] if duration is None else [f"--duration={duration:g}"]),
+        ],
+        cwd=root,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
+        text=True,
+    )
+    lines: queue.Queue[tuple[float, dict[str, Any]]] = queue.Queue()
+
+    def read() -> None:
+        assert proc.stdout is not None
+        for text in proc.stdout:
+            lines.put((time.time(), json.loads(text)))
+
+    threading.Thread(target=read, daemon=True).start()
+
+    def next_line(wanted: Any) -> tuple[float, dict[str, Any]]:
+        while True:
+            at, line = lines.get(timeout=600)
+            if wanted(line):
+                return at, line
+
+    out: dict[str, list[float]] = {"page": [], "json": [], "run": [], "key": []}
+    try:
+        url = next_line(lambda line: "url" in line)[1]["url"]
+        next_line(lambda line: "metrics" in line)
+        with start_chromium(1400, 1000) as driver:
+            driver.get(url)
+            driver.execute_script(SHOWN_JS)
+            thumb = WebDriverWait(driver, 600).until(
+                lambda d: d.execute_script(
+                    "var l = Array.from(document.querySelectorAll('label')).find("
+                    "function (e) { return / joint 1 | axis x /.test(e.textContent + ' '); });"
+                    "return l ? document.getElementById(l.htmlFor).querySelector('[role=slider]') : null;"
+                )
+            )
+            WebDriverWait(driver, 600).until(
+                lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
+            )
+            if not playing:
+                driver.execute_script(
+                    "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
+                    "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"
+                    " var c = n.querySelector('input[type=checkbox]'); if (c) { c.click(); return; } }"
+                )
+            time.sleep(2.0)  # the playback running (or paused) as a person finds it
+            for _ in range(changes):
+                driver.execute_script("arguments[0].focus()", thumb)
+                pressed = time.time()
+                ActionChains(driver).send_keys(Keys.ARROW_RIGHT).perform()
+                at, line = next_line(lambda line: "metrics" in line or "error" in line)
+                run = str(line["run"])
+                shown = WebDriverWait(driver, 600).until(
+                    lambda d, run=run: d.execute_script("return window.twolinkShown[arguments[0]]", run)
+                )
+                out["page"].append(shown / 1e3 - pressed)
+                keys = driver.execute_script("return window.twolinkKeys")
+                out["key"].append(keys[-1] / 1e3 - pressed if keys else float("nan"))
+                out["json"].append(at - pressed)
+                out["run"].append(float(line.get("seconds", float("nan"))))
+                time.sleep(RESUME_AFTER + 1.0)  # the arm plays again before the next press
+    finally:
+        proc.terminate()
+        proc.wait(timeout=60)
+    return out
+
+
+def tune_page_section(quick: bool) -> dict[str, Any]:
+    """``tune`` in Chromium: key press → updated page (see the module docstring)."""
+    import shutil
+
+    changes = 2 if quick else 5
+    if not (shutil.which("chromium") or Path("/usr/bin/chromium").exists()):
+        print("\ntune in Chromium: skipped (no /usr/bin/chromium: scripts/install_browser.sh)")
+        return {}
+    print(
+        f"\ntune in headless Chromium (software WebGL), the arm playing: one ArrowRight on the first gain's "
+        f"first slider → the page shows the new run (status line, metrics, plots); median and max of {changes}"
+    )
+    out: dict[str, Any] = {}
+    cases = [(name, law, goal, None) for (name, law), goal in PAGE_GOALS.items()]
+    # the Panda once more with one period (the periods control at 1): tune runs three by default
+    cases.insert(2, ("panda", "osc", PAGE_GOALS[("panda", "osc")], 4.0))
+    for robot_name, law, goal, duration in cases[:1] if quick else cases:
+        for playing in (True, False):
+            got = _tune_page_latency(robot_name, law, changes, playing, duration)
+            page = statistics.median(got["page"])
+            how = "playing" if playing else "paused"
+            length = "3 periods" if duration is None else f"{duration:g} s"
+            print(
+                f"  {law + ' on the ' + robot_name + ', ' + length + ', ' + how:40s} key → page {page:6.3f} s "
+                f"(max {max(got['page']):6.3f} s), key → keydown in the page {statistics.median(got['key']):6.3f} s, "
+                f"key → JSON {statistics.median(got['json']):6.3f} s, run {statistics.median(got['run']):6.3f} s"
+                + (f"  (goal {goal:g} s: {'met' if page <= goal else 'NOT met'})" if playing else "")
+            )
+            out[f"{law}_{robot_name}_{length.replace(' ', '_')}_{how}"] = {
+                "page_median_seconds": page,
+                "page_max_seconds": max(got["page"]),
+                "keydown_median_seconds": statistics.median(got["key"]),
+                "json_median_seconds": statistics.median(got["json"]),
+                "run_median_seconds": statistics.median(got["run"]),
+            }
+    return {"tune_page_latency": out}
+
+
 def tune_section(quick: bool) -> dict[str, Any]:
     """``tune``: the latency from a change to updated results (see the module docstring)."""
     changes = 2 if quick else 5
@@ -1439,6 +1594,7 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.tune_only:
         results.update(tune_section(quick))
+        results.update(tune_page_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0

@@ -10,8 +10,9 @@ previous run and the defaults, and the ``twolink-pin simulate …`` line that re
 ``knobs.py``      the controls of a law's gains, from its ``Gains`` declaration
 ``runner.py``     one run: simulated, measured, its gains and plant
 ``panel.py``      the controls in the page and the ``RunSpec`` they describe
+``typed_js.py``   the page's script: typed values sent on Enter or blur, focus holds playback
 ``scene.py``      the arm (Pinocchio's ``ViserVisualizer``), ghost, trail, playback
-``plots.py``      joint errors, torques against limits, task errors, the law's state
+``plots.py``      joint errors, torques, task errors, the law's state; previous, defaults, kept
 ``address.py``    ``--host`` and ``--port`` checked before the server starts
 ``outputs.py``    the page's file names kept inside the tuner's folder
 ``app.py``        :class:`Tuner`: the server, the metrics table, save and export, watch

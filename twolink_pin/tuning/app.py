@@ -9,16 +9,19 @@ import contextlib
 import io
 import os
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
-from twolink_pin.tuning.knobs import Knob, knobs_of
+from twolink_pin.tuning.knobs import Knob, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
 from twolink_pin.tuning.outputs import page_path
 from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
+from twolink_pin.tuning.scene import RESUME_AFTER
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
@@ -29,14 +32,26 @@ WATCH_PERIOD = 0.25
 """How often the law's file is looked at [s] (``watch``)."""
 
 
-def metrics_table(this: Finished, previous: Finished | None, defaults: Finished) -> str:
-    """The metrics of this run beside the previous one and the defaults, as Markdown."""
+WIDE = 3
+"""A run with more joints than this shows, per metric, its largest joint (the panel is narrow)."""
 
-    def cells(done: Finished | None, pick: Callable[[Finished], Any]) -> str:
+
+def metrics_table(this: Finished, columns: Mapping[str, Finished | None]) -> str:
+    """The metrics of this run beside other runs (column name → run; None: "–"), as
+    Markdown. Up to :data:`WIDE` joints a cell lists every joint; beyond, the largest
+    joint's value and which joint (``0.012 (j4)``): 6 or 7 joints fit the panel."""
+    runs = {"this run": this, **columns}
+
+    def cell(done: Finished | None, pick: Callable[[Finished], Any]) -> str:
         if done is None:
             return "–"
-        value = pick(done)
-        return ", ".join(f"{x:.4g}" for x in value) if hasattr(value, "__len__") else f"{value:.4g}"
+        value = np.asarray(pick(done), dtype=float)
+        if value.ndim == 0:
+            return f"{float(value):.3g}"
+        if value.size <= WIDE:
+            return ", ".join(f"{x:.3g}" for x in value)
+        j = int(np.nanargmax(np.abs(value)))
+        return f"{value[j]:.3g} (j{j + 1})"
 
     def m(kind: str, name: str) -> Callable[[Finished], Any]:
         return lambda d: getattr(getattr(d.metrics, kind), name)
@@ -53,10 +68,10 @@ def metrics_table(this: Finished, previous: Finished | None, defaults: Finished)
             ("task RMS \\|p − p_d\\| [mm]", lambda d: d.task.position_rms_mm if d.task else float("nan")),
             ("task RMS angle [deg]", lambda d: d.task.orientation_rms_deg if d.task else float("nan")),
         ]
-    lines = ["| | this run | previous | defaults |", "|---|---|---|---|"]
-    lines += [
-        f"| {name} | {cells(this, f)} | {cells(previous, f)} | {cells(defaults, f)} |" for name, f in rows
-    ]
+    lines = ["| | " + " | ".join(runs) + " |", "|---" * (len(runs) + 1) + "|"]
+    lines += [f"| {name} | " + " | ".join(cell(run, f) for run in runs.values()) + " |" for name, f in rows]
+    if this.result.q.shape[1] > WIDE:
+        lines.append("\n(largest joint shown: `tune --json` prints every joint)")
     return "\n".join(lines)
 
 
@@ -166,25 +181,37 @@ class Tuner:
         )
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
-        knobs = knobs_of(type(controller).Gains, gains_used(controller))
+        used = gains_used(controller)
+        knobs = knobs_of(type(controller).Gains, used)
         self._knobs = knobs
+        self._law, self._default_gains = base.law, used
         self.server = self._start_server(host, port)
         self.server.gui.configure_theme(control_width="large")
         gui = self.server.gui
-        gui.add_markdown(f"**twolink-pin tune** · {controller.title} (`{controller.name}`) on {robot.name}")
-        self.status = gui.add_markdown("starting…")
+        gui.add_markdown(
+            f"**twolink-pin tune** · {controller.title} (`{controller.name}`) on {robot.name}", order=0.0
+        )
+        self.status = gui.add_markdown("starting…", order=1.0)
         from twolink_pin.tuning.panel import Panel
         from twolink_pin.tuning.plots import Plots
         from twolink_pin.tuning.scene import ArmScene
 
-        self.panel = Panel(self.server, knobs, base, payload, self.changed)
-        with gui.add_folder("playback"):
-            self.scene = ArmScene(self.server, robot)
-        with gui.add_folder("metrics"):
+        _, reference = self._runner.arm(payload)
+        period = float(getattr(reference, "period", 0.0) or 0.0)
+        matrices = matrices_of(type(controller).Gains, used)  # a full matrix keeps its off-diagonal terms
+        self.panel = Panel(self.server, knobs, base, payload, self.changed, matrices, period, order=10.0)
+        with gui.add_folder("metrics", order=20.0):
             self.metrics = gui.add_markdown("")
-        with gui.add_folder("plots"):
-            self.plots = Plots(self.server)
-        with gui.add_folder("as a command"):
+            self.keep = gui.add_button(
+                "keep this run",
+                hint="pin the run shown as a reference: a column here, grey curves in the plots",
+            )
+            self.keep.on_click(lambda _: self._keep_latest())
+        with gui.add_folder("plots", order=30.0) as folder:
+            self.plots = Plots(self.server, folder)
+        with gui.add_folder("playback", order=50.0):
+            self.scene = ArmScene(self.server, robot)
+        with gui.add_folder("as a command", order=60.0):
             self.command = gui.add_markdown("")
             hint = f"a file name inside {self.folder} (also offered as a download)"
             self.save_path = gui.add_text("run file (.npz)", "tune-run.npz", hint=hint)
@@ -196,6 +223,7 @@ class Tuner:
         self._latest: Finished | None = None
         self._previous: Finished | None = None
         self._defaults: Finished | None = None
+        self._kept: tuple[str, Finished] | None = None
         self._law_version = 0
         self._knobs_version = 0  # the law version the controls were last checked against
         self._base = base
@@ -251,6 +279,7 @@ class Tuner:
             return
         bound = f" (given up after {self._limit:g} s without progress: --timeout)" if self._limit else ""
         self.status.content = f"running…{bound}"
+        self.scene.hold(True)  # the page's time goes to the controls and the new run, not the playback
         self._session.submit(Request(spec, payload, self._law_version))
 
     def close(self) -> None:
@@ -301,6 +330,7 @@ class Tuner:
             self.status.content = (
                 f"**run {generation} failed** (the last good run stays on screen): {text}{kept}"
             )
+            self.scene.hold(False, RESUME_AFTER)
             self._report({"run": generation, "error": text, "command": command})
             return
         self.panel.show_error(None, "")
@@ -310,18 +340,50 @@ class Tuner:
             if self._defaults is None:
                 self._defaults = outcome
             previous, defaults = self._previous, self._defaults
-        result = outcome.result
-        self.scene.show(result.t, result.q, result.q_des)
-        self.plots.show(outcome)
-        self.metrics.content = metrics_table(outcome, previous, defaults)
-        self.command.content = f"```\n{command}\n```"
         left, self._left_behind = self._left_behind, ""
-        self.status.content = (
-            f"run {generation}: {result.duration:g} s simulated in {outcome.seconds:.2f} s"
-            + kept
-            + (f" · {left}" if left else "")
-        )
+        self._show(outcome, previous, defaults, command, generation, kept + (f" · {left}" if left else ""))
         self._report(run_line(outcome, command, generation))
+
+    def _show(
+        self,
+        done: Finished,
+        previous: Finished | None,
+        defaults: Finished | None,
+        command: str,
+        generation: int,
+        suffix: str = "",
+    ) -> None:
+        result = done.result
+        kept = self._kept
+        columns: dict[str, Finished | None] = {"previous": previous, "defaults": defaults}
+        if kept is not None:
+            columns[kept[0]] = kept[1]
+        self.plots.show(done, columns)  # first: the status line below says all is shown
+        with self.server.atomic():
+            self.metrics.content = metrics_table(done, columns)
+            self.command.content = f"```\n{command}\n```"
+            self.status.content = (
+                f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s{suffix}"
+            )
+        self.scene.show(result.t, result.q, result.q_des)
+        self.scene.hold(False, RESUME_AFTER)
+
+    def _keep_latest(self) -> None:
+        """Pin the run shown as a reference, named as ``compare`` names a variant."""
+        from twolink_pin.law_variant import format_variant
+
+        with self._lock:
+            done, previous, defaults = self._latest, self._previous, self._defaults
+        if done is None:
+            return
+        law = self._law if isinstance(self._law, str) else done.result.controller
+        try:
+            name = format_variant(law, done.gains, defaults=self._default_gains)
+        except TwolinkPinError:
+            name = f"kept run ({law})"
+        self._kept = (name, done)
+        self._show(done, previous, defaults, self._command_of(done.request.spec, done.request.payload), 0)
+        self.status.content = f"kept `{name}` as a reference"
 
     def _check_controls(self, request: Request) -> str:
         """After ``--watch`` reloaded the law: whether its ``Gains`` declaration still gives the

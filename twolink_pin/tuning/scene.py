@@ -1,6 +1,17 @@
 """The tuner's 3-D scene in Viser: the arm (its URDF meshes, through Pinocchio's
 ``ViserVisualizer``), its translucent ghost following the reference, the end effector's
-trail and desired path, and the playback (play/pause, a time scrubber, a speed)."""
+trail and desired path, and the playback (play/pause, a time scrubber, a speed).
+
+The playback is kept light so that the page answers a control at once: :data:`FPS` frames
+a second (each moves the arm and its ghost), the time scrubber's number updated
+:data:`SCRUBBER_HZ` times a second (each update re-renders the panel), and no frame at all
+while :meth:`ArmScene.hold` holds it: the tuner holds it from a control's move until
+:data:`RESUME_AFTER` seconds after the new run is shown, so a burst of key presses meets a
+still scene. (Viser's client renders on demand, each scene update opening a 250-ms window of
+continuous frames: with software WebGL a playing arm keeps the browser's main thread busy.)
+An arm whose visual meshes are heavy (more than :data:`TRIANGLES` triangles: the UR5's and
+the Panda's hold about 10⁵) is drawn with its URDF's collision geometry, about 50 times
+lighter, when it has one (:func:`light_model`)."""
 
 from __future__ import annotations
 
@@ -10,16 +21,25 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from twolink_pin.errors import TwolinkPinError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visual_model
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
 
-FPS = 30.0
+FPS = 10.0
 """Playback frames per second."""
+SCRUBBER_HZ = 2.0
+"""Updates of the time scrubber per second while playing."""
+RESUME_AFTER = 2.0
+"""The playback goes on this long after a hold is released [s]."""
 TRAIL_POINTS = 400
 """Largest number of points of the trail and the desired path."""
+TRIANGLES = 20_000
+"""The most triangles of visual meshes the tuner draws (twice: the arm and its ghost)."""
+ARM_RGBA = (0.62, 0.66, 0.72, 1.0)
+"""The colour of an arm drawn with its collision geometry (which has none of its own)."""
 TRAIL_RGB = (194, 37, 92)
 DESIRED_RGB = (43, 138, 62)
 
@@ -29,6 +49,30 @@ def _segments(points: np.ndarray) -> np.ndarray:
     step = max(1, len(points) // TRAIL_POINTS)
     p = points[::step]
     return np.stack([p[:-1], p[1:]], axis=1).astype(np.float32)
+
+
+def _triangles(geometry: Any) -> int:
+    return sum(int(getattr(obj.geometry, "num_tris", 0)) for obj in geometry.geometryObjects)
+
+
+def light_model(robot: RobotModel) -> Any:
+    """The geometry the tuner draws: the visual meshes, or, when they hold more than
+    :data:`TRIANGLES` triangles, the collision geometry if it is lighter (coloured
+    :data:`ARM_RGBA`)."""
+    import pinocchio as pin
+
+    visual = visual_model(robot)
+    if _triangles(visual) <= TRIANGLES:
+        return visual
+    try:
+        collision = visual_model(robot, pin.GeometryType.COLLISION)
+    except TwolinkPinError:
+        return visual
+    if not collision.ngeoms or _triangles(collision) >= _triangles(visual):
+        return visual
+    for obj in collision.geometryObjects:
+        obj.meshColor = np.array(ARM_RGBA)
+    return collision
 
 
 def view_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -56,7 +100,7 @@ class ArmScene:
 
         self._server = server
         self._robot = robot
-        visual = visual_model(robot)
+        visual = light_model(robot)
         self.arm = ViserVisualizer(robot.model, pin.GeometryModel(), visual)
         self.arm.initViewer(viewer=server)
         self.arm.loadViewerModel("arm")
@@ -69,6 +113,12 @@ class ArmScene:
         self.time = server.gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0, hint="the instant shown")
         self.speed = server.gui.add_slider("speed", 0.1, 4.0, 0.1, 1.0, hint="× real time")
         self.time.on_update(self._on_scrub)
+        from twolink_pin.tuning.typed_js import FOCUS_LABEL
+
+        self.focus = server.gui.add_text(
+            FOCUS_LABEL, "0", hint="set by the page: a gain's control has the focus"
+        )
+        self.focus.on_update(lambda _: self.hold(self.focus.value == "1", RESUME_AFTER, why="focus"))
         self._lock = threading.Lock()
         self._t = np.zeros(1)
         self._q = np.array([robot.home])
@@ -76,6 +126,9 @@ class ArmScene:
         self._now = 0.0
         self._stop = threading.Event()
         self._framed = False
+        self._held = threading.Event()
+        self._resume_at = 0.0
+        self._holds: set[str] = set()
         self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
         self._thread.start()
 
@@ -101,6 +154,21 @@ class ArmScene:
         self.time.max = float(t[-1])
         self._draw()
 
+    def hold(self, held: bool, resume_after: float = 0.0, why: str = "run") -> None:
+        """Stop drawing frames (True), or go on ``resume_after`` seconds from now (False),
+        without touching play/pause; each reason ``why`` (a run in flight, a focused
+        control) holds until it is released."""
+        with self._lock:
+            if held:
+                self._holds.add(why)
+            else:
+                self._holds.discard(why)
+                self._resume_at = max(self._resume_at, time.monotonic() + resume_after)
+            if self._holds:
+                self._held.set()
+            else:
+                self._held.clear()
+
     def close(self) -> None:
         """Stop the playback thread."""
         self._stop.set()
@@ -124,17 +192,19 @@ class ArmScene:
             self.ghost.display(q_des)
 
     def _play(self) -> None:
-        last = time.monotonic()
+        last = scrubbed = time.monotonic()
         while not self._stop.wait(1.0 / FPS):
             now = time.monotonic()
             elapsed, last = now - last, now
-            if not self.playing.value:
+            if not self.playing.value or self._held.is_set() or now < self._resume_at:
                 continue
             with self._lock:
                 end = float(self._t[-1])
                 self._now = (self._now + elapsed * float(self.speed.value)) % end if end > 0 else 0.0
                 shown = self._now
-            self.time.value = round(shown, 2)
+            if now - scrubbed >= 1.0 / SCRUBBER_HZ:
+                scrubbed = now
+                self.time.value = round(shown, 2)
             self._draw()
 
 

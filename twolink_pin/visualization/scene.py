@@ -163,8 +163,9 @@ def _visual_error(robot: RobotModel, dirs: Sequence[Path], exc: Exception) -> In
     return InvalidURDFError(path, "<visual>", f"Pinocchio could not build the visual geometry: {detail}")
 
 
-def visual_model(robot: RobotModel) -> pin.GeometryModel:
-    """The URDF's visual geometry of ``robot``, meshes loaded, attached to ``robot.model``'s joints.
+def visual_model(robot: RobotModel, kind: pin.GeometryType = pin.GeometryType.VISUAL) -> pin.GeometryModel:
+    """The URDF's visual geometry of ``robot`` (``kind``: or its collision geometry), meshes
+    loaded, attached to ``robot.model``'s joints.
 
     Mesh paths (``package://name/...`` or relative) are looked up in
     ``robot.profile.package_dirs``, then in the URDF's folder and its parents up to 4
@@ -178,7 +179,7 @@ def visual_model(robot: RobotModel) -> pin.GeometryModel:
     dirs = _search_dirs(robot)
     try:
         return pin.buildGeomFromUrdf(
-            robot.model, str(robot.urdf_path), pin.GeometryType.VISUAL, package_dirs=[str(d) for d in dirs]
+            robot.model, str(robot.urdf_path), kind, package_dirs=[str(d) for d in dirs]
         )
     except (ValueError, RuntimeError) as exc:
         raise _visual_error(robot, dirs, exc) from exc
