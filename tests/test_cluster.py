@@ -341,7 +341,7 @@ def test_ctrl_c_cancels_the_tasks_on_the_scheduler_and_leaves_no_output(
     finally:
         if process.poll() is None:
             process.kill()
-    assert process.returncode == 130 and stdout == ""
+    assert process.returncode == 130 and stdout == "", (process.returncode, stdout[-2000:], stderr[-2000:])
     assert stderr.rstrip().endswith("twolink-pin: interrupted")
     assert sorted(p.name for p in tmp_path.iterdir()) == []  # no folder, no staging folder
     _deadline_wait(lambda: not _sweep_tasks(scheduler), "the tasks' cancellation")

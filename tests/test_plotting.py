@@ -1051,7 +1051,7 @@ def test_figures_are_freed_after_saving(
 
 def test_no_pyplot_and_only_the_public_names() -> None:
     """Building and saving figures never imports pyplot (checked in a fresh interpreter),
-    and the package exports exactly its six save functions (no report tables)."""
+    and the package exports exactly its seven save functions (no report tables)."""
     code = (
         "import sys, tempfile, numpy as np\n"
         "import twolink_pin.plotting as p\n"
@@ -1067,5 +1067,6 @@ def test_no_pyplot_and_only_the_public_names() -> None:
         "save_simulation_figures",
         "save_task_error_figure",
         "save_trajectory_figures",
+        "save_velocity_limits_figure",
     ]
     assert not hasattr(plotting, "REPORT_FIGURES") and not hasattr(plotting, "CONTROLLER_TITLES")

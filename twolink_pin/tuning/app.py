@@ -193,32 +193,12 @@ class Tuner:
         )
         self.status = gui.add_markdown("starting…", order=1.0)
         from twolink_pin.tuning.panel import Panel
-        from twolink_pin.tuning.plots import Plots
-        from twolink_pin.tuning.scene import ArmScene
 
         _, reference = self._runner.arm(payload)
         period = float(getattr(reference, "period", 0.0) or 0.0)
         matrices = matrices_of(type(controller).Gains, used)  # a full matrix keeps its off-diagonal terms
         self.panel = Panel(self.server, knobs, base, payload, self.changed, matrices, period, order=10.0)
-        with gui.add_folder("metrics", order=20.0):
-            self.metrics = gui.add_markdown("")
-            self.keep = gui.add_button(
-                "keep this run",
-                hint="pin the run shown as a reference: a column here, grey curves in the plots",
-            )
-            self.keep.on_click(lambda _: self._keep_latest())
-        with gui.add_folder("plots", order=30.0) as folder:
-            self.plots = Plots(self.server, folder)
-        with gui.add_folder("playback", order=50.0):
-            self.scene = ArmScene(self.server, robot)
-        with gui.add_folder("as a command", order=60.0):
-            self.command = gui.add_markdown("")
-            hint = f"a file name inside {self.folder} (also offered as a download)"
-            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz", hint=hint)
-            gui.add_button("save run").on_click(lambda event: self._save(event.client))
-            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html", hint=hint)
-            gui.add_button("export animation").on_click(lambda event: self._export(event.client))
-            self.saved = gui.add_markdown(f"files are written in `{self.folder}`")
+        self._add_results(robot)
         self._lock = threading.Lock()
         self._latest: Finished | None = None
         self._previous: Finished | None = None
@@ -242,6 +222,33 @@ class Tuner:
             )
             self._watcher.start()
         self.changed()
+
+    def _add_results(self, robot: RobotModel) -> None:
+        """The page's folders below the controls: metrics (with "keep this run"), plots,
+        playback, and the run as a command with save and export."""
+        from twolink_pin.tuning.plots import Plots
+        from twolink_pin.tuning.scene import ArmScene
+
+        gui = self.server.gui
+        with gui.add_folder("metrics", order=20.0):
+            self.metrics = gui.add_markdown("")
+            self.keep = gui.add_button(
+                "keep this run",
+                hint="pin the run shown as a reference: a column here, grey curves in the plots",
+            )
+            self.keep.on_click(lambda _: self._keep_latest())
+        with gui.add_folder("plots", order=30.0) as folder:
+            self.plots = Plots(self.server, folder)
+        with gui.add_folder("playback", order=50.0):
+            self.scene = ArmScene(self.server, robot)
+        with gui.add_folder("as a command", order=60.0):
+            self.command = gui.add_markdown("")
+            hint = f"a file name inside {self.folder} (also offered as a download)"
+            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz", hint=hint)
+            gui.add_button("save run").on_click(lambda event: self._save(event.client))
+            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html", hint=hint)
+            gui.add_button("export animation").on_click(lambda event: self._export(event.client))
+            self.saved = gui.add_markdown(f"files are written in `{self.folder}`")
 
     def _start_server(self, host: str, port: int) -> Any:
         """The Viser server on ``host``:``port``, stopped quietly at exit."""
