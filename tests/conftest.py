@@ -22,9 +22,16 @@ Whole modules move together (a module's fixtures are set up once per stretch of 
 
 from __future__ import annotations
 
+import signal
 from typing import Any
 
 import pytest
+
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    # pytest started as a background job (`make test &` from a script: the shell ignores SIGINT
+    # there, and every process started inherits that): the commands the Ctrl-C tests start
+    # would ignore Ctrl-C as a background job should (twolink_pin.cli) and run to their end.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 GROUPS: dict[str, str] = {
     "test_docs.py": "docs",  # the executed tutorial and the site built from it (tests/docs_build.py)
@@ -182,3 +189,20 @@ def pytest_xdist_make_scheduler(config: pytest.Config, log: Any) -> Any:
             return GROUPS.get(nodeid.split("::", 1)[0].rsplit("/", 1)[-1]) or super()._split_scope(nodeid)
 
     return FileGroupScheduling(config, log)
+
+
+@pytest.fixture(autouse=True)
+def _signals_left_as_found() -> Any:
+    """A test leaves SIGINT's handler and the main thread's signal mask as it found them: a
+    process started later inherits both (SIGINT ignored or blocked there, a Ctrl-C test's
+    command would run to its end and exit 0)."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = (signal.getsignal(signal.SIGINT), signal.pthread_sigmask(signal.SIG_BLOCK, []))
+    yield
+    after = (signal.getsignal(signal.SIGINT), signal.pthread_sigmask(signal.SIG_BLOCK, []))
+    assert after == before, f"SIGINT's handler or the signal mask changed: {before} -> {after}"
