@@ -88,6 +88,16 @@ def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any
     )
 
 
+def limits_payload(check: Any) -> dict[str, Any]:
+    """``trajectory --json``'s limit fields of a :class:`~twolink_pin.feasibility.TorqueCheck`:
+    ``limits_check`` (:meth:`~twolink_pin.limits.LimitsCheck.summary`) and its grid."""
+    t = check.limits_check.motion.t
+    return {
+        "limits_check": check.limits_check.summary(),
+        "limits_check_grid": {"instants": len(t), "step": float(t[1] - t[0])},
+    }
+
+
 def limits_check_lines(check: Any) -> list[str]:
     """A :class:`~twolink_pin.limits.LimitsCheck` as a table: per kind and joint the peak, its
     time, the limit and the margin (``none``: the robot gives no such limit), then the

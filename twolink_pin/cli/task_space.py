@@ -65,8 +65,7 @@ def pose_trajectory_command(args: Any, robot: RobotModel, traj: PoseTrajectory, 
     points."""
     import pinocchio as pin
 
-    from twolink_pin.cli.commands.model import limits_payload
-    from twolink_pin.cli.output import emit, fmt, limits_check_lines
+    from twolink_pin.cli.output import emit, fmt, limits_check_lines, limits_payload
 
     figures: list[str] = []
     if args.plot:

@@ -15,7 +15,7 @@ retimed path, changes by far less than its limits' margins between two samples),
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
 
@@ -27,7 +27,20 @@ from twolink_pin.limits.kinds import KINDS, LimitKind, Motion
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
     from twolink_pin.model import RobotModel
-    from twolink_pin.trajectory import Trajectory
+
+
+class PeriodicReference(Protocol):
+    """What a check asks of a reference (a :class:`~twolink_pin.trajectory.Trajectory` is one;
+    the limits sit below the trajectories and do not import them)."""
+
+    t0: float
+    """Start of the first period [s]."""
+    period: float
+    """Repetition period [s]."""
+
+    def sample(self, t: np.ndarray) -> Any:
+        """Desired ``q`` [rad], ``v`` [rad/s] and ``a`` [rad/s²] at the times ``t`` [s], each (N, nv)."""
+
 
 MIN_SAMPLES = 4001
 """Fewest instants at which one period is checked."""
@@ -49,7 +62,7 @@ def check_grid(t0: float, period: float, samples: int | None = None) -> np.ndarr
 
 def reference_motion(
     robot: RobotModel,
-    trajectory: Trajectory,
+    trajectory: PeriodicReference,
     samples: int | None = None,
     friction: Friction | None = None,
 ) -> Motion:
@@ -156,7 +169,7 @@ def check_motion(motion: Motion, limits: JointLimits) -> LimitsCheck:
 
 def check_limits(
     robot: RobotModel,
-    trajectory: Trajectory,
+    trajectory: PeriodicReference,
     *,
     samples: int | None = None,
     limits: JointLimits | None = None,

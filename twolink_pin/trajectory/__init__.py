@@ -12,6 +12,7 @@
 ``retiming.py``             :func:`time_optimal`: a path retimed to its shortest duration within the limits (TOPP-RA)
 ``optimal.py``              :func:`optimize`: the least effort or the shortest duration through via points (the core in ``optimal/``)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
+``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)
 ``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)
 ==========================  ================================================================
 """

@@ -45,7 +45,7 @@ def read_samples(file: Path, document: dict[str, Any], robot: RobotModel) -> Sam
     Raises:
         InvalidParameterError: a key or value is wrong (named with the file).
     """
-    from twolink_pin.trajectory.file import (
+    from twolink_pin.trajectory.file_values import (
         MAX_ANGLE,
         MAX_TIME,
         check_trajectory_limits,

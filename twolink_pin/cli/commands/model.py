@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from twolink_pin.cli.commands.common import robot_from_args, trajectory_from_args
-from twolink_pin.cli.output import emit, fmt, limits_check_lines, pose_lines
+from twolink_pin.cli.output import emit, fmt, limits_check_lines, limits_payload, pose_lines
 from twolink_pin.errors import InvalidParameterError
 
 if TYPE_CHECKING:
@@ -364,16 +364,6 @@ def cmd_trajectory(args: argparse.Namespace) -> int:
     lines += [f"figure {f}" for f in figures]
     emit(args, payload, "\n".join(lines))
     return 0
-
-
-def limits_payload(check: Any) -> dict[str, Any]:
-    """``trajectory --json``'s limit fields of a :class:`~twolink_pin.feasibility.TorqueCheck`:
-    ``limits_check`` (:meth:`~twolink_pin.limits.LimitsCheck.summary`) and its grid."""
-    t = check.limits_check.motion.t
-    return {
-        "limits_check": check.limits_check.summary(),
-        "limits_check_grid": {"instants": len(t), "step": float(t[1] - t[0])},
-    }
 
 
 def _fourier_trajectory(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:

@@ -210,7 +210,7 @@ def _optimize_text(robot: RobotModel, result: Any, scale: float, source: str, fi
 
 def sampled_trajectory_command(args: argparse.Namespace, robot: RobotModel, traj: Any, check: Any) -> int:
     """``trajectory`` for a ``samples`` file: its samples, period, via times and every limit."""
-    from twolink_pin.cli.commands.model import limits_check_lines, limits_payload
+    from twolink_pin.cli.output import limits_check_lines, limits_payload
 
     figures: list[str] = []
     if args.plot:
