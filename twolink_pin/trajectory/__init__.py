@@ -10,6 +10,8 @@
 ``pose_ik.py``              :func:`solve_pose`: 6-D (position and orientation) damped least-squares IK
 ``sampled.py``              :class:`SampledTrajectory`: samples of q, q̇, q̈ (and τ), quintic Hermite between
 ``retiming.py``             :func:`time_optimal`: a path retimed to its shortest duration within the limits (TOPP-RA)
+``retiming_path.py``        the path a retiming times: pieces from rest to rest, their resting ends stretched
+``retiming_samples.py``     a TOPP-RA timing as samples (quintic Hermite between them), its via times
 ``optimal.py``              :func:`optimize`: the least effort or the shortest duration through via points (the core in ``optimal/``)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)

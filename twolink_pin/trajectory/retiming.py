@@ -71,8 +71,15 @@ from twolink_pin.limits import (
 from twolink_pin.limits.active import ActiveLimit, active_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
-from twolink_pin.trajectory.sampled import SampledTrajectory, hermite_coefficients
-from twolink_pin.trajectory.se3 import PoseTrajectory
+from twolink_pin.trajectory.retiming_path import PathPiece, path_lengths, path_pieces
+from twolink_pin.trajectory.retiming_samples import (
+    Timing,
+    exact_motion,
+    represented,
+    retimed_via_times,
+    timing_of,
+)
+from twolink_pin.trajectory.sampled import SampledTrajectory
 
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
@@ -80,8 +87,6 @@ if TYPE_CHECKING:
 GRIDPOINTS = 300
 """Intervals of TOPP-RA's grid over the whole path (split among an SE(3) path's segments by
 their joint-space length)."""
-END_ZONE = 0.05
-"""The fraction of a resting path's parameter at each end that is stretched (:class:`_EndsStretched`)."""
 SUBPOINTS = 4
 """Points per grid interval at which TOPP-RA's rows keep the limits (:func:`_params`): its
 interpolation discretisation keeps them at both ends of an interval only, and the motion
@@ -107,10 +112,6 @@ not, the limits are tightened by twice what it found."""
 REPRESENTATION = 1e-5
 """Acceleration error sought of the samples' interpolation, a fraction of the path's largest
 acceleration (an interval is halved, at most :data:`MAX_LEVEL` times, until it is met)."""
-MAX_LEVEL = 4
-"""Most halvings of a grid interval for the samples (the first and last intervals of a resting
-path do not reach :data:`REPRESENTATION`: the motion leaves rest like ``t² + c t^{5/2}`` there,
-no polynomial; their error is what :data:`MARGIN` leaves room for)."""
 
 
 class TimeOptimal(NamedTuple):
@@ -135,106 +136,6 @@ class TimeOptimal(NamedTuple):
     """Wall time of the retiming [s]."""
 
 
-class _Piece(NamedTuple):
-    """A stretch of geometric path retimed from rest to rest."""
-
-    path: Callable[[np.ndarray, int], np.ndarray]
-    """``(s, order) -> q^{(order)}(s)``, shape (len(s), nv)."""
-    start: float
-    end: float
-
-
-def path_pieces(trajectory: Trajectory) -> list[_Piece]:
-    """The geometric path of ``trajectory`` (module docstring): one piece, or one per SE(3)
-    segment."""
-    if isinstance(trajectory, PoseTrajectory):
-        return [
-            _Piece(functools.partial(trajectory.segment_path, k), 0.0, 1.0)
-            for k in range(len(trajectory.times) - 1)
-        ]
-    span = float(getattr(trajectory, "span", trajectory.period))
-    orders = _rest_orders(trajectory, trajectory.t0, span)
-    return [_Piece(_EndsStretched(trajectory, trajectory.t0, span, *orders), 0.0, 1.0)]
-
-
-def _rest_orders(trajectory: Trajectory, start: float, span: float) -> tuple[int, int]:
-    """How the trajectory leaves rest at its start and reaches it at its end: ``m`` with
-    ``q − q_end ~ (t − t_end)^m`` (the first of q̇, q̈, jerk that is not zero, 4 if none is;
-    1: it does not rest there)."""
-    ends = trajectory.sample(np.array([start, start + span]))
-    scale = max(float(np.abs(trajectory.sample(np.linspace(start, start + span, 65)).v).max()), 1e-300)
-    orders = []
-    for index in (0, 1):
-        sizes = [float(np.abs(x[index]).max()) for x in (ends.v, ends.a, ends.jerk)]
-        zero = [size <= 1e-9 * scale * span ** (-r) for r, size in enumerate(sizes)]
-        orders.append(zero.index(False) + 1 if False in zero else 4)
-    return orders[0], orders[1]
-
-
-def _end_map(m: int) -> tuple[float, float, float]:
-    """``(α, β, γ)`` of ``ψ(x) = x^{1/m} (α + β x + γ x²)``: ``ψ(1) = 1``, ``ψ'(1) = 1``,
-    ``ψ''(1) = 0`` (a C² join with the identity), monotone for m = 1 .. 4."""
-    p = 1.0 / m
-    A = np.array([[1.0, 1.0, 1.0], [p, p + 1, p + 2], [p * (p - 1), (p + 1) * p, (p + 2) * (p + 1)]])
-    a, b, c = np.linalg.solve(A, [1.0, 1.0, 0.0])
-    return float(a), float(b), float(c)
-
-
-class _EndsStretched:
-    """A trajectory's path in a parameter ``σ ∈ [0, 1]``: ``s = start + span φ(σ)``, ``φ(σ) = σ``
-    but within :data:`END_ZONE` of an end where the trajectory rests, there ``δ ψ(σ/δ)`` with
-    ``ψ(x) ~ x^{1/m}`` (:func:`_end_map`). In ``s`` the tangent of a polynomial that leaves rest
-    with zero velocity, acceleration and jerk vanishes like ``s³``: TOPP-RA's constraints lose
-    their scale and its steps their digits near the ends (it declared such paths not
-    controllable on a finer grid there). In ``σ`` the tangent stays finite and ``ṡ²`` grows
-    linearly from rest, what TOPP-RA's constant path acceleration per interval represents."""
-
-    def __init__(self, trajectory: Trajectory, start: float, span: float, m0: int, m1: int) -> None:
-        self.trajectory, self.start, self.span = trajectory, start, span
-        self.ends = ((m0, _end_map(m0)), (m1, _end_map(m1)))
-        self._last: tuple[np.ndarray, tuple[np.ndarray, ...]] | None = None  # q, q', q'' at the last σ
-
-    def phi(self, sigma: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``φ, φ', φ''`` at ``σ`` (inside [1e-9, 1 − 1e-9]: the ends are singular)."""
-        x = np.clip(np.asarray(sigma, dtype=float), 1e-9, 1.0 - 1e-9)
-        phi, d1, d2 = x.copy(), np.ones_like(x), np.zeros_like(x)
-        delta = END_ZONE
-        for side, (m, (a, b, c)) in enumerate(self.ends):
-            if m == 1:
-                continue
-            y = x / delta if side == 0 else (1.0 - x) / delta
-            zone = y < 1.0
-            p, yy = 1.0 / m, y[zone]
-            psi = yy**p * (a + b * yy + c * yy**2)
-            dpsi = yy ** (p - 1) * (p * a + (p + 1) * b * yy + (p + 2) * c * yy**2)
-            ddpsi = yy ** (p - 2) * (p * (p - 1) * a + (p + 1) * p * b * yy + (p + 2) * (p + 1) * c * yy**2)
-            sign = 1.0 if side == 0 else -1.0
-            phi[zone] = delta * psi if side == 0 else 1.0 - delta * psi
-            d1[zone], d2[zone] = dpsi, sign * ddpsi / delta
-        return phi, d1, d2
-
-    def sigma_of(self, t: np.ndarray) -> np.ndarray:
-        """The parameter ``σ`` at which the path is the trajectory's at time ``t`` [s]."""
-        sigma = np.linspace(0.0, 1.0, 20001)
-        phi = self.phi(sigma)[0]
-        phi[0], phi[-1] = 0.0, 1.0
-        return np.interp((np.asarray(t, dtype=float) - self.start) / self.span, phi, sigma)
-
-    def __call__(self, sigma: np.ndarray, order: int) -> np.ndarray:
-        sigma = np.asarray(sigma, dtype=float)
-        if self._last is None or not np.array_equal(self._last[0], sigma):  # q, q', q'' asked in turn
-            phi, d1, d2 = self.phi(sigma)
-            sample = self.trajectory.sample(self.start + self.span * phi)
-            v, a = np.atleast_2d(sample.v), np.atleast_2d(sample.a)
-            values = (
-                np.atleast_2d(sample.q),
-                v * (self.span * d1)[:, None],
-                a * (self.span * d1)[:, None] ** 2 + v * (self.span * d2)[:, None],
-            )
-            self._last = (sigma.copy(), values)
-        return self._last[1][order]
-
-
 @functools.cache
 def _toppra() -> Any:
     """toppra (1.1 s to import: only here), its logger quiet, and the two classes on it."""
@@ -246,7 +147,7 @@ def _toppra() -> Any:
     logging.getLogger("toppra").setLevel(logging.ERROR)
 
     class Path(AbstractGeometricPath):
-        def __init__(self, piece: _Piece, nv: int) -> None:
+        def __init__(self, piece: PathPiece, nv: int) -> None:
             self.piece, self._nv = piece, nv
 
         def __call__(self, s: Any, order: int = 0) -> np.ndarray:
@@ -295,7 +196,7 @@ class _Stage(NamedTuple):
         return self.s[::SUBPOINTS]
 
 
-def _stage(robot: RobotModel, piece: _Piece, grid: np.ndarray, friction: Friction | None) -> _Stage:
+def _stage(robot: RobotModel, piece: PathPiece, grid: np.ndarray, friction: Friction | None) -> _Stage:
     """Sample ``piece`` at :data:`SUBPOINTS` points per interval of ``grid`` and compute its
     torque coefficients there."""
     theta = np.arange(SUBPOINTS) / SUBPOINTS
@@ -431,7 +332,7 @@ def _solve(
         for _ in range(FRICTION_PASSES if friction is not None else 1):
             interrupts.check()
             constraint = lib.Limits(_params(stage, limits, cap, friction, x_ref), robot.nv)
-            path = lib.Path(_Piece(lambda s, r: s, grid[0], grid[-1]), robot.nv)
+            path = lib.Path(PathPiece(lambda s, r: s, grid[0], grid[-1]), robot.nv)
             algorithm = lib.toppra.algorithm.TOPPRA(
                 [constraint], path, gridpoints=grid, solver_wrapper="seidel"
             )
@@ -448,133 +349,6 @@ def _solve(
             return np.asarray(sd, dtype=float)
         cap_factor *= 4.0
     raise OptimizationError(what, "the path speed cap still binds after raising it 8 times", 8)
-
-
-class _Timing(NamedTuple):
-    """A piece timed by TOPP-RA: ``ṡ`` at its grid points, constant ``s̈`` on each interval."""
-
-    piece: _Piece
-    stage: _Stage
-    sd: np.ndarray
-    """``ṡ`` at the grid points, shape (N + 1,)."""
-    u: np.ndarray
-    """``s̈`` on each interval, shape (N,)."""
-    t: np.ndarray
-    """The time of each grid point [s], shape (N + 1,)."""
-
-
-def _timing(piece: _Piece, stage: _Stage, sd: np.ndarray, t0: float) -> _Timing:
-    """``ṡ`` on ``stage``'s grid as a timing starting at ``t0`` [s]."""
-    ds = np.diff(stage.grid)
-    mean = 0.5 * (sd[:-1] + sd[1:])
-    if np.any(mean <= 0):
-        raise OptimizationError(
-            "the time-optimal retiming", "TOPP-RA stopped on the path (ṡ = 0 inside it)", 1
-        )
-    t = t0 + np.concatenate([[0.0], np.cumsum(ds / mean)])
-    return _Timing(piece, stage, sd, (sd[1:] ** 2 - sd[:-1] ** 2) / (2.0 * ds), t)
-
-
-def _exact(timing: _Timing, interval: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, ...]:
-    """The timed path at the fraction ``tau`` of the time of each ``interval``: ``t`` [s],
-    ``q``, ``q̇``, ``q̈`` (``s(t)`` quadratic on an interval: ``s̈ = u``)."""
-    dt = np.diff(timing.t)[interval] * tau
-    sd, u = timing.sd[interval], timing.u[interval]
-    grid = timing.stage.grid
-    s = np.minimum(grid[interval] + sd * dt + 0.5 * u * dt**2, grid[interval + 1])
-    speed = sd + u * dt
-    path = timing.piece.path
-    d1, d2 = path(s, 1), path(s, 2)
-    return (
-        timing.t[interval] + dt,
-        path(s, 0),
-        d1 * speed[:, None],
-        d2 * speed[:, None] ** 2 + d1 * u[:, None],
-    )
-
-
-def _fractions(m: np.ndarray, offset: float) -> np.ndarray:
-    """``(j + offset)/m_i`` for j = 0..m_i (offset 0: the m_i + 1 ends of m_i equal parts) or
-    j = 0..m_i − 1 (offset 0.5: their midpoints), for each i, concatenated."""
-    count = m + 1 if offset == 0.0 else m
-    start = np.repeat(np.cumsum(count) - count, count)
-    j = np.arange(int(count.sum())) - start
-    return (j + offset) / np.repeat(m, count)
-
-
-def _hermite_midpoint_acceleration(
-    t: np.ndarray, q: np.ndarray, v: np.ndarray, a: np.ndarray, steps: np.ndarray
-) -> np.ndarray:
-    """The quintic Hermite's acceleration halfway through the ``steps`` (row ``i`` to ``i + 1``),
-    shape (len(steps), nv): ``(2 c₂ + 3 c₃ + 3 c₄ + 2.5 c₅) / h²`` with its coefficients in ``τ``."""
-    i, j = steps, steps + 1
-    h = t[j] - t[i]
-    c = hermite_coefficients(h, q[i], v[i], a[i], q[j], v[j], a[j])
-    return (2.0 * c[:, 2] + 3.0 * c[:, 3] + 3.0 * c[:, 4] + 2.5 * c[:, 5]) / h[:, None] ** 2
-
-
-def _piece_rows(timing: _Timing, tolerance: float) -> tuple[np.ndarray, ...]:
-    """One timing's samples: each grid interval at ``2^level + 1`` evenly spaced times, both
-    ends included (each interior grid point twice: its acceleration before and after), the
-    level raised (at most :data:`MAX_LEVEL`) until the quintic Hermite between them is the
-    exact timing to ``tolerance`` [rad/s²] of acceleration at every midpoint (near a resting
-    path's ends the motion is no polynomial)."""
-    n = timing.u.size
-    level = np.zeros(n, dtype=int)
-    rows: list[tuple[np.ndarray, ...] | None] = [None] * n
-    todo = np.arange(n)
-    while todo.size:
-        m = 2 ** level[todo]
-        t, q, v, a = _exact(timing, np.repeat(todo, m + 1), _fractions(m, 0.0))
-        _, _, _, mid = _exact(timing, np.repeat(todo, m), _fractions(m, 0.5))
-        inner = np.ones(t.size - 1, dtype=bool)
-        inner[np.cumsum(m + 1)[:-1] - 1] = False  # the step from one interval's end to the next's start
-        error = np.abs(_hermite_midpoint_acceleration(t, q, v, a, np.flatnonzero(inner)) - mid).max(axis=1)
-        worst = np.maximum.reduceat(error, np.concatenate([[0], np.cumsum(m)[:-1]]))
-        done = (worst <= tolerance) | (level[todo] >= MAX_LEVEL)
-        bounds = np.concatenate([[0], np.cumsum(m + 1)])
-        for k in np.flatnonzero(done):
-            rows[int(todo[k])] = tuple(x[bounds[k] : bounds[k + 1]] for x in (t, q, v, a))
-        todo = todo[~done]
-        level[todo] += 1
-    return tuple(np.concatenate([r[i] for r in rows if r is not None]) for i in range(4))
-
-
-def _represented(timings: list[_Timing], tolerance: float) -> tuple[np.ndarray, ...]:
-    """Every timing's samples (:func:`_piece_rows`), one after the other."""
-    parts = [_piece_rows(timing, tolerance) for timing in timings]
-    return tuple(np.concatenate([p[i] for p in parts]) for i in range(4))
-
-
-def _time_at(timing: _Timing, s: np.ndarray) -> np.ndarray:
-    """When the timing reaches the path parameters ``s`` [s]: within an interval
-    ``s(τ) = s_i + ṡ_i τ + u_i τ²/2``."""
-    grid = timing.stage.grid
-    i = np.clip(np.searchsorted(grid, s, side="right") - 1, 0, grid.size - 2)
-    d = np.clip(s - grid[i], 0.0, np.diff(grid)[i])
-    sd, u = timing.sd[i], timing.u[i]
-    root = np.sqrt(np.maximum(sd**2 + 2.0 * u * d, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tau = np.where(sd + root > 0, 2.0 * d / (sd + root), 0.0)
-    return timing.t[i] + tau
-
-
-def _via_times(trajectory: Trajectory, timings: list[_Timing]) -> np.ndarray:
-    """When the retimed path passes the reference's via points [s]."""
-    if isinstance(trajectory, PoseTrajectory):
-        return np.array([timings[0].t[0]] + [timing.t[-1] for timing in timings])
-    path = timings[0].piece.path
-    assert isinstance(path, _EndsStretched)
-    return _time_at(timings[0], path.sigma_of(np.asarray(trajectory.via_times, dtype=float)))
-
-
-def _lengths(pieces: list[_Piece]) -> np.ndarray:
-    """Each piece's joint-space length [rad] (50 chords)."""
-    out = []
-    for piece in pieces:
-        q = piece.path(np.linspace(piece.start, piece.end, 51), 0)
-        out.append(float(np.linalg.norm(np.diff(q, axis=0), axis=1).sum()))
-    return np.array(out)
 
 
 def _torque(
@@ -611,27 +385,30 @@ def _over(motion: Motion, limits: JointLimits, per_interval: int) -> np.ndarray:
 def _timed(
     robot: RobotModel,
     trajectory: Trajectory,
-    pieces: list[_Piece],
+    pieces: list[PathPiece],
     stages: list[_Stage],
     limits: JointLimits,
     friction: Friction | None,
-) -> tuple[SampledTrajectory, list[_Timing]]:
+) -> tuple[SampledTrajectory, list[Timing]]:
     """Each piece timed within ``limits`` (TOPP-RA), one after the other, and the samples of
     the whole: what :func:`time_optimal` checks."""
-    timings: list[_Timing] = []
+    timings: list[Timing] = []
     for piece, stage in zip(pieces, stages, strict=True):
         sd = _solve(robot, stage, limits, friction, "the time-optimal retiming")
-        timings.append(_timing(piece, stage, sd, 0.0 if not timings else float(timings[-1].t[-1])))
+        timings.append(timing_of(piece, stage.grid, sd, 0.0 if not timings else float(timings[-1].t[-1])))
     scale = max(
-        max(float(np.abs(_exact(tm, np.arange(tm.u.size), np.zeros(tm.u.size))[3]).max()) for tm in timings),
+        max(
+            float(np.abs(exact_motion(tm, np.arange(tm.u.size), np.zeros(tm.u.size))[3]).max())
+            for tm in timings
+        ),
         1e-9,
     )
-    t, q, v, a = _represented(timings, REPRESENTATION * scale)
+    t, q, v, a = represented(timings, REPRESENTATION * scale)
     same = np.flatnonzero(np.diff(t) == 0)
     q[same + 1], v[same + 1] = q[same], v[same]  # a junction of two pieces: one configuration
     q[-1], v[-1] = q[0], v[0]  # the path closes (to its IK's digits for an SE(3) reference)
     tau = _torque(robot, q, v, a, friction)
-    return SampledTrajectory(t, q, v, a, tau, _via_times(trajectory, timings)), timings
+    return SampledTrajectory(t, q, v, a, tau, retimed_via_times(trajectory, timings)), timings
 
 
 def time_optimal(
@@ -670,7 +447,7 @@ def time_optimal(
     start = time.perf_counter()
     wanted = base.scaled(limit_scale)
     pieces = path_pieces(trajectory)
-    lengths = _lengths(pieces)
+    lengths = path_lengths(pieces)
     if not np.all(lengths > 0):
         k = int(np.flatnonzero(lengths <= 0)[0])
         raise InvalidParameterError("trajectory", f"segment {k} does not move", "a path that moves to retime")
