@@ -109,6 +109,34 @@ def test_a_binding_replan_meets_the_kkt_conditions() -> None:
     assert kkt_residual(qp, solution) < KKT_TOLERANCE
 
 
+def test_a_run_whose_replan_cannot_hold_ends_alone_in_a_batch() -> None:
+    """Run 1 of three starts where the position rows cannot hold (the single run fails at
+    t = 0 naming the row): in a batch that run ends at t = 0 with the law's reason, and the two
+    others equal their single runs (a second method: each simulated alone)."""
+    offsets = np.array([[0.1, -0.1], [3.0, 3.0], [0.0, 0.3]])
+    config = SimulationConfig(duration=0.15)
+    trajectory = default_trajectory(ROBOT)
+    with pytest.raises(ControllerError) as alone:
+        simulate(
+            ModelPredictive(ROBOT), Plant(ROBOT), trajectory,
+            SimulationConfig(duration=0.15, q0_offset=(3.0, 3.0)),
+        )  # fmt: skip
+    assert "failed at t = 0 s" in str(alone.value) and "position range" in str(alone.value)
+    batch = simulate_batch(
+        ModelPredictive(ROBOT), Plant(ROBOT), trajectory, config, q0_offsets=offsets, record=True
+    )
+    assert np.isnan(batch.diverged_at[[0, 2]]).all() and batch.diverged_at[1] == 0.0
+    reason = batch.divergence[1]
+    assert reason is not None and "the MPC replan at t = 0 s (run 1)" in reason, reason
+    assert "cannot all hold" in reason and "position range" in reason, reason
+    for i in (0, 2):
+        single = simulate(
+            ModelPredictive(ROBOT), Plant(ROBOT), trajectory,
+            SimulationConfig(duration=0.15, q0_offset=tuple(offsets[i])),
+        )  # fmt: skip
+        np.testing.assert_allclose(batch.q[i], single.q, rtol=0, atol=1e-12)
+
+
 def test_a_batch_of_n_runs_equals_its_single_runs() -> None:
     """Three start offsets (one far enough for the limits to bind at its first replans) and
     per-run weights in one batch: each run equals its single run to rounding."""
@@ -245,3 +273,33 @@ def test_controllers_and_tune_list_its_gains_with_units(capsys: pytest.CaptureFi
         1.0,
         0.95,
     )
+
+
+def test_a_sweep_keeps_its_runs_when_one_replan_cannot_hold(
+    tmp_path: object, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``sweep mpc`` whose draws put one start where the rows cannot hold (this seed: run 5,
+    which alone fails at t = 0): the sweep finishes, writes every run, and counts that one
+    among the runs that did not finish (it used to end the whole sweep with exit 1)."""
+    import json
+    from pathlib import Path
+
+    from twolink_pin.cli import main
+
+    out = Path(str(tmp_path)) / "sweep"
+    argv = ["sweep", "mpc", "--samples", "8", "--q0-offset", "1.5", "1.5", "--q0-spread", "1.5"]
+    assert main([*argv, "--duration", "0.05", "--out", str(out), "--no-plot"]) == 0
+    text = capsys.readouterr().out
+    assert "8 runs" in text and "(1 diverged" in text, text
+    import csv
+
+    rows = list(csv.DictReader((out / "runs.csv").open()))
+    assert [r["diverged"] for r in rows] == ["0"] * 5 + ["1"] + ["0"] * 2
+    assert float(rows[5]["diverged_at"]) == 0.0
+    q0 = (float(rows[5]["q0_offset1"]), float(rows[5]["q0_offset2"]))
+    with pytest.raises(ControllerError, match="failed at t = 0 s"):  # that start alone fails
+        simulate(
+            ModelPredictive(ROBOT), Plant(ROBOT), default_trajectory(ROBOT),
+            SimulationConfig(duration=0.05, q0_offset=q0),
+        )  # fmt: skip
+    assert json.loads((out / "summary.json").read_text())["samples"] == 8

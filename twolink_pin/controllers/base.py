@@ -442,6 +442,16 @@ class Controller(abc.ABC, Generic[G]):
         updates ``z`` moves only by the ``dz`` :meth:`compute` returns (zeros for a plan)."""
         raise NotImplementedError(f"{type(self).__name__} declares an update period but no update()")
 
+    def run_failure(self, run: int) -> str | None:
+        """Why the law gave up run ``run`` of the batch it computes, or ``None`` (the default).
+
+        A law that cannot go on with one of its N runs (a planning law whose problem has no
+        solution for that run) sets that run's state ``z`` (or its torque) to NaN in
+        :meth:`update` (or :meth:`compute`) and says why here: the engine ends that run at that
+        time with this text, as it ends a diverged one, and the other runs go on. A single run
+        ends with an error naming the law, the time and this text."""
+        return None
+
     def scaled_gains(self) -> dict[str, Any]:
         """Values for the per-joint or per-estimate gains left ``None``, derived from the
         robot (override in a law whose gains default to ``None``)."""

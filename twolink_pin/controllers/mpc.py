@@ -10,7 +10,7 @@ import numpy as np
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, StateVariable, Terms
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.dynamics import joint_inertia
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import InvalidParameterError, OptimizationError
 from twolink_pin.limits import joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.optimal import solve_qp
@@ -94,8 +94,9 @@ class ModelPredictive(Controller[MPCGains]):
     from and its accelerations $a_k$ ($2 + (2 + K) n_v$ numbers) — recorded like any state.
     **A batch of N runs** takes one derivatives call for all N plans, builds the N QPs as batched
     arrays and solves their unconstrained minimisers in one call; the runs where a row binds go
-    to ProxQP one after the other. The runs never mix, so a batch equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, fails
-    the run at that time naming the row (:class:`~twolink_pin.errors.OptimizationError`; exit 1).
+    to ProxQP one after the other. The runs never mix, so a batch equals its single runs. A QP whose rows cannot all hold, or a solver that stops short, ends
+    that run at that time naming the row (:meth:`run_failure`): a single run fails (exit 1), a run
+    of a batch or a sweep is flagged with the time and the text while the others go on.
     """
 
     name = "mpc"
@@ -129,6 +130,7 @@ class ModelPredictive(Controller[MPCGains]):
             np.broadcast_to(np.atleast_2d(k), (np.atleast_2d(k).shape[0], nv)).copy() for k in (g.kp, g.kd)
         )
         self._zeros: dict[tuple[int, ...], np.ndarray] = {}
+        self._failures: dict[int, str] = {}  # run → why its replan failed (:meth:`run_failure`)
         s = self.horizon.interval * np.arange(self.horizon.knots + 1)[None, :, None]
         self._knot_times = (s, 0.5 * s * s)  # s and s²/2 [s, s²] at the knots, (1, K + 1, 1)
         K = self.horizon.knots
@@ -171,18 +173,33 @@ class ModelPredictive(Controller[MPCGains]):
         qps, u_bar = self._problems(x, terms)
         step, inside = qps.unconstrained()
         at = f"the MPC replan at t = {x.t:.6g} s"
-        for i in np.flatnonzero(~inside):  # a row binds: ProxQP, one run after the other
+        given_up = ~(np.isfinite(x.q).all(1) & np.isfinite(x.v).all(1) & np.isfinite(x.z).all(1))
+        failed = [int(i) for i in np.flatnonzero(given_up)]  # ended already: no QP
+        for i in np.flatnonzero(~inside & ~given_up):  # a row binds: ProxQP, one run after the other
             what = at if len(inside) == 1 else f"{at} (run {i})"
-            solution = solve_qp(
-                qps.qp(int(i)), what=what, max_iter=MAX_ITER, infeasibility_eps=INFEASIBILITY_EPS
-            )
+            try:
+                solution = solve_qp(
+                    qps.qp(int(i)), what=what, max_iter=MAX_ITER, infeasibility_eps=INFEASIBILITY_EPS
+                )
+            except OptimizationError as exc:  # this run ends here (run_failure says why), the others go on
+                self._failures.setdefault(int(i), str(exc))  # the first reason: what ended it
+                failed.append(int(i))
+                continue
             step[i] = solution.x
         u = u_bar + step.reshape(u_bar.shape)
         nv = x.q.shape[1]
         z = np.empty(x.z.shape)
         z[:, 0], z[:, 1] = x.t, x.z[:, 1] + 1
         z[:, 2 : 2 + nv], z[:, 2 + nv : 2 + 2 * nv], z[:, 2 + 2 * nv :] = x.q, x.v, u.reshape(u.shape[0], -1)
+        z[failed, 2:] = np.nan
         return z
+
+    def run_failure(self, run: int) -> str | None:
+        return self._failures.get(run)
+
+    def initial_state(self) -> np.ndarray:
+        self._failures.clear()  # a new simulation: no run given up yet
+        return super().initial_state()
 
     def problems(self, x: LawInput, terms: Terms) -> HorizonQPs:
         """The QPs of the runs at a replan (what :meth:`update` solves; e.g. to check its KKT

@@ -2,7 +2,9 @@
 
 A run has diverged at the first sample whose state ``(q, q̇, z)`` is non-finite or beyond
 :data:`~twolink_pin.simulation.config.DIVERGENCE_LIMIT`, or whose commanded torque is
-non-finite (the law's fault, named as such). :func:`flag_block` looks within a block of
+non-finite (the law's fault, named as such). A run the law gave up (its state or torque set
+non-finite, :meth:`~twolink_pin.controllers.Controller.run_failure`) is reported with the law's
+reason. :func:`flag_block` looks within a block of
 written samples, :func:`late_divergence` at the state after the block's last step; both
 record the time and a one-line detail per run, or raise at once (single runs).
 """
@@ -10,6 +12,7 @@ record the time and a one-line detail per run, or raise at once (single runs).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -34,16 +37,22 @@ def late_divergence(
     detail: list[str | None],
     name: str,
     stop_on_divergence: bool,
+    why: Callable[[int], str | None] = lambda run: None,
 ) -> np.ndarray:
-    """Flag the live runs whose state after a block (at ``t`` [s]) has diverged; returns them."""
+    """Flag the live runs whose state after a block (at ``t`` [s]) has diverged; returns them
+    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`)."""
     current = bad_rows(q[None])[0] | bad_rows(v[None])[0] | bad_rows(z[None])[0]
     late = alive & current
     if late.any():
         if stop_on_divergence:
+            first = int(np.flatnonzero(late)[0])
+            given = why(first)
+            if given is not None:
+                raise ControllerError(name, t, given)
             raise SimulationDivergedError(name, t, state_detail(q, v, z, late))
         for r in np.flatnonzero(late):
             diverged_at[r] = t
-            detail[r] = state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r])
+            detail[r] = why(int(r)) or state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r])
         alive &= ~late
     return late
 
@@ -71,8 +80,10 @@ def flag_block(
     detail: list[str | None],
     name: str,
     raise_now: bool,
+    why: Callable[[int], str | None] = lambda run: None,
 ) -> np.ndarray:
-    """Flag the runs that diverged within buffer rows ``start:stop``; returns them."""
+    """Flag the runs that diverged within buffer rows ``start:stop``; returns them
+    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`)."""
     rows = slice(start, stop)
     state_bad = bad_rows(Q[rows]) | bad_rows(V[rows]) | bad_rows(Z[rows])
     torque_bad = ~np.isfinite(T[rows]).all(axis=-1)
@@ -82,7 +93,12 @@ def flag_block(
         first = int(np.argmax(bad[:, r]))
         k = start + first + off
         t = float(times[k])
-        if torque_bad[first, r] and not state_bad[first, r]:
+        given = why(int(r))
+        if given is not None:  # the law gave this run up and says why
+            if raise_now:
+                raise ControllerError(name, t, given)
+            what = given
+        elif torque_bad[first, r] and not state_bad[first, r]:
             what = f"the controller returned a non-finite torque τ = {T[start + first, r].tolist()}"
             if raise_now:
                 raise ControllerError(name, t, what)
@@ -106,3 +122,21 @@ def flag_block(
         detail[r] = what
     alive &= ~newly
     return newly
+
+
+def law_reason(controller: object) -> Callable[[int], str | None]:
+    """``controller.run_failure`` as the checks ask it: a law's reason for giving up a run, or
+    None (a law without the method, or whose method raises or returns no text: the state's own
+    detail is reported instead)."""
+    method = getattr(controller, "run_failure", None)
+
+    def why(run: int) -> str | None:
+        if method is None:
+            return None
+        try:
+            text = method(run)
+        except Exception:  # user code: a broken reason never hides the failure itself
+            return None
+        return text if isinstance(text, str) and text.strip() else None
+
+    return why

@@ -59,7 +59,7 @@ from twolink_pin.simulation.containment import (
     update_steps,
 )
 from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
-from twolink_pin.simulation.divergence import flag_block, late_divergence
+from twolink_pin.simulation.divergence import flag_block, late_divergence, law_reason
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.task_reference import reference_rows
@@ -381,6 +381,7 @@ class _Run:
         return flag_block(
             o.Q, o.V, o.Z, o.T, start, stop, self.times, off,
             self.alive, self.diverged_at, self.detail, self.controller.name, raise_now,
+            law_reason(self.controller),
         )  # fmt: skip
 
     def check(self, k0: int, k1: int, rq: np.ndarray, rv: np.ndarray, stop_on_divergence: bool) -> None:
@@ -393,8 +394,9 @@ class _Run:
             q, v, z = self.q, self.v, self.z
             name = self.controller.name
             newly |= late_divergence(
-                q, v, z, self.alive, k1 * self.dt, self.diverged_at, self.detail, name, stop_on_divergence
-            )
+                q, v, z, self.alive, k1 * self.dt, self.diverged_at, self.detail, name, stop_on_divergence,
+                law_reason(self.controller),
+            )  # fmt: skip
             if newly.any():  # park them on the reference, keep the batch going
                 j = 2 * (k1 - k0)
                 q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
