@@ -303,3 +303,16 @@ def test_a_sweep_keeps_its_runs_when_one_replan_cannot_hold(
             SimulationConfig(duration=0.05, q0_offset=q0),
         )  # fmt: skip
     assert json.loads((out / "summary.json").read_text())["samples"] == 8
+
+
+def test_a_duration_that_is_no_whole_number_of_steps_replans_every_ten_steps() -> None:
+    """0.1003 s at dt = 1 ms is 100 steps of 1.003 ms (the engine stretches the step to end on
+    the duration): the replanning period counts 10 configured steps, as the control period does,
+    instead of being refused against the stretched step (``report --controller mpc`` failed so
+    on the twolink's retimed reference, 0.5281 s)."""
+    config = SimulationConfig(duration=0.1003)
+    result = simulate(ModelPredictive(ROBOT), Plant(ROBOT), default_trajectory(ROBOT), config)
+    names = list(result.state_names)
+    replans = result.state[:, names.index("replans")]
+    replanned = result.t[np.flatnonzero(np.diff(replans)) + 1]  # when the count went up
+    np.testing.assert_allclose(replanned, 10 * (0.1003 / 100) * np.arange(1, 11), rtol=0, atol=1e-12)

@@ -249,7 +249,9 @@ class _Run:
         noisy = events is not None and events.noise is not None
         self.noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
         self.compute = law_call(controller, self.noise if noisy else None)
-        self.update_every = update_steps(controller, dt)
+        # the configured step, as for the control period: a duration that is not a whole number of
+        # steps stretches each step a little (dt above) and the period counts steps alike
+        self.update_every = update_steps(controller, config.dt)
         self.update = (
             None
             if self.update_every is None
