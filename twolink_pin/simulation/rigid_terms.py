@@ -10,8 +10,8 @@ parameters, built the first time a law asks):
                 asked again for the same values (same dtype, shape and bytes)
 ``gravity``     ``pin.computeGeneralizedGravity``
 ``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
-``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
-                LU with pivoting: no inverse is formed)
+``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``'s
+                LU with pivoting, :mod:`twolink_pin.small_linalg`: no inverse is formed)
 ``inverse_dynamics_derivatives``  ``pin.computeRNEADerivatives`` at K states per run (τ, ∂τ/∂q,
                 ∂τ/∂q̇, M̂: what a planning law linearises its plan's torque with)
 ``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
@@ -50,6 +50,7 @@ from twolink_pin.dynamics import InverseDynamicsDerivatives, inverse_dynamics_de
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.model.parameters import model_with_parameters
+from twolink_pin.small_linalg import solve
 
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 """The one convention of :meth:`RigidBodyTerms.frame`."""
@@ -203,8 +204,8 @@ class RigidBodyTerms:
         if M.shape[0] != n:
             M = np.broadcast_to(M, (n, self._nv, self._nv))
         if b.ndim == 2:
-            return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
-        return frozen(np.linalg.solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
+            return frozen(solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
+        return frozen(solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
 
     def inverse_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray
