@@ -46,7 +46,7 @@ def solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         and a.shape[-1] == a.shape[-2]
     ):
         with np.errstate(call=_singular, invalid="call", over="ignore", divide="ignore", under="ignore"):
-            return _SOLVE(a, b)  # type: ignore[no-any-return]
+            return _SOLVE(a, b)
     return np.linalg.solve(a, b)
 
 
@@ -60,7 +60,7 @@ def inv(a: np.ndarray) -> np.ndarray:
         and a.shape[-1] == a.shape[-2]
     ):
         with np.errstate(call=_singular, invalid="call", over="ignore", divide="ignore", under="ignore"):
-            return _INV(a)  # type: ignore[no-any-return]
+            return _INV(a)
     return np.linalg.inv(a)
 
 
