@@ -72,3 +72,24 @@ def test_small_linalg_raises_as_numpy_on_a_singular_matrix() -> None:
         np.isnan(solve(nan, np.ones((1, 3, 1)))).all()
         == np.isnan(np.linalg.solve(nan, np.ones((1, 3, 1)))).all()
     )
+
+
+@pytest.mark.parametrize("name", ["twolink", "panda"])
+def test_one_run_saturated_acceleration_is_the_plants(name: str) -> None:
+    # The engine's clip (maximum then minimum against rows) against Plant.acceleration
+    # (numpy.clip through motor_torque): the same ABA input, so the same bits; torques
+    # beyond the limits both ways, and a NaN passed through as NaN.
+    from twolink_pin.model import load_robot
+    from twolink_pin.plant import Plant
+    from twolink_pin.simulation.forward import SingleRunDynamics
+
+    robot = load_robot(name)
+    plant = Plant(robot, saturate=True)
+    accel = SingleRunDynamics(plant)
+    rng = np.random.default_rng(5)
+    for scale in (0.5, 3.0):
+        q, v = rng.normal(size=(1, robot.nv)), rng.normal(size=(1, robot.nv))
+        tau = scale * plant.limits * rng.choice([-1.0, 1.0], size=(1, robot.nv))
+        assert _same_bits(accel(q, v, tau)[0], plant.acceleration(q[0], v[0], tau[0]))
+    tau[0, 0] = np.nan
+    assert np.isnan(accel(q, v, tau)).all() == np.isnan(plant.acceleration(q[0], v[0], tau[0])).all()
