@@ -50,6 +50,8 @@ from twolink_pin.small_linalg import inv
 SINGULAR_RATIO = 1e-3
 """ε: the task inertia is damped when the smallest eigenvalue of ``J M⁻¹ Jᵀ`` normalised to a
 unit diagonal is below ε (its largest is at most k: a condition number above about 1000 k)."""
+_CERTIFIED = SINGULAR_RATIO**-2
+"""``1/ε²``: the bound on ``‖B⁻¹‖_F²`` that certifies no eigenvalue below ε (:func:`certified_inverse`)."""
 _HALF_SKEW = np.zeros((9, 3))
 """``E.reshape(9) @ _HALF_SKEW = (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2`` (row-major 3 × 3): one
 product whose entries are exactly ``0.5 (a − b)`` (the ±½ products are exact, the zeros add
@@ -219,7 +221,7 @@ def certified_inverse(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             with contextlib.suppress(np.linalg.LinAlgError):
                 inverse[i] = np.linalg.inv(b)
     flat = inverse.reshape(inverse.shape[0], -1)
-    return inverse, np.vecdot(flat, flat) <= SINGULAR_RATIO**-2
+    return inverse, np.vecdot(flat, flat) <= _CERTIFIED
 
 
 class TaskInertia:
@@ -237,7 +239,8 @@ class TaskInertia:
         S = scale[:, :, None] * scale[:, None, :]  # S_ij = scale_i scale_j
         B = A * S
         core, certain = certified_inverse(B)
-        if not np.logical_and.reduce(certain):  # some run may be near a singularity
+        # some run may be near a singularity (one run: its flag, without a reduction)
+        if not (certain[0] if certain.shape[0] == 1 else np.logical_and.reduce(certain)):
             uncertain = ~certain
             core[uncertain] = self._eigen_inverse(B[uncertain], t)
         return core * S
