@@ -35,6 +35,7 @@ matrix only: a batch still equals its single runs bit for bit.
 from __future__ import annotations
 
 import contextlib
+import math
 import warnings
 from typing import NamedTuple
 
@@ -44,10 +45,13 @@ import pinocchio as pin
 from twolink_pin.controllers.base import LawInput, Terms
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
+from twolink_pin.small_linalg import inv
 
 SINGULAR_RATIO = 1e-3
 """ε: the task inertia is damped when the smallest eigenvalue of ``J M⁻¹ Jᵀ`` normalised to a
 unit diagonal is below ε (its largest is at most k: a condition number above about 1000 k)."""
+_CERTIFIED = SINGULAR_RATIO**-2
+"""``1/ε²``: the bound on ``‖B⁻¹‖_F²`` that certifies no eigenvalue below ε (:func:`certified_inverse`)."""
 _HALF_SKEW = np.zeros((9, 3))
 """``E.reshape(9) @ _HALF_SKEW = (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2`` (row-major 3 × 3): one
 product whose entries are exactly ``0.5 (a − b)`` (the ±½ products are exact, the zeros add
@@ -129,6 +133,8 @@ def _moving_rows(J: np.ndarray, nv: int) -> np.ndarray:
 def rotation_error(R: np.ndarray, R_des: np.ndarray) -> np.ndarray:
     """``log(R R_dᵀ)`` [rad] in world axes, shape (N, 3), for (N, 3, 3) and (1 or N, 3, 3)."""
     E = np.matmul(R, R_des.transpose(0, 2, 1))
+    if E.shape[0] == 1:  # one run (the engine's N = 1, at every RK4 stage): the same bits on floats
+        return _one_rotation_error(E)
     # The skew part (E₂₁ − E₁₂, E₀₂ − E₂₀, E₁₀ − E₀₁) / 2 from E's rows of 9 (few numpy calls:
     # this runs at every RK4 stage of a task-space law).
     w = E.reshape(-1, 9).dot(_HALF_SKEW)
@@ -142,6 +148,22 @@ def rotation_error(R: np.ndarray, R_des: np.ndarray) -> np.ndarray:
         for i in np.flatnonzero(angle > np.pi - 1e-6):
             out[i] = pin.log3(E[i])
     return out
+
+
+def _one_rotation_error(E: np.ndarray) -> np.ndarray:
+    """:func:`rotation_error` of one run from ``E = R R_dᵀ`` (1, 3, 3), on Python floats: the
+    same operations in the same order as the batch's numpy calls (``0.5 a − 0.5 b`` as the
+    product with :data:`_HALF_SKEW` rounds it, the squares summed left to right, the trace
+    ``(E₀₀ + E₁₁) + E₂₂``), and numpy's own ``arctan2`` (its SIMD loop rounds differently from
+    ``math.atan2``), so a single run equals its row of a batch bit for bit (tests/test_task_space.py)."""
+    e0, e1, e2, e3, e4, e5, e6, e7, e8 = E.reshape(9).tolist()
+    w0, w1, w2 = 0.5 * e7 - 0.5 * e5, 0.5 * e2 - 0.5 * e6, 0.5 * e3 - 0.5 * e1
+    sin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    angle = float(np.arctan2(sin, 0.5 * (e0 + e4 + e8 - 1.0)))
+    if angle > np.pi - 1e-6:  # near π the skew part vanishes
+        return np.array([pin.log3(E[0])])
+    factor = angle / sin if sin > 1e-9 else 1.0 + angle * angle / 6.0
+    return np.array([[factor * w0, factor * w1, factor * w2]])
 
 
 def pose_error(
@@ -192,14 +214,14 @@ def certified_inverse(B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ``‖B⁻¹‖_F² ≤ 1/ε²`` (the Frobenius norm bounds the spectral radius ``1/|s|_min``). A run whose
     LU meets an exact zero pivot gets no inverse (``inf``) and no certificate."""
     try:
-        inverse = np.linalg.inv(B)
+        inverse = inv(B)  # numpy.linalg.inv's LAPACK call, without its wrapper
     except np.linalg.LinAlgError:  # an exactly singular run stops the batch's inv: run by run
         inverse = np.full_like(B, np.inf)
         for i, b in enumerate(B):
             with contextlib.suppress(np.linalg.LinAlgError):
                 inverse[i] = np.linalg.inv(b)
     flat = inverse.reshape(inverse.shape[0], -1)
-    return inverse, np.vecdot(flat, flat) <= SINGULAR_RATIO**-2
+    return inverse, np.vecdot(flat, flat) <= _CERTIFIED
 
 
 class TaskInertia:
@@ -217,7 +239,8 @@ class TaskInertia:
         S = scale[:, :, None] * scale[:, None, :]  # S_ij = scale_i scale_j
         B = A * S
         core, certain = certified_inverse(B)
-        if not np.logical_and.reduce(certain):  # some run may be near a singularity
+        # some run may be near a singularity (one run: its flag, without a reduction)
+        if not (certain[0] if certain.shape[0] == 1 else np.logical_and.reduce(certain)):
             uncertain = ~certain
             core[uncertain] = self._eigen_inverse(B[uncertain], t)
         return core * S

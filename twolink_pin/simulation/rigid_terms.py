@@ -10,8 +10,8 @@ parameters, built the first time a law asks):
                 asked again for the same values (same dtype, shape and bytes)
 ``gravity``     ``pin.computeGeneralizedGravity``
 ``bias``        ``pin.nonLinearEffects`` (``Ĉ q̇ + ĝ``)
-``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``,
-                LU with pivoting: no inverse is formed)
+``solve_mass``  ``pin.crba`` then a batched linear solve (``numpy.linalg.solve``'s
+                LU with pivoting, :mod:`twolink_pin.small_linalg`: no inverse is formed)
 ``inverse_dynamics_derivatives``  ``pin.computeRNEADerivatives`` at K states per run (τ, ∂τ/∂q,
                 ∂τ/∂q̇, M̂: what a planning law linearises its plan's torque with)
 ``frame``       ``pin.forwardKinematics`` (q, q̇, 0) + ``pin.computeJointJacobians``,
@@ -50,6 +50,7 @@ from twolink_pin.dynamics import InverseDynamicsDerivatives, inverse_dynamics_de
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.model.parameters import model_with_parameters
+from twolink_pin.small_linalg import solve
 
 WORLD_ALIGNED = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
 """The one convention of :meth:`RigidBodyTerms.frame`."""
@@ -203,8 +204,8 @@ class RigidBodyTerms:
         if M.shape[0] != n:
             M = np.broadcast_to(M, (n, self._nv, self._nv))
         if b.ndim == 2:
-            return frozen(np.linalg.solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
-        return frozen(np.linalg.solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
+            return frozen(solve(M, np.broadcast_to(b, (n, self._nv))[..., None])[..., 0])
+        return frozen(solve(M, b if b.shape[0] == n else np.broadcast_to(b, (n, *b.shape[1:]))))
 
     def inverse_dynamics_derivatives(
         self, q: np.ndarray, v: np.ndarray, a: np.ndarray
@@ -250,14 +251,18 @@ class RigidBodyTerms:
         hit = cache.get(key)
         if hit is not None:
             return hit
-        result = self._frame(fid, q, v)
+        result = self._frame(fid, q, v, key)
         if len(cache) >= FRAME_CACHE:
             del cache[next(iter(cache))]
         cache[key] = result
         return result
 
-    def _frame(self, fid: int, q: np.ndarray, v: np.ndarray) -> FrameTerms:
+    def _frame(self, fid: int, q: np.ndarray, v: np.ndarray, key: tuple[object, ...]) -> FrameTerms:
         n = max(q.shape[0], v.shape[0])
+        if self._fused:
+            models, data = self._dynamics()
+            if len(models) == 1 and q.shape == v.shape == (1, self._nv) and q.dtype == v.dtype == np.float64:
+                return self._fused_one(fid, q, v, key, models[0], data)
         Q, V = self._states(q, n), self._states(v, n)
         if self._fused:
             models, data = self._dynamics()
@@ -317,6 +322,37 @@ class RigidBodyTerms:
                 key = (q.dtype, v.dtype, q.shape, v.shape, q.tobytes(), v.tobytes())
                 self._last_bias = (key, frozen(bias))
         return _frame_terms(placement, jacobian, drift)
+
+    def _fused_one(
+        self,
+        fid: int,
+        q: np.ndarray,
+        v: np.ndarray,
+        key: tuple[object, ...],
+        model: pin.Model,
+        data: pin.Data,
+    ) -> FrameTerms:
+        """:meth:`_fused_pass` of one run ((1, nv) float64 ``q``, ``v``; ``key``: :meth:`frame`'s,
+        whose last two items are their bytes): the same Pinocchio calls on the same rows, the
+        results taken as the fresh arrays Pinocchio returns (the placement's homogeneous matrix,
+        the Jacobian) or copied out of the ``Data`` (M̂ symmetrised straight from it), without
+        the batch's buffers and row copies."""
+        pin.computeAllTerms(model, data, q[0], v[0])
+        H = pin.updateFramePlacement(model, data, fid).homogeneous  # a new (4, 4) array
+        jacobian = pin.getFrameJacobian(model, data, fid, WORLD_ALIGNED)[None]  # a new array
+        # .vector is a view into a temporary Motion: copied
+        drift = np.array(pin.getFrameClassicalAcceleration(model, data, fid, WORLD_ALIGNED).vector)[None]
+        M = data.M  # the upper triangle, in the Data: np.where makes the new symmetric array
+        q_key = (q.dtype, q.shape, key[3])
+        self._last_mass = (q_key, frozen(np.where(self._lower, M.T, M)[None]))
+        self._last_gravity = (q_key, frozen(data.g[None].copy()))
+        self._last_bias = (
+            (q.dtype, v.dtype, q.shape, v.shape, key[3], key[4]),
+            frozen(data.nle[None].copy()),
+        )
+        position = np.ascontiguousarray(H[None, :3, 3])
+        rotation = np.ascontiguousarray(H[None, :3, :3])
+        return FrameTerms(frozen(position), frozen(rotation), frozen(jacobian), frozen(drift))
 
 
 def _frame_terms(placement: np.ndarray, jacobian: np.ndarray, drift: np.ndarray) -> FrameTerms:

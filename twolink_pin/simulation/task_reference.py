@@ -121,4 +121,7 @@ def reference_rows(
     ``a_des`` (the rows of the read-only ``rq``, ``rv``, ``ra``, each (K, 1, nv)) and the
     four task fields of :func:`task_reference` (None for a law that is not task-space)."""
     px, pr, pw, pa = task_reference(controller, trajectory, t, joint)
-    return [(rq[i], rv[i], ra[i], px[i], pr[i], pw[i], pa[i]) for i in range(len(rq))]
+    # Rows by iteration (the same read-only views as rq[i]; no Python __getitem__ of NONES per row)
+    if px is NONES:
+        return [(q, v, a, None, None, None, None) for q, v, a in zip(rq, rv, ra, strict=True)]
+    return list(zip(rq, rv, ra, px, pr, pw, pa, strict=True))
