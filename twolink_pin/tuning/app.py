@@ -20,7 +20,8 @@ from twolink_pin.tuning.address import check_listen
 from twolink_pin.tuning.knobs import Knob, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
 from twolink_pin.tuning.outputs import page_path
-from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
+from twolink_pin.tuning.periods import Cuts
+from twolink_pin.tuning.runner import Finished, Partial, PeriodDone, Request, Runner
 from twolink_pin.tuning.scene import RESUME_AFTER
 
 if TYPE_CHECKING:
@@ -177,8 +178,14 @@ class Tuner:
         self.address = check_listen(host, port)  # a refused host or port: exit 2 before serving
         self._limit = limit
         self._runner = Runner(
-            arm, lambda: self._session.superseded(), self._partial, alive=lambda: self._session.alive()
+            arm,
+            lambda: self._session.superseded(),
+            self._partial,
+            alive=lambda: self._session.alive(),
+            period_done=self._period,
         )
+        self._shown = threading.Lock()  # a run's period is shown only while that run is the newest
+        self._cuts = Cuts()
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         used = gains_used(controller)
@@ -287,7 +294,8 @@ class Tuner:
         bound = f" (given up after {self._limit:g} s without progress: --timeout)" if self._limit else ""
         self.status.content = f"running…{bound}"
         self.scene.hold(True)  # the page's time goes to the controls and the new run, not the playback
-        self._session.submit(Request(spec, payload, self._law_version))
+        with self._shown:  # after this, no period of an older run is shown
+            self._session.submit(Request(spec, payload, self._law_version))
 
     def close(self) -> None:
         """Stop the runs, the playback and the server (quietly: no line of Viser's)."""
@@ -322,6 +330,35 @@ class Tuner:
         self.scene.show(part.t[::step], part.q[::step], part.q_des[::step])
         self.plots.show_partial(part)
         self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+
+    def _period(self, part: PeriodDone) -> None:
+        """Show the run in flight up to the end of its period k (on the worker thread): its
+        metrics beside the other runs' cut to the same k periods, the plots over ``0 … k T``
+        (the other runs faded over the same window), the status line; the scene keeps
+        playing the last finished run. Never for a superseded run (checked under the lock
+        :meth:`changed` takes to submit)."""
+        from twolink_pin.tuning.periods import heading
+
+        done, k = part.done, part.k
+        with self._lock:
+            columns: dict[str, Finished | None] = {
+                "previous": self._latest,
+                "defaults": self._defaults or done,
+            }
+            if self._kept is not None:
+                columns[self._kept[0]] = self._kept[1]
+        cut = {name: run if run is done else self._cuts(run, k) for name, run in columns.items()}
+        with self._shown:
+            if self._session.superseded():
+                return
+            generation = self._session.generation
+            self.plots.show(done, columns)  # the others resampled on this run's times: 0 … k T
+            with self.server.atomic():
+                self.metrics.content = heading(k, part.periods) + metrics_table(done, cut)
+                self.status.content = (
+                    f"run {generation}: period {k} of {part.periods} shown ({done.result.duration:g} s "
+                    f"simulated in {done.seconds:.2f} s); running…"
+                )
 
     def _deliver(self, generation: int, request: Request, outcome: Finished | Exception) -> None:
         command = self._command_of(request.spec, request.payload)

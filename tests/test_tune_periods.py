@@ -1,0 +1,97 @@
+"""tune shows each finished period of a run in flight (issue 38, items 1 and 5): the runner
+publishes the run cut at the end of each reference period but the last, measured by the
+final table's definitions; those metrics equal the metrics of a separate ``simulate`` of
+that many periods (a second run: the engine's steps do not depend on the duration)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from twolink_pin.metrics import compute_metrics
+from twolink_pin.model import load_robot
+from twolink_pin.run_spec import RunSpec
+from twolink_pin.simulation import SimulationConfig, simulate
+from twolink_pin.trajectory import default_trajectory
+from twolink_pin.tuning.periods import cut_run, period_ends, periods_of
+from twolink_pin.tuning.runner import PeriodDone, Request, Runner
+
+DT = 2e-3
+"""A coarser step than the default: the test's runs stay short [s]."""
+
+
+@pytest.fixture(scope="module")
+def arm() -> tuple[object, object]:
+    robot = load_robot("twolink")
+    return robot, default_trajectory(robot)
+
+
+def run_periods(arm: tuple[object, object], law: str, periods: int) -> tuple[list[PeriodDone], object]:
+    """A run of ``periods`` periods of ``law`` through the tuner's runner: its period
+    partials and the finished run."""
+    robot, reference = arm
+    period = float(reference.period)  # type: ignore[attr-defined]
+    shown: list[PeriodDone] = []
+    runner = Runner(lambda payload: arm, period_done=shown.append)  # type: ignore[arg-type, return-value]
+    spec = RunSpec(law=law, simulation=SimulationConfig(duration=periods * period, dt=DT))
+    return shown, runner(Request(spec, 0.0))
+
+
+def one_period(arm: tuple[object, object], law: str) -> object:
+    """A separate ``simulate`` of the first period only (the second method)."""
+    robot, reference = arm
+    spec = RunSpec(law=law, simulation=SimulationConfig(duration=float(reference.period), dt=DT))  # type: ignore[attr-defined]
+    scenario = spec.build(robot, spec.read_parameters(robot))  # type: ignore[arg-type]
+    return simulate(*scenario, reference, spec.simulation)  # type: ignore[arg-type]
+
+
+def assert_same_metrics(got: object, want: object) -> None:
+    """Every field of two :class:`~twolink_pin.metrics.Metrics` (nested tuples: norms,
+    crossings with their names) equal to rtol 1e-12 (NaN where never crossed)."""
+    for a, b in zip(got, want, strict=True):  # type: ignore[call-overload]
+        if isinstance(a, tuple):
+            assert_same_metrics(a, b)
+        elif isinstance(a, str):
+            assert a == b
+        else:
+            np.testing.assert_allclose(
+                np.asarray(a, dtype=float), np.asarray(b, dtype=float), rtol=1e-12, atol=0
+            )
+
+
+def test_the_first_period_of_a_three_period_run_measures_as_a_one_period_simulate(
+    arm: tuple[object, object],
+) -> None:
+    """pd on the twolink, 3 periods: two period partials (k = 1, 2 of 3); the first's result is
+    the first period of a separate one-period ``simulate`` (same samples) and its metrics are
+    ``compute_metrics`` of that run (rtol 1e-12), its "last period" row included; the second
+    ends at t = 2 T and is the finished run's first two periods."""
+    shown, finished = run_periods(arm, "pd", 3)
+    assert [(p.k, p.periods) for p in shown] == [(1, 3), (2, 3)]
+    alone = one_period(arm, "pd")
+    first = shown[0].done
+    assert len(first.result.t) == len(alone.t)  # type: ignore[attr-defined]
+    for name in ("t", "q", "v", "tau_command", "tau", "q_des", "v_des"):
+        np.testing.assert_allclose(getattr(first.result, name), getattr(alone, name), rtol=1e-12, atol=1e-12)
+    assert_same_metrics(first.metrics, compute_metrics(alone))  # type: ignore[arg-type]
+    period = float(arm[1].period)  # type: ignore[attr-defined]
+    assert shown[1].done.result.t[-1] == pytest.approx(2 * period)
+    assert_same_metrics(shown[1].done.metrics, cut_run(finished, 2).metrics)  # type: ignore[arg-type, union-attr]
+
+
+def test_an_adaptive_laws_estimates_cut_at_a_period_are_a_one_period_runs(arm: tuple[object, object]) -> None:
+    """The law's state (estimates, their true values) laid out as ``simulate`` lays it out."""
+    shown, _ = run_periods(arm, "adaptive", 2)
+    alone = one_period(arm, "adaptive")
+    first = shown[0].done.result
+    np.testing.assert_allclose(first.p_hat, alone.p_hat, rtol=1e-12, atol=1e-12)  # type: ignore[attr-defined]
+    np.testing.assert_array_equal(first.p_true, alone.p_true)  # type: ignore[attr-defined]
+    assert first.parameter_names == alone.parameter_names  # type: ignore[attr-defined]
+    assert first.state_names == alone.state_names  # type: ignore[attr-defined]
+
+
+def test_period_ends_are_the_samples_at_k_periods_before_the_runs_end() -> None:
+    assert period_ends(12.0, 1e-3, 4.0) == [4000, 8000]
+    assert period_ends(10.0, 1e-3, 4.0) == [4000, 8000]  # the third period is cut short
+    assert period_ends(4.0, 1e-3, 4.0) == []
+    assert periods_of(10.0, 4.0) == 3 and periods_of(12.0, 4.0) == 3 and periods_of(1.0, float("inf")) == 0
