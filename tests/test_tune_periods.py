@@ -9,40 +9,41 @@ import numpy as np
 import pytest
 
 from twolink_pin.metrics import compute_metrics
-from twolink_pin.model import load_robot
+from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.run_spec import RunSpec
-from twolink_pin.simulation import SimulationConfig, simulate
-from twolink_pin.trajectory import default_trajectory
+from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate
+from twolink_pin.trajectory import Trajectory, default_trajectory
 from twolink_pin.tuning.periods import cut_run, period_ends, periods_of
-from twolink_pin.tuning.runner import PeriodDone, Request, Runner
+from twolink_pin.tuning.runner import Finished, PeriodDone, Request, Runner
 
+Arm = tuple[RobotModel, Trajectory]
 DT = 2e-3
 """A coarser step than the default: the test's runs stay short [s]."""
 
 
 @pytest.fixture(scope="module")
-def arm() -> tuple[object, object]:
+def arm() -> Arm:
     robot = load_robot("twolink")
     return robot, default_trajectory(robot)
 
 
-def run_periods(arm: tuple[object, object], law: str, periods: int) -> tuple[list[PeriodDone], object]:
+def run_periods(arm: Arm, law: str, periods: int) -> tuple[list[PeriodDone], Finished]:
     """A run of ``periods`` periods of ``law`` through the tuner's runner: its period
     partials and the finished run."""
-    robot, reference = arm
-    period = float(reference.period)  # type: ignore[attr-defined]
+    reference = arm[1]
+    period = float(reference.period)
     shown: list[PeriodDone] = []
-    runner = Runner(lambda payload: arm, period_done=shown.append)  # type: ignore[arg-type, return-value]
+    runner = Runner(lambda payload: arm, period_done=shown.append)
     spec = RunSpec(law=law, simulation=SimulationConfig(duration=periods * period, dt=DT))
     return shown, runner(Request(spec, 0.0))
 
 
-def one_period(arm: tuple[object, object], law: str) -> object:
+def one_period(arm: Arm, law: str) -> SimulationResult:
     """A separate ``simulate`` of the first period only (the second method)."""
     robot, reference = arm
-    spec = RunSpec(law=law, simulation=SimulationConfig(duration=float(reference.period), dt=DT))  # type: ignore[attr-defined]
-    scenario = spec.build(robot, spec.read_parameters(robot))  # type: ignore[arg-type]
-    return simulate(*scenario, reference, spec.simulation)  # type: ignore[arg-type]
+    spec = RunSpec(law=law, simulation=SimulationConfig(duration=float(reference.period), dt=DT))
+    scenario = spec.build(robot, spec.read_parameters(robot))
+    return simulate(*scenario, reference, spec.simulation)
 
 
 def assert_same_metrics(got: object, want: object) -> None:
@@ -60,7 +61,7 @@ def assert_same_metrics(got: object, want: object) -> None:
 
 
 def test_the_first_period_of_a_three_period_run_measures_as_a_one_period_simulate(
-    arm: tuple[object, object],
+    arm: Arm,
 ) -> None:
     """pd on the twolink, 3 periods: two period partials (k = 1, 2 of 3); the first's result is
     the first period of a separate one-period ``simulate`` (same samples) and its metrics are
@@ -70,24 +71,27 @@ def test_the_first_period_of_a_three_period_run_measures_as_a_one_period_simulat
     assert [(p.k, p.periods) for p in shown] == [(1, 3), (2, 3)]
     alone = one_period(arm, "pd")
     first = shown[0].done
-    assert len(first.result.t) == len(alone.t)  # type: ignore[attr-defined]
+    assert len(first.result.t) == len(alone.t)
     for name in ("t", "q", "v", "tau_command", "tau", "q_des", "v_des"):
         np.testing.assert_allclose(getattr(first.result, name), getattr(alone, name), rtol=1e-12, atol=1e-12)
-    assert_same_metrics(first.metrics, compute_metrics(alone))  # type: ignore[arg-type]
-    period = float(arm[1].period)  # type: ignore[attr-defined]
+    assert_same_metrics(first.metrics, compute_metrics(alone))
+    period = float(arm[1].period)
     assert shown[1].done.result.t[-1] == pytest.approx(2 * period)
-    assert_same_metrics(shown[1].done.metrics, cut_run(finished, 2).metrics)  # type: ignore[arg-type, union-attr]
+    cut = cut_run(finished, 2)
+    assert cut is not None
+    assert_same_metrics(shown[1].done.metrics, cut.metrics)
 
 
-def test_an_adaptive_laws_estimates_cut_at_a_period_are_a_one_period_runs(arm: tuple[object, object]) -> None:
+def test_an_adaptive_laws_estimates_cut_at_a_period_are_a_one_period_runs(arm: Arm) -> None:
     """The law's state (estimates, their true values) laid out as ``simulate`` lays it out."""
     shown, _ = run_periods(arm, "adaptive", 2)
     alone = one_period(arm, "adaptive")
     first = shown[0].done.result
-    np.testing.assert_allclose(first.p_hat, alone.p_hat, rtol=1e-12, atol=1e-12)  # type: ignore[attr-defined]
-    np.testing.assert_array_equal(first.p_true, alone.p_true)  # type: ignore[attr-defined]
-    assert first.parameter_names == alone.parameter_names  # type: ignore[attr-defined]
-    assert first.state_names == alone.state_names  # type: ignore[attr-defined]
+    assert first.p_hat is not None and alone.p_hat is not None
+    np.testing.assert_allclose(first.p_hat, alone.p_hat, rtol=1e-12, atol=1e-12)
+    np.testing.assert_array_equal(first.p_true, alone.p_true)
+    assert first.parameter_names == alone.parameter_names
+    assert first.state_names == alone.state_names
 
 
 def test_period_ends_are_the_samples_at_k_periods_before_the_runs_end() -> None:
