@@ -17,7 +17,7 @@ import numpy as np
 
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
-from twolink_pin.tuning.knobs import Knob, knobs_of, matrices_of
+from twolink_pin.tuning.knobs import knob_changes, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
 from twolink_pin.tuning.outputs import page_path
 from twolink_pin.tuning.periods import Cuts
@@ -107,21 +107,6 @@ def error_text(exc: BaseException) -> str:
         if where and where.strip(" ()") not in text:
             text += where
     return text
-
-
-def knob_changes(old: list[Knob], new: list[Knob]) -> list[str]:
-    """What differs between two sets of controls (names, defaults, units): ``[]`` when the
-    page's controls still fit the law's ``Gains`` declaration."""
-    before = {k.label: k for k in old}
-    after = {k.label: k for k in new}
-    changes = [f"new control {label!r}" for label in after if label not in before]
-    changes += [f"control {label!r} gone" for label in before if label not in after]
-    changes += [
-        f"{label!r} default {after[label].value:g} (was {before[label].value:g})"
-        for label in after
-        if label in before and after[label].value != before[label].value
-    ]
-    return changes
 
 
 def _stop_quietly(server: Any) -> None:
@@ -332,11 +317,9 @@ class Tuner:
         self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
 
     def _period(self, part: PeriodDone) -> None:
-        """Show the run in flight up to the end of its period k (on the worker thread): its
-        metrics beside the other runs' cut to the same k periods, the plots over ``0 … k T``
-        (the other runs faded over the same window), the status line; the scene keeps
-        playing the last finished run. Never for a superseded run (checked under the lock
-        :meth:`changed` takes to submit)."""
+        """Show the run in flight up to the end of its period k (worker thread): its metrics
+        beside the other runs' cut to k periods, the plots over ``0 … k T``; the scene keeps
+        the last finished run. Never a superseded run's (the lock :meth:`changed` submits under)."""
         from twolink_pin.tuning.periods import heading
 
         done, k = part.done, part.k
@@ -348,13 +331,17 @@ class Tuner:
             if self._kept is not None:
                 columns[self._kept[0]] = self._kept[1]
         cut = {name: run if run is done else self._cuts(run, k) for name, run in columns.items()}
+        command = self._command_of(done.request.spec, done.request.payload)  # the run whose start is shown
         with self._shown:
             if self._session.superseded():
                 return
             generation = self._session.generation
             self.plots.show(done, columns)  # the others resampled on this run's times: 0 … k T
             with self.server.atomic():
-                self.metrics.content = heading(k, part.periods) + metrics_table(done, cut)
+                self.metrics.content = heading(k, part.periods, done.result.duration) + metrics_table(
+                    done, cut
+                )
+                self.command.content = f"```\n{command}\n```"
                 self.status.content = (
                     f"run {generation}: period {k} of {part.periods} shown ({done.result.duration:g} s "
                     f"simulated in {done.seconds:.2f} s); running…"

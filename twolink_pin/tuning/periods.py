@@ -170,13 +170,11 @@ class Cuts:
         return cut
 
 
-def heading(k: int, periods: int) -> str:
-    """The line above the metrics of a run shown up to the end of its period ``k`` of ``periods``."""
+def heading(k: int, periods: int, seconds: float) -> str:
+    """The line above the metrics of a run shown up to the end of its period ``k`` of
+    ``periods``, at ``seconds`` [s] simulated."""
     span = "period 1" if k == 1 else f"periods 1–{k}"
-    return (
-        f"**over {span} of {periods}** (t ≤ {k} T; every column cut to the same periods; "
-        "the plots show the same window)\n\n"
-    )
+    return f"**over {span} of {periods}** (t ≤ {seconds:g} s: every column, and the plots)\n\n"
 
 
 __all__ = [
