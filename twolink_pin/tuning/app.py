@@ -20,7 +20,7 @@ from twolink_pin.tuning.address import check_listen
 from twolink_pin.tuning.knobs import knob_changes, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
 from twolink_pin.tuning.outputs import page_path
-from twolink_pin.tuning.periods import Cuts
+from twolink_pin.tuning.periods import Cuts, heading
 from twolink_pin.tuning.runner import Finished, Partial, PeriodDone, Request, Runner
 from twolink_pin.tuning.scene import RESUME_AFTER
 
@@ -306,46 +306,47 @@ class Tuner:
         self.status.content = self._left_behind
 
     _left_behind = ""
+    _period_shown: tuple[int, str] = (0, "")  # the run whose period is shown, and its status line
 
     def _partial(self, part: Partial) -> None:
-        """Show the part of the run in flight simulated so far (on the worker thread)."""
+        """Show the part of the run in flight simulated so far (on the worker thread); once a
+        period of it is shown, only how far it got (the period's table and plots stay)."""
         if self._session.superseded():
+            return
+        progress = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+        shown = self._period_shown
+        if shown[0] == self._session.generation:
+            self.status.content = f"{shown[1]}; {progress}"
             return
         step = max(1, len(part.t) // 600)  # the final run redraws at full resolution
         self.scene.show(part.t[::step], part.q[::step], part.q_des[::step])
         self.plots.show_partial(part)
-        self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+        self.status.content = progress
 
     def _period(self, part: PeriodDone) -> None:
         """Show the run in flight up to the end of its period k (worker thread): its metrics
         beside the other runs' cut to k periods, the plots over ``0 … k T``; the scene keeps
         the last finished run. Never a superseded run's (the lock :meth:`changed` submits under)."""
-        from twolink_pin.tuning.periods import heading
-
-        done, k = part.done, part.k
+        done, k, seconds = part.done, part.k, part.done.result.duration
         with self._lock:
             columns: dict[str, Finished | None] = {
                 "previous": self._latest,
                 "defaults": self._defaults or done,
             }
-            if self._kept is not None:
-                columns[self._kept[0]] = self._kept[1]
+            columns.update([self._kept] if self._kept is not None else [])
         cut = {name: run if run is done else self._cuts(run, k) for name, run in columns.items()}
         command = self._command_of(done.request.spec, done.request.payload)  # the run whose start is shown
         with self._shown:
             if self._session.superseded():
                 return
             generation = self._session.generation
+            line = f"run {generation}: period {k} of {part.periods} shown ({seconds:g} s simulated in {done.seconds:.2f} s)"
             self.plots.show(done, columns)  # the others resampled on this run's times: 0 … k T
             with self.server.atomic():
-                self.metrics.content = heading(k, part.periods, done.result.duration) + metrics_table(
-                    done, cut
-                )
+                self.metrics.content = heading(k, part.periods, seconds) + metrics_table(done, cut)
                 self.command.content = f"```\n{command}\n```"
-                self.status.content = (
-                    f"run {generation}: period {k} of {part.periods} shown ({done.result.duration:g} s "
-                    f"simulated in {done.seconds:.2f} s); running…"
-                )
+                self.status.content = f"{line}; running…"
+            self._period_shown = (generation, line)
 
     def _deliver(self, generation: int, request: Request, outcome: Finished | Exception) -> None:
         command = self._command_of(request.spec, request.payload)
