@@ -99,3 +99,64 @@ def test_period_ends_are_the_samples_at_k_periods_before_the_runs_end() -> None:
     assert period_ends(10.0, 1e-3, 4.0) == [4000, 8000]  # the third period is cut short
     assert period_ends(4.0, 1e-3, 4.0) == []
     assert periods_of(10.0, 4.0) == 3 and periods_of(12.0, 4.0) == 3 and periods_of(1.0, float("inf")) == 0
+
+
+class Recorded:
+    """Stands for the page's status line: keeps every text it is given."""
+
+    def __init__(self) -> None:
+        self.texts: list[str] = []
+
+    @property
+    def content(self) -> str:
+        return self.texts[-1] if self.texts else ""
+
+    @content.setter
+    def content(self, text: str) -> None:
+        self.texts.append(text)
+
+
+def test_a_superseded_run_never_shows_its_period_and_the_newer_runs_periods_show(arm: Arm) -> None:
+    """Run 1's law waits at t = 4.01 s, in the block of samples that ends its first period,
+    until run 2 has been asked for: run 1's first period is never shown (it is cancelled at
+    the end of that block); run 2's is, before run 2's complete line."""
+    import queue
+    import threading
+
+    from twolink_pin.controllers.pd import PDFeedforward
+    from twolink_pin.tuning import Tuner
+
+    blocked, release = threading.Event(), threading.Event()
+
+    class WaitingPD(PDFeedforward):
+        def compute(self, x, terms):
+            if float(np.max(x.t)) >= 4.01 and not blocked.is_set():
+                blocked.set()
+                assert release.wait(60.0)
+            return super().compute(x, terms)
+
+    lines: queue.Queue[dict[str, object]] = queue.Queue()
+    tuner = Tuner(
+        RunSpec(law=WaitingPD, simulation=SimulationConfig(duration=8.0, dt=DT)),
+        0.0,
+        lambda payload: arm,
+        lambda spec, payload: "twolink-pin simulate …",
+        lambda spec, payload: {},
+        lines.put,
+    )
+    status = Recorded()
+    tuner.status = status
+    try:
+        assert blocked.wait(60.0)
+        tuner.panel.sliders[-1].value = 1.5  # kd × (all)
+        tuner.changed()
+        release.set()
+        line = lines.get(timeout=60.0)
+        assert tuner.session.idle(60.0)
+    finally:
+        tuner.close()
+    assert line["run"] == 2 and tuner.session.cancelled == 1
+    assert not [text for text in status.texts if text.startswith("run 1")]
+    shown = [i for i, text in enumerate(status.texts) if text.startswith("run 2: period 1 of 2 shown")]
+    done = [i for i, text in enumerate(status.texts) if text.startswith("run 2: 8 s simulated")]
+    assert shown and done and shown[0] < done[0]
