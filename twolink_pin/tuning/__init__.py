@@ -3,12 +3,14 @@
 Every change of a control re-simulates the run in the background (latest wins: a change
 supersedes the run waiting, and a run that ends after a newer change is dropped) and the
 page shows the new run: the arm, its ghost and trail, the plots, the metrics beside the
-previous run and the defaults, and the ``twolink-pin simulate …`` line that reproduces it.
+previous run and the defaults, and the ``twolink-pin simulate …`` line that reproduces it —
+period by period as the run goes (each column of the table cut to the same periods).
 
 ================  ===================================================================
 ``latest.py``     :class:`LatestWins`: one worker, one waiting request, stuck runs left behind
 ``knobs.py``      the controls of a law's gains, from its ``Gains`` declaration
-``runner.py``     one run: simulated, measured, its gains and plant
+``runner.py``     one run: simulated, measured, its gains and plant; each finished period at once
+``periods.py``    a run's first k periods as a run (measured as the final table), other runs cut
 ``panel.py``      the controls in the page and the ``RunSpec`` they describe
 ``typed_js.py``   the page's script: typed values sent on Enter or blur, focus holds playback
 ``scene.py``      the arm (Pinocchio's ``ViserVisualizer``), ghost, trail, playback

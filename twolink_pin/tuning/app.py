@@ -17,10 +17,11 @@ import numpy as np
 
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
-from twolink_pin.tuning.knobs import Knob, knobs_of, matrices_of
+from twolink_pin.tuning.knobs import knob_changes, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
 from twolink_pin.tuning.outputs import page_path
-from twolink_pin.tuning.runner import Finished, Partial, Request, Runner
+from twolink_pin.tuning.periods import Cuts, heading
+from twolink_pin.tuning.runner import Finished, Partial, PeriodDone, Request, Runner
 from twolink_pin.tuning.scene import RESUME_AFTER
 
 if TYPE_CHECKING:
@@ -108,21 +109,6 @@ def error_text(exc: BaseException) -> str:
     return text
 
 
-def knob_changes(old: list[Knob], new: list[Knob]) -> list[str]:
-    """What differs between two sets of controls (names, defaults, units): ``[]`` when the
-    page's controls still fit the law's ``Gains`` declaration."""
-    before = {k.label: k for k in old}
-    after = {k.label: k for k in new}
-    changes = [f"new control {label!r}" for label in after if label not in before]
-    changes += [f"control {label!r} gone" for label in before if label not in after]
-    changes += [
-        f"{label!r} default {after[label].value:g} (was {before[label].value:g})"
-        for label in after
-        if label in before and after[label].value != before[label].value
-    ]
-    return changes
-
-
 def _stop_quietly(server: Any) -> None:
     """Stop a Viser server without its "(viser) Server stopped" line on stdout (printed by its
     thread as it ends: stdout is redirected until that thread has ended)."""
@@ -177,8 +163,14 @@ class Tuner:
         self.address = check_listen(host, port)  # a refused host or port: exit 2 before serving
         self._limit = limit
         self._runner = Runner(
-            arm, lambda: self._session.superseded(), self._partial, alive=lambda: self._session.alive()
+            arm,
+            lambda: self._session.superseded(),
+            self._partial,
+            alive=lambda: self._session.alive(),
+            period_done=self._period,
         )
+        self._shown = threading.Lock()  # a run's period is shown only while that run is the newest
+        self._cuts = Cuts()
         robot, _ = self._runner.arm(payload)
         controller = base.build(robot, base.read_parameters(robot)).controller  # a refused value: exit 2 here
         used = gains_used(controller)
@@ -287,7 +279,8 @@ class Tuner:
         bound = f" (given up after {self._limit:g} s without progress: --timeout)" if self._limit else ""
         self.status.content = f"running…{bound}"
         self.scene.hold(True)  # the page's time goes to the controls and the new run, not the playback
-        self._session.submit(Request(spec, payload, self._law_version))
+        with self._shown:  # after this, no period of an older run is shown
+            self._session.submit(Request(spec, payload, self._law_version))
 
     def close(self) -> None:
         """Stop the runs, the playback and the server (quietly: no line of Viser's)."""
@@ -313,15 +306,47 @@ class Tuner:
         self.status.content = self._left_behind
 
     _left_behind = ""
+    _period_shown: tuple[int, str] = (0, "")  # the run whose period is shown, and its status line
 
     def _partial(self, part: Partial) -> None:
-        """Show the part of the run in flight simulated so far (on the worker thread)."""
+        """Show the part of the run in flight simulated so far (on the worker thread); once a
+        period of it is shown, only how far it got (the period's table and plots stay)."""
         if self._session.superseded():
+            return
+        progress = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+        shown = self._period_shown
+        if shown[0] == self._session.generation:
+            self.status.content = f"{shown[1]}; {progress}"
             return
         step = max(1, len(part.t) // 600)  # the final run redraws at full resolution
         self.scene.show(part.t[::step], part.q[::step], part.q_des[::step])
         self.plots.show_partial(part)
-        self.status.content = f"running… {part.t[-1]:.3g} of {part.duration:g} s simulated"
+        self.status.content = progress
+
+    def _period(self, part: PeriodDone) -> None:
+        """Show the run in flight up to the end of its period k (worker thread): its metrics
+        beside the other runs' cut to k periods, the plots over ``0 … k T``; the scene keeps
+        the last finished run. Never a superseded run's (the lock :meth:`changed` submits under)."""
+        done, k, seconds = part.done, part.k, part.done.result.duration
+        with self._lock:
+            columns: dict[str, Finished | None] = {
+                "previous": self._latest,
+                "defaults": self._defaults or done,
+            }
+            columns.update([self._kept] if self._kept is not None else [])
+        cut = {name: run if run is done else self._cuts(run, k) for name, run in columns.items()}
+        command = self._command_of(done.request.spec, done.request.payload)  # the run whose start is shown
+        with self._shown:
+            if self._session.superseded():
+                return
+            generation = self._session.generation
+            line = f"run {generation}: period {k} of {part.periods} shown ({seconds:g} s simulated in {done.seconds:.2f} s)"
+            self.plots.show(done, columns)  # the others resampled on this run's times: 0 … k T
+            with self.server.atomic():
+                self.metrics.content = heading(k, part.periods, seconds) + metrics_table(done, cut)
+                self.command.content = f"```\n{command}\n```"
+                self.status.content = f"{line}; running…"
+            self._period_shown = (generation, line)
 
     def _deliver(self, generation: int, request: Request, outcome: Finished | Exception) -> None:
         command = self._command_of(request.spec, request.payload)

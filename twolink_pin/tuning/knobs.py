@@ -218,12 +218,28 @@ def parse_typed(name: str, text: str, count: int | None, matrix: bool = False) -
     raise InvalidParameterError(name, text, f"{shape}, got {len(numbers)}")
 
 
+def knob_changes(old: list[Knob], new: list[Knob]) -> list[str]:
+    """What differs between two sets of controls (names, defaults, units): ``[]`` when the
+    page's controls still fit the law's ``Gains`` declaration."""
+    before = {k.label: k for k in old}
+    after = {k.label: k for k in new}
+    changes = [f"new control {label!r}" for label in after if label not in before]
+    changes += [f"control {label!r} gone" for label in before if label not in after]
+    changes += [
+        f"{label!r} default {after[label].value:g} (was {before[label].value:g})"
+        for label in after
+        if label in before and after[label].value != before[label].value
+    ]
+    return changes
+
+
 __all__ = [
     "SCALE_RANGE",
     "SPAN",
     "Knob",
     "format_typed",
     "gains_from",
+    "knob_changes",
     "knobs_of",
     "matrices_of",
     "nice_step",
