@@ -180,7 +180,7 @@ class Runner:
         arm: Callable[[float], tuple[RobotModel, Trajectory]],
         cancelled: Callable[[], bool] = lambda: False,
         partial: Callable[[Partial], None] | None = None,
-        stream_after: float = 1.0,
+        stream_after: float = 2.0,
         stream_period: float = 0.5,
         alive: Callable[[], None] = lambda: None,
         period_done: Callable[[PeriodDone], None] | None = None,
