@@ -33,3 +33,27 @@ def test_true_parameters_are_constant_curves_beside_the_estimates() -> None:
     np.testing.assert_array_equal(data[3], np.full(11, 3.0))
     np.testing.assert_array_equal(data[4], np.full(11, 4.0))
     assert series[3]["label"] == "p1 true" and series[3]["dash"]
+
+
+def test_a_law_state_is_drawn_one_panel_per_unit_as_the_law_declares_it() -> None:
+    """mpc's state mixes seconds, a count, rad, rad/s and rad/s²: the page draws one panel per
+    unit (as the report's state figure), each with the columns the law declares in that unit."""
+    from types import SimpleNamespace
+
+    from twolink_pin import Plant, SimulationConfig, load_robot, simulate
+    from twolink_pin.controllers import ModelPredictive
+    from twolink_pin.trajectory import default_trajectory
+    from twolink_pin.tuning.plots import panels
+
+    robot = load_robot()
+    law = ModelPredictive(robot)
+    result = simulate(law, Plant(robot), default_trajectory(robot), SimulationConfig(duration=0.03))
+    drawn = panels(SimpleNamespace(result=result, task=None, robot=robot))  # type: ignore[arg-type]
+    declared = law.state_variables()
+    assert result.state is not None
+    for unit in {v.unit for v in declared}:
+        title = f"law state z [{unit}]" if unit else "law state z"
+        columns = [i for i, v in enumerate(declared) if v.unit == unit]
+        assert drawn[title].names == tuple(declared[i].name for i in columns)
+        np.testing.assert_array_equal(drawn[title].columns, result.state[:, columns])
+    assert len([title for title in drawn if title.startswith("law state")]) == 5

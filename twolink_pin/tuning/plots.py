@@ -90,8 +90,13 @@ def panels(done: Finished) -> Panels:
         title = "law state: estimates p̂" + (" (dashed: the true p)" if truth is not None else "")
         out[title] = Curves(t, result.p_hat, names, truth)
     elif result.state is not None and result.state.size:
-        names = tuple(result.state_names) or tuple(f"z{j + 1}" for j in range(result.state.shape[1]))
-        out["law state z"] = Curves(t, result.state, names)
+        width = result.state.shape[1]
+        names = tuple(result.state_names) or tuple(f"z{j + 1}" for j in range(width))
+        units = tuple(result.state_units) if len(result.state_units) == width else ("",) * width
+        for unit in dict.fromkeys(units):  # one panel per unit, as the report's state figure
+            picked = [j for j in range(width) if units[j] == unit]
+            title = f"law state z [{unit}]" if unit else "law state z"
+            out[title] = Curves(t, result.state[:, picked], tuple(names[j] for j in picked))
     return out
 
 
