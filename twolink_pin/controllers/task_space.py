@@ -155,7 +155,8 @@ def _one_rotation_error(E: np.ndarray) -> np.ndarray:
     same operations in the same order as the batch's numpy calls (``0.5 a − 0.5 b`` as the
     product with :data:`_HALF_SKEW` rounds it, the squares summed left to right, the trace
     ``(E₀₀ + E₁₁) + E₂₂``), and numpy's own ``arctan2`` (its SIMD loop rounds differently from
-    ``math.atan2``), so a single run equals its row of a batch bit for bit (tests/test_task_space.py)."""
+    ``math.atan2``), so a single run equals its row of a batch bit for bit, but for the sign of a zero component
+    (the batch's product adds +0 terms; tests/test_single_run_paths.py)."""
     e0, e1, e2, e3, e4, e5, e6, e7, e8 = E.reshape(9).tolist()
     w0, w1, w2 = 0.5 * e7 - 0.5 * e5, 0.5 * e2 - 0.5 * e6, 0.5 * e3 - 0.5 * e1
     sin = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)

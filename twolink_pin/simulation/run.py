@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from twolink_pin.arrays import readonly, readonly_or_none
@@ -146,28 +148,51 @@ def _recorded_run(
 def _single_result(
     controller: Controller, plant: Plant, trajectory: Trajectory, config: SimulationConfig, samples: Samples
 ) -> SimulationResult:
-    """The run's ``samples`` (N = 1) as a :class:`SimulationResult`: the applied torque, the
-    law's estimates picked out of its state, read-only arrays."""
-    tau_command = samples.tau_command[:, 0, :]
-    z = samples.z[:, 0, :]
+    """The run's ``samples`` (N = 1) as a :class:`SimulationResult` (:func:`run_result`)."""
+    rows: dict[str, np.ndarray | None] = {"t": samples.t}
+    for name in SAMPLED:
+        x = getattr(samples, name)
+        rows[name] = None if x is None else x[:, 0, :]
+    return run_result(controller, plant, trajectory, config, rows)
+
+
+SAMPLED = ("q", "v", "tau_command", "q_des", "v_des", "a_des", "z", "q_measured", "v_measured")
+"""The per-sample rows of one run :func:`run_result` reads (besides ``t``), each (K, ·)."""
+
+
+def run_result(
+    controller: Controller,
+    plant: Plant,
+    trajectory: Trajectory,
+    config: SimulationConfig,
+    rows: Mapping[str, np.ndarray | None],
+) -> SimulationResult:
+    """One run's rows (``t`` and :data:`SAMPLED`, each (K, ·) from sample 0; the measured ones
+    may be absent or None) of ``simulate(controller, plant, trajectory, config)`` as its
+    :class:`SimulationResult`: the applied torque, the law's estimates picked out of its state,
+    read-only arrays. ``simulate`` makes its result so, and so does a run cut short (``tune``'s
+    finished periods of a run in flight)."""
+    tau_command = np.asarray(rows["tau_command"])
+    z = np.asarray(rows["z"])
     estimates = controller.state_size > 0 and controller.estimates
     true = estimated_truth(controller, plant)
     names, units = state_labels(controller, z.shape[1])
     columns = controller.estimate_columns if estimates else None
     p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
     limits = plant.joint_limits
+    measured = [rows.get(name) for name in ("q_measured", "v_measured")]
     return SimulationResult(
         controller=controller.name,
         method=config.method,
         dt=config.duration / config.steps,
-        t=readonly(samples.t),
-        q=readonly(samples.q[:, 0, :]),
-        v=readonly(samples.v[:, 0, :]),
+        t=readonly(np.asarray(rows["t"])),
+        q=readonly(np.asarray(rows["q"])),
+        v=readonly(np.asarray(rows["v"])),
         tau_command=readonly(tau_command),
         tau=readonly(plant.applied_torque(tau_command)),
-        q_des=readonly(samples.q_des[:, 0, :]),
-        v_des=readonly(samples.v_des[:, 0, :]),
-        a_des=readonly(samples.a_des[:, 0, :]),
+        q_des=readonly(np.asarray(rows["q_des"])),
+        v_des=readonly(np.asarray(rows["v_des"])),
+        a_des=readonly(np.asarray(rows["a_des"])),
         torque_limits=readonly(plant.limits),
         saturate=plant.saturate,
         reference_period=trajectory.period,
@@ -183,8 +208,8 @@ def _single_result(
         state=readonly(z) if z.shape[1] else None,
         state_names=names,
         state_units=units,
-        q_measured=None if samples.q_measured is None else readonly(samples.q_measured[:, 0, :]),
-        v_measured=None if samples.v_measured is None else readonly(samples.v_measured[:, 0, :]),
+        q_measured=None if measured[0] is None else readonly(np.asarray(measured[0])),
+        v_measured=None if measured[1] is None else readonly(np.asarray(measured[1])),
         position_limits=readonly(np.stack([limits.position_lower, limits.position_upper])),
         velocity_limits=readonly(limits.velocity),
         joint_names=limits.joint_names,

@@ -67,51 +67,11 @@ def result_of(
 ) -> SimulationResult:
     """The samples ``blocks`` (the engine's :class:`~twolink_pin.simulation.engine.Samples`
     fields of one run, each (K, ·), from sample 0) of the run ``simulate(controller, plant,
-    trajectory, config)`` as the result ``simulate`` makes of them: the applied torque, the
-    law's estimates picked out of its state, read-only arrays (``dt`` is the run's)."""
-    from twolink_pin.simulation import SimulationResult
-    from twolink_pin.simulation.run import estimated_truth, state_labels
+    trajectory, config)`` as the result ``simulate`` makes of them
+    (:func:`~twolink_pin.simulation.run.run_result`)."""
+    from twolink_pin.simulation.run import run_result
 
-    z = blocks["z"]
-    estimates = controller.state_size > 0 and controller.estimates
-    true = estimated_truth(controller, plant)
-    names, units = state_labels(controller, z.shape[1])
-    columns = controller.estimate_columns if estimates else None
-    p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
-    limits = plant.joint_limits
-    tau_command = blocks["tau_command"]
-    return SimulationResult(
-        controller=controller.name,
-        method=config.method,
-        dt=config.duration / config.steps,
-        t=readonly(blocks["t"]),
-        q=readonly(blocks["q"]),
-        v=readonly(blocks["v"]),
-        tau_command=readonly(tau_command),
-        tau=readonly(plant.applied_torque(tau_command)),
-        q_des=readonly(blocks["q_des"]),
-        v_des=readonly(blocks["v_des"]),
-        a_des=readonly(blocks["a_des"]),
-        torque_limits=readonly(plant.limits),
-        saturate=plant.saturate,
-        reference_period=trajectory.period,
-        p_hat=readonly(p_hat) if p_hat is not None else None,
-        p_true=None if not estimates or true is None else readonly(true),
-        parameter_names=controller.parameter_names if estimates else (),
-        control_period=None
-        if config.hold_steps is None
-        else config.hold_steps * config.duration / config.steps,
-        parameter_units=controller.parameter_units if estimates else (),
-        parameter_kinds=controller.parameter_kinds if estimates else (),
-        robot=plant.robot.name,
-        state=readonly(z) if z.shape[1] else None,
-        state_names=names,
-        state_units=units,
-        position_limits=readonly(np.stack([limits.position_lower, limits.position_upper])),
-        velocity_limits=readonly(limits.velocity),
-        joint_names=limits.joint_names,
-        position_stops=plant.position_stops,
-    )
+    return run_result(controller, plant, trajectory, config, blocks)
 
 
 def first_samples(result: SimulationResult, count: int) -> SimulationResult:
