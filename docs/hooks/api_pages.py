@@ -95,6 +95,7 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
             "memory",
             "errors",
             "arrays",
+            "small_linalg",
             "mathml",
             "openmp",
             "blas",
