@@ -188,6 +188,14 @@ def _quiet_worker_start() -> None:
 
 _quiet_worker_start()
 
+# pyarrow (the sweeps' Parquet files) allocates through the system's malloc. libarrow also
+# carries jemalloc, and at the limit on processes and threads "<jemalloc>: background thread
+# creation failed (11)" was written to fd 2 dozens of times beside the command's one line
+# (tests/test_cluster_limit.py's fork case, twice on 6 Dec 2026 under load; 16 runs with the
+# pool chosen passed, and 10 of 11 without). Set before pyarrow is imported, here or in a worker
+# this command spawns (they inherit it); a user's own value stays.
+os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
+
 
 def main() -> int:
     """Run ``twolink-pin`` with the process's arguments. Ends the process (it never returns)."""

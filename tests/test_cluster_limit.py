@@ -197,3 +197,17 @@ def test_a_worker_that_dies_in_its_imports_is_one_line_naming_the_error(tmp_path
         "(ModuleNotFoundError: import of pinocchio halted"
     ), lines[0]
     assert done.returncode == 2 and left == []
+
+
+def test_the_command_allocates_parquet_memory_without_jemalloc() -> None:
+    """pyarrow's bundled jemalloc printed "<jemalloc>: background thread creation failed"
+    dozens of times beside the one line at the process limit (the fork case above, now and then):
+    the command makes pyarrow use the system allocator, in its own process and in the workers
+    it spawns (they inherit the environment)."""
+    code = (
+        "import twolink_pin_entry, os, pyarrow;"
+        "print(pyarrow.default_memory_pool().backend_name, os.environ['ARROW_DEFAULT_MEMORY_POOL'])"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "ARROW_DEFAULT_MEMORY_POOL"}
+    done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert done.stdout.split() == ["system", "system"], done.stderr
