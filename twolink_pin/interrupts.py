@@ -20,6 +20,7 @@ from __future__ import annotations
 import signal
 from collections.abc import Iterator
 from contextlib import contextmanager
+from typing import Any
 
 
 class Terminated(KeyboardInterrupt):
@@ -89,4 +90,27 @@ def check(since: int = 0) -> None:
         raise Terminated if received[-1] == signal.SIGTERM else KeyboardInterrupt
 
 
-__all__ = ["Terminated", "check", "deferred", "deferring", "note", "on_signal", "received", "spared_children"]
+def result_of(future: Any, since: int, poll: float = 0.2) -> Any:
+    """``future.result()``, checking every ``poll`` seconds [s] whether a signal was received
+    after the first ``since`` entries of :data:`received` (:func:`check`): a KeyboardInterrupt
+    raised where Python drops it (a gc callback, which distributed installs; a finaliser) would
+    otherwise wait for the future's end (the report went on for 30 s after Ctrl-C on a loaded
+    machine)."""
+    while True:
+        try:
+            return future.result(timeout=poll)
+        except TimeoutError:
+            check(since=since)
+
+
+__all__ = [
+    "Terminated",
+    "check",
+    "deferred",
+    "deferring",
+    "note",
+    "on_signal",
+    "received",
+    "result_of",
+    "spared_children",
+]

@@ -238,6 +238,7 @@ def _run_all(
     tried, shown = False, animated
     animation = None
     workers = min(options.workers or 1, len(order) + 1)  # None was resolved to the cores
+    heard = len(interrupts.received)  # a signal from here on stops the waits below (result_of)
     with worker_pool(workers) as pool:
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
@@ -256,7 +257,7 @@ def _run_all(
         tick("model and trajectory")
         for name in order:
             try:
-                runs[name] = futures[name].result()
+                runs[name] = interrupts.result_of(futures[name], heard)
             except (SimulationDivergedError, ControllerError) as exc:  # the others' results are kept
                 failed[name] = str(exc)
             tick(f"controller {name}")
@@ -266,12 +267,12 @@ def _run_all(
                 tick("animation")
         if options.animation and not tried:
             tick("animation")  # every law failed: nothing to animate
-        traj_figs = traj_future.result()
+        traj_figs = interrupts.result_of(traj_future, heard)
         tick("trajectory figures")
         overlays = _write_overlays(fig_dir, rows, runs, options)
         within_limits = None
         if limits_future is not None:
-            within_limits = limits_future.result()
+            within_limits = interrupts.result_of(limits_future, heard)
             tick("the reference within the limits")
         identification = None
         if sections and pending is not None:

@@ -64,17 +64,22 @@ class CourseReport:
         adaptive run is the run along its trajectory when it is the same run."""
         if pending is None:
             return None
+        from twolink_pin import interrupts
         from twolink_pin.twolink import report_identification as ident
 
         reused, (runs_future, fit_future) = pending
-        excitation_runs = {key: f.result() for key, f in runs_future.items()}
+        heard = len(interrupts.received)  # a signal from here on stops the waits (result_of)
+        excitation_runs = {key: interrupts.result_of(f, heard) for key, f in runs_future.items()}
         if reused and REUSED_LAW in runs:
             result = runs[REUSED_LAW]
             assert result.p_hat is not None
             own = (np.asarray(result.t), np.asarray(result.p_hat)[:, : np.asarray(robot.p).size])
             excitation_runs = {"report": own, **excitation_runs}
         section = ident._identification_section(
-            options, fig_dir, excitation_runs, None if fit_future is None else fit_future.result()
+            options,
+            fig_dir,
+            excitation_runs,
+            None if fit_future is None else interrupts.result_of(fit_future, heard),
         )
         section["beside_law"] = REUSED_LAW  # the page shows it after this law's section (Fig. 27's)
         return section
