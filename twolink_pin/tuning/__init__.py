@@ -9,6 +9,7 @@ period by period as the run goes (each column of the table cut to the same perio
 ================  ===================================================================
 ``latest.py``     :class:`LatestWins`: one worker, one waiting request, stuck runs left behind
 ``knobs.py``      the controls of a law's gains, from its ``Gains`` declaration
+``outcomes.py``   what a run is asked for and gives: request, finished run, part, period
 ``runner.py``     one run: simulated, measured, its gains and plant; each finished period at once
 ``periods.py``    a run's first k periods as a run (measured as the final table), other runs cut
 ``panel.py``      the controls in the page and the ``RunSpec`` they describe

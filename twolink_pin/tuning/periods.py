@@ -29,7 +29,7 @@ if TYPE_CHECKING:
     from twolink_pin.plant import Plant
     from twolink_pin.simulation import SimulationConfig, SimulationResult
     from twolink_pin.trajectory import Trajectory
-    from twolink_pin.tuning.runner import Finished
+    from twolink_pin.tuning.outcomes import Finished
 
 PER_SAMPLE = (
     *("t", "q", "v", "tau_command", "tau", "q_des", "v_des", "a_des"),

@@ -15,80 +15,18 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from twolink_pin.errors import TwolinkPinError
 from twolink_pin.simulation.deadline import RunCancelled, watched
+from twolink_pin.tuning.outcomes import Finished, Partial, PeriodDone, Request
 
 if TYPE_CHECKING:
-    from twolink_pin.controllers import Controller
-    from twolink_pin.metrics import Metrics
     from twolink_pin.model import RobotModel
-    from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationResult
-    from twolink_pin.task_metrics import TaskMetrics
     from twolink_pin.trajectory import Trajectory
-
-
-class Request(NamedTuple):
-    """What one run is asked for."""
-
-    spec: RunSpec
-    """The run (law, gains, plant, simulation settings)."""
-    payload: float
-    """Point mass at the end effector [kg] (a robot option: the arm is loaded with it)."""
-    law_version: int = 0
-    """Bumped when the law's file changed (``--watch``): the law is read again first."""
-
-
-class Finished(NamedTuple):
-    """A run that ended (the tuner shows it and prints its JSON line)."""
-
-    request: Request
-    robot: RobotModel
-    controller: Controller
-    result: SimulationResult
-    metrics: Metrics
-    task: TaskMetrics | None
-    """Task-space metrics (mm, deg) of a task-space law, else None."""
-    gains: dict[str, Any]
-    """The gains the law ran with (:func:`~twolink_pin.run_spec.gains_used`)."""
-    plant: str
-    """Which plant (:func:`~twolink_pin.run_spec.plant_description`)."""
-    seconds: float
-    """Wall-clock time of the run [s]."""
-
-
-class Partial(NamedTuple):
-    """The part of a run in flight simulated so far (samples 0 … k − 1 of its result)."""
-
-    request: Request
-    t: np.ndarray
-    """Times [s], (k,)."""
-    q: np.ndarray
-    """Joint positions [rad], (k, nv)."""
-    q_des: np.ndarray
-    """Reference [rad], (k, nv)."""
-    tau_command: np.ndarray
-    """The law's torques [N·m], (k, nv)."""
-    torque_limits: np.ndarray
-    """The plant's effort limits [N·m], (nv,)."""
-    duration: float
-    """The whole run's duration [s]."""
-
-
-class PeriodDone(NamedTuple):
-    """A run in flight shown up to the end of its reference period ``k`` of ``periods``."""
-
-    done: Finished
-    """The run's first k periods as a run of their own (samples ``0 … round(k T / dt)``), its
-    metrics those of the final table; ``seconds``: the wall-clock time so far [s]."""
-    k: int
-    """The periods simulated (1 … periods − 1)."""
-    periods: int
-    """The periods of the whole run."""
 
 
 _FIELDS = ("t", "q", "v", "z", "tau_command", "q_des", "v_des", "a_des")
