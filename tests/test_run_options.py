@@ -45,6 +45,8 @@ SAMPLES = {
     "--sensor-noise": ["--sensor-noise", "0.001"],
     "--noise-seed": ["--sensor-noise", "0.001", "--noise-seed", "5"],
     "--delay": ["--delay", "2"],
+    "--scene": ["--scene", str(Path(__file__).resolve().parents[1] / "examples" / "wall.toml")],
+    "--wall": ["--wall", "0.9,0,0:-1,0,0"],
 }
 """A non-default value of each run option (a new option needs one here)."""
 NOT_FROM_OPTIONS = {"law", "law_gains", "shared", "parameters_use", "rtol", "atol", "v0_offset"}

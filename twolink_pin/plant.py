@@ -6,7 +6,9 @@ clips to the URDF torque limits when ``saturate`` is on (off by default, as in t
 A plant may also push back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
 sensor noise, a delay; none by default), and may make each joint's position range a hard
 stop (``position_stops``: :mod:`twolink_pin.simulation.stops`, off by default: a joint then
-passes its range and the run records the crossing); the engine then runs
+passes its range and the run records the crossing), and may touch the surfaces of a scene
+(``scene``: :mod:`twolink_pin.contact`, none by default; the Pinocchio plant's contact is
+:class:`~twolink_pin.contact.CompliantContact`); the engine then runs
 :mod:`twolink_pin.simulation.events`.
 
 :class:`Plant` is one frozen value; a variant is :func:`dataclasses.replace` of it.
@@ -28,6 +30,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.dynamics import ABA_CONVENTION, Friction
 from twolink_pin.errors import InvalidParameterError
@@ -78,6 +81,7 @@ class Plant:
         delay: Steps between a measurement and the torque it produces.
         position_stops: Make each joint's position range a hard, perfectly inelastic stop
             (:mod:`twolink_pin.simulation.stops`); joints without a range have none.
+        scene: The surfaces the arm may touch (:class:`~twolink_pin.contact.Scene`), or None.
         model: The Pinocchio model integrated (default ``robot.model``; the model after a
             payload step in :func:`~twolink_pin.simulation.events.payload_plant`).
         friction_source: Where ``friction`` comes from, in words (the summaries show it).
@@ -92,6 +96,7 @@ class Plant:
     sensor_noise: SensorNoise | None = None
     delay: int = 0
     position_stops: bool = False
+    scene: Scene | None = None
     model: pin.Model = field(default=None, repr=False)
     friction_source: str = ""
     limits: np.ndarray = field(init=False, repr=False)
@@ -121,6 +126,15 @@ class Plant:
                 raise InvalidParameterError(
                     name, value, f"a twolink_pin.disturbances.{kind.__name__} or None"
                 )
+        if self.scene is not None:
+            if not isinstance(self.scene, Scene):
+                raise InvalidParameterError("scene", self.scene, "a twolink_pin.contact.Scene or None")
+            if self.scene.frame is not None and not robot.model.existFrame(self.scene.frame):
+                raise InvalidParameterError(
+                    "scene.frame",
+                    self.scene.frame,
+                    f"a frame of {robot.name}: {[f.name for f in robot.model.frames]}",
+                )
         wrench = self.wrench
         if wrench is not None and wrench.frame is not None and not robot.model.existFrame(wrench.frame):
             raise InvalidParameterError(
@@ -138,10 +152,10 @@ class Plant:
 
     @property
     def has_events(self) -> bool:
-        """Whether the plant pushes back: a wrench, a payload step, sensor noise, a delay or
-        joint stops."""
+        """Whether the plant pushes back: a wrench, a payload step, sensor noise, a delay,
+        joint stops or a scene to touch."""
         return (
-            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise))
+            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise, self.scene))
             or self.delay > 0
             or self.position_stops
         )
@@ -193,6 +207,8 @@ class Plant:
             parts.append(f"delay {self.delay} steps")
         if self.position_stops:
             parts.append("joint stops")
+        if self.scene is not None:
+            parts.append(self.scene.describe() if values else "contact")
         return ", ".join(parts)
 
     def friction_dict(self) -> dict[str, Any] | None:
@@ -226,6 +242,8 @@ class PlantOptions:
         position_stops: Each joint's position range a hard stop (``--joint-stops``;
             :mod:`twolink_pin.simulation.stops`): off, a joint may pass its range, and the run
             says so.
+        scene: The surfaces the arm may touch and their contact properties (``--scene FILE``,
+            ``--wall …``; :mod:`twolink_pin.contact`), or None (free space).
 
     The wrench, payload step, sensor noise and delay are the plant's events (:mod:`twolink_pin.disturbances`: what each does,
     and when, on the engine's grid); all off by default, as in the course report.
@@ -239,10 +257,15 @@ class PlantOptions:
     sensor_noise: SensorNoise | None = None
     delay: int = 0
     position_stops: bool = False
+    scene: Scene | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.position_stops, bool):
             raise InvalidParameterError("position_stops", self.position_stops, "True or False")
+        if isinstance(self.scene, Mapping):  # from_dict: the scene comes back from JSON as a mapping
+            object.__setattr__(self, "scene", Scene(**self.scene))
+        elif self.scene is not None and not isinstance(self.scene, Scene):
+            raise InvalidParameterError("scene", self.scene, "a twolink_pin.contact.Scene or None")
         # as_dict / from_dict: the events come back from JSON as mappings
         for name, kind in (("wrench", Wrench), ("payload_step", PayloadStep), ("sensor_noise", SensorNoise)):
             value = getattr(self, name)
@@ -292,6 +315,7 @@ class PlantOptions:
             sensor_noise=self.sensor_noise,
             delay=self.delay,
             position_stops=self.position_stops,
+            scene=self.scene,
             friction_source=source,
         )
 

@@ -16,6 +16,7 @@
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)
 ``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)
+``force.py``                :class:`ForceReference`: a desired normal force on a surface over time, :func:`with_force`
 ==========================  ================================================================
 """
 
@@ -38,6 +39,7 @@ from twolink_pin.trajectory.file import (
     read_trajectory_file,
     write_trajectory_file,
 )
+from twolink_pin.trajectory.force import ForceReference, with_force
 from twolink_pin.trajectory.fourier import FourierTrajectory
 from twolink_pin.trajectory.optimal import OptimalTrajectory, effort_integral, optimize
 from twolink_pin.trajectory.polynomial import JointTrajectory
@@ -48,6 +50,7 @@ from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory, pose_trajecto
 
 __all__ = [
     "NEUTRAL_AMPLITUDE",
+    "ForceReference",
     "FourierTrajectory",
     "JointTrajectory",
     "OptimalTrajectory",
@@ -72,5 +75,6 @@ __all__ = [
     "read_trajectory_file",
     "solve_pose",
     "time_optimal",
+    "with_force",
     "write_trajectory_file",
 ]

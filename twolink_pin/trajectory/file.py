@@ -13,6 +13,17 @@ or through end-effector positions of the robot's end-effector frame (solved by
     positions = [[0.45, 0.10, 0.40], ...]       # m: (x, y, z), or (x, y) for a planar arm
     seed = [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]   # rad, optional IK seed (default: home)
 
+A ``positions`` file may ask for straight lines between its points, ``path = "lines"``
+(default ``"polynomial"``, as above): the end effector then moves along each line with a
+rest-to-rest time scaling and stops at every via point (the SE(3) reference's position path,
+for any arm, its joint path solved by the position's inverse kinematics).
+
+A via file (``joints`` or ``positions``) may also carry a force reference: ``force``, one
+normal force [N] per time, pressed on the scene's surface ``force_surface`` (optional: the
+scene's only surface) — :mod:`~twolink_pin.trajectory.force`::
+
+    force = [0.0, 10.0, 10.0, 10.0, 0.0]        # N, linear between the via times
+
 or through end-effector poses: ``positions`` (3 coordinates) and, per row, the orientation
 as roll, pitch, yaw [rad] (``R = Rz(yaw) Ry(pitch) Rx(roll)``, the URDF's ``rpy``, what
 Pinocchio's ``rpy.rpyToMatrix`` builds; chosen over a quaternion because three angles are
@@ -55,7 +66,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 import pinocchio as pin
@@ -66,6 +77,7 @@ from twolink_pin.files import read_input_file
 from twolink_pin.limits import POSITION, joint_limits
 from twolink_pin.limits.check import check_grid
 from twolink_pin.model import RobotModel
+from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
 from twolink_pin.trajectory.file_values import (
     MAX_ANGLE,
@@ -74,11 +86,13 @@ from twolink_pin.trajectory.file_values import (
     check_within_limits,
     parse_numbers,
 )
+from twolink_pin.trajectory.force import MAX_FORCE, ForceReference, with_force
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
 from twolink_pin.trajectory.sampled import SampledTrajectory
 from twolink_pin.trajectory.se3 import MAX_POSITION, PoseTrajectory, pose_trajectory
 
+TrajectoryT = TypeVar("TrajectoryT", bound=Trajectory)
 MAX_TRAJECTORY_BYTES = 16 << 20
 """Largest trajectory file read (16 MiB: a ``samples`` table of a retimed UR5 path is about
 1 MiB; via points need far less)."""
@@ -92,7 +106,10 @@ MIN_TIME_STEP = 1e-3
 CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
-KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed"})
+KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed", "force", "force_surface", "path"})
+PATHS = ("polynomial", "lines")
+"""A ``positions`` file's ``path``: one polynomial per joint through the via points (default),
+or straight lines between them (:class:`~twolink_pin.trajectory.se3.PoseTrajectory`, position only)."""
 FOURIER_KEYS = frozenset({"period", "harmonics", "a", "b", "offset"})
 """Keys of a ``fourier`` table."""
 
@@ -168,7 +185,9 @@ def read_trajectory_file(
     else:
         points, seed = _position_rows(file, document, rows, robot)
         if "rpy" in document:
-            return _pose_file(file, document, robot, times, points, seed, period)
+            return _carrying(_pose_file(file, document, robot, times, points, seed, period), file, document)
+        if _path(file, document) == "lines":
+            return _carrying(_line_file(file, robot, times, points, seed, period), file, document)
         try:
             via_q = cartesian_via_q(robot, points, seed)
         except InverseKinematicsError as err:
@@ -188,7 +207,73 @@ def read_trajectory_file(
     except InvalidParameterError as err:
         raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
     check_trajectory_limits(robot, trajectory, f"{file}")
+    return _carrying(trajectory, file, document)
+
+
+def _path(file: Path, document: dict[str, Any]) -> str:
+    """The file's ``path`` (:data:`PATHS`), checked."""
+    path = document.get("path", "polynomial")
+    if path not in PATHS or ("joints" in document and path != "polynomial"):
+        raise InvalidParameterError(
+            f"{file}: path",
+            path,
+            f"one of {PATHS} ('lines' with 'positions' only: straight lines between them)",
+        )
+    return str(path)
+
+
+def _line_file(
+    file: Path, robot: RobotModel, times: np.ndarray, points: np.ndarray, seed: np.ndarray | None, period: Any
+) -> PoseTrajectory:
+    """Straight lines between the via positions (``path = "lines"``): the position-only
+    :class:`PoseTrajectory` through them, the orientations there the forward kinematics'."""
+    try:
+        via_q = cartesian_via_q(robot, points, seed)
+    except InverseKinematicsError as err:
+        raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
+    data = robot.model.createData()
+    poses = []
+    for q in via_q:
+        pin.framesForwardKinematics(robot.model, data, q)
+        poses.append(data.oMf[robot.ee_frame_id].copy())
+    positions = np.array([pose.translation for pose in poses])
+    positions[:, : points.shape[1]] = points  # exactly the file's (the IK reaches them to its tolerance)
+    rotations = np.array([pose.rotation for pose in poses])
+    rotations[-1] = rotations[0]
+    try:
+        trajectory = pose_trajectory(
+            robot, tuple(times), positions, rotations, None if period is None else float(period), via_q[0],
+            position_rows=points.shape[1],
+        )  # fmt: skip
+    except InvalidParameterError as err:
+        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    except InverseKinematicsError as err:
+        raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
+    check_trajectory_limits(robot, trajectory, f"{file}")
     return trajectory
+
+
+def _carrying(trajectory: TrajectoryT, file: Path, document: dict[str, Any]) -> TrajectoryT:
+    """``trajectory`` carrying the file's ``force`` column [N] (one value per via time, on the
+    surface ``force_surface``; :mod:`~twolink_pin.trajectory.force`), if it has one."""
+    if "force" not in document:
+        if "force_surface" in document:
+            raise InvalidParameterError(
+                f"{file}: force_surface", document["force_surface"], "a 'force' column [N] beside it"
+            )
+        return trajectory
+    times = _via_times(file, document)
+    values = parse_numbers(file, "force", document["force"], "one normal force [N] per time", MAX_FORCE, "N")
+    if values.shape != times.shape:
+        raise InvalidParameterError(
+            f"{file}: force", document["force"], f"one normal force [N] per time ({times.size})"
+        )
+    surface = document.get("force_surface")
+    try:
+        reference = ForceReference(tuple(times), tuple(values), surface, trajectory.period)
+    except InvalidParameterError as err:
+        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
+    return with_force(trajectory, reference)
 
 
 def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:

@@ -61,9 +61,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     robot = robot_from_args(args)
     spec = run_spec(args, args.controller)
-    spec.check_effective(robot)
+    reference = trajectory_from_args(args, robot)
+    spec.check_effective(robot, trajectory=reference)
     scenario = spec.build(robot, identified_parameters(spec, robot))
-    result = simulate(*scenario, trajectory_from_args(args, robot), spec.simulation)
+    result = simulate(*scenario, reference, spec.simulation)
     metrics = compute_metrics(result)
     for warning in position_warnings(result.controller, result):
         print(warning, file=sys.stderr)
@@ -187,9 +188,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     laws = [v.law for v in variants]
     shared = run_spec(args)
     shared.check_law_gains(laws)
-    shared.check_effective(robot, laws)
-    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     reference = trajectory_from_args(args, robot)
+    shared.check_effective(robot, laws, reference)
+    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(rows), "run", "compare")
@@ -349,7 +350,7 @@ def _run_to_animate(args: argparse.Namespace) -> tuple[Any, Any, Any, Any, Any]:
     robot = robot_from_args(args)
     reference = trajectory_from_args(args, robot)
     spec = run_spec(args, args.controller)
-    spec.check_effective(robot)
+    spec.check_effective(robot, trajectory=reference)
     scenario = spec.build(robot, identified_parameters(spec, robot))
     result = simulate(*scenario, reference, spec.simulation)
     return robot, reference, result, spec, scenario.controller
