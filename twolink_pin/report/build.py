@@ -335,7 +335,7 @@ def _write_animation(
             result.q_des,
             path=stage / "animation.html",
             via_points=points,
-            **run_overlays(options.run.plant.wrench, result.t),
+            **run_overlays(options.run.plant.wrench, result.t, options.run.plant.scene, result.wrench),
         )
     except InvalidURDFError as exc:  # a missing mesh: the report without its animation
         warnings.append(f"no animation: {exc}")
