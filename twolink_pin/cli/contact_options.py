@@ -38,11 +38,10 @@ def wall(text: str) -> Scene:
         values = [finite(x) for x in parts[2:]]
     except argparse.ArgumentTypeError:
         raise argparse.ArgumentTypeError(f"expected finite numbers: {expected}") from None
-    properties = dict(zip(("stiffness", "damping", "friction"), values, strict=False))
-    properties.setdefault("stiffness", DEFAULT_STIFFNESS)
-    properties.setdefault("damping", DEFAULT_DAMPING)
+    stiffness, damping, friction = values + [DEFAULT_STIFFNESS, DEFAULT_DAMPING, 0.0][len(values) :]
     try:
-        return Scene((Surface(point, normal, **properties),), radius=DEFAULT_RADIUS)
+        surface = Surface(point, normal, stiffness=stiffness, damping=damping, friction=friction)
+        return Scene((surface,), radius=DEFAULT_RADIUS)
     except TwolinkPinError as exc:
         raise argparse.ArgumentTypeError(f"{exc}: {expected}") from None
 

@@ -94,9 +94,9 @@ class CompliantContact:
         self._offsets = np.array([s.unit_normal @ np.array(s.point) for s in surfaces]) + scene.radius  # (S,)
         self._bounded = any(s.size is not None for s in surfaces)
         # per surface, as Python floats: (n_x, n_y, n_z, n·x + r, k, b, μ, the face if bounded)
-        self._surfaces = [
-            (*s.normal, float(s.unit_normal @ np.array(s.point)) + scene.radius, s.stiffness, s.damping,
-             s.friction, _face(s))
+        self._surfaces: list[tuple[float, float, float, float, float, float, float, Face | None]] = [
+            (s.normal[0], s.normal[1], s.normal[2], float(s.unit_normal @ np.array(s.point)) + scene.radius,
+             s.stiffness, s.damping, s.friction, _face(s))
             for s in surfaces
         ]  # fmt: skip
         self._eps2 = scene.slip_velocity**2

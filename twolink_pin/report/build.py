@@ -25,6 +25,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from twolink_pin import interrupts
+from twolink_pin.contact_metrics import contact_metrics
 from twolink_pin.errors import (
     ControllerError,
     InvalidURDFError,
@@ -90,7 +91,7 @@ def build_report(
     variants = laws_to_run(options, robot)
     laws = [v.law for v in variants]
     options.run.check_law_gains(laws)
-    options.run.check_effective(robot, laws)
+    options.run.check_effective(robot, laws, reference_trajectory(robot, options))
     rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
     steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
     steps += sections.steps(options) if sections else 0
@@ -133,6 +134,7 @@ def _build(
     cfg = options.run.simulation
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
     task = {n: task_metrics(r[0], robot) for n, r in runs.items()}  # every law moves the end effector
+    contact = {n: m for n, r in runs.items() if (m := contact_metrics(r[0], robot)) is not None}  # a scene
     table = ComparisonTable(
         {n: r[1] for n, r in runs.items()},
         {n: r[3] for n, r in runs.items()},
@@ -141,8 +143,9 @@ def _build(
         plants={n: plant_description(rows[n].scenario) for n in names},
         gains={n: gains_used(rows[n].scenario.controller) for n in names},
         task=task,
+        contact=contact,
     )
-    controllers, lams = _law_entries(runs, rows, task)
+    controllers, lams = _law_entries(runs, rows, task, contact)
     errata: list[dict[str, Any]] = []
     if sections:
         done_runs = {n: r[0] for n, r in runs.items()}
@@ -347,9 +350,10 @@ def _law_entries(
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
     rows: dict[str, Row],
     task: dict[str, Any],
+    contact: dict[str, Any],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Each row that ran as ``results.json`` shows it (its law, gains, metrics, figures,
-    estimates, limits), and the λ [1/s] of those that have one."""
+    estimates, limits, contact), and the λ [1/s] of those that have one."""
     controllers = {}
     lams: dict[str, float] = {}
     for name, (result, metrics, figures, seconds) in runs.items():
@@ -365,6 +369,7 @@ def _law_entries(
             "gains": controller.gains.describe(),
             "metrics": metrics.as_dict(),
             "task_metrics": task[name].as_dict() if name in task else None,
+            "contact_metrics": contact[name].as_dict() if name in contact else None,
             "figures": figures,
             "seconds": seconds,
             "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),

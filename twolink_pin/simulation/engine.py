@@ -174,7 +174,11 @@ class _Run:
         # choose the dynamics of each step, offset what the law measures, delay its torque.
         self.events = events = PlantEvents(plant, runs, threads, nv, dt) if plant.has_events else None
         contact = None if events is None else events.contact
-        self.sensor = None if contact is None else ForceSensor(contact, force_reference, events.force_noise)
+        self.sensor = (
+            None
+            if events is None or contact is None
+            else ForceSensor(contact, force_reference, events.force_noise)
+        )
         self.line = line = DelayLine(plant.delay) if plant.delay > 0 else None
         self.stop = events.stop if events is not None and events.stops is not None else None
         self.accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)

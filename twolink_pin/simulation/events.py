@@ -105,7 +105,8 @@ class PlantEvents:
         key = (after, pushing)
         accel = self._accels.get(key)
         if accel is None:
-            accel = self._accels[key] = self._accel(self._after if after else self._before, pushing)
+            dynamics = self._after if after and self._after is not None else self._before
+            accel = self._accels[key] = self._accel(dynamics, pushing)
         return accel
 
     def _accel(self, dynamics: Accel, pushing: bool) -> Accel:

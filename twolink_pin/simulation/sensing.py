@@ -79,7 +79,7 @@ class ForceSensor:
         new, measure = tuple.__new__, self.measure
 
         def sensed(x: LawInput, terms: Any) -> Any:
-            part = x[-1]
+            part: Any = x[-1]  # the reference's part: (None, normal, force_des)
             reading = new(ContactInput, (measure(x[1], x[2]), part[1], part[2]))
             return law(new(LawInput, (*x[:-1], reading)), terms)
 

@@ -107,7 +107,8 @@ def law_input(
     ``contact``: what the force sensor reads (None: no scene)."""
     joint = TrajectorySample(q_des, v_des, a_des, np.zeros_like(a_des))
     task = task_reference(controller, trajectory, np.array([t]), joint)
-    return LawInput(t, q, v, z, q_des, v_des, a_des, *(x[0] for x in task), contact)
+    x_des, R_des, twist_des, accel_des = (x[0] for x in task)
+    return LawInput(t, q, v, z, q_des, v_des, a_des, x_des, R_des, twist_des, accel_des, contact)
 
 
 def reference_rows(

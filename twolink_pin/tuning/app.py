@@ -397,7 +397,8 @@ class Tuner:
             self.status.content = (
                 f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s{suffix}"
             )
-        self.scene.show(result.t, result.q, result.q_des)
+        force = None if result.wrench is None else -np.asarray(result.wrench)[:, :3]  # on the arm
+        self.scene.show(result.t, result.q, result.q_des, done.request.spec.plant.scene, force)
         self.scene.hold(False, RESUME_AFTER)
 
     def _keep_latest(self) -> None:

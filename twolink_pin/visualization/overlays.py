@@ -222,6 +222,7 @@ def add_surfaces(vis: Any, scene: Scene, extent: float, centre: np.ndarray) -> l
         u, w = surface.axes()
         n = surface.unit_normal
         point = np.array(surface.point)
+        size: tuple[float, ...]
         if surface.size is None:
             span = SURFACE_SPAN * extent
             size = (span, span, 0.01 * extent)
