@@ -226,7 +226,7 @@ def test_cli_options_give_the_librarys_run(capsys: pytest.CaptureFixture[str]) -
         ("--wrench", "1,2,3@2:1"),
         ("--payload-step", "2"),
         ("--payload-step", "-1@2"),
-        ("--sensor-noise", "1,2,3"),
+        ("--sensor-noise", "1,2,3,4"),
         ("--sensor-noise", "-0.1"),
         ("--delay", "-2"),
     ],
