@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from twolink_pin.contact_metrics import SETTLE, contact_metrics
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.plotting import _style
+from twolink_pin.plotting._style import DESIRED_COLOR, new_figure, save_figure
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.task_metrics import frame_positions
 
@@ -46,11 +46,11 @@ def _contact_figure(results: Mapping[str, SimulationResult], robot: RobotModel, 
     t0 = np.asarray(first.t)
     reference = frame_positions(robot, np.asarray(first.q_des), int(robot.ee_frame_id))
     u = along_axis(normal, reference)
-    fig = _style.new_figure(CONTACT_FIGSIZE)
+    fig = new_figure(CONTACT_FIGSIZE)
     force_ax, along_ax, depth_ax = fig.subplots(3, 1, sharex=True)
     if first.force_des is not None:
-        force_ax.plot(t0, first.force_des, color=_style.DESIRED_COLOR, ls="--", lw=1.2, label="desired f_d")
-    along_ax.plot(t0, reference @ u, color=_style.DESIRED_COLOR, ls="--", lw=1.2, label="reference")
+        force_ax.plot(t0, first.force_des, color=DESIRED_COLOR, ls="--", lw=1.2, label="desired f_d")
+    along_ax.plot(t0, reference @ u, color=DESIRED_COLOR, ls="--", lw=1.2, label="reference")
     for (name, result), color in zip(results.items(), COLORS * len(results), strict=False):
         t = np.asarray(result.t)
         m = contact_metrics(result, robot)
@@ -73,7 +73,7 @@ def _contact_figure(results: Mapping[str, SimulationResult], robot: RobotModel, 
         f"force pressed on the surface (shaded: the impact, {SETTLE:g} s after the first contact)",
         fontsize=10,
     )
-    axis = ", ".join(f"{c:.3g}" for c in u)
+    axis = ", ".join(f"{c:.3g}" for c in np.round(u, 6) + 0.0)
     along_ax.set_ylabel("along the surface [m]")
     along_ax.set_title(f"end effector's position along ({axis})", fontsize=10)
     depth_ax.set_ylabel("penetration [mm]")
@@ -103,7 +103,7 @@ def save_contact_figure(
     """
     if not results or any(r.wrench is None or r.contact_normal is None for r in results.values()):
         raise InvalidParameterError("results", list(results), "runs against a scene (--scene or --wall)")
-    return _style.save_figure(_contact_figure(results, robot, title), Path(path))
+    return save_figure(_contact_figure(results, robot, title), Path(path))
 
 
 __all__ = ["save_contact_figure"]

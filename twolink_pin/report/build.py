@@ -67,7 +67,11 @@ def laws_to_run(options: ReportOptions, robot: Any) -> tuple[Variant, ...]:
     if options.controllers is not None:
         return parse_variants(options.controllers)
     laws = robot.profile.report.laws
-    return parse_variants(tuple(laws) if laws is not None else builtin_laws())
+    pressing = (
+        options.run.plant.scene is not None
+        and reference_trajectory(robot, options).force_reference is not None
+    )
+    return parse_variants(tuple(laws) if laws is not None else builtin_laws(pressing))
 
 
 def build_report(

@@ -76,9 +76,8 @@ def inline_animation(
         fps: Animation frames per second of motion [1/s], > 0.
         loop: Repeat the animation forever.
         height: Height of the frame in the notebook [px], 100 to 2000.
-        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's triad
-            and a scene's surfaces,
-            as :func:`~twolink_pin.visualization.write_html`.
+        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's
+            triad and a scene's surfaces, as :func:`~twolink_pin.visualization.write_html`.
 
     Returns:
         The animation; its ``_repr_html_`` is the ``<iframe srcdoc=…>``.

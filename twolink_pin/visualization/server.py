@@ -136,9 +136,8 @@ def serve(
         loop: Repeat the motion forever.
         open_browser: Open :attr:`LiveViewer.url` with :mod:`webbrowser`.
         quiet: Do not print the URL on stdout.
-        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's triad
-            and a scene's surfaces,
-            as :func:`~twolink_pin.visualization.write_html` (the live page has no legend:
+        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's
+            triad and a scene's surfaces, as :func:`~twolink_pin.visualization.write_html` (the live page has no legend:
             the arrow's scale is :func:`~twolink_pin.visualization.overlays.wrench_scale`).
 
     Raises:

@@ -188,11 +188,12 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from twolink_pin.studies.comparison import run_comparison
 
     robot = robot_from_args(args)
-    variants = parse_variants(args.controllers or list(builtin_laws()))  # LAW or LAW@KEY=VALUE…
-    laws = [v.law for v in variants]
     shared = run_spec(args)
-    shared.check_law_gains(laws)
     reference = trajectory_from_args(args, robot)
+    pressing = shared.plant.scene is not None and reference.force_reference is not None  # the force laws too
+    variants = parse_variants(args.controllers or list(builtin_laws(pressing)))  # LAW or LAW@KEY=VALUE…
+    laws = [v.law for v in variants]
+    shared.check_law_gains(laws)
     shared.check_effective(robot, laws, reference)
     rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     warnings: list[str] = []  # printed once the progress bar is gone
