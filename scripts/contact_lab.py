@@ -69,7 +69,9 @@ def lab(robot_name: str, duration: float, out: Path) -> str:
     results, rows = {}, []
     for law in LAWS:
         gains = setup["impedance"] if law == "impedance" else {}
-        spec = RunSpec(law=law, gains=tuple(gains.items()), plant=PlantOptions(scene=scene), simulation=config)
+        spec = RunSpec(
+            law=law, gains=tuple(gains.items()), plant=PlantOptions(scene=scene), simulation=config
+        )
         start = time.perf_counter()
         result = simulate(*spec.build(robot), trajectory, config)
         metrics = contact_metrics(result, robot)

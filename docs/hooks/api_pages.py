@@ -52,11 +52,16 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, what pushes back on it, a law with its plant, a law's variants, the run description, "
-        "and the engine.",
-        ("plant", "disturbances", "scenario", "law_variant", "run_spec", "simulation"),
+        "The simulated arm, what pushes back on it, the surfaces it touches, a law with its plant, a law's "
+        "variants, the run description, and the engine.",
+        ("plant", "disturbances", "contact", "scenario", "law_variant", "run_spec", "contact_checks", "simulation"),
     ),
-    ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
+    (
+        "metrics",
+        "Metrics",
+        "RMS, L2 and max norms of a run or a batch; the end effector's errors; the contact's.",
+        ("metrics", "task_metrics", "contact_metrics"),
+    ),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),
     (
         "identification",

@@ -87,6 +87,7 @@ class CompliantContact:
         self._model = robot.model
         self._data = robot.model.createData()
         self._frame = contact_frame(robot, scene)
+        self._origin = self._data.oMf[self._frame]  # a view of the frame's placement in the Data
         self._runs = runs
         self._step = step
         surfaces = scene.surfaces
@@ -133,20 +134,24 @@ class CompliantContact:
     def _evaluate(self, q: np.ndarray, v: np.ndarray) -> ContactForces:
         """Every run by the same scalar code (:meth:`_run`): a batch equals its single runs bit
         for bit, and one run costs a Pinocchio call and a few microseconds of Python floats."""
-        model, data, fid, run = self._model, self._data, self._frame, self._run
+        model, data, fid, run, origin = self._model, self._data, self._frame, self._run, self._origin
         touching: set[tuple[int, int]] = set()
         found = []
         for i in range(q.shape[0]):
-            J = pin.computeFrameJacobian(model, data, q[i], fid, WORLD_ALIGNED)
-            found.append(run(i, data.oMf[fid].translation.tolist(), J, v[i], touching))
+            J = pin.computeFrameJacobian(model, data, q[i], fid, WORLD_ALIGNED)  # also sets data.oMf[fid]
+            found.append(run(i, origin.translation.tolist(), J, v[i], touching))
         if not touching:
-            self._touching.clear()
-            self._checked.clear()
+            if self._touching:
+                self._touching, self._checked = set(), set()
             return self._free
         self._check_step(q, touching)
-        zero = self._zero_row
-        wrench, tau, depth = zip(*(zero if x is None else x for x in found), strict=True)
-        forces = ContactForces(np.array(wrench), np.array(tau), np.array(depth))
+        if len(found) == 1:  # one run: its rows as they are
+            wrench, tau, depth = found[0]  # type: ignore[misc]
+            forces = ContactForces(wrench[None], tau[None], np.array([depth]))
+        else:
+            zero = self._zero_row
+            rows = zip(*(zero if x is None else x for x in found), strict=True)
+            forces = ContactForces(*(np.array(column) for column in rows))
         for array in forces:  # the law's sensor reads them as they are
             array.setflags(False)  # type: ignore[call-arg]
         return forces
