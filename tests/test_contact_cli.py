@@ -124,3 +124,78 @@ def test_a_contact_too_stiff_for_the_step_fails_the_run_naming_the_limit(
         code=1,
     )  # fmt: skip
     assert "contact with surface 'wall' at t = " in err and "largest stable stiffness at --dt 0.001 s" in err
+
+
+def test_a_sweep_against_a_wall_has_the_contact_columns(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Each row carries the contact metrics; a run never in contact has none (null), and the
+    summary's statistics are over the runs that have them."""
+    out = tmp_path / "sweep"
+    argv = [
+        "sweep",
+        "pd",
+        "--samples",
+        "3",
+        "--duration",
+        "0.3",
+        "--wall",
+        "0.9,0,0:-1,0,0",
+        "--out",
+        str(out),
+    ]
+    assert main(argv) == 0
+    capsys.readouterr()
+    rows = json.loads((out / "runs.json").read_text())
+    assert all(row["contact_time_in_contact"] == 0 and row["contact_force_rms_error"] is None for row in rows)
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["metrics"]["contact_force_rms_error"] == {"median": None, "p5": None, "p95": None}
+    assert summary["metrics"]["contact_max_penetration_mm"]["median"] == 0
+
+
+def test_the_animation_draws_the_surfaces_and_the_contact_force() -> None:
+    from twolink_pin.visualization.motion import prepare_motion
+    from twolink_pin.visualization.overlays import run_overlays
+    from twolink_pin.visualization.scene import scene_commands
+
+    scene = read_scene(SCENE)
+    t = np.linspace(0.0, 1.0, 11)
+    q = np.tile(ROBOT.home + np.array([0.0, 0.6]), (11, 1))
+    contact = np.zeros((11, 6))
+    contact[5:, 0] = 10.0  # pressing the wall with 10 N from t = 0.5 s
+    overlays = run_overlays(None, t, scene, contact)
+    np.testing.assert_array_equal(overlays["wrench"][6], [-10.0, 0.0, 0.0])  # the wall's push on the arm
+    motion = prepare_motion(ROBOT, t, q, q, None, 10.0, **overlays)
+    drawn = scene_commands(ROBOT, motion)
+    paths = {str(c.get("path", "")) for c in drawn.commands}
+    assert any("surfaces/wall" in p for p in paths) and any("wrench" in p for p in paths)
+    assert drawn.wrench_scale is not None
+
+
+def test_tunes_simulate_line_names_the_scene() -> None:
+    from twolink_pin.cli.simulate_line import simulate_argv
+
+    spec = RunSpec(law="hybrid", plant=PlantOptions(scene=read_scene(SCENE)))
+    assert simulate_argv(spec, scene=SCENE)[-1] == f"--scene={SCENE}"
+    from twolink_pin.cli.contact_options import wall
+
+    plane = RunSpec(law="pd", plant=PlantOptions(scene=wall("0.9,0,0:-1,0,0:2000:30:0.1")))
+    token = simulate_argv(plane)[-1]
+    assert token.startswith("--wall=") and wall(token.removeprefix("--wall=")) == plane.plant.scene
+
+
+def test_the_lab_script_prints_its_table_and_draws_its_figure(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "contact_lab", EXAMPLES.parent / "scripts" / "contact_lab.py"
+    )
+    assert spec is not None and spec.loader is not None
+    script = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(script)
+    script.main(["--robots", "twolink", "--duration", "1.5", "--out", str(tmp_path)])
+    table = capsys.readouterr().out.strip().splitlines()
+    assert [row.split("|")[1].strip() for row in table[2:]] == ["hybrid", "force", "impedance"]
+    assert (tmp_path / "contact_twolink.png").is_file()

@@ -135,6 +135,9 @@ def _chunk_rows(
 
 
 def percentile_stats(column: np.ndarray) -> dict[str, float | None]:
+    """Median, 5th and 95th percentiles of ``column`` over its defined (non-NaN) values: a contact
+    metric is NaN for a run never in contact, or without a force reference; None for none."""
+    column = column[~np.isnan(column)]
     if column.size == 0:
         return {"median": None, "p5": None, "p95": None}
     p5, p50, p95 = np.percentile(column, PERCENTILES)
