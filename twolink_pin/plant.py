@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.contact.compliant import CompliantContact
 from twolink_pin.contact.scene import Scene
 from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.dynamics import ABA_CONVENTION, Friction
@@ -159,6 +160,15 @@ class Plant:
             or self.delay > 0
             or self.position_stops
         )
+
+    def contact_model(self, runs: int, step: float | None = None) -> CompliantContact | None:
+        """This plant's contact with its scene for ``runs`` runs advanced together (None without a
+        scene): the Pinocchio plant's spring–damper (:class:`~twolink_pin.contact.CompliantContact`),
+        checked against the RK4 ``step`` [s]. The engine asks it ``(q, q̇) -> ContactForces`` at
+        every stage: the force sensor reads ``wrench``, the plant's ABA adds ``tau``. A plant of
+        another engine answers with its own contact (``tau`` zero where its engine applies the
+        contact itself)."""
+        return None if self.scene is None else CompliantContact(self.robot, self.scene, runs, step)
 
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
         """Motor torque actually applied [N·m]: ``tau`` clipped to the limits if saturating."""

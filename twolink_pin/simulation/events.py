@@ -32,7 +32,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from twolink_pin.contact.compliant import CompliantContact, check_start
+from twolink_pin.contact.compliant import check_start
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.rigid_terms import RigidBodyTerms
@@ -72,9 +72,9 @@ class PlantEvents:
         self._block: tuple[np.ndarray, np.ndarray] | None = None
         self._k0 = 0
         self._k = 0
-        self.contact = None if plant.scene is None else CompliantContact(plant.robot, plant.scene, runs, dt)
-        """The plant's contact with its scene (None without one); ``dt`` [s]: the step it is
-        checked against."""
+        self.contact = plant.contact_model(runs, dt)
+        """The plant's contact with its scene (:meth:`~twolink_pin.plant.Plant.contact_model`;
+        None without one); ``dt`` [s]: the step it is checked against."""
         felt = self.noise is not None and self.noise.sigma_f > 0 and self.contact is not None
         self._force_generators = self.noise.force_generators(runs) if felt and self.noise is not None else []
         self._force_block: np.ndarray | None = None
