@@ -199,3 +199,21 @@ def test_the_lab_script_prints_its_table_and_draws_its_figure(
     table = capsys.readouterr().out.strip().splitlines()
     assert [row.split("|")[1].strip() for row in table[2:]] == ["hybrid", "force", "impedance"]
     assert (tmp_path / "contact_twolink.png").is_file()
+
+
+def test_the_reports_contact_table_reads_results_json_and_a_line_reference_has_no_coefficients() -> None:
+    """The report's contact table is results.json's contact metrics (— where a metric is
+    undefined); a straight-line reference (a PoseTrajectory) has no polynomial coefficients to show
+    (the report failed on one before)."""
+    from twolink_pin.contact_metrics import CONTACT_UNITS
+    from twolink_pin.report.build import _trajectory_facts  # the function under test
+    from twolink_pin.report.pages import _contact_table
+
+    metrics = dict.fromkeys(CONTACT_UNITS, 1.5) | {"force_rms_error": None}
+    table = _contact_table(
+        {"controllers": {"hybrid": {"contact_metrics": metrics}, "pd": {"contact_metrics": None}}}
+    )
+    assert table is not None and [row[0] for row in table["rows"]] == ["hybrid"]
+    assert table["rows"][0][1] == "—" and table["headers"][1] == "RMS force error [N]"
+    facts = _trajectory_facts(read_trajectory_file(SLIDE, ROBOT), None, [])
+    assert facts["coefficients"] is None and len(facts["times"]) == 7

@@ -174,6 +174,7 @@ def _build(
         "failed": table.failed,
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),
+        "contact_figure": _contact_figure(stage, robot, {n: runs[n][0] for n in contact}),
         "comparison_csv": table.csv(),
         "overlays": ran.overlays,
         "animation": ran.animation,
@@ -387,14 +388,26 @@ def _law_entries(
     return controllers, lams
 
 
+def _contact_figure(stage: Path, robot: Any, results: dict[str, SimulationResult]) -> str | None:
+    """``figures/contact.png``: the runs against the scene drawn together (None without a scene)."""
+    if not results:
+        return None
+    from twolink_pin.plotting.contact import save_contact_figure
+
+    save_contact_figure(results, robot, stage / "figures" / "contact.png")
+    return "contact.png"
+
+
 def _trajectory_facts(trajectory: Any, via: Any, figures: list[str]) -> dict[str, Any]:
     """The reference as ``results.json`` shows it: via times [s] and joints [rad], the
-    end effector's via points [m] (the robot's default reference), period [s], coefficients."""
+    end effector's via points [m] (the robot's default reference), period [s], coefficients
+    (None for a reference without: via poses, the straight lines of ``path = "lines"``)."""
+    coefficients = getattr(trajectory, "coefficients", None)
     return {
         "times": trajectory.times.tolist(),
         "via_q": trajectory.via_q.tolist(),
         "via_xy": None if via is None else [list(p) for p in via.xy],
         "period_s": trajectory.period,
-        "coefficients": trajectory.coefficients.tolist(),
+        "coefficients": None if coefficients is None else coefficients.tolist(),
         "figures": figures,
     }
