@@ -217,3 +217,36 @@ def test_the_reports_contact_table_reads_results_json_and_a_line_reference_has_n
     assert table["rows"][0][1] == "—" and table["headers"][1] == "RMS force error [N]"
     facts = _trajectory_facts(read_trajectory_file(SLIDE, ROBOT), None, [])
     assert facts["coefficients"] is None and len(facts["times"]) == 7
+
+
+def test_tunes_view_draws_the_surfaces_and_the_contact_force() -> None:
+    """The tuner in-process (no browser) on hybrid against the wall: its first run reports the
+    contact's line, and its Viser scene holds the wall and the contact force's arrows."""
+    import queue
+
+    from twolink_pin.cli.simulate_line import command_line, simulate_argv
+    from twolink_pin.tuning import Tuner
+
+    reference = read_trajectory_file(SLIDE, ROBOT)
+    lines: queue.Queue[dict[str, object]] = queue.Queue()
+    spec = RunSpec(
+        law="hybrid",
+        plant=PlantOptions(scene=read_scene(SCENE)),
+        simulation=SimulationConfig(duration=1.5, q0_offset=0.0),
+    )
+    tuner = Tuner(
+        spec,
+        0.0,
+        lambda payload: (ROBOT, reference),
+        lambda spec, payload: command_line(simulate_argv(spec, None, payload, SLIDE, SCENE)),
+        lambda spec, payload: {},
+        lines.put,
+    )
+    try:
+        first = lines.get(timeout=120)
+        scene = tuner.scene
+        assert [h.name for h in scene._surface_handles] == ["/surfaces/wall"]
+        assert scene._arrows is not None and np.ptp(scene._arrows[:, 1] - scene._arrows[:, 0]) > 0
+    finally:
+        tuner.close()
+    assert f"--scene={SCENE}" in str(first["command"])

@@ -18,6 +18,8 @@ OpenMP's wait policy is set here, before anything below imports Pinocchio (see
 """
 
 from twolink_pin import openmp as _openmp  # noqa: F401  # first: sets the wait policy before pinocchio loads
+from twolink_pin.contact import Scene, Surface, read_scene
+from twolink_pin.contact_metrics import ContactMetrics, contact_metrics
 from twolink_pin.controllers import (
     CONTROLLERS,
     Adaptive,
@@ -78,6 +80,7 @@ from twolink_pin.scenario import Scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (
+    ForceReference,
     FourierTrajectory,
     JointTrajectory,
     OptimalTrajectory,
@@ -92,6 +95,7 @@ from twolink_pin.trajectory import (
     optimize,
     read_trajectory_file,
     time_optimal,
+    with_force,
 )
 from twolink_pin.twolink import excitation as _twolink_excitation  # noqa: F401  # registers its stored excitation
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
@@ -106,9 +110,11 @@ __all__ = [
     "BatchMetrics",
     "BatchResult",
     "ComputedTorque",
+    "ContactMetrics",
     "Controller",
     "ControllerError",
     "ControllerSpecError",
+    "ForceReference",
     "FourierTrajectory",
     "Friction",
     "Gains",
@@ -134,11 +140,13 @@ __all__ = [
     "RunningMetrics",
     "SampledTrajectory",
     "Scenario",
+    "Scene",
     "SimulationConfig",
     "SimulationDivergedError",
     "SimulationResult",
     "SlotineLiGains",
     "StateVariable",
+    "Surface",
     "Terms",
     "TimeOptimal",
     "Trajectory",
@@ -151,6 +159,7 @@ __all__ = [
     "build_trajectory",
     "cartesian_trajectory",
     "compute_metrics",
+    "contact_metrics",
     "coriolis_matrix",
     "default_trajectory",
     "example_robot_urdf",
@@ -167,6 +176,7 @@ __all__ = [
     "optimise_excitation",
     "optimize",
     "read_log",
+    "read_scene",
     "read_trajectory_file",
     "regressor",
     "simulate",
@@ -175,4 +185,5 @@ __all__ = [
     "terms_for",
     "time_optimal",
     "twolink_urdf_path",
+    "with_force",
 ]
