@@ -112,6 +112,11 @@ class CompliantContact:
         self.time = 0.0
         """The simulated time [s] of the step under way (set by the caller)."""
 
+    @property
+    def free(self) -> ContactForces:
+        """What a call answers when no run touches any surface (the same object every time)."""
+        return self._free
+
     def kinematics(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The touching frame's origin [m] (N, 3) and world-aligned Jacobian (N, 6, nv) at ``q``."""
         model, data, fid = self._model, self._data, self._frame

@@ -75,8 +75,11 @@ class PlantEvents:
         self.contact = plant.contact_model(runs, dt)
         """The plant's contact with its scene (:meth:`~twolink_pin.plant.Plant.contact_model`;
         None without one); ``dt`` [s]: the step it is checked against."""
-        felt = self.noise is not None and self.noise.sigma_f > 0 and self.contact is not None
-        self._force_generators = self.noise.force_generators(runs) if felt and self.noise is not None else []
+        self.felt = self.noise is not None and self.noise.sigma_f > 0 and self.contact is not None
+        """Whether the force sensor is noisy (:meth:`force_noise`)."""
+        self._force_generators = (
+            self.noise.force_generators(runs) if self.felt and self.noise is not None else []
+        )
         self._force_block: np.ndarray | None = None
         self.delay = plant.delay
         self._nv = nv
@@ -117,8 +120,11 @@ class PlantEvents:
         kinematics, force = self._kinematics, self._force
         frame = None if self._wrench is None else self._wrench.frame
 
+        free = getattr(contact, "free", None)  # what it answers when no run touches: nothing to add
+
         def pushed(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-            external = None if contact is None else contact(q, v).tau
+            touched = None if contact is None else contact(q, v)
+            external = None if touched is None or touched is free else touched.tau
             if pushing:
                 assert kinematics is not None and force is not None
                 J = kinematics.frame(q, np.zeros_like(v), frame).jacobian

@@ -40,14 +40,14 @@ class ForceSensor:
     Args:
         contact: The plant's contact (its scene's surfaces).
         reference: The force reference (None: ``force_des`` is 0), on one of the scene's surfaces.
-        noise: The step's force noise, (N, 6) or None, when asked (the plant's events').
+        noise: The step's force noise (N, 6), when asked (the plant's events'); None: none.
     """
 
     def __init__(
         self,
         contact: CompliantContact,
         reference: ForceReference | None,
-        noise: Callable[[], np.ndarray | None] = lambda: None,
+        noise: Callable[[], np.ndarray | None] | None = None,
     ) -> None:
         scene = contact.scene
         surface = scene.surfaces[scene.index(reference.surface) if reference is not None else 0]
@@ -70,13 +70,14 @@ class ForceSensor:
         """What the sensor reads at the state ``(q, q̇)`` (N, nv): the contact wrench the end
         effector applies to the surfaces [N; N·m] plus the step's noise, (N, 6), read-only."""
         wrench = self.contact(q, v).wrench  # read-only already
-        noise = self._noise()
+        noise = None if self._noise is None else self._noise()
         return wrench if noise is None else read_only(wrench + noise)
 
     def wrap(self, law: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
         """``law`` (the engine's call of the law) with the sensor's reading in ``x.contact``
         (the engine's input carries the reference's part there)."""
-        new, measure = tuple.__new__, self.measure
+        new, contact = tuple.__new__, self.contact
+        measure = self.measure if self._noise is not None else (lambda q, v: contact(q, v).wrench)
 
         def sensed(x: LawInput, terms: Any) -> Any:
             part: Any = x[-1]  # the reference's part: (None, normal, force_des)
