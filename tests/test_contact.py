@@ -4,7 +4,8 @@ Each against an independent construction:
 
 * a static push ``τ = ĝ + Jᵀ F`` into a surface reads ``F`` at the sensor (statics);
 * a bounce without damping keeps the arm's energy (the spring stores ½ k δ² and gives it back),
-  and with damping loses some at every contact, never gains;
+  and with damping loses some at every contact, never gains; a pendulum dropped on a floor
+  likewise;
 * with friction the tangential force never leaves Coulomb's cone ``|f_t| <= μ f_n``;
 * the joint-space stiffness is the contact torque's derivative (finite differences);
 * RK4's largest stable stiffness is ``m (2√2/h)²`` without damping (its stability function);
@@ -22,7 +23,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
-from conftest_sim import ROBOT
+from conftest_sim import ROBOT, ConstantTorque, pendulum
 
 from twolink_pin.contact import (
     CompliantContact,
@@ -181,6 +182,27 @@ def test_a_bounce_without_damping_keeps_the_energy_and_with_damping_loses_some()
         for b, a in zip(before, after, strict=False):
             assert a < b - 1e-4 * b  # every bounce loses energy
         assert np.all(np.diff(e[~inside]) <= 1e-6 * e[0])  # never any gain, in contact or out
+
+
+def test_a_pendulum_dropped_on_a_floor_loses_energy_at_every_bounce() -> None:
+    """The double pendulum (gravity in its plane) falls from near its top onto a floor with no
+    torque: its energy ½ q̇ᵀMq̇ + U(q) is kept between contacts (1e-8 J) and drops through every
+    one, never rising."""
+    robot = pendulum()
+    floor = Scene((Surface((0.0, 0.0, -0.02), (0.0, 0.0, 1.0), 2000.0, 5.0, name="floor"),))
+    plant = Plant(robot, scene=floor)
+    run = simulate(
+        ConstantTorque(robot), plant, held(np.array([0.3, 0.0])), SimulationConfig(3.0, q0_offset=0.0)
+    )
+    energy = np.array([plant.energy(q, v) for q, v in zip(run.q, run.v, strict=True)])
+    inside = run.penetration > 0
+    edges = np.flatnonzero(np.diff(inside.astype(int)))
+    assert len(edges) >= 6  # three bounces at least
+    for start, end in zip(edges[::2], edges[1::2], strict=False):
+        assert energy[end + 1] < energy[start] - 1e-3  # a bounce loses energy
+    free = np.diff(energy[~inside])
+    assert np.all(free <= 1e-8)  # never any gain
+    assert np.all(np.abs(free[np.diff(np.flatnonzero(~inside)) == 1]) <= 1e-8)  # kept in flight
 
 
 def test_the_tangential_force_stays_within_the_friction_cone() -> None:
