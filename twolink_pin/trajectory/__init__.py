@@ -15,6 +15,7 @@
 ``optimal.py``              :func:`optimize`: the least effort or the shortest duration through via points (the core in ``optimal/``)
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)
+``file_extras.py``          what a via file adds: straight lines between its points, a force column
 ``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)
 ``force.py``                :class:`ForceReference`: a desired normal force on a surface over time, :func:`with_force`
 ==========================  ================================================================

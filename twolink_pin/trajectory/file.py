@@ -66,7 +66,7 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -77,8 +77,8 @@ from twolink_pin.files import read_input_file
 from twolink_pin.limits import POSITION, joint_limits
 from twolink_pin.limits.check import check_grid
 from twolink_pin.model import RobotModel
-from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.cartesian import cartesian_via_q
+from twolink_pin.trajectory.file_extras import carrying, line_file, path_kind
 from twolink_pin.trajectory.file_values import (
     MAX_ANGLE,
     MAX_TIME,
@@ -86,13 +86,11 @@ from twolink_pin.trajectory.file_values import (
     check_within_limits,
     parse_numbers,
 )
-from twolink_pin.trajectory.force import MAX_FORCE, ForceReference, with_force
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
 from twolink_pin.trajectory.sampled import SampledTrajectory
 from twolink_pin.trajectory.se3 import MAX_POSITION, PoseTrajectory, pose_trajectory
 
-TrajectoryT = TypeVar("TrajectoryT", bound=Trajectory)
 MAX_TRAJECTORY_BYTES = 16 << 20
 """Largest trajectory file read (16 MiB: a ``samples`` table of a retimed UR5 path is about
 1 MiB; via points need far less)."""
@@ -107,9 +105,6 @@ CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
 KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed", "force", "force_surface", "path"})
-PATHS = ("polynomial", "lines")
-"""A ``positions`` file's ``path``: one polynomial per joint through the via points (default),
-or straight lines between them (:class:`~twolink_pin.trajectory.se3.PoseTrajectory`, position only)."""
 FOURIER_KEYS = frozenset({"period", "harmonics", "a", "b", "offset"})
 """Keys of a ``fourier`` table."""
 
@@ -185,9 +180,11 @@ def read_trajectory_file(
     else:
         points, seed = _position_rows(file, document, rows, robot)
         if "rpy" in document:
-            return _carrying(_pose_file(file, document, robot, times, points, seed, period), file, document)
-        if _path(file, document) == "lines":
-            return _carrying(_line_file(file, robot, times, points, seed, period), file, document)
+            return carrying(
+                _pose_file(file, document, robot, times, points, seed, period), file, document, times
+            )
+        if path_kind(file, document) == "lines":
+            return carrying(line_file(file, robot, times, points, seed, period), file, document, times)
         try:
             via_q = cartesian_via_q(robot, points, seed)
         except InverseKinematicsError as err:
@@ -207,73 +204,7 @@ def read_trajectory_file(
     except InvalidParameterError as err:
         raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
     check_trajectory_limits(robot, trajectory, f"{file}")
-    return _carrying(trajectory, file, document)
-
-
-def _path(file: Path, document: dict[str, Any]) -> str:
-    """The file's ``path`` (:data:`PATHS`), checked."""
-    path = document.get("path", "polynomial")
-    if path not in PATHS or ("joints" in document and path != "polynomial"):
-        raise InvalidParameterError(
-            f"{file}: path",
-            path,
-            f"one of {PATHS} ('lines' with 'positions' only: straight lines between them)",
-        )
-    return str(path)
-
-
-def _line_file(
-    file: Path, robot: RobotModel, times: np.ndarray, points: np.ndarray, seed: np.ndarray | None, period: Any
-) -> PoseTrajectory:
-    """Straight lines between the via positions (``path = "lines"``): the position-only
-    :class:`PoseTrajectory` through them, the orientations there the forward kinematics'."""
-    try:
-        via_q = cartesian_via_q(robot, points, seed)
-    except InverseKinematicsError as err:
-        raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
-    data = robot.model.createData()
-    poses = []
-    for q in via_q:
-        pin.framesForwardKinematics(robot.model, data, q)
-        poses.append(data.oMf[robot.ee_frame_id].copy())
-    positions = np.array([pose.translation for pose in poses])
-    positions[:, : points.shape[1]] = points  # exactly the file's (the IK reaches them to its tolerance)
-    rotations = np.array([pose.rotation for pose in poses])
-    rotations[-1] = rotations[0]
-    try:
-        trajectory = pose_trajectory(
-            robot, tuple(times), positions, rotations, None if period is None else float(period), via_q[0],
-            position_rows=points.shape[1],
-        )  # fmt: skip
-    except InvalidParameterError as err:
-        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
-    except InverseKinematicsError as err:
-        raise InverseKinematicsError(err.target, f"{file}: {err.reason}", err.q) from None
-    check_trajectory_limits(robot, trajectory, f"{file}")
-    return trajectory
-
-
-def _carrying(trajectory: TrajectoryT, file: Path, document: dict[str, Any]) -> TrajectoryT:
-    """``trajectory`` carrying the file's ``force`` column [N] (one value per via time, on the
-    surface ``force_surface``; :mod:`~twolink_pin.trajectory.force`), if it has one."""
-    if "force" not in document:
-        if "force_surface" in document:
-            raise InvalidParameterError(
-                f"{file}: force_surface", document["force_surface"], "a 'force' column [N] beside it"
-            )
-        return trajectory
-    times = _via_times(file, document)
-    values = parse_numbers(file, "force", document["force"], "one normal force [N] per time", MAX_FORCE, "N")
-    if values.shape != times.shape:
-        raise InvalidParameterError(
-            f"{file}: force", document["force"], f"one normal force [N] per time ({times.size})"
-        )
-    surface = document.get("force_surface")
-    try:
-        reference = ForceReference(tuple(times), tuple(values), surface, trajectory.period)
-    except InvalidParameterError as err:
-        raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
-    return with_force(trajectory, reference)
+    return carrying(trajectory, file, document, times)
 
 
 def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:
