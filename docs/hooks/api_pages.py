@@ -54,7 +54,16 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "Plant and simulation",
         "The simulated arm, what pushes back on it, the surfaces it touches, a law with its plant, a law's "
         "variants, the run description, and the engine.",
-        ("plant", "disturbances", "contact", "scenario", "law_variant", "run_spec", "contact_checks", "simulation"),
+        (
+            "plant",
+            "disturbances",
+            "contact",
+            "scenario",
+            "law_variant",
+            "run_spec",
+            "contact_checks",
+            "simulation",
+        ),
     ),
     (
         "metrics",
