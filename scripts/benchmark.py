@@ -648,13 +648,14 @@ SINGLE_RUN_ROBOTS = ("twolink", "ur5")
 
 
 def _built_in_laws() -> list[str]:
-    """The names of the package's own laws, in registry order (plugins and files left out)."""
+    """The names of the package's own laws that run in free space, in registry order (plugins and
+    files left out; ``force`` and ``hybrid`` press on a surface: ``--contact-only``)."""
     from twolink_pin.controllers.loading import available_controllers
 
     return [
         n
         for n, cls in available_controllers().items()
-        if cls.__module__.startswith("twolink_pin.controllers")
+        if cls.__module__.startswith("twolink_pin.controllers") and not cls.force_control
     ]
 
 
