@@ -23,7 +23,7 @@ from twolink_pin.symbolic.grouping import Grouping, group
 from twolink_pin.symbolic.kinematics import Matrix, Vector
 from twolink_pin.symbolic.lagrange import christoffel, regressor_column, skew_defect, standard_terms
 from twolink_pin.symbolic.skeleton import Skeleton
-from twolink_pin.symbolic.trig_ring import TrigRing
+from twolink_pin.symbolic.trig_ring import TILTED_TOLERANCE, TrigRing
 
 
 @dataclass(frozen=True)
@@ -54,7 +54,7 @@ class Derivation:
 def derive(skeleton: Skeleton) -> Derivation:
     """Derive the dynamics of ``skeleton`` (see the module docstring)."""
     start = time.perf_counter()
-    ring = TrigRing(skeleton.kinds, list(skeleton.lengths()))
+    ring = TrigRing(skeleton.kinds, list(skeleton.lengths()), TILTED_TOLERANCE if skeleton.tilted else None)
     masses, gravities = standard_terms(ring, skeleton)
     grouping = group(ring, masses, gravities)
     kept_masses = tuple(masses[k] for k in grouping.kept)
@@ -78,6 +78,7 @@ def to_json(derivation: Derivation) -> dict[str, Any]:
     return {
         "kinds": list(ring.kinds),
         "lengths": list(ring.length_names),
+        "tolerance": ring.tolerance,
         "kept": list(derivation.grouping.kept),
         "combination": [
             {str(d): [terms(num), terms(den)] for d, (num, den) in combo.items()}
@@ -94,7 +95,12 @@ def to_json(derivation: Derivation) -> dict[str, Any]:
 def from_json(data: dict[str, Any]) -> Derivation:
     """The inverse of :func:`to_json` (raises ``KeyError``, ``TypeError`` or ``ValueError`` on
     a malformed document)."""
-    ring = TrigRing([str(k) for k in data["kinds"]], [str(name) for name in data["lengths"]])
+    tolerance = data["tolerance"]
+    ring = TrigRing(
+        [str(k) for k in data["kinds"]],
+        [str(name) for name in data["lengths"]],
+        None if tolerance is None else float(tolerance),
+    )
     poly = ring.from_dict
     grouping = Grouping(
         kept=tuple(int(k) for k in data["kept"]),

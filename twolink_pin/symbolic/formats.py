@@ -231,7 +231,7 @@ def equations_json(eq: Equations, source: str = "") -> dict[str, Any]:
     import sympy as sp
 
     def strings(matrix: Any) -> list[list[str]]:
-        return [[sp.sstr(matrix[r, c]) for c in range(matrix.cols)] for r in range(matrix.rows)]
+        return [[sp.sstr(matrix[r, c], order="none") for c in range(matrix.cols)] for r in range(matrix.rows)]
 
     def latexes(matrix: Any) -> list[list[str]]:
         return [[latex_entry(eq, matrix[r, c]) for c in range(matrix.cols)] for r in range(matrix.rows)]
@@ -249,7 +249,7 @@ def equations_json(eq: Equations, source: str = "") -> dict[str, Any]:
         "base_parameters": [
             {
                 "symbol": str(b),
-                "definition": sp.sstr(d),
+                "definition": sp.sstr(d, order="none"),
                 "latex": latex_entry(eq, d),
                 "value": float(v),
                 "unit": u,

@@ -102,7 +102,10 @@ def _ring_fraction(ring: TrigRing, field: Any, value: Any) -> tuple[Any, Any]:
     numerator, denominator = expr.as_numer_denom()
     gens = [ring.gen(name) for name in ring.length_names]
     names = dict(zip(ring.length_names, gens))
-    return _to_ring(ring, numerator, names), _to_ring(ring, denominator, names)
+    num, den = _to_ring(ring, numerator, names), _to_ring(ring, denominator, names)
+    if den.is_ground:  # a polynomial: cleaned of inexact constants' residues (tilted arms)
+        return ring.clean(num * ring.ring(1 / den.LC)), ring.one
+    return ring.clean(num), ring.clean(den)
 
 
 def _to_ring(ring: TrigRing, expr: Any, names: dict[str, Any]) -> Any:

@@ -115,13 +115,20 @@ def christoffel(ring: TrigRing, M: Matrix) -> Matrix:
 
 def skew_defect(ring: TrigRing, M: Matrix, C: Matrix) -> Any:
     """``N + Nᵀ`` with ``N = Ṁ − 2C``: the zero polynomial in every entry when ``Ṁ − 2C`` is
-    skew-symmetric; returns the first nonzero entry, or None."""
+    skew-symmetric; returns the first nonzero entry, or None. (For a tilted arm, whose
+    constants are inexact, an entry whose coefficients are all below the ring's tolerance
+    times Ṁ's largest counts as zero.)"""
     n = len(M)
     two = ring.constant(Fraction(2))
-    N = [[ring.time_derivative(M[r][c]) - two * C[r][c] for c in range(n)] for r in range(n)]
+    Mdot = [[ring.time_derivative(M[r][c]) for c in range(n)] for r in range(n)]
+    N = [[Mdot[r][c] - two * C[r][c] for c in range(n)] for r in range(n)]
+    scale = max((abs(float(x)) for row in Mdot for p in row for x in p.itercoeffs()), default=0.0)
     for r in range(n):
         for c in range(r, n):
             entry = ring.reduce(N[r][c] + N[c][r])
+            if ring.tolerance is not None:
+                if all(abs(float(x)) <= ring.tolerance * scale for x in entry.itercoeffs()):
+                    continue
             if entry != ring.zero:
                 return entry
     return None

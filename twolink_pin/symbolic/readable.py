@@ -7,7 +7,7 @@ integer frequency vectors f — ``c2 c3 − s2 s3`` becomes ``cos(q2 + q3)``,
 rates and g. This form is unique (the functions ``cos(f·q)``, ``sin(f·q)`` of distinct f
 with first nonzero component positive are independent), so it is a normal form as well as
 a short one: no heuristic simplifier is run, and it costs milliseconds for a 6-joint arm.
-Then each coefficient's common factors are pulled out (``sympy.factor_terms``).
+Then each coefficient is factored when short, its common factors pulled out otherwise.
 
 ``M``, ``C``, ``g`` are written **by parameter**: ``Σ_k β_k (…)``.
 """
@@ -19,7 +19,7 @@ from fractions import Fraction
 from functools import lru_cache
 from typing import Any
 
-from twolink_pin.symbolic.trig_ring import REVOLUTE, TrigRing
+from twolink_pin.symbolic.trig_ring import TrigRing
 
 Frequency = tuple[int, ...]
 Series = dict[Frequency, tuple[Fraction, Fraction]]
@@ -126,7 +126,23 @@ FACTOR_TERMS = 8
 def _tidy(expr: Any, terms: int) -> Any:
     import sympy as sp
 
+    if expr.has(sp.Float):  # factoring decimals writes 1.0*x and splits them into products
+        return expr
     return sp.factor(expr) if 1 < terms <= FACTOR_TERMS else sp.factor_terms(expr)
+
+
+SHOWN_DENOMINATOR = 10**6
+"""A rational coefficient with a larger denominator (an inexact constant of a tilted arm: the
+nearest fraction of cos 0.3) is written as a 15-digit decimal number."""
+
+
+def number(coeff: Any) -> Any:
+    """A rational coefficient as SymPy shows it (:data:`SHOWN_DENOMINATOR`)."""
+    import sympy as sp
+
+    if int(coeff.denominator) > SHOWN_DENOMINATOR:
+        return sp.Float(float(coeff), 15)
+    return sp.Rational(int(coeff.numerator), int(coeff.denominator))
 
 
 def poly_expr(p: Any, gens: Sequence[Any]) -> Any:
@@ -135,10 +151,17 @@ def poly_expr(p: Any, gens: Sequence[Any]) -> Any:
 
     terms = []
     for monom, coeff in p.iterterms():
-        factors = [sp.Rational(int(coeff.numerator), int(coeff.denominator))]
+        factors = [number(coeff)]
         factors += [gens[i] ** e for i, e in enumerate(monom) if e]
         terms.append(sp.Mul(*factors))
     return sp.Add(*terms)
+
+
+def _common(expr: Any) -> Any:
+    """``expr`` with its terms' common factors pulled out (not with decimals: see :func:`_tidy`)."""
+    import sympy as sp
+
+    return expr if expr.has(sp.Float) else sp.factor_terms(expr)
 
 
 def by_parameter(
@@ -148,14 +171,5 @@ def by_parameter(
     import sympy as sp
 
     return sp.Add(
-        *[
-            b * sp.factor_terms(to_expr(ring, part, names, q))
-            for b, part in zip(beta, parts)
-            if part != ring.zero
-        ]
+        *[b * _common(to_expr(ring, part, names, q)) for b, part in zip(beta, parts) if part != ring.zero]
     )
-
-
-def joint_angles(kinds: Sequence[str], q: Sequence[Any]) -> list[Any]:
-    """The angle of each revolute joint (0 for a prismatic one: it adds no frequency)."""
-    return [qj if kind == REVOLUTE else 0 for kind, qj in zip(kinds, q)]

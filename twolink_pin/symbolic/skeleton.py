@@ -100,6 +100,13 @@ class Skeleton:
         return len(self.joints)
 
     @property
+    def tilted(self) -> bool:
+        """Whether some rotation entry, axis or gravity component is not 0 or ±1 (an inexact
+        constant: :mod:`~twolink_pin.symbolic.trig_ring`, tilted arms)."""
+        numbers = [x for j in self.joints for x in (*j.axis, *(y for row in j.rotation for y in row))]
+        return any(x not in (0, 1, -1) for x in (*numbers, *self.gravity_direction))
+
+    @property
     def kinds(self) -> tuple[str, ...]:
         return tuple(j.kind for j in self.joints)
 

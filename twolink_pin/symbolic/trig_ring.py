@@ -12,6 +12,16 @@ state exactly when their reduced forms are equal, so identities (``Ṁ − 2C`` 
 two columns of the regressor dependent) are checked exactly, with no simplifier's guess.
 
 ``∂/∂q_j`` of a revolute joint's polynomial is ``−s_j ∂/∂c_j + c_j ∂/∂s_j`` (:meth:`TrigRing.dq`).
+
+**Tilted arms.** A placement turned by an angle that is not a multiple of a quarter turn
+(``rpy="0 0 0.3"``), or a joint axis off the frame's axes, brings numbers such as cos 0.3
+that are not rational: they enter as the nearest fractions (:mod:`~twolink_pin.symbolic.skeleton`),
+and identities such as ``cos² + sin² = 1`` then hold only to ~1e-17 — a residue that exact
+algebra would count as a term (an extra base parameter, a 40-digit fraction). With a
+``tolerance`` (the derivation passes :data:`TILTED_TOLERANCE` for such arms) every reduced
+polynomial is cleaned: coefficients below ``tolerance`` × its largest are dropped, and one
+within ``tolerance`` (relative) of a fraction of denominator ≤ 10⁴ becomes that fraction.
+Legitimate coefficients are products of a few rotation entries and rationals, far above it.
 """
 
 from __future__ import annotations
@@ -20,6 +30,10 @@ from collections.abc import Sequence
 from functools import cached_property
 from typing import Any
 
+TILTED_TOLERANCE = 1e-12
+"""The cleaning tolerance of an arm whose constants are not all exact (module docstring)."""
+SIMPLE_DENOMINATOR = 10**4
+"""A coefficient this close to a fraction with at most this denominator is that fraction."""
 REVOLUTE = "revolute"
 PRISMATIC = "prismatic"
 
@@ -31,14 +45,17 @@ class TrigRing:
         kinds: Each joint's kind, :data:`REVOLUTE` or :data:`PRISMATIC`, in joint order.
         lengths: Names of the arm's length symbols [m] (placements' offsets).
 
+    With ``tolerance``, :meth:`reduce` also cleans (module docstring: tilted arms).
+
     Generator names: ``c1, s1`` (revolute joint 1) or ``q1`` (prismatic joint 1), ...; the
     lengths; ``dq1 ..``, ``w1 ..``, ``ddq1 ..`` (q̇, the reference rate, q̈); ``g``.
     """
 
-    def __init__(self, kinds: Sequence[str], lengths: Sequence[str]) -> None:
+    def __init__(self, kinds: Sequence[str], lengths: Sequence[str], tolerance: float | None = None) -> None:
         from sympy import QQ
         from sympy.polys.rings import ring
 
+        self.tolerance = tolerance
         self.kinds = tuple(kinds)
         self.n = len(self.kinds)
         names: list[str] = []
@@ -90,9 +107,10 @@ class TrigRing:
         return {i: self.one - c**2 for i, c in self._cosines.items()}
 
     def reduce(self, p: Any) -> Any:
-        """``p`` with every ``s_j^k`` (k ≥ 2) replaced using ``s_j² = 1 − c_j²``: the canonical form."""
+        """``p`` with every ``s_j^k`` (k ≥ 2) replaced using ``s_j² = 1 − c_j²``: the canonical form
+        (cleaned, with a tolerance)."""
         if not any(m[i] >= 2 for m in p.itermonoms() for i in self._sine_indices):
-            return p
+            return p if self.tolerance is None else self.clean(p)
         out = self.zero
         for monom, coeff in p.iterterms():
             factor = self.one
@@ -102,7 +120,28 @@ class TrigRing:
                     factor *= self._one_minus_cos_squared[i] ** (exps[i] // 2)
                     exps[i] %= 2
             out += self.ring({tuple(exps): coeff}) * factor
-        return self.reduce(out) if out != p else out
+        return self.reduce(out)
+
+    def clean(self, p: Any) -> Any:
+        """``p`` without the residues of inexact constants (module docstring: tilted arms)."""
+        from fractions import Fraction
+
+        from sympy import QQ
+
+        if self.tolerance is None or not p:
+            return p
+        largest = max(abs(float(c)) for c in p.itercoeffs())
+        out = {}
+        for monom, coeff in p.iterterms():
+            value = float(coeff)
+            if abs(value) < self.tolerance * largest:
+                continue
+            if coeff.denominator > SIMPLE_DENOMINATOR:
+                simple = Fraction(value).limit_denominator(SIMPLE_DENOMINATOR)
+                if abs(float(simple) - value) <= self.tolerance * abs(value):
+                    coeff = QQ(simple.numerator, simple.denominator)
+            out[monom] = coeff
+        return self.ring(out)
 
     def dq(self, p: Any, j: int) -> Any:
         """``∂p/∂q_j`` (1-based joint), reduced."""
