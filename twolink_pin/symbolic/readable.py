@@ -7,13 +7,15 @@ integer frequency vectors f — ``c2 c3 − s2 s3`` becomes ``cos(q2 + q3)``,
 rates and g. This form is unique (the functions ``cos(f·q)``, ``sin(f·q)`` of distinct f
 with first nonzero component positive are independent), so it is a normal form as well as
 a short one: no heuristic simplifier is run, and it costs milliseconds for a 6-joint arm.
-Then each coefficient is factored when short, its common factors pulled out otherwise.
+Then the factor common to all terms is pulled out, and each coefficient is factored when
+short (and the arm small), and ``1 ± cos 2u`` is written as ``2 cos² u`` or ``2 sin² u``.
 
 ``M``, ``C``, ``g`` are written **by parameter**: ``Σ_k β_k (…)``.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from fractions import Fraction
 from functools import lru_cache
@@ -70,65 +72,139 @@ def _monomial_series(n: int, joint: int, cos_power: int, sin_power: int) -> Seri
     return out
 
 
+@lru_cache(maxsize=65536)
+def _signature_series(
+    n: int, signature: tuple[tuple[int, int, int], ...]
+) -> tuple[tuple[Frequency, Any, Any], ...]:
+    """The trigonometric polynomial of ``Π_j cos^a q_j sin^b q_j`` (``signature``: the
+    ``(j, a, b)`` of the joints it involves), its coefficients as SymPy rationals."""
+    from sympy import QQ
+
+    series: Series = {tuple(0 for _ in range(n)): (Fraction(1), Fraction(0))}
+    for joint, cos_power, sin_power in signature:
+        series = _multiply(series, _monomial_series(n, joint, cos_power, sin_power))
+    return tuple(
+        (freq, QQ(a.numerator, a.denominator), QQ(b.numerator, b.denominator))
+        for freq, (a, b) in series.items()
+    )
+
+
 def trig_series(ring: TrigRing, p: Any) -> dict[Frequency, tuple[Any, Any]]:
     """``p`` as ``{f: (a_f, b_f)}`` with ``p = Σ a_f cos(f·q) + b_f sin(f·q)``; ``a_f``, ``b_f``
     polynomials of ``ring`` free of the cosines and sines."""
     n = ring.n
-    trig = {ring.index[f"c{j}"]: (j - 1, "c") for j in ring.revolute_joints}
-    trig.update({ring.index[f"s{j}"]: (j - 1, "s") for j in ring.revolute_joints})
-    out: dict[Frequency, list[Any]] = {}
+    pairs = [(j - 1, ring.index[f"c{j}"], ring.index[f"s{j}"]) for j in ring.revolute_joints]
+    trig_indices = [i for _, c, s in pairs for i in (c, s)]
+    out: dict[Frequency, tuple[dict[Any, Any], dict[Any, Any]]] = {}
     for monom, coeff in p.iterterms():
+        signature = tuple((joint, monom[c], monom[s]) for joint, c, s in pairs if monom[c] or monom[s])
         rest = list(monom)
-        series: Series = {tuple(0 for _ in range(n)): (Fraction(1), Fraction(0))}
-        powers: dict[int, list[int]] = {}
-        for i, (joint, which) in trig.items():
-            if monom[i]:
-                powers.setdefault(joint, [0, 0])[0 if which == "c" else 1] = monom[i]
-                rest[i] = 0
-        for joint, (cos_power, sin_power) in powers.items():
-            series = _multiply(series, _monomial_series(n, joint, cos_power, sin_power))
-        term = ring.ring({tuple(rest): coeff})
-        for freq, (a, b) in series.items():
-            slot = out.setdefault(freq, [ring.zero, ring.zero])
+        for i in trig_indices:
+            rest[i] = 0
+        key = tuple(rest)
+        for freq, a, b in _signature_series(n, signature):
+            cos_terms, sin_terms = out.setdefault(freq, ({}, {}))
             if a:
-                slot[0] += term * ring.constant(a)
+                cos_terms[key] = cos_terms.get(key, 0) + coeff * a
             if b:
-                slot[1] += term * ring.constant(b)
-    return {f: (a, b) for f, (a, b) in out.items() if a != ring.zero or b != ring.zero}
+                sin_terms[key] = sin_terms.get(key, 0) + coeff * b
+    series = {}
+    for freq, (cos_terms, sin_terms) in out.items():
+        a = ring.ring({k: v for k, v in cos_terms.items() if v})
+        b = ring.ring({k: v for k, v in sin_terms.items() if v})
+        if a or b:
+            series[freq] = (a, b)
+    return series
 
 
 def _angle(freq: Frequency, q: Sequence[Any]) -> Any:
-    return sum((f * qj for f, qj in zip(freq, q) if f), 0)
+    """``f·q``, a common factor pulled out (``2 q2 + 2 q3`` → ``2 (q2 + q3)``)."""
+    import sympy as sp
+
+    common = math.gcd(*freq)
+    inner = sp.Add(*[(f // common) * qj for f, qj in zip(freq, q) if f])
+    return _product(sp.Integer(common), [inner])
 
 
 def to_expr(ring: TrigRing, p: Any, names: dict[str, Any], q: Sequence[Any]) -> Any:
-    """``p`` as a SymPy expression in cos and sin of the angles ``q`` (module docstring);
-    ``names`` maps the ring's other generator names to SymPy symbols."""
+    """``p`` as a SymPy expression in cos and sin of the angles ``q`` (module docstring), the
+    factor common to all its terms (a number and a monomial) pulled out in front; ``names``
+    maps the ring's other generator names to SymPy symbols."""
     import sympy as sp
 
     gens = [names.get(name) for name in ring.names]
+    series = sorted(trig_series(ring, p).items())
+    content, monom = _common_factor(ring, [x for _, ab in series for x in ab if x])
     out = []
-    for freq, (a, b) in sorted(trig_series(ring, p).items()):
+    for freq, (a, b) in series:
         angle = _angle(freq, q)
         for coeff, fn in ((a, sp.cos), (b, sp.sin)):
             if coeff == ring.zero:
                 continue
-            expr = _tidy(poly_expr(coeff, gens), len(coeff))
+            expr = _tidy(ring, _divided(ring, coeff, content, monom), gens)
             out.append(expr if angle == 0 else expr * fn(angle))
-    return sp.Add(*out)
+    return _product(poly_expr(ring.ring({monom: content}), gens), [sp.Add(*out)])
 
 
 FACTOR_TERMS = 8
-"""A coefficient of at most this many terms is factored (``dq2 l2y + dq2 l3y + dq3 l2y + dq3 l3y``
-→ ``(dq2 + dq3)(l2y + l3y)``); a longer one only has its common factors pulled out."""
+"""A coefficient of at most this many terms of an arm of at most :data:`FACTOR_JOINTS` joints
+is factored (``dq2 l2y + dq2 l3y + dq3 l2y + dq3 l3y`` → ``(dq2 + dq3)(l2y + l3y)``); other
+coefficients only have their common factor pulled out."""
+FACTOR_JOINTS = 3
+"""Beyond this many joints the coefficients are not factored: SymPy's multivariate factoring
+(~20 ms a coefficient) would take most of the time of a larger arm (docs/equations.md)."""
 
 
-def _tidy(expr: Any, terms: int) -> Any:
+def _common_factor(ring: TrigRing, polys: Sequence[Any]) -> tuple[Any, tuple[int, ...]]:
+    """The rational content (negative when every coefficient is) and the monomial common to
+    every term of ``polys`` (``(1, 0…0)`` with a decimal coefficient among them, or none)."""
+    from sympy import QQ
+
+    monom: tuple[int, ...] | None = None
+    numerators, denominators = [], []
+    for poly in polys:
+        for exps, coeff in poly.iterterms():
+            monom = exps if monom is None else tuple(min(a, b) for a, b in zip(monom, exps))
+            numerators.append(abs(int(coeff.numerator)))
+            denominators.append(int(coeff.denominator))
+    zero = tuple(0 for _ in ring.names)
+    if monom is None or max(denominators) > SHOWN_DENOMINATOR:
+        return QQ(1), zero
+    sign = -1 if all(c < 0 for poly in polys for c in poly.itercoeffs()) else 1
+    return QQ(sign * math.gcd(*numerators), math.lcm(*denominators)), monom
+
+
+def _divided(ring: TrigRing, p: Any, content: Any, monom: tuple[int, ...]) -> Any:
+    """``p / (content · monomial)`` (exact: both divide every term)."""
+    return ring.ring({tuple(e - m for e, m in zip(exps, monom)): c / content for exps, c in p.iterterms()})
+
+
+def _tidy(ring: TrigRing, p: Any, gens: Sequence[Any]) -> Any:
+    """A coefficient polynomial as an expression: factored in the ring (no conversion of
+    expressions) when short and the arm small (:data:`FACTOR_TERMS`, :data:`FACTOR_JOINTS`),
+    else with its common factor pulled out."""
+
+    decimal = any(int(c.denominator) > SHOWN_DENOMINATOR for c in p.itercoeffs())
+    if ring.n <= FACTOR_JOINTS and 1 < len(p) <= FACTOR_TERMS and not decimal:
+        content, factors = p.factor_list()
+        return _product(number(content), [poly_expr(f, gens) ** power for f, power in factors])
+    content, monom = _common_factor(ring, [p])
+    return _product(
+        poly_expr(ring.ring({monom: content}), gens), [poly_expr(_divided(ring, p, content, monom), gens)]
+    )
+
+
+def _product(front: Any, factors: Sequence[Any]) -> Any:
+    """``front · Π factors``, a number in front kept there (SymPy distributes ``−1 · (a + b)``
+    into ``−a − b`` and ``2 (a + b)`` into ``2a + 2b``)."""
     import sympy as sp
 
-    if expr.has(sp.Float):  # factoring decimals writes 1.0*x and splits them into products
-        return expr
-    return sp.factor(expr) if 1 < terms <= FACTOR_TERMS else sp.factor_terms(expr)
+    rest = sp.Mul(*factors)
+    if front == 1:
+        return rest
+    if front.is_Number and rest.is_Add:
+        return sp.Mul(front, rest, evaluate=False)
+    return front * rest
 
 
 SHOWN_DENOMINATOR = 10**6
@@ -157,11 +233,32 @@ def poly_expr(p: Any, gens: Sequence[Any]) -> Any:
     return sp.Add(*terms)
 
 
-def _common(expr: Any) -> Any:
-    """``expr`` with its terms' common factors pulled out (not with decimals: see :func:`_tidy`)."""
+def _squares(expr: Any) -> Any:
+    """``1 − cos 2u`` → ``2 sin² u`` and ``1 + cos 2u`` → ``2 cos² u`` (a factored coefficient's
+    ``β (1 − cos 2(q2 + q3))/2`` reads ``β sin²(q2 + q3)``)."""
     import sympy as sp
 
-    return expr if expr.has(sp.Float) else sp.factor_terms(expr)
+    def half_angle(e: Any) -> tuple[int, Any] | None:
+        if not (e.is_Add and len(e.args) == 2 and sp.S.One in e.args):
+            return None
+        other = e.args[0] if e.args[1] == sp.S.One else e.args[1]
+        sign, cosine = (-1, -other) if other.could_extract_minus_sign() else (1, other)
+        if isinstance(cosine, sp.cos):
+            return sign, cosine.args[0] / 2
+        return None
+
+    def square(e: Any) -> Any:
+        sign, u = half_angle(e)  # type: ignore[misc]
+        return 2 * (sp.cos(u) ** 2 if sign > 0 else sp.sin(u) ** 2)
+
+    return expr.replace(lambda e: half_angle(e) is not None, square)
+
+
+def _common(expr: Any) -> Any:
+    """``expr`` with ``1 ± cos 2u`` written as squares (not with decimals)."""
+    import sympy as sp
+
+    return expr if expr.has(sp.Float) else _squares(expr)
 
 
 def by_parameter(

@@ -103,13 +103,24 @@ def course_check(eq: Any) -> dict[str, Any]:
     Returns:
         ``found``: p in the base parameters (or None); ``M``, ``C``, ``Y``: whether each
         equals the report's; ``p_expressions``: whether p found, in masses and lengths,
-        equals the report's expressions; ``p_values``: p of this arm [kg·m²].
+        equals the report's expressions; ``p_values``: p of this arm [kg·m²]; ``latex``: the
+        derived M and C written in p beside the report's, entry by entry, and p found.
     """
     import sympy as sp
 
+    from twolink_pin.symbolic.formats import latex_entry
+
     found = course_parameters(eq)
     if found is None:
-        return {"found": None, "M": False, "C": False, "Y": False, "p_expressions": False, "p_values": None}
+        return {
+            "found": None,
+            "M": False,
+            "C": False,
+            "Y": False,
+            "p_expressions": False,
+            "p_values": None,
+            "latex": None,
+        }
     course = course_matrices(eq.q, eq.dq, eq.ddq, eq.w)
     p = course["p"]
     # β in terms of p: invert the found map on the base parameters it involves
@@ -129,7 +140,26 @@ def course_check(eq: Any) -> dict[str, Any]:
         sp.simplify(found[name].xreplace(definitions).xreplace(terms) - expected[name]) == 0 for name in found
     )
     values = eq.symbol_values
+
+    def entries(name: str, derived: Any, report: Any) -> list[dict[str, str]]:
+        written = sp.simplify(eq.shown(derived).xreplace(beta_of_p))
+        return [
+            {
+                "derived": f"{name}_{{{r + 1}{c + 1}}} = {latex_entry(eq, written[r, c])}",
+                "report": f"{name}_{{{r + 1}{c + 1}}} = {latex_entry(eq, report[r, c])}",
+            }
+            for r in range(2)
+            for c in range(2)
+            if name == "C" or c >= r
+        ]
+
+    latex = {
+        "p": [f"{sp.latex(sym)} = {latex_entry(eq, found[str(sym)])}" for sym in p],
+        "M": entries("M", eq.M, course["M"]),
+        "C": entries("C", eq.C, course["C"]),
+    }
     return {
+        "latex": latex,
         "found": {name: str(value) for name, value in found.items()},
         "M": same(eq.M, course["M"]),
         "C": same(eq.C, course["C"]),
