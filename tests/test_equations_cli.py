@@ -191,3 +191,20 @@ def test_first_joints_holds_the_others_at_zero() -> None:
     full = pin.crba(ur5.model, ur5.model.createData(), np.concatenate([q, np.zeros(3)]))
     reduced = pin.crba(arm, arm.createData(), q)
     np.testing.assert_allclose(np.triu(reduced), np.triu(full[:3, :3]), atol=1e-12)
+
+
+def test_the_reports_equations_facts() -> None:
+    """What the report shows: the twolink's M, C, g as LaTeX that converts to MathML; an arm of
+    more joints than the page shows is a line naming the command that writes them."""
+    from twolink_pin.mathml import latex_to_mathml
+    from twolink_pin.report.facts import REPORT_EQUATIONS_JOINTS, equations_facts
+
+    shown = equations_facts(load_robot())
+    assert shown["shown"] and shown["zero"] == ["β3"]
+    assert shown["M"][0] == r"M_{11} = \beta_{1} + \beta_{4} + 2 \beta_{2} l_{2x} \cos{\left(q_{2} \right)}"
+    for latex in shown["M"] + shown["C"] + shown["g"] + [b["latex"] for b in shown["base_parameters"]]:
+        assert "<math" in latex_to_mathml(latex)
+    ur5 = equations_facts(load_robot("ur5"))
+    assert (
+        REPORT_EQUATIONS_JOINTS < 6 and not ur5["shown"] and "twolink-pin equations --robot" in ur5["reason"]
+    )

@@ -194,7 +194,7 @@ def _header(eq: Equations, source: str) -> list[str]:
         f"N_JOINTS = {eq.n}",
         f"JOINT_NAMES = {tuple(eq.joint_names)!r}",
         f"GRAVITY = {eq.gravity!r}  # [m/s²]",
-        *[f"{name} = {value!r}  # {eq.length_meanings[name]}" for name, value in eq.lengths.items()],
+        *[f"{name} = {value!r}  # [m] {eq.length_meanings[name]}" for name, value in eq.lengths.items()],
         f"BASE_PARAMETERS = {tuple(str(d) for d in eq.beta_definitions)!r}",
         f"BASE_PARAMETER_UNITS = {tuple(eq.beta_units)!r}",
         f"p_base = _np.array({[float(x) for x in eq.beta_values]!r})",

@@ -126,7 +126,7 @@ class Skeleton:
             parent = "the base" if joint.parent < 0 else f"joint '{self.joints[joint.parent].name}'"
             for name, axis in zip(joint.length_names(i), "xyz"):
                 if name is not None:
-                    out[name] = f"origin of joint '{joint.name}' along {axis} of the frame of {parent} [m]"
+                    out[name] = f"origin of joint '{joint.name}' along {axis} of the frame of {parent}"
         return out
 
     def key(self) -> str:
