@@ -145,21 +145,46 @@ def equations_text(eq: Equations, source: str = "") -> str:
     return "\n".join(lines) + "\n"
 
 
-def _broken(eq: Equations, label: str, expr: Any) -> str:
-    """One ``align*`` row, broken at the top-level terms into lines of about :data:`LINE`."""
+def _signed(text: str) -> str:
+    """A term as it continues a sum: ``+ a`` or ``- a``."""
+    return f"- {text[1:].lstrip()}" if text.startswith("-") else f"+ {text}"
+
+
+def _pieces(eq: Equations, expr: Any) -> list[str]:
+    """LaTeX pieces of ``expr``, each at most about :data:`LINE` long where it can be split
+    (at the terms of a sum, inside a product's one parenthesised sum), that read as ``expr``
+    when written one after the other."""
     import sympy as sp
 
-    terms = sp.Add.make_args(expr) if isinstance(expr, sp.Add) else (expr,)
+    text = latex_entry(eq, expr)
+    if len(text) <= LINE:
+        return [text]
+    if isinstance(expr, sp.Add):
+        out: list[str] = []
+        for i, term in enumerate(sp.Add.make_args(expr)):
+            pieces = _pieces(eq, term)
+            out += [_signed(pieces[0]) if i else pieces[0], *pieces[1:]]
+        return out
+    sums = [f for f in expr.args if isinstance(f, sp.Add)] if isinstance(expr, sp.Mul) else []
+    if len(sums) == 1:
+        rest = sp.Mul(*[f for f in expr.args if f is not sums[0]])
+        head = {"1": "", "-1": "-"}.get(latex_entry(eq, rest), latex_entry(eq, rest))
+        inner = _pieces(eq, sums[0])
+        inner[0] = rf"{head} \bigl( {inner[0]}".lstrip()
+        inner[-1] += r" \bigr)"
+        return inner
+    return [text]
+
+
+def _broken(eq: Equations, label: str, expr: Any) -> str:
+    """One ``align*`` row, broken into lines of about :data:`LINE` (:func:`_pieces`)."""
     lines, current = [], ""
-    for i, term in enumerate(terms):
-        text = latex_entry(eq, term)
-        if i:
-            text = f"- {text[1:].lstrip()}" if text.startswith("-") else f"+ {text}"
-        if current and len(current) + len(text) > LINE:
+    for piece in _pieces(eq, expr):
+        if current and len(current) + len(piece) > LINE:
             lines.append(current)
-            current = text
+            current = piece
         else:
-            current = f"{current} {text}".strip()
+            current = f"{current} {piece}".strip()
     lines.append(current)
     return f"{label} &= {lines[0]}" + "".join(rf" \\ &\quad {line}" for line in lines[1:])
 
@@ -198,6 +223,7 @@ def equations_latex(eq: Equations, source: str = "") -> str:
             r"\documentclass{article}",
             r"\usepackage[margin=2cm,landscape]{geometry}",
             r"\usepackage{amsmath}",
+            r"\allowdisplaybreaks",  # a long align* (a 3-joint arm's C) breaks across pages
             r"\begin{document}",
             rf"\title{{Equations of motion of {_escape(eq.robot)}}}\date{{}}\maketitle",
             r"$$M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) = Y(q, \dot q, \ddot q)\,\beta = \tau$$",

@@ -2,7 +2,8 @@
 declares (:class:`~twolink_pin.model.profile.ReportSections`).
 
 The report asks the robot's profile for its sections instead of testing its name; for the
-twolink they are the closed-form check, Table 1 and Table 2 beside ours, the errata, and
+twolink they are the closed-form check, the equations derived from the URDF written in the
+course's p beside its formulas, Table 1 and Table 2 beside ours, the errata, and
 the identification section beside Fig. 27 (:mod:`twolink_pin.twolink.report_identification`).
 Imported with the profile when the package is imported: what it needs is imported when
 called.
