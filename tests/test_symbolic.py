@@ -33,10 +33,12 @@ ARMS: dict[str, tuple[str, float, int | None]] = {
     "asr_twodof": ("asr_twodof", 0.0, None),
     "ur5-3": ("ur5", 0.0, 3),
     "rpr": (str(FIXTURES / "rpr_arm.urdf"), 0.5, None),
+    "branching": (str(FIXTURES / "branching_arm.urdf"), 0.0, None),
 }
 """Arms of every kind it accepts: planar, vertical, spatial with quarter-turn placements (the
-UR5's first three joints), and a prismatic joint behind a tilted placement, an unaligned
-axis, a folded fixed joint and a payload (``rpr_arm.urdf``)."""
+UR5's first three joints), a prismatic joint behind a tilted placement, an unaligned axis, a
+folded fixed joint and a payload (``rpr_arm.urdf``), and a tree of two branches
+(``branching_arm.urdf``)."""
 
 
 class Arm:
