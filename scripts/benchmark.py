@@ -39,6 +39,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
     .venv/bin/python scripts/benchmark.py --contact-only [--quick] # issue 46: the contact lab, contact's cost
+    .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -1639,6 +1640,12 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 46's goals: the twolink's contact lab, a run with the wall against one without",
     )
     parser.add_argument(
+        "--equations-only",
+        action="store_true",
+        help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
+        "scaling table (scripts/equations_benchmark.py)",
+    )
+    parser.add_argument(
         "--contention-only",
         action="store_true",
         help="only the contention row: two batches at once, and one alone (default threads against 1)",
@@ -1681,6 +1688,13 @@ def main(argv: list[str] | None = None) -> int:
         results.update(contact_section(quick, args.repeats or (1 if quick else 5)))
         results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
         print(f"load average at the end {results['machine']['load_average_end']}")
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.equations_only:
+        from equations_benchmark import equations_section  # scripts/: the script's own folder
+
+        results.update(equations_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0
