@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.arm_effects import refuse_idle
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.law_variant import Variant
@@ -232,6 +233,7 @@ class RunSpec:
             )
         if plant.position_stops:
             self._check_stops(robot)
+        refuse_idle(plant, robot, sim.method)  # the arm's effects (twolink_pin.arm_effects)
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
             for cls in classes
@@ -361,8 +363,14 @@ def law_spec(spec: RunSpec, variant: Variant) -> RunSpec:
     parameters, use = spec.parameters, spec.parameters_use
     if variant.parameters is not None:
         parameters, use = variant.parameters, variant.parameters_use
+    plant = spec.plant
+    if variant.plant:  # its plant keys over the command's plant options
+        try:
+            plant = dataclasses.replace(plant, **dict(variant.plant))
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
     return dataclasses.replace(
-        spec, gains=tuple(gains.items()), lam=lam, parameters=parameters, parameters_use=use
+        spec, gains=tuple(gains.items()), lam=lam, parameters=parameters, parameters_use=use, plant=plant
     )
 
 

@@ -16,6 +16,7 @@ from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_r
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
+from twolink_pin.cli.plant_options import add_plant_options
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -112,6 +113,7 @@ def add_sim_options(parser: argparse.ArgumentParser) -> None:
         help="the robot's friction in the plant: of the laws that estimate friction (law, default), of every "
         "law (on), of none (off)",
     )
+    add_plant_options(parser)
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
