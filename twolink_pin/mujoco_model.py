@@ -95,7 +95,7 @@ def urdf_for_mujoco(robot: RobotModel) -> str:
 
 def _failed(robot: RobotModel, exc: Exception) -> InvalidURDFError:
     reason = " ".join(str(exc).split())
-    return InvalidURDFError(str(robot.urdf_path), "MuJoCo", f"MuJoCo cannot compile it: {reason}")
+    return InvalidURDFError(str(robot.urdf_path), "MuJoCo", f"cannot compile it: {reason}")
 
 
 def arm_spec(robot: RobotModel) -> Any:
@@ -220,6 +220,7 @@ def _add_payload(spec: Any, robot: RobotModel, mass: float) -> None:
     point = body.add_body(name="twolink_pin_payload", pos=np.array(frame.placement.translation, dtype=float))
     point.explicitinertial = True
     point.mass = mass
+    point.ipos = np.zeros(3)  # the mass at the body's origin (not MjSpec's default)
     point.inertia = np.zeros(3)
 
 

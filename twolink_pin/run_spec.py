@@ -412,6 +412,8 @@ def build_rows(
         if spec.parameters is not None and spec.parameters not in files:
             files[spec.parameters] = read(spec) if read is not None else spec.read_parameters(robot)
         try:
+            if variant.plant:  # its own plant options: refused where they would do nothing
+                refuse_idle(spec.plant, robot, spec.simulation.method)
             scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
         except InvalidParameterError as exc:
             raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
