@@ -406,6 +406,11 @@ def _add_report(sub: Any, c: Any) -> None:
     p.add_argument(
         "--no-limits-section", action="store_true", help="skip the section 'The reference within the limits'"
     )
+    p.add_argument(
+        "--no-sim-to-sim",
+        action="store_true",
+        help="skip the section 'Sim-to-sim': each law on Pinocchio and on MuJoCo with the arm's effects (docs/mujoco.md)",
+    )
     add_robot_options(p)
     add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)
