@@ -3,7 +3,8 @@ with the arm's effects on, and the difference attributed to each effect.
 
 **The rows of a law** are ``compare`` rows (variants, :mod:`twolink_pin.law_variant`), each run
 with the report's settings over :data:`PERIODS` periods of the reference (short runs: the section
-costs what its ``PERIODS × (3 + effects)`` periods of each law cost):
+costs what ``PERIODS × (3 + effects)`` periods of each law cost; a report of shorter runs keeps
+their duration):
 
 * ``LAW`` — the report's plant (Pinocchio's, the report's friction and options);
 * ``LAW@plant=mujoco@soft_limits=off`` — the same arm on MuJoCo with every effect off: the
@@ -70,13 +71,13 @@ __all__ = [
 
 
 def arm_effects(robot: Any, options: ReportOptions) -> list[dict[str, str]]:
-    """The effects ``robot`` has that the report's plant leaves out, each as ``{"key", "label",
-    "setting"}`` (the variant setting that turns it on): the per-joint ones the arm gives a value
-    of, soft limits where a joint has a range, the effort clamp where a joint has a limit and the
-    report does not clip, and MuJoCo's ``implicitfast``."""
+    """The effects ``robot`` has that the report's plant leaves out, each as ``{"key", "short",
+    "label", "setting"}`` (``setting``: the variant setting that turns it on): the per-joint ones
+    the arm gives a value of, soft limits where a joint has a range, the effort clamp where a
+    joint has a limit and the report does not clip, and MuJoCo's ``implicitfast``."""
     plant = options.run.plant
     found = []
-    for name, label in (
+    for name, short in (
         ("armature", "armature"),
         ("joint_damping", "joint damping"),
         ("frictionloss", "dry friction"),
@@ -88,29 +89,20 @@ def arm_effects(robot: Any, options: ReportOptions) -> list[dict[str, str]]:
         except InvalidParameterError:  # the arm gives none
             continue
         shown = ", ".join(f"{x:g}" for x in values)
-        found.append(
-            {"key": name, "label": f"{label} ({shown}) {UNITS[name]}, {source}", "setting": f"@{name}={ARM}"}
-        )
+        label = f"{short} ({shown}) {UNITS[name]}, {source}"
+        found.append(_effect(name, short, label, f"@{name}={ARM}"))
     if joint_limits(robot).given(POSITION).any():
-        found.append(
-            {
-                "key": "soft_limits",
-                "label": "soft joint limits (MuJoCo's solref, solimp)",
-                "setting": "@soft_limits=on",
-            }
-        )
+        label = "soft joint limits (MuJoCo's default solref, solimp)"
+        found.append(_effect("soft_limits", "soft limits", label, "@soft_limits=on"))
     if not plant.saturate and np.isfinite(robot.torque_limits).any():
-        found.append(
-            {"key": "saturate", "label": "effort clamp at the URDF limits", "setting": "@saturate=on"}
-        )
-    found.append(
-        {
-            "key": "integrator",
-            "label": "MuJoCo's implicitfast, the law held over each step",
-            "setting": "@integrator=implicitfast",
-        }
-    )
+        found.append(_effect("saturate", "effort clamp", "effort clamp at the URDF limits", "@saturate=on"))
+    label = "MuJoCo's implicitfast, the law held over each step"
+    found.append(_effect("integrator", "implicitfast", label, "@integrator=implicitfast"))
     return found
+
+
+def _effect(key: str, short: str, label: str, setting: str) -> dict[str, str]:
+    return {"key": key, "short": short, "label": label, "setting": setting}
 
 
 def row_texts(variant: Variant, effects: list[dict[str, str]]) -> list[tuple[str, str, str]]:
@@ -158,7 +150,7 @@ def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[
     start, cpu = time.perf_counter(), time.process_time()
     robot = load_robot(options.robot, payload=options.payload)
     trajectory = reference_trajectory(robot, options)
-    duration = PERIODS * float(trajectory.period)
+    duration = min(PERIODS * float(trajectory.period), options.run.simulation.duration)
     rows = []
     for label, short, text in row_texts(variant, arm_effects(robot, options)):
         rows.append(
