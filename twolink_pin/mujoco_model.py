@@ -24,7 +24,8 @@ the end-effector frame's origin: ``--payload`` and a picked-up payload step), on
 whose force range is the URDF effort limit when the plant saturates, and MuJoCo's options
 (integrator; automatic reset off, so that an unstable run fails with its cause instead of
 restarting; MuJoCo's console and ``MUJOCO_LOG.TXT`` logging off: warnings are read from
-``MjData.warning``). A URDF MuJoCo cannot compile raises
+``MjData.warning``; without geoms its contact stage off, and its constraint stage too when no
+joint has a range or dry friction: nothing they could add, a fifth of ``mj_forward``'s time). A URDF MuJoCo cannot compile raises
 :class:`~twolink_pin.errors.InvalidURDFError` naming the file and MuJoCo's own reason.
 """
 
@@ -207,7 +208,12 @@ def compile_model(
         "euler": mujoco.mjtIntegrator.mjINT_EULER,
         "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
     }[integrator]
-    model.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    flags = mujoco.mjtDisableBit
+    model.opt.disableflags |= flags.mjDSBL_AUTORESET
+    if model.ngeom == 0:  # nothing can touch: no collision stage (a scene's geoms keep it)
+        model.opt.disableflags |= flags.mjDSBL_CONTACT
+        if not (model.jnt_limited.any() or model.dof_frictionloss.any() or model.neq):
+            model.opt.disableflags |= flags.mjDSBL_CONSTRAINT  # no constraint can be active
     return model
 
 
