@@ -359,6 +359,65 @@ def mpc() -> list[Path]:
     ]
 
 
+def mujoco() -> list[Path]:
+    """docs/mujoco.md's figures: the report's sim-to-sim section for the course's five laws (each
+    effect's difference from the Pinocchio plant, 2 periods), and computed torque on Pinocchio's
+    plant and on MuJoCo with each of the twolink's effects overlaid (12 s); prints the table."""
+    from twolink_pin import PlantOptions, RunSpec, SimulationConfig, default_trajectory, simulate
+    from twolink_pin.law_variant import parse_variant
+    from twolink_pin.plotting.overlay import save_overlay_figure
+    from twolink_pin.plotting.sim_to_sim import save_sim_to_sim_figure
+    from twolink_pin.report import ReportOptions
+    from twolink_pin.report.sim_to_sim import sim_to_sim_law
+
+    options = ReportOptions(workers=1)
+    laws = [
+        sim_to_sim_law(law, parse_variant(law), options)
+        for law in ("pd", "computed-torque", "robust", "adaptive", "adaptive-friction")
+    ]
+    for law in laws:
+        for row in law["rows"]:
+            print(
+                f"mujoco: {law['law']:18s} {row['short']:18s} RMS {row['rms_e']:.5g} max {row['max_e']:.5g} "
+                f"Δ {row.get('delta_rms_e', 0):+.3e} {row.get('delta_max_e', 0):+.3e}"
+            )
+    out = [
+        save_sim_to_sim_figure(
+            laws, IMAGES / "mujoco_sim_to_sim.png", "twolink: what each effect on MuJoCo changes"
+        )
+    ]
+    robot = load_robot("twolink")
+    reference = default_trajectory(robot)
+    runs = {}
+    for label, plant in (
+        ("Pinocchio", PlantOptions()),
+        ("MuJoCo + armature", PlantOptions(engine="mujoco", armature="arm")),
+        ("MuJoCo + dry friction", PlantOptions(engine="mujoco", frictionloss="arm")),
+        ("MuJoCo + implicitfast", PlantOptions(engine="mujoco", integrator="implicitfast")),
+        (
+            "MuJoCo + every effect",
+            PlantOptions(
+                engine="mujoco",
+                armature="arm",
+                joint_damping="arm",
+                frictionloss="arm",
+                saturate=True,
+                integrator="implicitfast",
+            ),
+        ),
+    ):
+        spec = RunSpec(law="computed-torque", plant=plant, simulation=SimulationConfig(duration=12.0))
+        runs[label] = simulate(*spec.build(robot), reference, spec.simulation)
+    out.append(
+        save_overlay_figure(
+            runs,
+            IMAGES / "mujoco_computed_torque.png",
+            "computed-torque on the twolink: Pinocchio and MuJoCo with the arm's effects",
+        )
+    )
+    return out
+
+
 MAKERS: dict[str, Callable[[], list[Path]]] = {
     "report": report,
     "animation": animation,
@@ -369,6 +428,7 @@ MAKERS: dict[str, Callable[[], list[Path]]] = {
     "limits": limits,
     "within_limits": within_limits,
     "mpc": mpc,
+    "mujoco": mujoco,
 }
 
 

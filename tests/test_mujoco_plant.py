@@ -26,6 +26,7 @@ import pytest
 from conftest_sim import ConstantTorque, ConstantTorqueGains, evaluate
 
 from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench
+from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.mujoco_model import arm_spec
 from twolink_pin.mujoco_plant import MujocoPlant
@@ -361,3 +362,27 @@ def test_a_payload_is_the_same_point_mass_on_both_plants(name: str) -> None:
     np.testing.assert_allclose(_full_m(model, data), np.triu(M) + np.triu(M, 1).T, rtol=0, atol=1e-12)
     bias = pin.nonLinearEffects(after.model, after.model.createData(), q, v)
     np.testing.assert_allclose(data.qfrc_bias, bias, rtol=0, atol=1e-11)
+
+
+def test_a_law_that_believes_the_effects_has_them_in_its_model() -> None:
+    """``believed_effects``: computed torque's ``τ = M q̈_r + C q̇_r + g − K s`` with the plant's
+    armature in its M is the law without it plus ``diag(a) q̈_r`` (fixed gains; the UR5 at a
+    random state), adaptive-friction's believed viscous friction gains the joint damping; the
+    option is refused without an effect to believe."""
+    robot = load_robot("ur5")
+    rng = np.random.default_rng(5)
+    q, v, q_des, v_des, a_des = rng.uniform(-1, 1, (5, robot.nv))
+    gains = (("k", 10.0), ("lam", 5.0))
+    plant = PlantOptions(armature="arm")
+    taus = []
+    for believed in (False, True):
+        spec = RunSpec(law="computed-torque", gains=gains, plant=plant, believed_effects=believed)
+        taus.append(evaluate(spec.build(robot).controller, q, v, q_des, v_des, a_des)[0])
+    a_r = a_des - 5.0 * (v - v_des)
+    np.testing.assert_allclose(taus[1] - taus[0], 0.1 * a_r, rtol=0, atol=1e-12)
+    twolink = load_robot()
+    spec = RunSpec(law="adaptive-friction", plant=PlantOptions(joint_damping=(0.5, 0.25)), believed_effects=True)
+    believed = spec.build(twolink).controller.friction  # type: ignore[attr-defined]
+    assert believed.viscous == pytest.approx((0.4 + 0.5, 0.2 + 0.25))
+    with pytest.raises(InvalidParameterError, match="--believe-effects"):
+        RunSpec(law="pd", believed_effects=True).check_effective(twolink)

@@ -53,6 +53,7 @@ SAMPLES = {
     "--solref": ["--plant", "mujoco", "--solref", "0.01,1"],
     "--solimp": ["--plant", "mujoco", "--solimp", "0.8,0.9,0.01"],
     "--mujoco-integrator": ["--plant", "mujoco", "--mujoco-integrator", "euler"],
+    "--believe-effects": ["--armature", "0.1", "--believe-effects"],
 }
 """A non-default value of each run option (a new option needs one here)."""
 NOT_FROM_OPTIONS = {"law", "law_gains", "shared", "parameters_use", "rtol", "atol", "v0_offset"}

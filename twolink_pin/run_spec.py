@@ -76,6 +76,9 @@ class RunSpec:
             ``p0`` seeds the laws that estimate, the others run as usual.
         simulation: Duration, step, integrator, initial offset, control period.
         shared: Whether this spec is the common part of several laws' runs.
+        believed_effects: The law's model includes the plant's armature (in its ``M(q)``) and
+            joint damping (in the viscous friction a friction-estimating law believes)
+            (``--believe-effects``; :mod:`twolink_pin.arm_effects`).
     """
 
     law: str | type[Controller] | None = None
@@ -87,6 +90,7 @@ class RunSpec:
     parameters_use: str = ""
     simulation: SimulationConfig = field(default_factory=SimulationConfig)
     shared: bool = False
+    believed_effects: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "gains", _frozen_gains(self.gains))
@@ -202,8 +206,14 @@ class RunSpec:
                     if smoothing
                     else belief.friction
                 )
+        believed = robot
+        if self.believed_effects:  # the law's M(q) with the plant's armature, its friction with the damping
+            believed = dataclasses.replace(robot, model=plant.model)
+            if friction is not None and plant.joint_damping.any():
+                viscous = tuple(float(v + d) for v, d in zip(friction.viscous, plant.joint_damping))
+                friction = dataclasses.replace(friction, viscous=viscous)
         controller = make_controller(
-            cls, robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
+            cls, believed, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
         )
         return Scenario(controller, plant)
 
@@ -234,6 +244,10 @@ class RunSpec:
         if plant.position_stops:
             self._check_stops(robot)
         refuse_idle(plant, robot, sim.method)  # the arm's effects (twolink_pin.arm_effects)
+        if self.believed_effects and plant.armature is None and plant.joint_damping is None:
+            raise InvalidParameterError(
+                "--believe-effects", True, "a plant with armature or joint damping to believe (--armature, --joint-damping)"
+            )
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
             for cls in classes
@@ -335,6 +349,7 @@ class RunSpec:
             "parameters_use": self.parameters_use,
             "simulation": {k: list(v) if isinstance(v, tuple) else v for k, v in sim.items()},
             "shared": self.shared,
+            "believed_effects": self.believed_effects,
         }
 
     @classmethod
@@ -353,6 +368,7 @@ class RunSpec:
             parameters_use=data.get("parameters_use", ""),
             simulation=SimulationConfig(**sim),
             shared=bool(data.get("shared", False)),
+            believed_effects=bool(data.get("believed_effects", False)),
         )
 
 

@@ -106,6 +106,12 @@ def add_plant_options(p: argparse.ArgumentParser) -> None:
         help="the soft limits' impedance (--plant mujoco; MuJoCo's default 0.9,0.95,0.001,0.5,2)",
     )
     group.add_argument(
+        "--believe-effects",
+        action="store_true",
+        help="the law's model includes the plant's armature (its M(q)) and joint damping (the friction a "
+        "friction-estimating law believes)",
+    )
+    group.add_argument(
         "--mujoco-integrator",
         choices=INTEGRATORS,
         default="rk4",

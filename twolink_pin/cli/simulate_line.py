@@ -73,6 +73,8 @@ def _effect_tokens(spec: RunSpec) -> list[str]:
             tokens.append(f"--{name}={_numbers(value)}")
     if plant.integrator != "rk4":
         tokens.append(f"--mujoco-integrator={plant.integrator}")
+    if spec.believed_effects:
+        tokens.append("--believe-effects")
     return tokens
 
 

@@ -109,6 +109,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
         parameters_use=mode,
         simulation=_config(args),
         shared=several,
+        believed_effects=bool(getattr(args, "believe_effects", False)),
     )
 
 
