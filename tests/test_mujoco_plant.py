@@ -381,7 +381,9 @@ def test_a_law_that_believes_the_effects_has_them_in_its_model() -> None:
     a_r = a_des - 5.0 * (v - v_des)
     np.testing.assert_allclose(taus[1] - taus[0], 0.1 * a_r, rtol=0, atol=1e-12)
     twolink = load_robot()
-    spec = RunSpec(law="adaptive-friction", plant=PlantOptions(joint_damping=(0.5, 0.25)), believed_effects=True)
+    spec = RunSpec(
+        law="adaptive-friction", plant=PlantOptions(joint_damping=(0.5, 0.25)), believed_effects=True
+    )
     believed = spec.build(twolink).controller.friction  # type: ignore[attr-defined]
     assert believed.viscous == pytest.approx((0.4 + 0.5, 0.2 + 0.25))
     with pytest.raises(InvalidParameterError, match="--believe-effects"):

@@ -15,7 +15,9 @@ from twolink_pin.report import MARKER, ReportOptions, build_report
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
-SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False, sim_to_sim=False)
+SHORT = ReportOptions(
+    run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False, sim_to_sim=False
+)
 
 
 @pytest.fixture(scope="module")

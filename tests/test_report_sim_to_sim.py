@@ -51,14 +51,18 @@ def test_the_report_shows_the_section_and_its_figure(tmp_path: Path) -> None:
     results.json, its figure written; --no-sim-to-sim leaves it out."""
     run = RunSpec(shared=True, simulation=SimulationConfig(duration=DURATION))
     short = {"workers": 1, "animation": False, "identification": False, "limits_section": False}
-    results = build_report(tmp_path / "r", ReportOptions(run=run, controllers=("pd",), **short), command_line="pytest")
+    results = build_report(
+        tmp_path / "r", ReportOptions(run=run, controllers=("pd",), **short), command_line="pytest"
+    )
     section = results["sim_to_sim"]
     assert [law["law"] for law in section["laws"]] == ["pd"]
     page = (tmp_path / "r" / "index.html").read_text()
     assert 'id="sim-to-sim"' in page and page.count("<tr><td>pd</td>") >= 9
     assert (tmp_path / "r" / "figures" / section["figure"]).stat().st_size > 10_000
     assert "## Sim-to-sim" in (tmp_path / "r" / "report.md").read_text()
-    without = build_report(tmp_path / "w", ReportOptions(run=run, controllers=("pd",), sim_to_sim=False, **short))
+    without = build_report(
+        tmp_path / "w", ReportOptions(run=run, controllers=("pd",), sim_to_sim=False, **short)
+    )
     assert without["sim_to_sim"] is None
     assert without["controllers"]["pd"]["metrics"] == results["controllers"]["pd"]["metrics"]
 

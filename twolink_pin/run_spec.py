@@ -206,14 +206,14 @@ class RunSpec:
                     if smoothing
                     else belief.friction
                 )
-        believed = robot
+        law_robot = robot
         if self.believed_effects:  # the law's M(q) with the plant's armature, its friction with the damping
-            believed = dataclasses.replace(robot, model=plant.model)
+            law_robot = dataclasses.replace(robot, model=plant.model)
             if friction is not None and plant.joint_damping.any():
                 viscous = tuple(float(v + d) for v, d in zip(friction.viscous, plant.joint_damping))
                 friction = dataclasses.replace(friction, viscous=viscous)
         controller = make_controller(
-            cls, believed, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
+            cls, law_robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
         )
         return Scenario(controller, plant)
 
@@ -246,7 +246,9 @@ class RunSpec:
         refuse_idle(plant, robot, sim.method)  # the arm's effects (twolink_pin.arm_effects)
         if self.believed_effects and plant.armature is None and plant.joint_damping is None:
             raise InvalidParameterError(
-                "--believe-effects", True, "a plant with armature or joint damping to believe (--armature, --joint-damping)"
+                "--believe-effects",
+                True,
+                "a plant with armature or joint damping to believe (--armature, --joint-damping)",
             )
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
