@@ -36,11 +36,13 @@ joint or one per joint (the command line); None — none (the default: the cours
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
 import numpy as np
 
+from twolink_pin.dynamics import Friction
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -244,6 +246,19 @@ def refuse_idle(options: Any, robot: RobotModel, method: str) -> None:
         )
 
 
+def believe_effects(
+    robot: RobotModel, plant: Any, friction: Friction | None
+) -> tuple[RobotModel, Friction | None]:
+    """The robot and friction a law believes with the plant's effects (``--believe-effects``):
+    its model is the plant's (``model.armature`` set, so ``M(q)`` has the armature) and its
+    viscous friction, if it has one, gains the plant's joint damping."""
+    believed = dataclasses.replace(robot, model=plant.model)
+    if friction is not None and plant.joint_damping.any():
+        viscous = tuple(float(v + d) for v, d in zip(friction.viscous, plant.joint_damping))
+        friction = dataclasses.replace(friction, viscous=viscous)
+    return believed, friction
+
+
 def per_joint(name: str, values: Any, nv: int) -> np.ndarray:
     """An effect's values as a plant keeps them: a read-only (nv,) array of finite values >= 0
     (None: zeros)."""
@@ -272,6 +287,7 @@ __all__ = [
     "SOLREF",
     "SWITCHES",
     "UNITS",
+    "believe_effects",
     "check_effect",
     "check_solver",
     "per_joint",

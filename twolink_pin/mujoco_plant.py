@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+from collections.abc import Callable
 from dataclasses import KW_ONLY, dataclass, field
 from typing import Any, ClassVar
 
@@ -106,11 +107,11 @@ class MujocoPlant(Plant):
         """RK4 is the engine's: the law at each stage; MuJoCo's Euler and implicitfast hold it."""
         return self.integrator == "rk4"
 
-    def dynamics(self, runs: int, threads: int | None) -> MujocoDynamics | MujocoBatchDynamics:
+    def dynamics(self, runs: int, threads: int | None) -> Any:
         """``q̈`` of ``runs`` runs from MuJoCo: one ``MjData`` for one run, a ``Batch`` for N."""
         stepped = self.integrator != "rk4"
         if runs == 1:
-            return SteppedDynamics(self) if stepped else MujocoDynamics(self)
+            return SteppedDynamics(self) if stepped else MujocoDynamics(self).fast()
         return (
             SteppedBatchDynamics(self, runs, threads) if stepped else MujocoBatchDynamics(self, runs, threads)
         )
@@ -175,6 +176,25 @@ class MujocoDynamics:
         self._load(q, v, tau)
         self._forward(self.model, self.data)
         return self._qacc.copy()
+
+    def fast(self) -> Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]:
+        """This call as a closure over its arrays (no attribute look-ups: it runs four times per
+        step), carrying :meth:`failure`; the plain torque path only (no clamp, no friction),
+        else the method itself."""
+        if self._ctrl is not None or self._friction is not None:
+            return self
+        qpos, qvel, applied, qacc = self._qpos, self._qvel, self._applied, self._qacc
+        forward, model, data = self._forward, self.model, self.data
+
+        def accel(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+            qpos[...] = q
+            qvel[...] = v
+            applied[...] = tau
+            forward(model, data)
+            return qacc.copy()
+
+        accel.failure = self.failure  # type: ignore[attr-defined]
+        return accel
 
     def _load(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
         """The state and the torque into ``MjData``: with saturation the motors take ``τ`` (their

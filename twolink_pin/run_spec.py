@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
-from twolink_pin.arm_effects import refuse_idle
+from twolink_pin.arm_effects import believe_effects, refuse_idle
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.law_variant import Variant
@@ -207,11 +207,8 @@ class RunSpec:
                     else belief.friction
                 )
         law_robot = robot
-        if self.believed_effects:  # the law's M(q) with the plant's armature, its friction with the damping
-            law_robot = dataclasses.replace(robot, model=plant.model)
-            if friction is not None and plant.joint_damping.any():
-                viscous = tuple(float(v + d) for v, d in zip(friction.viscous, plant.joint_damping))
-                friction = dataclasses.replace(friction, viscous=viscous)
+        if self.believed_effects:
+            law_robot, friction = believe_effects(robot, plant, friction)
         controller = make_controller(
             cls, law_robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
         )
