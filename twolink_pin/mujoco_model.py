@@ -25,7 +25,8 @@ whose force range is the URDF effort limit when the plant saturates, and MuJoCo'
 (integrator; automatic reset off, so that an unstable run fails with its cause instead of
 restarting; MuJoCo's console and ``MUJOCO_LOG.TXT`` logging off: warnings are read from
 ``MjData.warning``; without geoms its contact stage off, and its constraint stage too when no
-joint has a range or dry friction: nothing they could add, a fifth of ``mj_forward``'s time). A URDF MuJoCo cannot compile raises
+joint has a range or dry friction, and its springs and dampers without damping: nothing they
+could add, a fifth of ``mj_forward``'s time). A URDF MuJoCo cannot compile raises
 :class:`~twolink_pin.errors.InvalidURDFError` naming the file and MuJoCo's own reason.
 """
 
@@ -214,6 +215,8 @@ def compile_model(
         model.opt.disableflags |= flags.mjDSBL_CONTACT
         if not (model.jnt_limited.any() or model.dof_frictionloss.any() or model.neq):
             model.opt.disableflags |= flags.mjDSBL_CONSTRAINT  # no constraint can be active
+    if not (model.dof_damping.any() or model.jnt_stiffness.any() or model.ntendon):
+        model.opt.disableflags |= flags.mjDSBL_SPRING | flags.mjDSBL_DAMPER  # no passive force
     return model
 
 
