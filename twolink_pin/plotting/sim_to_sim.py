@@ -2,7 +2,7 @@
 
 :func:`save_sim_to_sim_figure` draws, for each row of the report's section "Sim-to-sim"
 (:mod:`twolink_pin.report.sim_to_sim`) after the first, each law's differences ``Δ RMS ‖e‖``
-and ``Δ max |e|`` over the last period [mrad] from the law on the Pinocchio plant, as grouped
+and ``Δ max |e|`` [mrad] from the law on the Pinocchio plant, as grouped
 horizontal bars on symmetric-log axes (an effect can lower the error as well as raise it;
 "no effect" sits at rounding level, inside the linear band around 0).
 """
@@ -21,7 +21,7 @@ LINEAR_BAND = 1e-3
 """The symmetric-log axis is linear within ±this [mrad] (differences at rounding level)."""
 
 
-PANELS = (("delta_rms_e", "Δ RMS ‖e‖ [mrad]"), ("delta_max_e", "Δ last period max |e| [mrad]"))
+PANELS = (("delta_rms_e", "Δ RMS ‖e‖ [mrad]"), ("delta_max_e", "Δ max |e| [mrad]"))
 """The two panels: the row field [rad] and the axis label."""
 
 

@@ -133,9 +133,9 @@ def sim_to_sim_table(r: dict[str, Any]) -> dict[str, Any] | None:
         "controller",
         "plant",
         "RMS ‖e‖ [rad]",
-        "last period max |e| [rad]",
+        "max |e| [rad]",
         "Δ RMS ‖e‖ [rad]",
-        "Δ last period max |e| [rad]",
+        "Δ max |e| [rad]",
     ]
     rows = []
     for law in section["laws"]:
@@ -145,7 +145,8 @@ def sim_to_sim_table(r: dict[str, Any]) -> dict[str, Any] | None:
                 continue
             deltas = [row.get("delta_rms_e"), row.get("delta_max_e")]
             shown = ["" if row is law["rows"][0] else _signed(d) for d in deltas]
-            rows.append([law["law"], row["row"], fmt(row["rms_e"]), fmt(row["max_e"]), *shown])
+            label = row["row"] + (" — cannot act here, not rerun" if row.get("derived") else "")
+            rows.append([law["law"], label, fmt(row["rms_e"]), fmt(row["max_e"]), *shown])
     return section | {"headers": headers, "rows": rows}
 
 

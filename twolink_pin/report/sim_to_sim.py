@@ -2,9 +2,9 @@
 with the arm's effects on, and the difference attributed to each effect.
 
 **The rows of a law** are ``compare`` rows (variants, :mod:`twolink_pin.law_variant`), each run
-with the report's settings over :data:`PERIODS` periods of the reference (short runs: the section
-costs what ``PERIODS × (3 + effects)`` periods of each law cost; a report of shorter runs keeps
-their duration):
+with the report's settings over :data:`PERIODS` period of the reference, **started on it**
+(``--q0-offset 0``: no initial transient, so that what an effect does to the tracking is what
+the numbers show; at most the report's duration):
 
 * ``LAW`` — the report's plant (Pinocchio's, the report's friction and options);
 * ``LAW@plant=mujoco@soft_limits=off`` — the same arm on MuJoCo with every effect off: the
@@ -16,10 +16,15 @@ their duration):
   ``implicitfast`` integrator with the law held over each step);
 * ``…@plant=mujoco`` with every effect at once.
 
+An effect that cannot act on the run is not run again: soft limits on a run that never reaches a
+joint's range, the effort clamp on a commanded torque below :data:`CLAMP_MARGIN` of every limit
+(:func:`inactive`; MuJoCo with no effect is that run until the effect acts). Its row repeats the
+no-effect row's numbers and says why (``derived``). The section costs what
+``PERIODS × (3 + effects acting)`` periods of each law cost.
+
 **The numbers** are :func:`~twolink_pin.metrics.compute_metrics`' per-joint ones, as ``compare``'s
-table has them: ``RMS ‖e‖ = (Σ_j RMS(e_j)²)^½`` [rad] over the run and ``max |e|`` [rad], the
-largest ``|e_j(t)|`` of any joint over the last period (the initial offset's transient left out),
-and each row's difference from the first (Δ). An effect's Δ is what it alone changes; the
+table has them: ``RMS ‖e‖ = (Σ_j RMS(e_j)²)^½`` [rad] and ``max |e|`` [rad], the largest
+``|e_j(t)|`` of any joint, over the run; and each row's difference from the first (Δ). An effect's Δ is what it alone changes; the
 sum of the one-effect Δs need not be the all-effects Δ (the effects interact). A run that fails
 is a row saying when.
 
@@ -45,10 +50,10 @@ from twolink_pin.metrics import compute_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.report.options import ReportOptions
 from twolink_pin.report.runs import reference_trajectory
-from twolink_pin.simulation import simulate
+from twolink_pin.simulation import SimulationConfig, simulate
 
-PERIODS = 2
-"""The section's runs: this many periods of the reference."""
+PERIODS = 1
+"""The section's runs: this many periods of the reference, started on it."""
 MUJOCO = "@plant=mujoco"
 """The settings that put a row on MuJoCo."""
 NO_EFFECT = MUJOCO + "@soft_limits=off"
@@ -57,13 +62,16 @@ FIGURE = "sim_to_sim.png"
 """The section's figure (``figures/``): each effect's Δ RMS ‖e‖ per law."""
 
 __all__ = [
+    "CLAMP_MARGIN",
     "FIGURE",
     "MUJOCO",
     "NO_EFFECT",
     "PERIODS",
     "arm_effects",
     "collect",
+    "inactive",
     "row_texts",
+    "section_config",
     "sim_to_sim_law",
     "skipped",
     "submit",
@@ -123,12 +131,11 @@ def row_texts(variant: Variant, effects: list[dict[str, str]]) -> list[tuple[str
     return rows
 
 
-def _numbers(
-    text: str, options: ReportOptions, robot: Any, trajectory: Any, duration: float
-) -> dict[str, Any]:
-    """One row's run: its ``RMS ‖e‖`` and ``max |e|`` [rad], or what stopped it."""
+def _numbers(text: str, options: ReportOptions, robot: Any, trajectory: Any) -> dict[str, Any]:
+    """One row's run (module docstring): its ``RMS ‖e‖`` and ``max |e|`` [rad], how far it went
+    (each joint's position range and largest commanded torque), or what stopped it."""
     spec = options.run.for_law(parse_variant(text))
-    spec = dataclasses.replace(spec, simulation=dataclasses.replace(spec.simulation, duration=duration))
+    spec = dataclasses.replace(spec, simulation=section_config(spec.simulation, trajectory))
     controller, plant = spec.build(robot)
     try:
         result = simulate(controller, plant, trajectory, spec.simulation)
@@ -138,11 +145,49 @@ def _numbers(
     return {
         "finished": True,
         "rms_e": float(np.sqrt(np.sum(np.square(metrics.rms.e)))),
-        "max_e": float(np.max(metrics.final_period_max_abs_e)),
+        "max_e": float(np.max(metrics.max.e)),
         "rms_e_joints": np.asarray(metrics.rms.e).tolist(),
-        "max_e_joints": np.asarray(metrics.final_period_max_abs_e).tolist(),
+        "max_e_joints": np.asarray(metrics.max.e).tolist(),
         "plant": plant.describe(),
+        "reach": {
+            "q_min": result.q.min(axis=0).tolist(),
+            "q_max": result.q.max(axis=0).tolist(),
+            "tau_peak": np.abs(result.tau_command).max(axis=0).tolist(),
+        },
     }
+
+
+def section_config(config: SimulationConfig, trajectory: Any) -> SimulationConfig:
+    """The section's run settings: the report's, over :data:`PERIODS` periods of the reference (at
+    most the report's duration), starting on the reference."""
+    duration = min(PERIODS * float(trajectory.period), config.duration)
+    return dataclasses.replace(config, duration=duration, q0_offset=0.0, v0_offset=0.0)
+
+
+CLAMP_MARGIN = 0.9
+"""The effort clamp cannot act when the run's commanded torque stays below this fraction of every
+limit at its samples (within a 1-ms step a law's torque does not grow by a tenth)."""
+
+
+def inactive(key: str, robot: Any, plain: dict[str, Any]) -> str | None:
+    """Why effect ``key`` cannot act on the run ``plain`` (MuJoCo with no effect, the run it equals
+    until the effect acts), or None: soft limits a run that never reaches a range, the clamp a
+    commanded torque below :data:`CLAMP_MARGIN` of every limit."""
+    if not plain["finished"]:
+        return None
+    reach = plain["reach"]
+    if key == "soft_limits":
+        bounds = joint_limits(robot)
+        lower, upper = np.asarray(bounds.position_lower), np.asarray(bounds.position_upper)
+        if (np.asarray(reach["q_min"]) > lower).all() and (np.asarray(reach["q_max"]) < upper).all():
+            return "the run never reaches a joint's range: the soft limits cannot act (the no-effect run)"
+    if key == "saturate":
+        if (np.asarray(reach["tau_peak"]) < CLAMP_MARGIN * np.asarray(robot.torque_limits)).all():
+            return (
+                f"its commanded torque stays below {CLAMP_MARGIN:.0%} of every effort limit: the clamp "
+                "cannot act (the no-effect run)"
+            )
+    return None
 
 
 def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[str, Any]:
@@ -150,13 +195,17 @@ def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[
     start, cpu = time.perf_counter(), time.process_time()
     robot = load_robot(options.robot, payload=options.payload)
     trajectory = reference_trajectory(robot, options)
-    duration = min(PERIODS * float(trajectory.period), options.run.simulation.duration)
-    rows = []
-    for label, short, text in row_texts(variant, arm_effects(robot, options)):
-        rows.append(
-            {"row": label, "short": short, "variant": text}
-            | _numbers(text, options, robot, trajectory, duration)
-        )
+    effects = arm_effects(robot, options)
+    keys = {f"MuJoCo + {e['label']}": e["key"] for e in effects}
+    rows: list[dict[str, Any]] = []
+    for label, short, text in row_texts(variant, effects):
+        row: dict[str, Any] = {"row": label, "short": short, "variant": text}
+        why = inactive(keys.get(label, ""), robot, rows[1]) if len(rows) > 1 else None
+        if why is None:
+            row |= _numbers(text, options, robot, trajectory)
+        else:  # the no-effect run's numbers: the run it would be
+            row |= {k: v for k, v in rows[1].items() if k not in row} | {"derived": why}
+        rows.append(row)
     first = rows[0]
     for row in rows:
         if row["finished"] and first["finished"]:
@@ -165,7 +214,7 @@ def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[
     return {
         "law": name,
         "rows": rows,
-        "duration_s": duration,
+        "duration_s": section_config(options.run.simulation, trajectory).duration,
         "seconds": time.perf_counter() - start,
         "cpu_seconds": time.process_time() - cpu,
     }
@@ -211,7 +260,7 @@ def collect(
     if isinstance(pending, str):
         return section | {"note": f"no sim-to-sim section: {pending}"}
     laws = [interrupts.result_of(future, heard) for future in pending.values()]
-    title = f"{robot.name}: what each effect on MuJoCo changes ({PERIODS} periods of the reference)"
+    title = f"{robot.name}: what each effect on MuJoCo changes (one period, started on the reference)"
     figure = save_sim_to_sim_figure(laws, Path(fig_dir) / FIGURE, title).name
     return section | {
         "duration_s": laws[0]["duration_s"] if laws else None,
