@@ -58,10 +58,13 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, what pushes back on it, the surfaces it touches, a law with its plant, a law's "
-        "variants, the run description, and the engine.",
+        "The simulated arm (Pinocchio's and MuJoCo's), the effects a real arm has, what pushes back on it, the "
+        "surfaces it touches, a law with its plant, a law's variants, the run description, and the engine.",
         (
             "plant",
+            "arm_effects",
+            "mujoco_model",
+            "mujoco_plant",
             "disturbances",
             "contact",
             "scenario",

@@ -27,8 +27,8 @@ divergence checks are the engine's.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -43,12 +43,32 @@ Accel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
 def payload_plant(plant: Plant) -> Plant:
-    """``plant`` with its payload step's mass carried from the start (the model after the step)."""
-    step = plant.payload_step
-    assert step is not None
-    robot = plant.robot
-    model = step.model(robot.model, robot.ee_frame_id)
-    return dataclasses.replace(plant, model=model)
+    """``plant`` with its payload step's mass carried from the start (the plant after the step:
+    :meth:`~twolink_pin.plant.Plant.after_payload`, its engine's)."""
+    return plant.after_payload()
+
+
+class Pushed:
+    """``dynamics`` with the generalized forces from outside the motors (the wrench's
+    ``J(q)ᵀ F``, the contact's ``τ_c``) added after the motors' torque is clipped: at every RK4
+    stage, or at the start of a step that the plant's own integrator takes (``held_step``:
+    MuJoCo's Euler and implicitfast evaluate their forces once per step). ``external(q, q̇)``
+    gives them, (N, nv) [N·m], or None (nothing pushes)."""
+
+    def __init__(
+        self, dynamics: Accel, external: Callable[[np.ndarray, np.ndarray], np.ndarray | None]
+    ) -> None:
+        self._dynamics = dynamics
+        self._external = external
+        if hasattr(dynamics, "held_step"):
+            self.held_step = self._held_step
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self._dynamics(q, v, tau, self._external(q, v)).copy()  # type: ignore[call-arg]
+
+    def _held_step(self, q: np.ndarray, v: np.ndarray, z: np.ndarray, tau: np.ndarray, *rest: Any) -> Any:
+        held = self._dynamics.held_step  # type: ignore[attr-defined]
+        return held(q, v, z, tau, *rest, external=self._external(q, v))
 
 
 class PlantEvents:
@@ -59,8 +79,9 @@ class PlantEvents:
     ) -> None:
         self._plant = plant
         self._before = dynamics_for(plant, runs, threads)
+        self._after_plant = payload_plant(plant) if plant.payload_step is not None else None
         self._after = (
-            dynamics_for(payload_plant(plant), runs, threads) if plant.payload_step is not None else None
+            dynamics_for(self._after_plant, runs, threads) if self._after_plant is not None else None
         )
         self._payload_time = plant.payload_step.time if plant.payload_step is not None else np.inf
         self._accels: dict[tuple[bool, bool], Accel] = {}  # (payload on, wrench on) → q̈
@@ -85,7 +106,7 @@ class PlantEvents:
         self._nv = nv
         self.stops = None
         if plant.position_stops:
-            after = payload_plant(plant).model if plant.payload_step is not None else plant.model
+            after = self._after_plant.model if self._after_plant is not None else plant.model
             self.stops = (JointStops(plant.joint_limits, plant.model), JointStops(plant.joint_limits, after))
 
     def stop(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -116,23 +137,33 @@ class PlantEvents:
         """``q̈`` of ``dynamics`` with the wrench (``pushing``) and the contact, if any."""
         contact = self.contact
         if not pushing and contact is None:
+            if hasattr(dynamics, "held_step"):  # a plant that steps itself: returns fresh arrays
+                return dynamics
             return lambda q, v, tau: dynamics(q, v, tau).copy()
         kinematics, force = self._kinematics, self._force
         frame = None if self._wrench is None else self._wrench.frame
-
         free = getattr(contact, "free", None)  # what it answers when no run touches: nothing to add
 
-        def pushed(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        def external(q: np.ndarray, v: np.ndarray) -> np.ndarray | None:
             touched = None if contact is None else contact(q, v)
-            external = None if touched is None or touched is free else touched.tau
+            torque = None if touched is None or touched is free else touched.tau
             if pushing:
                 assert kinematics is not None and force is not None
                 J = kinematics.frame(q, np.zeros_like(v), frame).jacobian
-                torque = np.vecmat(np.broadcast_to(force, (J.shape[0], 6)), J)
-                external = torque if external is None else external + torque
-            return dynamics(q, v, tau, external).copy()  # type: ignore[call-arg]
+                pushed = np.vecmat(np.broadcast_to(force, (J.shape[0], 6)), J)
+                torque = pushed if torque is None else torque + pushed
+            return torque
 
-        return pushed
+        return Pushed(dynamics, external)
+
+    def failure(self, run: int) -> str | None:
+        """The plant's own cause of run ``run``'s failure (its engine's), if it knows one."""
+        for dynamics in (self._after, self._before):
+            reason = getattr(dynamics, "failure", None)
+            text = reason(run) if reason is not None else None
+            if text:
+                return str(text)
+        return None
 
     def draw(self, k0: int, k1: int) -> None:
         """Draw the noise of steps ``k0 … k1 − 1`` (one block; every run its own generator)."""
@@ -185,4 +216,4 @@ class DelayLine:
         return (self._first if sample is None else outputs[sample][0]), dz
 
 
-__all__ = ["DelayLine", "PlantEvents", "payload_plant"]
+__all__ = ["DelayLine", "PlantEvents", "Pushed", "payload_plant"]

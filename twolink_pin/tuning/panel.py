@@ -19,6 +19,7 @@ import numpy as np
 
 from twolink_pin.disturbances import SensorNoise, Wrench
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.plant import ENGINES
 from twolink_pin.run_spec import FRICTION_CHOICES
 from twolink_pin.tuning.knobs import Knob, format_typed, gains_from, parse_typed
 from twolink_pin.tuning.typed_js import TYPED_SUFFIX, typed_html
@@ -107,6 +108,12 @@ class Panel:
             self.duration = gui.add_number(  # bounded: a run in flight is not interrupted
                 "duration [s]", sim.duration, min=sim.dt, max=max(MAX_DURATION, sim.duration), step=0.1
             )
+            self.engine = gui.add_dropdown(
+                "plant",
+                tuple(ENGINES),
+                initial_value=plant.engine,
+                hint="the simulator the arm runs on (--plant)",
+            )
             self.friction = gui.add_dropdown("plant friction", FRICTION_CHOICES, initial_value=plant.friction)
             self.saturate = gui.add_checkbox("saturate at the effort limits", plant.saturate)
             self.payload = gui.add_number("payload [kg]", payload, min=0.0, max=1e4, step=0.1)
@@ -133,6 +140,7 @@ class Panel:
             self.run_error = gui.add_markdown("")
         for handle in (
             self.duration,
+            self.engine,
             self.friction,
             self.saturate,
             self.payload,
@@ -247,6 +255,7 @@ class Panel:
             noise = None
         plant = dataclasses.replace(
             base.plant,
+            engine=str(self.engine.value),
             friction=str(self.friction.value),
             saturate=bool(self.saturate.value),
             wrench=wrench,
