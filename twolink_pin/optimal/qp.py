@@ -150,12 +150,7 @@ def solve_qp(
     if rho is not None or infeasibility_eps is not None:
         result = _solve_set(qp, warm, eps, max_iter, rho, infeasibility_eps)
     else:
-        result = _solve_default(qp, warm, eps, max_iter)
-        if result.info.status == proxqp.PROXQP_PRIMAL_INFEASIBLE:
-            # ProxQP's default infeasibility tolerance (1e-4) flags some feasible QPs: once more
-            # with the strict one before believing it (a box QP that x = 0 satisfies was flagged
-            # after 13 iterations: tests/test_qp.py, seed 8425)
-            result = _solve_set(qp, warm, eps, max_iter, None, STRICT_INFEASIBILITY_EPS)
+        result = _solve_default_checked(qp, warm, eps, max_iter)
     info = result.info
     status = info.status
     near = (
@@ -184,6 +179,18 @@ def solve_qp(
         float(info.pri_res),
         float(info.dua_res),
     )
+
+
+def _solve_default_checked(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -> Any:
+    """:func:`_solve_default`, and once more with :data:`STRICT_INFEASIBILITY_EPS` when it says
+    the QP cannot hold: ProxQP's default infeasibility tolerance (1e-4) flags some feasible QPs
+    (a box QP that x = 0 satisfies was flagged after 13 iterations: tests/test_qp.py, seed 8425)."""
+    import proxsuite
+
+    result = _solve_default(qp, warm, eps, max_iter)
+    if result.info.status == proxsuite.proxqp.PROXQP_PRIMAL_INFEASIBLE:
+        result = _solve_set(qp, warm, eps, max_iter, None, STRICT_INFEASIBILITY_EPS)
+    return result
 
 
 def _solve_default(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -> Any:
