@@ -53,6 +53,32 @@ def test_loopback_is_told_apart_from_every_interface() -> None:
     assert not check_listen("0.0.0.0").loopback
 
 
+@pytest.mark.parametrize(
+    ("host", "why"),
+    [
+        ("224.0.0.1", "224.0.0.1 is a multicast address"),
+        ("239.1.2.3", "239.1.2.3 is a multicast address"),
+        ("ff02::1", "ff02::1 is a multicast address"),
+        ("255.255.255.255", "255.255.255.255 is the broadcast address"),
+        # the loopback network's broadcast: Linux binds it and nothing connects (elsewhere: no bind)
+        ("127.255.255.255", "(nothing can connect to|cannot listen on) 127.255.255.255"),
+    ],
+)
+def test_a_multicast_or_broadcast_host_is_refused(host: str, why: str) -> None:
+    """Linux lets a TCP socket bind and listen on these (the page "served", and no browser
+    could reach it): refused, naming the address and why."""
+    with pytest.raises(InvalidParameterError, match=rf"--host = '{host}' is invalid: .*{why}"):
+        check_listen(host)
+
+
+def test_tune_on_a_broadcast_address_is_one_line_and_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    from twolink_pin.cli import main
+
+    assert main(["tune", "pd", "--host", "255.255.255.255", "--no-browser", "--duration", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "broadcast address" in err and "Traceback" not in err
+
+
 # --- where the page writes ------------------------------------------------------------
 
 
@@ -256,14 +282,15 @@ def test_save_and_export_write_inside_the_folder_offer_downloads_and_refuse_othe
         lines.get(timeout=WAIT)
         assert tuner.session.idle(WAIT)
         shown = tuner._latest.result  # the run on screen
+        files = tuner.files  # the folder "as a command"
         for refused in (str(outside), "../outside.npz"):
-            tuner.save_path.value = refused
-            tuner._save(page)  # the button's handler
-            assert tuner.saved.content.startswith("**not saved**") and refused in tuner.saved.content
-        tuner.save_path.value = "runs/kept.npz"
-        tuner._save(page)
-        tuner.html_path.value = "arm.html"
-        tuner._export(page)
+            files.save_path.value = refused
+            files.save(page)  # the button's handler
+            assert files.saved.content.startswith("**not saved**") and refused in files.saved.content
+        files.save_path.value = "runs/kept.npz"
+        files.save(page)
+        files.html_path.value = "arm.html"
+        files.export(page)
     finally:
         tuner.close()
     assert not outside.exists() and sorted(p.name for p in folder.rglob("*")) == [
