@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 import pytest
@@ -50,55 +51,63 @@ def mpc() -> Iterator[Tune]:
         tune.stop()
 
 
-def sized(width: int, height: int) -> Any:
+@contextmanager
+def sized(width: int, height: int) -> Iterator[Any]:
     """A Chromium whose page is exactly ``width`` × ``height`` CSS pixels."""
     require_chromium()
-    context = start_chromium(width, height)
-    driver = context.__enter__()
-    driver.execute_cdp_cmd(
-        "Emulation.setDeviceMetricsOverride",
-        {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False},
-    )
-    return context, driver
+    with start_chromium(width, height) as driver:
+        driver.execute_cdp_cmd(
+            "Emulation.setDeviceMetricsOverride",
+            {"width": width, "height": height, "deviceScaleFactor": 1, "mobile": False},
+        )
+        yield driver
 
 
-@pytest.mark.parametrize(("width", "height"), SIZES)
-def test_the_table_and_a_plot_stay_in_view_while_a_slider_far_down_moves(
-    mpc: Tune, width: int, height: int
+@pytest.fixture(scope="module")
+def laptop() -> Iterator[Any]:
+    with sized(*SIZES[0]) as driver:
+        yield driver
+
+
+def check_in_view(mpc: Tune, driver: Any) -> None:
+    """Focus mpc's last gain's slider, press ←, wait for the run on the page: the table, the
+    first plot and the slider are in view and uncovered, the results right of the slider."""
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    driver.get(mpc.url)
+    thumb = slider(driver, "limit_scale")  # the last gain, below twenty rows of controls
+    before = float(thumb.get_attribute("aria-valuenow"))
+    press(thumb, Keys.ARROW_LEFT)  # the controls' column scrolls it into view; 0.05 down
+    line = mpc.next(lambda x: ran(x) and x["gains"]["limit_scale"] == round(before - 0.05, 2))
+    WebDriverWait(driver, WAIT).until(lambda d: f"run {line['run']}: " in page_text(d))
+    where = driver.execute_script(GEOMETRY)
+    assert where == {"table": True, "plot": True, "thumb": True, "apart": True}, where
+
+
+def test_at_1366_by_768_the_table_and_a_plot_stay_in_view_while_a_slider_far_down_moves(
+    mpc: Tune, laptop: Any
 ) -> None:
+    check_in_view(mpc, laptop)
+
+
+def test_at_1920_by_1080_the_table_and_a_plot_stay_in_view_while_a_slider_far_down_moves(mpc: Tune) -> None:
+    with sized(*SIZES[1]) as driver:
+        check_in_view(mpc, driver)
+
+
+def test_the_horizon_moves_one_knot_a_press_and_follows_its_knot_interval(mpc: Tune, laptop: Any) -> None:
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 
-    context, driver = sized(width, height)
-    try:
-        driver.get(mpc.url)
-        thumb = slider(driver, "limit_scale")  # the last gain, below twenty rows of controls
-        before = float(thumb.get_attribute("aria-valuenow"))
-        press(thumb, Keys.ARROW_LEFT)  # the controls' column scrolls it into view; 0.05 down
-        line = mpc.next(lambda x: ran(x) and x["gains"]["limit_scale"] == round(before - 0.05, 2))
-        WebDriverWait(driver, WAIT).until(lambda d: f"run {line['run']}: " in page_text(d))
-        where = driver.execute_script(GEOMETRY)
-        assert where == {"table": True, "plot": True, "thumb": True, "apart": True}, where
-    finally:
-        context.__exit__(None, None, None)
-
-
-def test_the_horizon_moves_one_knot_a_press_and_follows_its_knot_interval(mpc: Tune) -> None:
-    from selenium.webdriver.common.keys import Keys
-    from selenium.webdriver.support.ui import WebDriverWait
-
-    context, driver = sized(*SIZES[0])
-    try:
-        driver.get(mpc.url)
-        press(slider(driver, "horizon [s]"), Keys.ARROW_RIGHT)
-        line = mpc.next(lambda x: ran(x) and x["gains"]["horizon"] != 0.2)
-        assert line["gains"]["horizon"] == 9 * 0.025 and line["gains"]["knot_interval"] == 0.025
-        box = number_box(driver, "knot_interval [s]")
-        type_into(box, "0.03")
-        press(box, Keys.ENTER)
-        moved = mpc.next(lambda x: ran(x) and x["gains"]["knot_interval"] == 0.03)
-        assert moved["gains"]["horizon"] == 8 * 0.03  # 0.225 s is 7.5 knots of 0.03 s: 8 (half to even)
-        assert f"--gain=horizon={json.dumps(8 * 0.03)}" in moved["command"]
-        WebDriverWait(driver, WAIT).until(lambda d: "horizon rounded to 8 × knot_interval" in page_text(d))
-    finally:
-        context.__exit__(None, None, None)
+    driver = laptop
+    press(slider(driver, "horizon [s]"), Keys.ARROW_RIGHT)
+    line = mpc.next(lambda x: ran(x) and x["gains"]["horizon"] != 0.2)
+    assert line["gains"]["horizon"] == 9 * 0.025 and line["gains"]["knot_interval"] == 0.025
+    box = number_box(driver, "knot_interval [s]")
+    type_into(box, "0.03")
+    press(box, Keys.ENTER)
+    moved = mpc.next(lambda x: ran(x) and x["gains"]["knot_interval"] == 0.03)
+    assert moved["gains"]["horizon"] == 8 * 0.03  # 0.225 s is 7.5 knots of 0.03 s: 8 (half to even)
+    assert f"--gain=horizon={json.dumps(8 * 0.03)}" in moved["command"]
+    WebDriverWait(driver, WAIT).until(lambda d: "horizon rounded to 8 × knot_interval" in page_text(d))

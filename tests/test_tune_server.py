@@ -371,3 +371,42 @@ def test_the_default_run_holds_three_periods_as_help_says(capsys: pytest.Capture
         parser.parse_args(["tune", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "default: 3 periods of the reference" in text and "(default 30)" not in text
+
+
+# --- numbers typed into the page's boxes (what the script sends, without a page) --------
+
+
+def test_typed_numbers_reach_the_run_settings_the_plant_and_the_playback_or_are_refused_there() -> None:
+    """The script's messages, as a page sends them: "2" into ``periods`` runs two periods;
+    "-1" into ``delay [steps]`` and "0" into the playback's speed are refused beside them,
+    naming what is expected, and nothing runs; "2e0" into the speed plays twice as fast."""
+    import json
+
+    tuner, lines = _tuner("pd", 0.2)
+    try:
+        lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        channel = tuner.panel.channel
+
+        def typed(n: int, label: str, text: str) -> None:
+            channel.received(json.dumps({"page": "p", "items": [[n, label, 0, text]]}))
+
+        typed(1, "periods", "2")
+        line = lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        typed(2, "delay [steps]", "-1")
+        typed(3, "speed", "0")
+        refused_speed = tuner.scene.note.content
+        typed(4, "speed", "2e0")
+        plant_note, speed_note = tuner.panel.plant.error.content, tuner.scene.note.content
+        speed = float(tuner.scene.speed.value)
+        generation = tuner.session.generation
+    finally:
+        tuner.close()
+    assert line["spec"]["simulation"]["duration"] == 8.0  # two 4-s periods of the twolink's reference
+    assert plant_note.startswith(
+        "**refused**: delay [steps] = '-1' is invalid: expected a whole number from 0 to"
+    )
+    assert refused_speed == "**refused**: speed = '0' is invalid: expected a number > 0"
+    assert speed_note == "" and speed == 2.0  # then "2e0" taken
+    assert generation == 2  # the refused values ran nothing; the speed is the playback's

@@ -3,7 +3,7 @@ the effort limits, the payload, a push (force and window), sensor noise and dela
 :class:`~twolink_pin.plant.PlantOptions` they describe.
 
 This is the one place of the page that knows the plant's options: a new one (another
-engine, contact) is a control added in :meth:`PlantControls.__init__`, its number boxes
+engine, contact) is a control added where :class:`PlantControls` makes the others, its number boxes
 registered with the channel, and its value set in :meth:`PlantControls.options`.
 
 A number typed into a box here runs on Enter or when the box loses focus (:mod:`.typed_js`),
