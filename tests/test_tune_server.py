@@ -410,3 +410,20 @@ def test_typed_numbers_reach_the_run_settings_the_plant_and_the_playback_or_are_
     assert refused_speed == "**refused**: speed = '0' is invalid: expected a number > 0"
     assert speed_note == "" and speed == 2.0  # then "2e0" taken
     assert generation == 2  # the refused values ran nothing; the speed is the playback's
+
+
+def test_the_plant_folders_engine_runs_the_arm_on_mujoco_and_its_line_says_so() -> None:
+    """The engine menu (the plant's folder) set to mujoco: the run and its command line are
+    MuJoCo's (``--plant mujoco``), as ``simulate`` would run it."""
+    tuner, lines = _tuner("pd", 0.2)
+    try:
+        lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        assert tuple(tuner.panel.plant.engine.options) == ("pinocchio", "mujoco")
+        tuner.panel.plant.engine.value = "mujoco"
+        tuner.changed()
+        line = lines.get(timeout=WAIT)
+    finally:
+        tuner.close()
+    assert "error" not in line, line
+    assert line["spec"]["plant"]["engine"] == "mujoco" and "--plant=mujoco" in line["command"]

@@ -28,6 +28,10 @@ from twolink_pin.errors import OptimizationError
 
 DEFAULT_EPS = 1e-9
 """Absolute tolerance on the primal and dual residuals (ProxQP's ``eps_abs``)."""
+STRICT_INFEASIBILITY_EPS = 1e-9
+"""ProxQP's primal and dual infeasibility tolerances for a second solve of a QP its default
+(1e-4) flagged infeasible: a problem that truly cannot hold is flagged again (or named below by
+its closest point), a feasible one is solved."""
 DEFAULT_MAX_ITER = 10_000
 """Most ProxQP iterations of one solve."""
 
@@ -147,6 +151,11 @@ def solve_qp(
         result = _solve_set(qp, warm, eps, max_iter, rho, infeasibility_eps)
     else:
         result = _solve_default(qp, warm, eps, max_iter)
+        if result.info.status == proxqp.PROXQP_PRIMAL_INFEASIBLE:
+            # ProxQP's default infeasibility tolerance (1e-4) flags some feasible QPs: once more
+            # with the strict one before believing it (a box QP that x = 0 satisfies was flagged
+            # after 13 iterations: tests/test_qp.py, seed 8425)
+            result = _solve_set(qp, warm, eps, max_iter, None, STRICT_INFEASIBILITY_EPS)
     info = result.info
     status = info.status
     near = (

@@ -1,5 +1,6 @@
-"""The plant's controls in Viser's GUI (the folder *plant*): the plant's friction, saturation at
-the effort limits, the payload, a push (force and window), sensor noise and delay, and the
+"""The plant's controls in Viser's GUI (the folder *plant*): the engine the arm runs on
+(``--plant``: Pinocchio's, MuJoCo's), the plant's friction, saturation at the effort limits,
+the payload, a push (force and window), sensor noise and delay, and the
 :class:`~twolink_pin.plant.PlantOptions` they describe.
 
 This is the one place of the page that knows the plant's options: a new one (another
@@ -20,7 +21,7 @@ from typing import Any
 
 from twolink_pin.disturbances import SensorNoise, Wrench
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.plant import FRICTION_CHOICES, PlantOptions
+from twolink_pin.plant import ENGINES, FRICTION_CHOICES, PlantOptions
 from twolink_pin.tuning.typed import Channel, read_number
 
 MAX_PUSH = 1000.0
@@ -47,6 +48,12 @@ class PlantControls:
     ) -> None:
         self._base, self._changed = base, changed
         wrench = base.wrench
+        self.engine = gui.add_dropdown(
+            "engine",
+            tuple(ENGINES),
+            initial_value=base.engine,
+            hint="the simulator the arm runs on (--plant)",
+        )
         self.friction = gui.add_dropdown("plant friction", FRICTION_CHOICES, initial_value=base.friction)
         self.saturate = gui.add_checkbox("saturate at the effort limits", base.saturate)
         self.payload = gui.add_number("payload [kg]", payload, min=0.0, max=MAX_PAYLOAD, step=0.1)
@@ -67,6 +74,7 @@ class PlantControls:
         self.delay = gui.add_number("delay [steps]", int(base.delay), min=0, max=MAX_DELAY, step=1)
         self.error = gui.add_markdown("")
         for handle in (
+            self.engine,
             self.friction,
             self.saturate,
             self.payload,
@@ -162,6 +170,7 @@ class PlantControls:
             noise = None
         return dataclasses.replace(
             base,
+            engine=str(self.engine.value),
             friction=str(self.friction.value),
             saturate=bool(self.saturate.value),
             wrench=wrench,
