@@ -1226,6 +1226,12 @@ def _tune_page_latency(
                 lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
             )
             if not playing:
+                driver.find_element("xpath", "//*[text()='playback']").click()  # its folder starts closed
+                WebDriverWait(driver, 600).until(
+                    lambda d: d.execute_script(
+                        "return Array.from(document.querySelectorAll('label')).some(e => e.textContent === 'play')"
+                    )
+                )
                 driver.execute_script(
                     "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
                     "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"

@@ -215,7 +215,7 @@ def tune() -> list[Path]:
         assert proc.stdout is not None
         url = json.loads(proc.stdout.readline())["url"]
         proc.stdout.readline()  # the first run
-        return [_photograph(url, IMAGES / "tune.png", 1280, 800, TUNE_READY)]
+        return [_photograph(url, IMAGES / "tune.png", 1366, 768, TUNE_READY)]  # a laptop's screen
     finally:
         proc.send_signal(signal.SIGINT)
         proc.wait(timeout=60)

@@ -17,8 +17,11 @@ OpenMP's wait policy is set here, before anything below imports Pinocchio (see
 :mod:`twolink_pin.openmp`): ``OMP_WAIT_POLICY=PASSIVE`` unless the user set it.
 """
 
-from twolink_pin import mujoco_plant as _mujoco_plant  # noqa: F401  # registers the engine 'mujoco' (--plant mujoco)
 from twolink_pin import openmp as _openmp  # noqa: F401  # first: sets the wait policy before pinocchio loads
+
+# isort: split
+
+from twolink_pin import mujoco_plant as _mujoco_plant  # noqa: F401  # registers the engine 'mujoco' (--plant mujoco)
 from twolink_pin.contact import Scene, Surface, read_scene
 from twolink_pin.contact_metrics import ContactMetrics, contact_metrics
 from twolink_pin.controllers import (

@@ -4,29 +4,14 @@ A run asks for them in its :class:`~twolink_pin.plant.PlantOptions`; the plant o
 models them as this table says (``both``: the two plants give the same motion, to rounding, with
 the engine's RK4; ``mujoco``: refused on the Pinocchio plant, which has no such element).
 
-=================  ==============  =======  ==============================================================
-effect             unit            plants   what it is, and how each plant models it
-=================  ==============  =======  ==============================================================
-``armature``       kg·m²           both     rotor inertia reflected through the gearbox, added to
-                                            ``M(q)``'s diagonal: Pinocchio's ``model.armature`` (ABA and
-                                            CRBA include it), MuJoCo's ``dof_armature``
-``joint_damping``  N·m·s/rad       both     ``τ_j −= d_j q̇_j``: subtracted from the torque that drives
-                                            Pinocchio's ABA; MuJoCo's ``dof_damping`` (``qfrc_passive``,
-                                            integrated implicitly by its ``euler`` and ``implicitfast``)
-``frictionloss``   N·m             mujoco   dry friction as MuJoCo's constraint: a joint sticks while
-                                            the force needed to hold it is below ``F_j``, slides against
-                                            ``F_j`` otherwise (soft: a slow creep while it sticks)
-``soft_limits``    (s, —)          mujoco   each joint's position range (the URDF's, as
-                                            :func:`~twolink_pin.limits.joint_limits` reads it) as MuJoCo's
-                                            joint-limit constraint, stiff but not infinitely: ``solref``
-                                            (time constant [s], damping ratio) and ``solimp``
-                                            (d0, dwidth, width [rad], midpoint, power)
-``saturate``       N·m             both     the URDF's effort limit as a clamp: ``np.clip`` on Pinocchio,
-                                            the actuator's force range on MuJoCo
-``integrator``     —               mujoco   ``rk4``: the engine's RK4 on MuJoCo's forward dynamics, the
-                                            law at every stage; ``euler``, ``implicitfast``: MuJoCo's
-                                            ``mj_step`` with that integrator, the law held over each step
-=================  ==============  =======  ==============================================================
+| effect | unit | plants | what it is, and how each plant models it |
+|---|---|---|---|
+| ``armature`` | kg·m² | both | rotor inertia reflected through the gearbox, added to ``M(q)``'s diagonal: Pinocchio's ``model.armature`` (ABA and CRBA include it), MuJoCo's ``dof_armature`` |
+| ``joint_damping`` | N·m·s/rad | both | ``τ_j −= d_j q̇_j``: subtracted from the torque that drives Pinocchio's ABA; MuJoCo's ``dof_damping`` (``qfrc_passive``, integrated implicitly by its ``euler`` and ``implicitfast``) |
+| ``frictionloss`` | N·m | mujoco | dry friction as MuJoCo's constraint: a joint sticks while the force needed to hold it is below ``F_j``, slides against ``F_j`` otherwise (soft: a slow creep while it sticks) |
+| ``soft_limits`` | (s, —) | mujoco | each joint's position range (the URDF's, as :func:`~twolink_pin.limits.joint_limits` reads it) as MuJoCo's joint-limit constraint, stiff but not infinitely: ``solref`` (time constant [s], damping ratio) and ``solimp`` (d0, dwidth, width [rad], midpoint, power) |
+| ``saturate`` | N·m | both | the URDF's effort limit as a clamp: ``np.clip`` on Pinocchio, the actuator's force range on MuJoCo |
+| ``integrator`` | — | mujoco | ``rk4``: the engine's RK4 on MuJoCo's forward dynamics, the law at every stage; ``euler``, ``implicitfast``: MuJoCo's ``mj_step`` with that integrator, the law held over each step |
 
 Where a per-joint value comes from (:func:`resolve_effect`): ``arm`` — the robot's profile
 (:class:`~twolink_pin.model.profile.ArmEffects`, its source cited), and for ``joint_damping`` and
