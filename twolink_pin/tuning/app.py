@@ -15,6 +15,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
 from twolink_pin.tuning.knobs import choices_of, knob_changes, knobs_of, matrices_of
