@@ -1532,17 +1532,20 @@ CONTACT_GOALS = {"hybrid_force_rms_error_N": 0.5, "contact_cost_ratio": 1.5}
 contact [N]; a run against the wall over the same run without it (time ratio)."""
 
 
+CONTACT_PLANTS = ("pinocchio", "mujoco")
+"""The plants the contact lab and its cost run on (``PlantOptions.engine``)."""
+CONTACT_LAWS = (("hybrid", {}), ("force", {}), ("impedance", {"k": 1000.0, "d": 300.0}))
+"""The lab's laws and their gains (impedance's stiffness: with the wall in series, about 10 N)."""
+
+
 def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
     """Issue 46: the contact lab on the twolink (examples/wall.toml, examples/wall_slide.toml;
-    scripts/contact_lab.py) — each law's contact metrics, ``hybrid``'s force RMS error against
-    its goal; then the cost of the contact: the lab's run with the wall and the same run without
-    it (the law, reference and step alike; the wall's scene left out), interleaved, the fastest
-    of ``repeats`` each, as a ratio (impedance: the lab's law that runs either way; pd: the
-    cheapest law, the contact's share largest)."""
+    scripts/contact_lab.py) on each plant — each law's contact metrics, ``hybrid``'s force RMS
+    error against its goal; then the cost of the contact on each plant: the lab's run with the
+    wall and the same run without it on the same plant (the law, reference and step alike; the
+    wall's scene left out), interleaved, the fastest of ``repeats`` each, as a ratio (impedance:
+    the lab's law that runs either way; pd: the cheapest law, the contact's share largest)."""
     from twolink_pin.contact import read_scene
-    from twolink_pin.contact_metrics import contact_metrics
-    from twolink_pin.plant import PlantOptions
-    from twolink_pin.run_spec import RunSpec
     from twolink_pin.trajectory import read_trajectory_file
 
     robot = load_robot()
@@ -1550,13 +1553,28 @@ def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
     scene = read_scene(examples / "wall.toml")
     lab = read_trajectory_file(examples / "wall_slide.toml", robot)
     config = SimulationConfig(duration=2.0 if quick else 6.0, q0_offset=0.0)
+    metrics = {engine: _contact_lab(robot, scene, lab, config, engine) for engine in CONTACT_PLANTS}
     reference = with_force(lab, None)  # the force column means nothing to the laws of the cost's runs
-    print(f"\ncontact lab on the twolink ({config.duration:g} s; goal: hybrid's force RMS error <= 0.5 N)")
+    cost = {
+        engine: _contact_cost(robot, scene, reference, config, engine, repeats) for engine in CONTACT_PLANTS
+    }
+    return {"contact": {"lab": metrics, "cost": cost, "goals": CONTACT_GOALS}}
+
+
+def _contact_lab(robot: Any, scene: Any, lab: Any, config: SimulationConfig, engine: str) -> dict[str, Any]:
+    """The lab's laws against the wall on the plant ``engine``: their contact metrics (printed)."""
+    from twolink_pin.contact_metrics import contact_metrics
+    from twolink_pin.plant import PlantOptions
+    from twolink_pin.run_spec import RunSpec
+
+    print(
+        f"\ncontact lab on the twolink, {engine} plant ({config.duration:g} s; goal: hybrid's force RMS "
+        "error <= 0.5 N)"
+    )
     metrics: dict[str, Any] = {}
-    for law, gains in (("hybrid", {}), ("force", {}), ("impedance", {"k": 1000.0, "d": 300.0})):
-        spec = RunSpec(
-            law=law, gains=tuple(gains.items()), plant=PlantOptions(scene=scene), simulation=config
-        )
+    for law, gains in CONTACT_LAWS:
+        plant = PlantOptions(scene=scene, engine=engine)
+        spec = RunSpec(law=law, gains=tuple(gains.items()), plant=plant, simulation=config)
         m = contact_metrics(simulate(*spec.build(robot), lab, config), robot)
         assert m is not None
         metrics[law] = m.as_dict()
@@ -1568,16 +1586,30 @@ def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
     rms = metrics["hybrid"]["force_rms_error"]
     verdict = "met" if rms is not None and rms <= CONTACT_GOALS["hybrid_force_rms_error_N"] else "NOT met"
     print(f"  hybrid's force RMS error {rms:.3g} N (goal <= 0.5 N: {verdict})")
+    return metrics
+
+
+def _contact_cost(
+    robot: Any, scene: Any, reference: Any, config: SimulationConfig, engine: str, repeats: int
+) -> dict[str, Any]:
+    """The lab's run with the wall over the same run without it, both on the plant ``engine``."""
+    from twolink_pin.plant import PlantOptions
+    from twolink_pin.run_spec import RunSpec
+
     cost: dict[str, Any] = {}
-    print(f"contact's cost: the lab's run with the wall / without it (fastest of {repeats}, interleaved)")
+    print(
+        f"contact's cost on the {engine} plant: the lab's run with the wall / without it (fastest of {repeats}, interleaved)"
+    )
     for law, gains in (("impedance", {"k": 1000.0, "d": 300.0}), ("pd", {})):
-        walled = RunSpec(
-            law=law, gains=tuple(gains.items()), plant=PlantOptions(scene=scene), simulation=config
-        )
-        free = RunSpec(law=law, gains=tuple(gains.items()), simulation=config)
+        walled = PlantOptions(scene=scene, engine=engine)
+        free = PlantOptions(engine=engine)
+        specs = {
+            key: RunSpec(law=law, gains=tuple(gains.items()), plant=plant, simulation=config)
+            for key, plant in (("wall", walled), ("free", free))
+        }
         times: dict[str, list[float]] = {"wall": [], "free": []}
         for _ in range(repeats):
-            for key, spec in (("wall", walled), ("free", free)):
+            for key, spec in specs.items():
                 scenario = spec.build(robot)
                 times[key].append(_timed(lambda s=scenario: simulate(*s, reference, config)))
         ratio = min(times["wall"]) / min(times["free"])
@@ -1591,7 +1623,7 @@ def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
                 else " (the cheapest law: the contact's share at its largest)"
             )
         )
-    return {"contact": {"lab": metrics, "cost": cost, "goals": CONTACT_GOALS}}
+    return cost
 
 
 def main(argv: list[str] | None = None) -> int:

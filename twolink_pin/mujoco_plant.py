@@ -47,6 +47,7 @@ import numpy as np
 from twolink_pin.arm_effects import MUJOCO_ONLY, SOLIMP, SOLREF, per_joint
 from twolink_pin.dynamics import smooth_sign
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.mujoco_contact import MujocoContact, add_scene, set_contact_properties
 from twolink_pin.mujoco_model import compile_model, require_mujoco
 from twolink_pin.plant import Plant, register_engine
 
@@ -88,10 +89,6 @@ class MujocoPlant(Plant):
         object.__setattr__(self, "solimp", tuple(self.solimp or SOLIMP))
         if self.integrator not in ("rk4", "euler", "implicitfast"):
             raise InvalidParameterError("integrator", self.integrator, "rk4, euler or implicitfast")
-        if self.scene is not None:  # MuJoCo's own contact is not built yet: never the other plant's
-            raise InvalidParameterError(
-                "--plant", "mujoco", "the pinocchio plant with a scene (the MuJoCo plant has no contact yet)"
-            )
         model = compile_model(
             self.robot,
             armature=self.armature,
@@ -103,7 +100,10 @@ class MujocoPlant(Plant):
             saturate=self.saturate,
             payload=self.carried,
             integrator=self.integrator,
+            scene=None if self.scene is None else add_scene(self.robot, self.scene),
         )
+        if self.scene is not None:
+            set_contact_properties(require_mujoco(), model, self.scene)
         object.__setattr__(self, "mj_model", model)
 
     @property
@@ -118,6 +118,15 @@ class MujocoPlant(Plant):
             return SteppedDynamics(self) if stepped else MujocoDynamics(self).fast()
         return (
             SteppedBatchDynamics(self, runs, threads) if stepped else MujocoBatchDynamics(self, runs, threads)
+        )
+
+    def contact_model(self, runs: int, step: float | None = None) -> MujocoContact | None:  # type: ignore[override]
+        """MuJoCo's own contact with the scene, read from the runs' ``MjData``
+        (:class:`~twolink_pin.mujoco_contact.MujocoContact`; MuJoCo applies it: no ``tau``)."""
+        if self.scene is None:
+            return None
+        return MujocoContact(
+            self.mj_model, self.robot, self.scene, runs, step if self.law_per_stage else None
         )
 
     def after_payload(self) -> MujocoPlant:
@@ -166,6 +175,7 @@ class MujocoDynamics:
         self._forward = mujoco.mj_forward
         self.model = model = copy.copy(plant.mj_model)  # its own options (the step)
         self.data = data = mujoco.MjData(model)
+        self._datas = [data]
         nv = model.nv
         self._qpos, self._qvel = data.qpos.reshape(1, nv), data.qvel.reshape(1, nv)
         self._qacc, self._applied = data.qacc.reshape(1, nv), data.qfrc_applied.reshape(1, nv)
@@ -204,6 +214,8 @@ class MujocoDynamics:
             return qacc.copy()
 
         accel.failure = self.failure  # type: ignore[attr-defined]
+        accel.datas = self.datas  # type: ignore[attr-defined]
+        accel.model = model  # type: ignore[attr-defined]
         return accel
 
     def _load(
@@ -226,6 +238,10 @@ class MujocoDynamics:
             viscous, coulomb = self._friction
             applied = applied - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
         self._applied[...] = applied if external is None else applied + external
+
+    def datas(self) -> list[Any]:
+        """The run's ``MjData`` (its contacts: :class:`~twolink_pin.mujoco_contact.MujocoContact`)."""
+        return self._datas
 
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of a failed run: its warnings, or its last ``q̈`` if non-finite or huge."""
@@ -264,11 +280,16 @@ class MujocoBatchDynamics:
         from mujoco import batch
 
         self.model = model = copy.copy(plant.mj_model)
-        self.batch = b = batch.Batch(model, nsim=runs, nthread=max(1, threads or 1))
+        # persistent: each run's whole MjData kept, its contacts read by get_data (a scene)
+        self.batch = b = batch.Batch(
+            model, nsim=runs, nthread=max(1, threads or 1), persistent=plant.scene is not None
+        )
         self._qpos, self._qvel, self._applied = b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied")
         self._ctrl = b.bind("ctrl") if plant.saturate else None
         self._qacc = b.bind("qacc")
         self._plant = plant
+        self._datas: list[Any] | None = None
+        self._ncon: np.ndarray | None = None
         friction = plant.friction
         self._friction = friction
 
@@ -294,6 +315,17 @@ class MujocoBatchDynamics:
         if self._friction is not None:
             applied = applied - self._friction.torque(v)
         self._applied[...] = applied if external is None else applied + external
+
+    def datas(self) -> list[Any]:
+        """Each run's ``MjData`` after the batch's last call, None for a run without contacts (its
+        contacts: :class:`~twolink_pin.mujoco_contact.MujocoContact`; copied out of the batch)."""
+        b = self.batch
+        if self._datas is None:
+            self._datas = [self._mujoco.MjData(self.model) for _ in range(b.nsim)]
+            self._ncon = b.bind("ncon")
+        ncon = self._ncon
+        assert ncon is not None
+        return [b.get_data(i, data) if n else None for i, (n, data) in enumerate(zip(ncon, self._datas))]
 
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of run ``run``'s failure (its warnings, or its last ``q̈``)."""

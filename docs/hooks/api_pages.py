@@ -65,6 +65,7 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
             "arm_effects",
             "mujoco_model",
             "mujoco_plant",
+            "mujoco_contact",
             "disturbances",
             "contact",
             "scenario",

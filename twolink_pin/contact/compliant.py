@@ -217,6 +217,11 @@ class CompliantContact:
         centres = position[:, None, :] - self._radius * self._normals[None]
         return np.column_stack([s.over_face(centres[:, i]) for i, s in enumerate(self.scene.surfaces)])
 
+    def check_starts(self, q: np.ndarray, touching: set[tuple[int, int]]) -> None:
+        """As the engine steps a contact of its own (MuJoCo's): ``touching`` the ``(run, surface)``
+        in contact at the state ``q`` (N, nv); each that starts checked (:meth:`_check_step`)."""
+        self._check_step(q, touching)
+
     def _check_step(self, q: np.ndarray, touching: set[tuple[int, int]]) -> None:
         """Fail the run when a contact that starts here is too stiff for the step (the effective
         mass at the state where it starts; :func:`~twolink_pin.contact.stability.too_stiff`)."""

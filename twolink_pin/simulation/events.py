@@ -8,7 +8,9 @@ events it asks :class:`PlantEvents` (built once per run) at each step k (``t_k =
   the payload from its step on, ``F_k`` the wrench if on during step k (``J`` the wrench
   frame's world-aligned Jacobian at each RK4 stage), ``τ_c`` the contact's joint torque with a
   scene (:attr:`PlantEvents.contact`, :class:`~twolink_pin.contact.CompliantContact`); neither
-  is saturated (the motors' limits clip the motors' torque only);
+  is saturated (the motors' limits clip the motors' torque only). A contact its engine applies
+  itself (``pushes`` False: MuJoCo's, :mod:`twolink_pin.mujoco_contact`) adds no ``τ_c`` and
+  follows (``follow``) the step's dynamics, whose runs it reads;
 * :meth:`PlantEvents.noise_at` — the law's measurement offset ``(q, q̇) + noise_k`` (one
   noise sample per step and run, from the run's own generator, drawn block by block so that
   a run's noise does not depend on its batch; :meth:`PlantEvents.draw` per block), and the
@@ -96,6 +98,8 @@ class PlantEvents:
         self.contact = plant.contact_model(runs, dt)
         """The plant's contact with its scene (:meth:`~twolink_pin.plant.Plant.contact_model`;
         None without one); ``dt`` [s]: the step it is checked against."""
+        self._follow = getattr(self.contact, "follow", None)
+        self._pushes = getattr(self.contact, "pushes", True)
         self.felt = self.noise is not None and self.noise.sigma_f > 0 and self.contact is not None
         """Whether the force sensor is noisy (:meth:`force_noise`)."""
         self._force_generators = (
@@ -128,14 +132,17 @@ class PlantEvents:
             contact.time = t
         key = (after, pushing)
         accel = self._accels.get(key)
-        if accel is None:
+        if accel is None or self._follow is not None:
             dynamics = self._after if after and self._after is not None else self._before
-            accel = self._accels[key] = self._accel(dynamics, pushing)
+            if self._follow is not None:  # a contact its engine computes: read from these runs
+                self._follow(dynamics)
+            if accel is None:
+                accel = self._accels[key] = self._accel(dynamics, pushing)
         return accel
 
     def _accel(self, dynamics: Accel, pushing: bool) -> Accel:
         """``q̈`` of ``dynamics`` with the wrench (``pushing``) and the contact, if any."""
-        contact = self.contact
+        contact = self.contact if self._pushes else None  # else its engine applies it itself
         if not pushing and contact is None:
             if hasattr(dynamics, "held_step"):  # a plant that steps itself: returns fresh arrays
                 return dynamics
