@@ -12,9 +12,9 @@ but impedance's stiffness (1000 N/m: with the surface in series, the reference's
 about 10 N). Prints one Markdown table per arm (force RMS and max error from 0.5 s after the
 first contact, peak impact force, RMS position error along the surface, max penetration: the
 contact metrics, :mod:`twolink_pin.contact_metrics`; a row per law and plant) and writes
-``contact_twolink.png`` and ``contact_panda.png``, ``…_mujoco.png`` on MuJoCo (the force with
-the desired force, the position along the surface, the penetration:
-:func:`~twolink_pin.plotting.contact.save_contact_figure`). The same runs are
+``contact_twolink.png`` and ``contact_panda.png`` (``contact_twolink_mujoco.png`` and
+``contact_panda_mujoco.png`` on MuJoCo: the force with the desired force, the position along
+the surface, the penetration: :func:`~twolink_pin.plotting.contact.save_contact_figure`). The same runs are
 ``twolink-pin compare hybrid force impedance --scene … --trajectory …`` (the page's commands).
 """
 

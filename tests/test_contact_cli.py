@@ -197,8 +197,11 @@ def test_the_lab_script_prints_its_table_and_draws_its_figure(
     spec.loader.exec_module(script)
     script.main(["--robots", "twolink", "--duration", "1.5", "--out", str(tmp_path)])
     table = capsys.readouterr().out.strip().splitlines()
-    assert [row.split("|")[1].strip() for row in table[2:]] == ["hybrid", "force", "impedance"]
+    rows = [(row.split("|")[1].strip(), row.split("|")[2].strip()) for row in table[2:]]
+    laws = ["hybrid", "force", "impedance"]
+    assert rows == [(law, plant) for plant in ("pinocchio", "mujoco") for law in laws]
     assert (tmp_path / "contact_twolink.png").is_file()
+    assert (tmp_path / "contact_twolink_mujoco.png").is_file()
 
 
 def test_the_reports_contact_table_reads_results_json_and_a_line_reference_has_no_coefficients() -> None:
