@@ -205,8 +205,11 @@ class MujocoContact:
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> ContactForces:
         touching: set[tuple[int, int]] = set()
-        run = self._run
-        rows = [None if data is None else run(data, i, touching) for i, data in enumerate(self._datas())]
+        run, datas = self._run, self._datas()
+        if self._runs == 1:  # one run: no list of rows (this runs at every RK4 stage)
+            rows = [None if datas[0] is None else run(datas[0], 0, touching)]
+        else:
+            rows = [None if data is None else run(data, i, touching) for i, data in enumerate(datas)]
         if touching != self._touching:
             if self._check is not None:
                 self._check.check_starts(q, touching)  # a contact too stiff for the step fails the run
@@ -241,7 +244,7 @@ class MujocoContact:
         for i in range(ncon):
             contact = data.contact[i]
             adr = contact.efc_address
-            if adr < 0 or contact.exclude:
+            if adr < 0:  # not in the constraint (excluded, or beyond the margin)
                 continue
             found = True
             dim = contact.dim
