@@ -38,8 +38,11 @@ as given (MuJoCo's meaning; K and B then unused on this plant).
 **What differs from the Pinocchio plant's contact** (:mod:`twolink_pin.contact.compliant`):
 MuJoCo's force is a constraint force: it never pulls (as the clip there), carries the added
 mass above, and below the friction cone it is MuJoCo's soft "stick" (a tangential viscous force
-``≈ B v_t``, capped at ``μ f_n``) where the Pinocchio plant's is ``μ λ v_t / √(v_t² + ε²)``; a
-box is touched on its sides and edges too (there only on its top face).
+``≈ B v_t``, capped at ``μ f_n``) where the Pinocchio plant's is ``μ λ v_t / √(v_t² + ε²)``;
+while the ball slides the elliptic cone couples the normal and friction rows, so part of the
+normal force is not the spring's (the ball penetrates less for the same force: ``f = K δ``
+holds at rest and without friction); a box is touched on its sides and edges too (there only on
+its top face).
 
 **The force sensor** (:class:`MujocoContact`, :meth:`MujocoPlant.contact_model
 <twolink_pin.mujoco_plant.MujocoPlant.contact_model>`) reads MuJoCo's contact force — a
