@@ -159,3 +159,20 @@ def test_a_contact_too_stiff_for_the_step_fails_on_mujoco_naming_the_limit() -> 
     with pytest.raises(ContactError, match=r"surface 'wall' at t = 0\.") as err:
         simulate(law, plant, held(at(0.52, 0.0)), SimulationConfig(duration=2.0, q0_offset=0.0))
     assert "largest stable stiffness at --dt 0.001 s" in str(err.value)
+
+
+def test_a_payload_step_in_contact_keeps_the_sensors_reading_on_mujoco() -> None:
+    """A payload picked up while hybrid presses on the wall (t = 1.5 s): MuJoCo's model after the
+    step takes over from the last state, so the sensor reads the contact through the switch (no
+    sample of zero force while the ball is pressed in)."""
+    from twolink_pin.disturbances import PayloadStep
+
+    scene = read_scene(EXAMPLES / "wall.toml")
+    trajectory = read_trajectory_file(EXAMPLES / "wall_slide.toml", ROBOT)
+    plant = PlantOptions(scene=scene, engine="mujoco", payload_step=PayloadStep(0.5, 1.5))
+    config = SimulationConfig(duration=1.8, q0_offset=0.0)
+    result = simulate(*RunSpec(law="hybrid", plant=plant, simulation=config).build(ROBOT), trajectory, config)
+    assert result.wrench is not None and result.penetration is not None
+    pressed = (result.t > 1.2) & (result.t < 1.8)
+    assert (result.penetration[pressed] > 1e-3).all()
+    assert (result.wrench[pressed, 0] > 5.0).all()  # f_n = −n·F on the wall (normal −x)

@@ -177,6 +177,7 @@ class MujocoContact:
         # the step's check where a contact starts (RK4 integrates MuJoCo's as the Pinocchio plant's)
         self._check = CompliantContact(robot, scene, runs, step) if step is not None else None
         self._datas: Any = list  # no dynamics followed yet: no run
+        self._followed: Any = None
         self._model = model
         self._force = np.zeros(6)
         self._touching: set[tuple[int, int]] = set()
@@ -204,6 +205,10 @@ class MujocoContact:
     def follow(self, dynamics: Any) -> None:
         """Read the contacts of ``dynamics`` from now on: its ``datas()``, each run's ``MjData``
         after its last call (None: a run without contacts)."""
+        followed = self._followed
+        if followed is not None and dynamics is not followed:  # a payload step: the plant after it
+            dynamics.resume(followed)  # its contacts at the last state read, before its first call
+        self._followed = dynamics
         self._model, self._datas = dynamics.model, dynamics.datas
 
     def __call__(self, q: np.ndarray, v: np.ndarray) -> ContactForces:

@@ -216,6 +216,8 @@ class MujocoDynamics:
         accel.failure = self.failure  # type: ignore[attr-defined]
         accel.datas = self.datas  # type: ignore[attr-defined]
         accel.model = model  # type: ignore[attr-defined]
+        accel.inputs = self.inputs  # type: ignore[attr-defined]
+        accel.resume = self.resume  # type: ignore[attr-defined]
         return accel
 
     def _load(
@@ -242,6 +244,17 @@ class MujocoDynamics:
     def datas(self) -> list[Any]:
         """The run's ``MjData`` (its contacts: :class:`~twolink_pin.mujoco_contact.MujocoContact`)."""
         return self._datas
+
+    def inputs(self) -> tuple[np.ndarray, ...]:
+        """The last call's ``qpos``, ``qvel``, ``qfrc_applied`` and ``ctrl`` rows, (1, ·) each."""
+        data = self.data
+        return data.qpos[None], data.qvel[None], data.qfrc_applied[None], data.ctrl[None]
+
+    def resume(self, previous: Any) -> None:
+        """Take over from ``previous`` (the plant before a payload step): its last call's inputs
+        evaluated here, so that the contact read before this plant's first call is its own."""
+        _resume(self.data.qpos, self.data.qvel, self.data.qfrc_applied, self.data.ctrl, previous)
+        self._forward(self.model, self.data)
 
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of a failed run: its warnings, or its last ``q̈`` if non-finite or huge."""
@@ -327,6 +340,17 @@ class MujocoBatchDynamics:
         assert ncon is not None
         return [b.get_data(i, data) if n else None for i, (n, data) in enumerate(zip(ncon, self._datas))]
 
+    def inputs(self) -> tuple[np.ndarray, ...]:
+        """The last call's ``qpos``, ``qvel``, ``qfrc_applied`` and ``ctrl`` rows, (N, ·) each."""
+        b = self.batch
+        return b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied"), b.bind("ctrl")
+
+    def resume(self, previous: Any) -> None:
+        """As :meth:`MujocoDynamics.resume`, every run."""
+        qpos, qvel, applied, ctrl = self.inputs()
+        _resume(qpos, qvel, applied, ctrl, previous)
+        self.batch.forward()
+
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of run ``run``'s failure (its warnings, or its last ``q̈``)."""
         return _warned(self._mujoco, self.batch.warning[run], self._qacc[run], counts_only=True)
@@ -356,16 +380,23 @@ class SteppedBatchDynamics(MujocoBatchDynamics):
             self._qpos, self._qvel, self._applied = b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied")
             self._ctrl = b.bind("ctrl") if self._ctrl is not None else None
             self._qacc = b.bind("qacc")
+            self._datas = None  # the contacts' reads bound to the new batch
         self._load(q, v, tau, external)
         self.batch.step()
         return self._qpos.copy(), self._qvel.copy(), (z + steps.hz * dz if nz else z)
+
+
+def _resume(qpos: np.ndarray, qvel: np.ndarray, applied: np.ndarray, ctrl: np.ndarray, previous: Any) -> None:
+    """``previous``'s last inputs written into these arrays (the same arm: the same sizes)."""
+    for target, source in zip((qpos, qvel, applied, ctrl), previous.inputs(), strict=True):
+        target[...] = source.reshape(target.shape)
 
 
 def _rebuilt(old: Any, model: Any) -> Any:
     """A batch of ``model`` (its options changed) carrying ``old``'s state rows."""
     from mujoco import batch
 
-    new = batch.Batch(model, nsim=old.nsim, nthread=old.nthread)
+    new = batch.Batch(model, nsim=old.nsim, nthread=old.nthread, persistent=old.persistent)
     new.state[...] = old.state
     return new
 
