@@ -48,7 +48,9 @@ def main(argv: list[str]) -> int:
     for name in argv:
         left = clean(Path(name))
         if left:
-            print(f"clean_report: kept {name}/ ({', '.join(left)}: not written by the report)", file=sys.stderr)
+            print(
+                f"clean_report: kept {name}/ ({', '.join(left)}: not written by the report)", file=sys.stderr
+            )
     return 0
 
 

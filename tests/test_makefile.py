@@ -44,7 +44,8 @@ def _tree(tmp_path: Path) -> Path:
     (report / "index.html").write_text("<html>")
     (report / "figures" / "a.png").write_bytes(b"png")
     (report / MARKER).write_text(
-        "written by twolink-pin report\n" + "".join(f"{MANIFEST_PREFIX}{n}\n" for n in ("figures", "index.html"))
+        "written by twolink-pin report\n"
+        + "".join(f"{MANIFEST_PREFIX}{n}\n" for n in ("figures", "index.html"))
     )
     (report / "notes.txt").write_text("mine")
     theirs = tmp_path / "theirs"
