@@ -160,7 +160,10 @@ def update_steps(controller: Controller, dt: float) -> int | None:
     period = controller.update_period()
     if period is None:
         return None
-    value = float(period)
+    try:
+        value = float(period)
+    except (TypeError, ValueError):  # a law's period that is no number: refused below, naming it
+        value = float("nan")
     steps = round(value / dt) if np.isfinite(value) and value > 0 else 0
     if steps < 1 or abs(steps * dt - value) > 1e-9 * value:
         raise InvalidParameterError(
