@@ -6,7 +6,7 @@ workflow lost, and the classes that run found or left open. Same form and classe
 from __future__ import annotations
 
 from corpus.cases import SIM, C, GiB
-from corpus.spec import Case, cli
+from corpus.spec import Case, cli, contains, text
 
 R5 = "{corpus}/laws/round5.py"
 """The laws of this round (``laws/round5.py``)."""
@@ -23,6 +23,14 @@ ROUND5: list[Case] = [
     # == a memory-starved solver: refused before it is made, against what is left under the limit ===
     C("hang-simulate-mpc-long-horizon-under-address-limit", "simulate mpc --duration 0.002 --gain horizon=0.9 --gain knot_interval=0.001", 2, err=("horizon", "900 knots", "fit in memory", "MB available"), run="proc", memory=3 * GiB // 2, timeout=60, note="ulimit -v 1.5 GiB: ProxQP's factor of 900 knots needs about 2 GB; the check compared its 0.9 GB estimate with the whole limit, not with what the process had left, and the solver aborted (SIGABRT)"),
     C("hang-simulate-mpc-horizon-that-fits-under-address-limit", "simulate mpc --duration 0.002 --gain horizon=0.3 --gain knot_interval=0.001", (0, 1), run="proc", memory=3 * GiB // 2, timeout=60, note="300 knots fit: the run goes (or its replan fails with a message), never an abort"),
+    # == files: --plot DIR holds a file of the user's; one command's outputs all or nothing ===========
+    C("dataloss-simulate-plot-over-a-users-file", f"simulate pd {SIM} --plot figs", 2, err=("pd_torque.png", "not a figure twolink-pin wrote"), setup=(text("figs/pd_torque.png", "my own figure"),), absent=("figs/pd_theta1.png",), note="a figure's name in a folder of the user's: refused before anything is moved (no figure of this run is left either)"),
+    C("dataloss-trajectory-plot-over-a-users-file", "trajectory --plot figs", 2, err=("trajectory_workspace.png", "not a figure twolink-pin wrote"), setup=(text("figs/trajectory_workspace.png", "mine"), text("figs/notes.txt", "mine")), absent=("figs/trajectory_theta1.png",)),
+    C("unclear-simulate-plot-again-replaces-its-own-figures", f"simulate pd {SIM} --plot figs", 0, setup=(cli("simulate", "pd", *SIM.split(), "--plot", "figs"),), changed=("figs",), note="the figures the folder's marker lists are the command's to replace"),
+    C("dataloss-simulate-plot-then-save-fails", f"simulate pd {SIM} --plot figs --save blocker/run.npz", 2, err=("blocker", "not a directory"), setup=(text("blocker", "a file"),), absent=("figs",), note="one command, all or nothing: the figures were left behind when --save failed"),
+    C("dataloss-identify-plot-then-save-fails", "identify --duration 4 --plot figs --save blocker/p.json", 2, err=("blocker", "not a directory"), setup=(text("blocker", "a file"),), absent=("figs",)),
+    # == messages: the runs a sweep counts as diverged say why, in its files =========================
+    C("unclear-sweep-mpc-runs-it-could-not-plan-say-why", "sweep mpc --samples 4 --chunk 2 --duration 0.05 --q0-offset 3.5 0 --q0-spread 1 --no-plot --out s", 0, exists=("s/runs.csv",), checks=(contains("s/runs.csv", "diverged_reason"), contains("s/runs.csv", "cannot all hold"), contains("s/runs.json", "position range")), note="runs that start beyond joint 1's range cannot plan: counted as diverged, their reason in runs.csv, runs.json and the Parquet files"),
     # == user code: a hook besides compute ===========================================================
     C("usercode-simulate-law-period-hook-raises", f"simulate {R5}:PeriodRaises {SIM}", 2, err=("corpus-period-raises", "RuntimeError", "period hook failed", "round5.py:"), not_err=("internal error",), note="the hook is asked while the law is built (user code contained): the law, its file and line named"),
     C("usercode-compare-law-period-hook-raises", f"compare {R5}:PeriodRaises pd {SIM} --no-plot --out c", 2, err=("corpus-period-raises", "period hook failed"), not_err=("internal error",), absent=("c",)),

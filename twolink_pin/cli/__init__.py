@@ -51,11 +51,13 @@ def _run(args: argparse.Namespace) -> int:
     """The command under its guards; an exception after a signal is the interrupt, whatever
     it turned into on its way (an ``ImportError`` from an interrupted import)."""
     from twolink_pin import user_code
+    from twolink_pin.files import outputs_together
     from twolink_pin.simulation.deadline import bounded, per_run_limit
 
     try:  # --timeout bounds each simulation (a law that never returns), not the whole command,
-        # and each import and construction of a law (user_code.guarded)
-        with per_run_limit(getattr(args, "timeout", None)), user_code.baseline(bounded):
+        # and each import and construction of a law (user_code.guarded); the command's files are
+        # written all or none (files.outputs_together: committed before its summary is printed)
+        with per_run_limit(getattr(args, "timeout", None)), user_code.baseline(bounded), outputs_together():
             with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
                 code = int(args.func(args))
     except BaseException:
