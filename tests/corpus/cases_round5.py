@@ -8,6 +8,28 @@ from __future__ import annotations
 from corpus.cases import SIM, C, GiB
 from corpus.spec import Case, cli, contains, text
 
+STILL = "times = [0.0, 1.0, 2.0, 3.0]\njoints = [[0.0, 0.3], [0.8, 0.3], [-0.5, 0.3], [0.0, 0.3]]\n"
+"""A reference whose joint 2 never moves."""
+BASE = ("link1.Izz + 0.1444 link2.m", "link2.mcx", "link2.mcy", "link2.Izz")
+"""The twolink's base parameters (``info --json``)."""
+
+
+def parameter_file(estimate: float) -> str:
+    """A parameter file of the twolink whose every base parameter is ``estimate``."""
+    import json
+
+    rows = [{"name": name, "estimate": estimate, "std": 0.1} for name in BASE]
+    return json.dumps(
+        {
+            "format": "twolink-pin identified parameters",
+            "version": 1,
+            "robot": "twolink",
+            "nv": 2,
+            "parameters": rows,
+        }
+    )
+
+
 R5 = "{corpus}/laws/round5.py"
 """The laws of this round (``laws/round5.py``)."""
 NOISY_FIT = cli(
@@ -29,6 +51,10 @@ ROUND5: list[Case] = [
     C("unclear-simulate-plot-again-replaces-its-own-figures", f"simulate pd {SIM} --plot figs", 0, setup=(cli("simulate", "pd", *SIM.split(), "--plot", "figs"),), changed=("figs",), note="the figures the folder's marker lists are the command's to replace"),
     C("dataloss-simulate-plot-then-save-fails", f"simulate pd {SIM} --plot figs --save blocker/run.npz", 2, err=("blocker", "not a directory"), setup=(text("blocker", "a file"),), absent=("figs",), note="one command, all or nothing: the figures were left behind when --save failed"),
     C("dataloss-identify-plot-then-save-fails", "identify --duration 4 --plot figs --save blocker/p.json", 2, err=("blocker", "not a directory"), setup=(text("blocker", "a file"),), absent=("figs",)),
+    # == messages: what is wrong, named ============================================================
+    C("unclear-identify-a-joint-never-moves", "identify --trajectory still.toml --duration 6", 2, err=("joint 2 (joint2)", "never moves", "0.01 rad/s"), not_err=("longer run", "excitation"), setup=(text("still.toml", STILL),), note="it spoke of 'the excitation' and advised a longer log; a longer log of a still joint is no better"),
+    C("nonfinite-simulate-model-parameter-file-1e300", "simulate computed-torque --duration 0.2 --model p.json", 2, err=("p.json", "link1.Izz + 0.1444 link2.m", "1e+300", "1e+09"), setup=(text("p.json", parameter_file(1e300)),), note="was 'physical fit = unbounded … Clarabel', the file and the values not named"),
+    C("nonfinite-simulate-p0-parameter-file-1e12", "simulate adaptive --duration 0.2 --p0 p.json", 2, err=("p.json", "1e+12", "1e+09"), setup=(text("p.json", parameter_file(1e12)),), note="was 'physical fit = infeasible'"),
     # == messages: the runs a sweep counts as diverged say why, in its files =========================
     C("unclear-sweep-mpc-runs-it-could-not-plan-say-why", "sweep mpc --samples 4 --chunk 2 --duration 0.05 --q0-offset 3.5 0 --q0-spread 1 --no-plot --out s", 0, exists=("s/runs.csv",), checks=(contains("s/runs.csv", "diverged_reason"), contains("s/runs.csv", "cannot all hold"), contains("s/runs.json", "position range")), note="runs that start beyond joint 1's range cannot plan: counted as diverged, their reason in runs.csv, runs.json and the Parquet files"),
     # == user code: a hook besides compute ===========================================================

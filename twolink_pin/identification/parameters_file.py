@@ -56,6 +56,11 @@ UNKNOWN_SIGMA_TOLERANCE = 0.01
 the torques it acts on: 1 %, ten times what the noisy fits of ``identify --noise-tau 0.5``
 leave there (the twolink's ``link2.mcy``: 0.025 %), and far below the model errors the laws
 are shown to tolerate (the docs' demos believe links 20 % light)."""
+MAX_ESTIMATE = 1e9
+"""Largest magnitude of an estimate or its σ in a parameter file [kg, kg·m, kg·m²; N·m·s/rad,
+N·m]: ten times the largest principal inertia a URDF may give (1e8 kg·m²,
+:mod:`twolink_pin.model.urdf_elements`), far beyond any arm's; the physical-consistency check's
+solver declared 1e12 'infeasible' and 1e300 'unbounded' without naming the file."""
 MODES = ("model", "p0")
 """How identified parameters seed a law (module docstring)."""
 
@@ -114,8 +119,12 @@ def identification_document(identification: Any, robot: RobotModel) -> dict[str,
 
 
 def _number(path: str, where: str, value: Any, what: str) -> float:
+    """``value`` as a float: a finite number of magnitude at most :data:`MAX_ESTIMATE`, else an
+    error naming the file, the entry and the value."""
     if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value)):
         raise InputFileError(path, f"{where}: {value!r} is not {what}")
+    if abs(value) > MAX_ESTIMATE:
+        raise InputFileError(path, f"{where}: {value:.6g} is beyond ±{MAX_ESTIMATE:g}, no arm's value")
     return float(value)
 
 
@@ -188,13 +197,10 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
             raise InputFileError(
                 file, f"parameters[{k}] repeats the name {name!r}; expected each parameter once"
             )
-        estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), "a finite number")
+        bounded = f"a finite number within ±{MAX_ESTIMATE:g}"
+        estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), bounded)
         std = row.get("std")
-        sigma = (
-            math.nan
-            if std is None
-            else _number(file, f"parameters[{k}] ({name}).std", std, "a finite number")
-        )
+        sigma = math.nan if std is None else _number(file, f"parameters[{k}] ({name}).std", std, bounded)
         values[name] = (estimate, abs(sigma))
     pset = ParameterSet.of(robot, friction=True)
     base_names = pset.base.names
@@ -232,7 +238,12 @@ def _refuse_unphysical(file: str, robot: RobotModel, pset: ParameterSet, base: n
     pseudo-inertia ⪰ 0 reproduce them: :func:`~twolink_pin.identification.physical.consistency`)."""
     from twolink_pin.identification.physical import consistency
 
-    check = consistency(robot, pset.base, base)
+    try:
+        check = consistency(robot, pset.base, base)
+    except InvalidParameterError as exc:  # the solver gave up: say which file it was checking
+        raise InputFileError(
+            file, f"its base parameters could not be checked for physical consistency ({exc})"
+        ) from None
     if not check.feasible:
         link, least = next(
             (n, s) for n, s in zip(check.links, check.least_eigenvalue) if s < -check.tolerance
