@@ -35,7 +35,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from twolink_pin.errors import InputFileError, OutputError
+from twolink_pin.errors import OutputError
+
+# the readers' checks, re-exported beside the writer
+from twolink_pin.input_files import check_input_file as check_input_file
+from twolink_pin.input_files import read_input_file as read_input_file
 from twolink_pin.readiness import ready
 from twolink_pin.user_code import restore_baseline
 
@@ -91,6 +95,7 @@ class OutputSet:
             with _signals_deferred():
                 for tmp, target in self.staged:
                     os.replace(tmp, target)
+                    _STAGING.discard(str(tmp))
         except OSError as exc:
             self.discard()
             raise OutputError(str(self.staged[0][1]), f"cannot write the file ({_reason(exc)})") from exc
@@ -105,6 +110,7 @@ class OutputSet:
         for tmp, _ in self.staged:
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
+            _STAGING.discard(str(tmp))
         for folder in self.created:
             with contextlib.suppress(OSError):
                 folder.rmdir()
@@ -115,6 +121,23 @@ class OutputSet:
 _PENDING: contextvars.ContextVar[OutputSet | None] = contextvars.ContextVar(
     "twolink_pin_outputs", default=None
 )
+
+_STAGING: set[str] = set()
+"""Temporary files and staging folders that exist now (what :func:`remove_staging` removes)."""
+
+
+def remove_staging() -> None:
+    """Remove every temporary file and staging folder this process has made and not yet moved
+    into place or removed: for an exit that runs no ``finally`` (the deadline's backstop,
+    :mod:`twolink_pin.simulation.deadline`)."""
+    for path in sorted(_STAGING, reverse=True):
+        if os.path.isdir(path) and not os.path.islink(path):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+    _STAGING.clear()
+
 
 FIGURES_MARKER = ".twolink-pin-figures"
 """The file in a ``--plot`` folder that lists the figures twolink-pin wrote there (``entry:
@@ -229,6 +252,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
         fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     except OSError as exc:
         raise OutputError(str(target), f"cannot write in {target.parent} ({_reason(exc)})") from exc
+    _STAGING.add(tmp)
     try:
         try:
             with os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8") as f:
@@ -243,11 +267,13 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
                 pending.staged.append((Path(tmp), Path(os.path.realpath(target))))
             else:
                 os.replace(tmp, target)
+                _STAGING.discard(tmp)
         except OSError as exc:
             raise OutputError(str(target), f"cannot write the file ({_reason(exc)})") from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        _STAGING.discard(tmp)
         raise
 
 
@@ -407,6 +433,7 @@ def _output_stage(out: Path, marker: str, note: str) -> Iterator[Path]:
         stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     except OSError as exc:
         raise OutputError(str(out.parent), f"cannot create a folder there ({_reason(exc)})") from exc
+    _STAGING.add(str(stage))
     try:
         os.chmod(stage, 0o777 & ~_umask())
         ready("writing")
@@ -423,60 +450,17 @@ def _output_stage(out: Path, marker: str, note: str) -> Iterator[Path]:
                 old = out.parent / f".{out.name}.old-{os.getpid()}"
                 os.replace(out, old)
             os.replace(stage, out)
+            _STAGING.discard(str(stage))
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
     except OSError as exc:
         shutil.rmtree(stage, ignore_errors=True)
+        _STAGING.discard(str(stage))
         code = errno.errorcode.get(exc.errno or 0, "")
         raise OutputError(
             str(out), f"cannot write the outputs ({_reason(exc)}{', ' + code if code else ''})"
         ) from exc
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
+        _STAGING.discard(str(stage))
         raise
-
-
-def check_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> Path:
-    """``path`` if it is a regular file of at most ``max_bytes`` that this process can read.
-
-    Reading a FIFO, a device (``/dev/zero``) or a directory would block, never end, or fail
-    obscurely: they are refused before any read.
-
-    Raises:
-        InputFileError: missing, not a regular file, unreadable, or larger than ``max_bytes``
-            (the message names the bound).
-    """
-    file = Path(path)
-    try:
-        info = os.stat(file)
-    except FileNotFoundError:
-        raise InputFileError(str(file), f"file not found (expected {what})") from None
-    except OSError as exc:
-        raise InputFileError(str(file), f"cannot be examined ({_reason(exc)})") from exc
-    if stat.S_ISDIR(info.st_mode):
-        raise InputFileError(str(file), f"is a directory (expected {what})")
-    if not stat.S_ISREG(info.st_mode):
-        raise InputFileError(str(file), f"is not a regular file (a device, pipe or socket; expected {what})")
-    if info.st_size > max_bytes:
-        raise InputFileError(
-            str(file), f"is {info.st_size} bytes, more than the {max_bytes} bytes accepted for {what}"
-        )
-    if not os.access(file, os.R_OK):
-        raise InputFileError(str(file), "cannot be read (permission denied)")
-    return file
-
-
-def read_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> bytes:
-    """The bytes of ``path`` after :func:`check_input_file`, read without following a swap to
-    a device between the check and the read (the size is checked again on the open file)."""
-    file = check_input_file(path, max_bytes, what)
-    try:
-        with open(file, "rb") as f:
-            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
-                raise InputFileError(str(file), f"is not a regular file (expected {what})")
-            data = f.read(max_bytes + 1)
-    except OSError as exc:
-        raise InputFileError(str(file), f"cannot be read ({_reason(exc)})") from exc
-    if len(data) > max_bytes:
-        raise InputFileError(str(file), f"is more than the {max_bytes} bytes accepted for {what}")
-    return data

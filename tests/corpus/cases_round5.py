@@ -63,5 +63,12 @@ ROUND5: list[Case] = [
     C("usercode-simulate-law-period-hook-raises", f"simulate {R5}:PeriodRaises {SIM}", 2, err=("corpus-period-raises", "RuntimeError", "period hook failed", "round5.py:"), not_err=("internal error",), note="the hook is asked while the law is built (user code contained): the law, its file and line named"),
     C("usercode-compare-law-period-hook-raises", f"compare {R5}:PeriodRaises pd {SIM} --no-plot --out c", 2, err=("corpus-period-raises", "period hook failed"), not_err=("internal error",), absent=("c",)),
     C("usercode-sweep-law-period-hook-raises", f"sweep {R5}:PeriodRaises --samples 2 {SIM} --no-plot --out s", 2, err=("corpus-period-raises", "period hook failed"), not_err=("internal error",), absent=("s",)),
+    # == user code: the process ended, the alarm ignored ==============================================
+    C("usercode-simulate-law-os-exit-0", f"simulate {R5}:ExitsHard {SIM} --save run.npz", 1, err=("corpus-exits-hard", "os._exit(0)", "t ="), absent=("run.npz",), note="os._exit(0) ended the process with status 0, a silent success; contained while a command runs"),
+    C("usercode-simulate-law-os-exit-0-proc", f"simulate {R5}:ExitsHard {SIM} --save run.npz", 1, err=("corpus-exits-hard", "os._exit(0)"), run="proc", absent=("run.npz",)),
+    C("usercode-sweep-law-os-exit-0", f"sweep {R5}:ExitsHard --samples 4 {SIM} --no-plot --out s", 1, err=("corpus-exits-hard", "os._exit(0)"), run="proc", absent=("s",), note="it left the sweep's staging folder behind"),
+    C("usercode-report-law-os-exit-0-in-a-worker", f"report --duration 1 --workers 2 --no-animation --no-limits-section --controller {R5}:ExitsHard --controller pd --out r", 1, err=("corpus-exits-hard", "os._exit(0)", "the report with the others"), run="proc", exists=("r/index.html",), timeout=120, note="in a report worker it broke the pool: 'internal error: BrokenProcessPool'"),
+    C("usercode-simulate-law-ignores-the-alarm", f"simulate {R5}:IgnoresAlarm {SIM} --timeout 2 --save run.npz", 1, err=("corpus-ignores-alarm", "--timeout 2 s", "SIGALRM"), run="proc", absent=("run.npz",), timeout=40, note="the alarm that ends it ignored: the backstop thread ends the process BACKSTOP_GRACE (10 s) past the bound, naming the law"),
+    C("usercode-sweep-law-blocks-the-alarm", f"sweep {R5}:BlocksAlarm --samples 2 {SIM} --timeout 2 --no-plot --out s", 1, err=("corpus-blocks-alarm", "--timeout 2 s", "SIGALRM"), run="proc", absent=("s",), timeout=40, note="and the sweep's staging folder removed"),
 ]
 # fmt: on

@@ -57,7 +57,12 @@ def _run(args: argparse.Namespace) -> int:
     try:  # --timeout bounds each simulation (a law that never returns), not the whole command,
         # and each import and construction of a law (user_code.guarded); the command's files are
         # written all or none (files.outputs_together: committed before its summary is printed)
-        with per_run_limit(getattr(args, "timeout", None)), user_code.baseline(bounded), outputs_together():
+        with (
+            per_run_limit(getattr(args, "timeout", None)),
+            user_code.baseline(bounded),
+            user_code.exits_contained(),  # a law's os._exit: an error naming it, and the cleanup
+            outputs_together(),
+        ):
             with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
                 code = int(args.func(args))
     except BaseException:

@@ -135,7 +135,7 @@ def integrate_adaptive(
     from scipy.integrate import solve_ivp  # with scipy.optimize 0.3 s to import: only for this method
 
     # bounded in wall-clock time (--timeout, simulation.deadline): past it, an error naming the law
-    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, last[0], seconds)):
+    with np.errstate(all="ignore"), bounded(lambda timeout: timed_out(controller, last[0], timeout)):
         sol = solve_ivp(
             rhs,
             (t[0], t[-1]),

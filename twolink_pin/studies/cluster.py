@@ -33,8 +33,15 @@ from urllib.parse import urlsplit
 
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
-from twolink_pin.studies.cluster_startup import handshake, kill_workers, probe, quiet_worker_exit, start_local
+from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout, WorkerKilled
+from twolink_pin.studies.cluster_startup import (
+    handshake,
+    kill_workers,
+    probe,
+    quiet_worker_deaths,
+    quiet_worker_exit,
+    start_local,
+)
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -239,7 +246,9 @@ class DaskEngine:
         finished = 0
         refreshed = time.monotonic()
         limit = window or 2 * self.slots + 2
+        quiet = quiet_worker_deaths() if self.cluster is not None else contextlib.nullcontext()
         try:
+            quiet.__enter__()  # a generator: entered here, left in its finally
             while finished < len(items):
                 while next_item < len(items) and len(self._pending) < limit:
                     key = f"{name}-{token}-{next_item}"
@@ -276,6 +285,7 @@ class DaskEngine:
             self.cancel()
             with contextlib.suppress(Exception):
                 self.client.unsubscribe_topic(topic)
+            quiet.__exit__(None, None, None)
 
     def _submit(
         self, fn: Callable[..., Any], topic: str, index: int, args: tuple[Any, ...], key: str, done: Any
@@ -300,11 +310,7 @@ class DaskEngine:
         if isinstance(exc, KilledWorker):
             deaths = int(getattr(exc, "allowed_failures", ALLOWED_FAILURES)) + 1
             last = getattr(getattr(exc, "last_worker", None), "address", "?")
-            error = ClusterError(
-                self.address,
-                f"{name} {index} killed {deaths} worker{'s' if deaths != 1 else ''} in a row (out of "
-                f"memory? a crash in the law?); the last was {last}: see its log",
-            )
+            error: ClusterError = WorkerKilled(self.address, name, index, deaths, str(last))
         elif isinstance(exc, ImportError):
             error = ClusterError(
                 self.address,
