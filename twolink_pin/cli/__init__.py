@@ -52,7 +52,9 @@ def _run(args: argparse.Namespace) -> int:
     it turned into on its way (an ``ImportError`` from an interrupted import)."""
     from twolink_pin import user_code
     from twolink_pin.files import outputs_together
-    from twolink_pin.simulation.deadline import bounded, per_run_limit
+    from twolink_pin.simulation.deadline import bounded, per_run_limit, start_backstop
+
+    start_backstop()  # its thread's memory held before any memory check counts what is left
 
     try:  # --timeout bounds each simulation (a law that never returns), not the whole command,
         # and each import and construction of a law (user_code.guarded); the command's files are

@@ -86,7 +86,7 @@ replan of 900 knots, the longest horizon 4 GB hold, takes 5 s) and longer than a
 BACKSTOP_GRACE = 10.0
 """Seconds past a bound (or past twice :data:`STALL` without progress) after which the
 backstop thread ends the process: the alarm that should have stopped the block was ignored,
-blocked or disarmed by the law (:meth:`bounded._backstop`)."""
+blocked or disarmed by the law (:func:`_watch`)."""
 BACKSTOP_TICK = 1.0
 """Seconds between two looks of the backstop thread."""
 PROGRESS = [0]
@@ -133,7 +133,7 @@ class bounded:
     raises nothing (the handler only raises while armed). A class, not a generator: a
     generator-based context manager has a gap between its ``yield`` and the block where an
     exception would escape both. A law that ignores, blocks or disarms the alarm is met by a
-    backstop thread that ends the process (:meth:`_backstop`)."""
+    backstop thread that ends the process (:func:`start_backstop`)."""
 
     def __init__(self, error: Callable[[RunTimeout], BaseException] | None = None) -> None:
         self.error = error
@@ -143,7 +143,6 @@ class bounded:
         self.started = 0.0
         self.seen = 0
         self.raised: RunTimeout | None = None
-        self.done = threading.Event()
 
     def _expire(self, signum: int, frame: object) -> None:
         if not self.armed:
@@ -168,7 +167,7 @@ class bounded:
 
     def _disarm(self) -> None:
         self.armed = False
-        self.done.set()
+        _WATCHED[0] = None
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, self.previous)
 
@@ -185,8 +184,8 @@ class bounded:
         ):
             return None
         self.seconds, self.started, self.seen = seconds, time.monotonic(), PROGRESS[0]
-        # the backstop before the alarm: an alarm that fires while a thread starts would escape
-        threading.Thread(target=self._backstop, name="twolink-pin-backstop", daemon=True).start()
+        start_backstop()  # before the alarm: an alarm that fires while a thread starts would escape
+        _WATCHED[0] = self
         self.previous = signal.signal(signal.SIGALRM, self._expire)
         try:
             self.armed = True
@@ -211,28 +210,48 @@ class bounded:
             if kind is None:
                 raise exc
 
-    def _backstop(self) -> None:
-        """In a thread while the block runs: when it is :data:`BACKSTOP_GRACE` past its bound,
-        or has made no progress for twice :data:`STALL` and the grace (the alarm looks at
-        the progress every :data:`STALL` seconds), the alarm did not stop it — the law
-        ignored, blocked or disarmed ``SIGALRM``: say so naming the law, remove the command's
-        staging files, end its child processes and the process (exit status 1)."""
-        seconds = self.seconds or 0.0
-        seen, since = PROGRESS[0], time.monotonic()
-        while not self.done.wait(BACKSTOP_TICK):
-            now = time.monotonic()
-            if PROGRESS[0] != seen:
-                seen, since = PROGRESS[0], now
-            late = now - self.started > seconds + BACKSTOP_GRACE
-            stalled = seconds > STALL and now - since > 2 * STALL + BACKSTOP_GRACE
-            if (late or stalled) and not self.done.is_set():
-                _end_process(
-                    self._raise(RunTimeout(STALL if stalled and not late else seconds, stalled and not late))
-                )
+
+_WATCHED: list[bounded | None] = [None]
+"""The bounded block that runs now (one at a time: an enclosing bound is not re-armed)."""
+_BACKSTOP: list[threading.Thread] = []
+
+
+def start_backstop() -> None:
+    """Start the process's backstop thread once (:func:`_watch`); the CLI starts it with the
+    command, so that its stack and its allocator's arena (some 70 MB of address space) are
+    held before any memory check (``mpc``'s horizon) counts what is left."""
+    if not _BACKSTOP:
+        thread = threading.Thread(target=_watch, name="twolink-pin-backstop", daemon=True)
+        _BACKSTOP.append(thread)
+        thread.start()
+
+
+def _watch() -> None:
+    """The backstop thread, for the life of the process: every :data:`BACKSTOP_TICK` seconds it
+    looks at the bounded block that runs (:data:`_WATCHED`). When that block is
+    :data:`BACKSTOP_GRACE` past its bound, or has made no progress for twice :data:`STALL` and
+    the grace (the alarm looks at the progress every :data:`STALL` seconds), the alarm did not
+    stop it — the law ignored, blocked or disarmed ``SIGALRM``: say so naming the law, remove
+    the command's staging files, end its child processes and the process (exit status 1)."""
+    block, seen, since = None, 0, 0.0
+    while True:
+        time.sleep(BACKSTOP_TICK)
+        now, current = time.monotonic(), _WATCHED[0]
+        if current is not block:
+            block, seen, since = current, PROGRESS[0], now
+        if block is None or not block.armed:
+            continue
+        if PROGRESS[0] != seen:
+            seen, since = PROGRESS[0], now
+        seconds = block.seconds or 0.0
+        late = now - block.started > seconds + BACKSTOP_GRACE
+        stalled = seconds > STALL and now - since > 2 * STALL + BACKSTOP_GRACE
+        if (late or stalled) and _WATCHED[0] is block and block.armed:
+            _end_process(block._raise(RunTimeout(seconds) if late else RunTimeout(STALL, stalled=True)))
 
 
 def _end_process(error: BaseException) -> None:
-    """The backstop's last resort (:meth:`bounded._backstop`), from its thread: one line on
+    """The backstop's last resort (:func:`_watch`), from its thread: one line on
     stderr, the staging files removed, the children ended, exit status 1."""
     import sys
 
@@ -281,6 +300,7 @@ __all__ = [
     "per_run_limit",
     "run_limit",
     "run_watcher",
+    "start_backstop",
     "timed_out",
     "watched",
 ]

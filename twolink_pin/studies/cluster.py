@@ -246,9 +246,7 @@ class DaskEngine:
         finished = 0
         refreshed = time.monotonic()
         limit = window or 2 * self.slots + 2
-        quiet = quiet_worker_deaths() if self.cluster is not None else contextlib.nullcontext()
         try:
-            quiet.__enter__()  # a generator: entered here, left in its finally
             while finished < len(items):
                 while next_item < len(items) and len(self._pending) < limit:
                     key = f"{name}-{token}-{next_item}"
@@ -285,7 +283,6 @@ class DaskEngine:
             self.cancel()
             with contextlib.suppress(Exception):
                 self.client.unsubscribe_topic(topic)
-            quiet.__exit__(None, None, None)
 
     def _submit(
         self, fn: Callable[..., Any], topic: str, index: int, args: tuple[Any, ...], key: str, done: Any
@@ -398,6 +395,8 @@ def open_cluster(
         assert workers is not None
         engine = _local_engine(address, workers, preload)
     client = engine.client
+    # an owned LocalCluster's worker killed by a task is the command's error, not Dask's log lines
+    quiet = quiet_worker_deaths() if engine.cluster is not None else contextlib.nullcontext()
     try:
         try:
             client.wait_for_workers(1, timeout=timeout)
@@ -406,7 +405,8 @@ def open_cluster(
                 engine.address,
                 f"has no worker after {timeout:g} s; start some with `dask worker {engine.address}`",
             ) from None
-        yield engine
+        with quiet:
+            yield engine
     except BaseException:
         engine.close(kill=True)
         raise
