@@ -135,7 +135,10 @@ def integrate_adaptive(
     from scipy.integrate import solve_ivp  # with scipy.optimize 0.3 s to import: only for this method
 
     # bounded in wall-clock time (--timeout, simulation.deadline): past it, an error naming the law
-    with np.errstate(all="ignore"), bounded(lambda timeout: timed_out(controller, last[0], timeout)):
+    with (
+        np.errstate(all="ignore"),
+        bounded(lambda timeout: timed_out(controller, last[0], timeout), stall=True),
+    ):
         sol = solve_ivp(
             rhs,
             (t[0], t[-1]),

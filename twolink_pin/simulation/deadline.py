@@ -122,8 +122,8 @@ exception raised inside a gc callback or ``__del__`` is printed and dropped by P
 
 class bounded:
     """Raise :class:`RunTimeout` inside the block once it has run for the bound in force
-    (:func:`per_run_limit`), or — a bound longer than :data:`STALL` — once it has made no
-    progress (:func:`note_progress`) for :data:`STALL` to twice that; or ``error(timeout)`` in
+    (:func:`per_run_limit`), or — with ``stall`` and a bound longer than :data:`STALL` — once it
+    has made no progress (:func:`note_progress`) for :data:`STALL` to twice that; or ``error(timeout)`` in
     its place, e.g. :func:`timed_out` naming the law. ``with`` gives the bound. No bound outside
     the main thread, without ``setitimer``, or when a bound is already armed (an enclosing
     simulation).
@@ -135,8 +135,13 @@ class bounded:
     exception would escape both. A law that ignores, blocks or disarms the alarm is met by a
     backstop thread that ends the process (:func:`start_backstop`)."""
 
-    def __init__(self, error: Callable[[RunTimeout], BaseException] | None = None) -> None:
+    def __init__(
+        self, error: Callable[[RunTimeout], BaseException] | None = None, *, stall: bool = False
+    ) -> None:
         self.error = error
+        self.stall = stall
+        """Whether the block's progress is counted (:func:`note_progress`: a law's calls), so
+        that :data:`STALL` applies; off for work that reports none (a symbolic derivation)."""
         self.seconds: float | None = None
         self.armed = False
         self.previous: Any = None
@@ -150,7 +155,9 @@ class bounded:
         if self.raised is None:
             seconds = self.seconds or 0.0
             remaining = seconds - (time.monotonic() - self.started)
-            if seconds > STALL and remaining > 1e-3:  # a look at the progress, not the bound yet
+            if (
+                self.stall and seconds > STALL and remaining > 1e-3
+            ):  # a look at the progress, not the bound yet
                 if PROGRESS[0] != self.seen:
                     self.seen = PROGRESS[0]
                     signal.setitimer(signal.ITIMER_REAL, min(STALL, remaining))
@@ -189,7 +196,7 @@ class bounded:
         self.previous = signal.signal(signal.SIGALRM, self._expire)
         try:
             self.armed = True
-            signal.setitimer(signal.ITIMER_REAL, min(seconds, STALL))
+            signal.setitimer(signal.ITIMER_REAL, min(seconds, STALL) if self.stall else seconds)
         except RunTimeout as exc:  # fired while being armed
             self._disarm()
             raise self._raise(exc) from None
@@ -245,7 +252,7 @@ def _watch() -> None:
             seen, since = PROGRESS[0], now
         seconds = block.seconds or 0.0
         late = now - block.started > seconds + BACKSTOP_GRACE
-        stalled = seconds > STALL and now - since > 2 * STALL + BACKSTOP_GRACE
+        stalled = block.stall and seconds > STALL and now - since > 2 * STALL + BACKSTOP_GRACE
         if (late or stalled) and _WATCHED[0] is block and block.armed:
             _end_process(block._raise(RunTimeout(seconds) if late else RunTimeout(STALL, stalled=True)))
 

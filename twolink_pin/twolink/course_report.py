@@ -125,12 +125,12 @@ def shows_identification(options: Any, laws: Sequence[str]) -> bool:
     and one of its ``laws`` (laws or variants) estimates the inertial parameters — the section
     answers a question about such a law (why its p̂ is still far from p at the end of the run),
     which a report of ``mpc`` and ``pd`` does not raise."""
-    from twolink_pin.law_variant import parse_variants
+    from twolink_pin.law_variant import parse_variant
     from twolink_pin.scenario import law_class
 
     if not options.identification:
         return False
-    return any("inertial" in law_class(v.law).estimates for v in parse_variants(tuple(laws)))
+    return any("inertial" in law_class(parse_variant(text).law).estimates for text in laws)
 
 
 def closed_form_check(robot: Any, samples: int = 1000) -> dict[str, Any]:
