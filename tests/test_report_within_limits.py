@@ -132,7 +132,9 @@ def test_the_reports_other_numbers_are_the_same_without_the_section(report: Path
     assert 'id="limits"' not in (tmp_path / "without" / "index.html").read_text()
     with_section = json.loads((report / "results.json").read_text())
     without = json.loads((tmp_path / "without" / "results.json").read_text())
-    wall = {"seconds", "total_seconds", "command_line", "within_limits"}
+    # how the run went, not what it found: the wall-clock figures, and whether the equations were
+    # derived or read from the cache (the first build derives them unless another test did)
+    wall = {"seconds", "total_seconds", "command_line", "within_limits", "from_cache"}
     compared = _compare(with_section, without, wall)
     assert compared > 300  # the model, trajectory, metrics, crossings, errata of both laws
 

@@ -35,11 +35,16 @@ else written to ``sys.stdout`` to stderr: :mod:`twolink_pin.cli.guard`)."""
 
 
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
-    """Print ``payload`` as one JSON line with ``--json``, else ``text``.
+    """Print ``payload`` as one JSON line with ``--json``, else ``text`` — after the command's
+    files are in place (:func:`~twolink_pin.files.commit_outputs`: a summary never names a file
+    that is not written).
 
     Raises:
-        OutputError: stdout is closed (nothing can be printed).
+        OutputError: stdout is closed (nothing can be printed), or the files cannot be put in place.
     """
+    from twolink_pin.files import commit_outputs
+
+    commit_outputs()
     stream = RESULT_STREAM if RESULT_STREAM is not None else sys.stdout
     if stream is None:
         from twolink_pin.errors import OutputError
