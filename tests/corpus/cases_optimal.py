@@ -42,8 +42,8 @@ OPTIMAL: list[Case] = [
     C("unclear-optimize-no-via-points", "optimize --trajectory f.toml", 2, err=("via points",), setup=(text("f.toml", "[fourier]\nperiod = 4.0\nharmonics = 1\na = [[0.1], [0.1]]\nb = [[0.0], [0.0]]\noffset = [0.0, 0.5]\n"),)),
     C("unclear-optimize-save-suffix", "optimize --save out.txt", 2, err=("--save", ".json", ".toml"), absent=("out.txt",)),
     # a solver that does not converge, constraints that cannot hold: exit 1, nothing written or replaced
-    C("wrong-optimize-not-converged", "optimize --max-iterations 1 --save out.json", 1, err=("no convergence in 1 SQP iterations", "violation"), absent=("out.json",)),
-    C("dataloss-optimize-not-converged-keeps-file", "optimize --max-iterations 1 --save mine.json", 1, err=("no convergence",), setup=(text("mine.json", '{"mine": true}\n'),), note="mine.json is byte-identical afterwards (every file not in changed is)"),
+    C("wrong-optimize-not-converged", "optimize --max-iterations 1 --save out.json", 1, err=("the cost did not settle in 1 SQP iterations", "the constraints hold", "try more iterations (--max-iterations"), absent=("out.json",)),
+    C("dataloss-optimize-not-converged-keeps-file", "optimize --max-iterations 1 --save mine.json", 1, err=("did not settle",), setup=(text("mine.json", '{"mine": true}\n'),), note="mine.json is byte-identical afterwards (every file not in changed is)"),
     C("unclear-optimize-via-too-fast", "optimize --trajectory via.json --save out.json", 2, err=("velocity limit of joint 1", "10 rad/s", "via point 0 to 1"), setup=(via("via.json", TOO_FAST),), absent=("out.json",), note="via points further apart than a joint can go between their times: refused before solving"),
     # Ctrl-C and SIGTERM while the optimiser runs: 130 / 143, no file
     C("interrupt-optimize-sigint", f"optimize --robot ur5 --trajectory {POSES} --cost time --save out.json", 130, err=("interrupted",), run="signal", signal=(SIGINT, "running", "group"), absent=("out.json",)),

@@ -36,7 +36,7 @@ def add_within_limits_options(p: argparse.ArgumentParser, retime: bool) -> None:
 
 def add_optimize_command(sub: Any, c: Any) -> None:
     """``optimize``: an optimal trajectory through the reference's via points."""
-    from twolink_pin.trajectory.optimal import COSTS, MAX_ITERATIONS
+    from twolink_pin.trajectory.optimal import COSTS, ENDS, MAX_ITERATIONS, REGULARISER_WEIGHT, REGULARISERS
 
     p = sub.add_parser(
         "optimize",
@@ -48,6 +48,28 @@ def add_optimize_command(sub: Any, c: Any) -> None:
         choices=COSTS,
         default="effort",
         help="∫τᵀτ dt with the via times (effort, default) or the duration (time)",
+    )
+    p.add_argument(
+        "--ends",
+        choices=tuple(ENDS),
+        default="smooth",
+        help="effort: at rest with zero acceleration and jerk at both ends (smooth, default: the course "
+        "polynomial's) or at rest only (rest: crocoddyl's; the torque may step at the start)",
+    )
+    p.add_argument(
+        "--regulariser",
+        choices=REGULARISERS,
+        default="velocity",
+        help="effort: add w ∫‖q̇‖² dt to ∫τᵀτ dt (velocity, default: keeps the joints the task barely needs "
+        "from racing to save a little torque elsewhere) or minimise the effort alone (none)",
+    )
+    p.add_argument(
+        "--regulariser-weight",
+        type=bounded(0.0, 1e6, unit=""),
+        default=REGULARISER_WEIGHT,
+        metavar="K",
+        help=f"the regulariser's weight, stated as its worth on the reference: K times the reference's ∫τᵀτ dt "
+        f"(default {REGULARISER_WEIGHT:g})",
     )
     add_trajectory_option(p)
     add_within_limits_options(p, retime=False)
