@@ -21,6 +21,7 @@ period missed them (the retimed twolink's peak |τ|/limit 0.9969, 0.9984 where t
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 import numpy as np
@@ -170,21 +171,76 @@ def check_motion(motion: Motion, limits: JointLimits) -> LimitsCheck:
         values = kind.of(motion)
         if values is None:
             continue
-        excess = limits.excess(kind, values)  # (K, nv), -inf where no limit
         given = limits.given(kind)
-        # a joint with a limit: its worst instant; without: its largest |value|
-        idx = np.where(given, np.argmax(excess, axis=0), np.argmax(np.abs(values), axis=0))
+        lower, upper = limits.bounds(kind)
+        idx = _worst_instants(values, lower, upper, given, kind.symmetric)
         cols = np.arange(values.shape[1])
         at = values[idx, cols]
-        lower, upper = limits.bounds(kind)
         if kind.symmetric:
             peak, limit = np.abs(at), upper
         else:
             nearer_upper = (upper - at) <= (at - lower)
             peak, limit = at, np.where(nearer_upper, upper, lower)
-        margin = np.where(given, -excess[idx, cols], np.inf)
+        margin = np.where(given, -limits.excess(kind, at[None, :])[0], np.inf)
         checks.append(KindCheck(kind, peak, motion.t[idx], limit, margin))
     return LimitsCheck(motion, limits, tuple(checks))
+
+
+class Shortfall(NamedTuple):
+    """A limit far below what a motion needs (:func:`shortfall`)."""
+
+    kind: KindCheck
+    """The kind's check."""
+    joint: int
+    """The joint (from 0)."""
+    ratio: float
+    """What the motion needs over the limit."""
+
+    def describe(self, names: tuple[str, ...] | list[str]) -> tuple[str, str, str]:
+        """``(what, value, need)`` for :class:`~twolink_pin.errors.InvalidParameterError`:
+        ``velocity limit of joint 2 (joint2)``, ``3.15e-300 rad/s``, ``the 4.57 rad/s …``."""
+        k, j = self.kind, self.joint
+        unit = k.kind.unit
+        return (
+            f"{k.kind.name} limit of joint {j + 1} ({names[j]})",
+            f"{float(k.limit[j]):.4g} {unit}",
+            f"{self.ratio:.3g} times less than the {float(k.peak[j]):.4g} {unit} the reference needs at its own "
+            f"timing (t = {float(k.time[j]):.4g} s)",
+        )
+
+
+def shortfall(check: LimitsCheck, factor: Callable[[LimitKind], float]) -> Shortfall | None:
+    """The velocity, acceleration or effort limit that ``check``'s motion needs most beyond,
+    when it needs more than ``factor(kind)`` times it (None otherwise): a limit so far below
+    what a reference needs that an optimisation's rows (each divided by its limit) would hold
+    numbers of 1e300 and its solver fail without naming it."""
+    worst: Shortfall | None = None
+    for k in check.kinds:
+        if not k.kind.symmetric:
+            continue
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            ratio = np.where(np.isfinite(k.limit) & (k.limit > 0), k.peak / k.limit, 0.0)
+        j = int(np.argmax(ratio))
+        if ratio[j] > factor(k.kind) and (worst is None or ratio[j] > worst.ratio):
+            worst = Shortfall(k, j, float(ratio[j]))
+    return worst
+
+
+def _worst_instants(
+    values: np.ndarray, lower: np.ndarray, upper: np.ndarray, given: np.ndarray, symmetric: bool
+) -> np.ndarray:
+    """Each joint's instant nearest its limit (or furthest beyond): the largest ``|x|`` for a
+    symmetric kind; the position nearest either end of its range; a joint without the limit
+    its largest ``|x|``. Chosen on the values themselves, not on ``|x| − limit``: beside a limit
+    of 1e300 that difference is −1e300 at every instant and its largest would be the first."""
+    largest = np.argmax(np.abs(values), axis=0)
+    if symmetric:
+        return largest
+    high, low = np.argmax(values, axis=0), np.argmin(values, axis=0)
+    cols = np.arange(values.shape[1])
+    to_upper, to_lower = upper - values[high, cols], values[low, cols] - lower
+    nearer = np.where(to_upper < to_lower, high, np.where(to_lower < to_upper, low, largest))
+    return np.where(given, nearer, largest)
 
 
 def check_limits(

@@ -36,10 +36,10 @@ ITERATION_LIMIT = 20_000
 """Most DAQP iterations (one row added or dropped each) of one QP."""
 BIG = 1e30
 """DAQP's "no bound" (it takes no infinities)."""
-OPTIMAL, INFEASIBLE = 1, -1
-"""DAQP's exit flags: solved; the rows cannot all hold."""
-EQUALITY = 5
-"""DAQP's sense of an equality row."""
+OPTIMAL, SOFT_OPTIMAL, INFEASIBLE = 1, 2, -1
+"""DAQP's exit flags: solved; solved with soft rows violated; the rows cannot all hold."""
+EQUALITY, SOFT = 5, 8
+"""DAQP's sense of an equality row, of a soft (elastic) row."""
 
 
 def solve_qp_active_set(
@@ -88,13 +88,43 @@ def solve_qp_active_set(
         lam = np.asarray(info["lam"], dtype=float)
         return QPSolution(np.asarray(x, dtype=float), lam[:m], lam[m:], int(info["iterations"]), 0.0, 0.0)
     if flag == INFEASIBLE:
-        reason = _infeasible_reason(qp, 1e-9, 10_000, flagged=True) if explain else None
+        reason = _elastic_reason(qp, A, upper, lower, sense, m) if explain else None
         raise OptimizationError(
             what,
             reason or "the linearised constraints cannot all hold (DAQP: infeasible)",
             int(info["iterations"]),
         )
     return solve_qp(qp, warm, what=what, explain=explain, **(fallback or {}))
+
+
+def _elastic_reason(
+    qp: QP, A: np.ndarray, upper: np.ndarray, lower: np.ndarray, sense: np.ndarray, m: int
+) -> str | None:
+    """Which inequality row cannot hold, in words: the QP solved again with every inequality
+    row soft (DAQP's elastic rows, violated where they must be) and the equalities kept — the
+    via points and the joins are what the problem is; a limit is what gives — then the row
+    violated most, by its label. ProxQP's closest feasible point when the equalities themselves
+    cannot hold (:func:`~twolink_pin.optimal.qp.solve_qp`'s explanation)."""
+    import daqp
+
+    soft = sense.copy()
+    soft[m:] = SOFT
+    x, _, flag, _ = daqp.solve(
+        np.ascontiguousarray(qp.H), np.ascontiguousarray(qp.g), np.ascontiguousarray(A), upper, lower, soft,
+        primal_tol=PRIMAL_TOLERANCE, iter_limit=ITERATION_LIMIT, rho_soft=1e-6,
+    )  # fmt: skip
+    if flag not in (OPTIMAL, SOFT_OPTIMAL) or qp.C is None or qp.l is None or qp.u is None:
+        return _infeasible_reason(qp, 1e-9, 10_000, flagged=True)
+    cx = qp.C @ np.asarray(x, dtype=float)
+    excess = np.maximum(qp.l - cx, cx - qp.u)
+    i = int(np.argmax(excess))
+    if not excess[i] > 0:
+        return _infeasible_reason(qp, 1e-9, 10_000, flagged=True)
+    row = qp.labels[i] if qp.labels is not None and i < len(qp.labels) else f"inequality row {i}"
+    return (
+        f"the constraints cannot all hold: with the equalities kept, {row} is missed by {excess[i]:.3g} "
+        f"(bounds [{qp.l[i]:.6g}, {qp.u[i]:.6g}] in the row's scale, value {cx[i]:.6g})"
+    )
 
 
 __all__ = ["solve_qp_active_set"]

@@ -49,7 +49,7 @@ from twolink_pin.trajectory.optimal_measures import (
     pose_error,
     violation,
 )
-from twolink_pin.trajectory.optimal_spline import Vias, check_vias, vias_of
+from twolink_pin.trajectory.optimal_spline import Vias, check_reference_needs, check_vias, vias_of
 from twolink_pin.trajectory.optimal_time import minimum_time
 from twolink_pin.trajectory.retiming import TimeOptimal
 from twolink_pin.trajectory.sampled import SampledTrajectory
@@ -158,6 +158,8 @@ def optimize(
     wanted = (joint_limits(robot) if limits is None else limits).scaled(limit_scale)
     vias = vias_of(via)
     check_vias(robot, vias, wanted, timed=cost == "effort")
+    if cost == "effort":  # the retiming checks its own (the timing free)
+        check_reference_needs(robot, via, wanted)
     from twolink_pin.blas import one_blas_thread
 
     with one_blas_thread():  # small dense algebra: BLAS threads only spin (twolink_pin.blas)

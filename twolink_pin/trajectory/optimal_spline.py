@@ -98,6 +98,25 @@ def _check_speeds(vias: Vias, limits: JointLimits) -> None:
         )
 
 
+SHORTFALL = 1e6
+"""A velocity, acceleration or effort limit below ``1/SHORTFALL`` of what the reference needs at
+its own timing is refused before solving (:func:`check_reference_needs`)."""
+
+
+def check_reference_needs(robot: RobotModel, reference: Trajectory, limits: JointLimits) -> None:
+    """Raise (bad input) for a limit a millionth or less of what ``reference`` needs at its own
+    timing (:data:`SHORTFALL`), named with its value and the need: no trajectory through the
+    same via points at the same times comes within it, and the solver's rows, divided by it,
+    would hold numbers of 1e300 (an effort limit of 1e-300 failed with "the equality
+    constraints cannot all hold (row 12 …)")."""
+    from twolink_pin.limits import check_limits, shortfall
+
+    short = shortfall(check_limits(robot, reference, limits=limits), lambda _: SHORTFALL)
+    if short is not None:
+        what, value, need = short.describe(limits.joint_names)
+        raise InvalidParameterError(what, value, f"a limit a millionth of the need or more: it is {need}")
+
+
 def check_vias(robot: RobotModel, vias: Vias, limits: JointLimits, timed: bool = True) -> None:
     """Raise (bad input) for a via point outside a joint's position range, two via points
     further apart than a velocity limit lets a joint go between their times, or a via point
@@ -209,6 +228,7 @@ __all__ = [
     "MAX_PIECES",
     "MIN_PIECES",
     "Vias",
+    "check_reference_needs",
     "check_vias",
     "fit",
     "knot_samples",

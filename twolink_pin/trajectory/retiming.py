@@ -66,13 +66,16 @@ from twolink_pin.limits import (
     JointLimits,
     LimitsCheck,
     Motion,
+    check_limits,
     check_motion,
     joint_limits,
     reference_motion,
+    shortfall,
 )
 from twolink_pin.limits.active import ActiveLimit, active_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
+from twolink_pin.trajectory.file_values import MAX_TIME
 from twolink_pin.trajectory.retiming_path import PathPiece, path_lengths, path_pieces
 from twolink_pin.trajectory.retiming_samples import (
     Timing,
@@ -262,19 +265,40 @@ def _params(
 
 
 def _check_rest(robot: RobotModel, stage: _Stage, limits: JointLimits, where: str) -> None:
-    """Raise (bad input) where the path's rest points need more than an effort limit: the
-    torque at rest there is gravity (and nothing can lower it)."""
-    for index, label in ((0, "start"), (-1, "end")):
+    """Raise (bad input) where the path needs more than an effort limit to hold still: at its
+    rest points (the torque there is gravity, and nothing can lower it), then anywhere along it
+    (``c(s)``: gravity, which the timing cannot lower either)."""
+    points = [(0, f"at rest at the start of {where}"), (-1, f"at rest at the end of {where}")]
+    points += [(int(i), f"to hold still on {where}") for i in np.argsort(-np.abs(stage.c).max(axis=1))[:1]]
+    for index, label in points:
         excess = np.abs(stage.c[index]) - limits.effort
         j = int(np.argmax(excess))
         if excess[j] > 0:
             raise InvalidParameterError(
                 f"effort limit of joint {j + 1} ({limits.joint_names[j]})",
                 f"{limits.effort[j]:g} N·m",
-                f"at least the {abs(stage.c[index][j]):.4g} N·m that gravity needs at rest at the {label} of {where} "
+                f"at least the {abs(stage.c[index][j]):.4g} N·m that gravity needs {label} "
                 f"(q = {np.round(stage.q[index], 4).tolist()} rad): the path needs more torque than the limits allow "
                 "even at rest",
             )
+
+
+def _check_needs(robot: RobotModel, trajectory: Trajectory, limits: JointLimits, span: float) -> None:
+    """Raise (bad input) for a velocity, acceleration or effort limit so far below what the
+    reference needs at its own timing (over ``span`` [s]) that no retiming shorter than
+    :data:`~twolink_pin.trajectory.file_values.MAX_TIME` keeps it: slowed ``k`` times, a path
+    needs ``1/k`` of its velocity and ``1/k²`` of its acceleration and dynamic torque (the
+    gravity, which it does not lower, is :func:`_check_rest`'s). A limit scale of 1e-300 gave
+    numpy's warnings and "TOPP-RA found no admissible timing"."""
+    factor = MAX_TIME / max(span, 1e-300)
+    short = shortfall(
+        check_limits(robot, trajectory, limits=limits), lambda kind: factor if kind is VELOCITY else factor**2
+    )
+    if short is not None:
+        what, value, need = short.describe(limits.joint_names)
+        raise InvalidParameterError(
+            what, value, f"a limit a retiming shorter than {MAX_TIME:g} s can keep: it is {need}"
+        )
 
 
 def _solve(
@@ -408,6 +432,7 @@ def time_optimal(
     _toppra()  # imported once (about 1 s), before the clock starts
     start = time.perf_counter()
     wanted = base.scaled(limit_scale)
+    _check_needs(robot, trajectory, wanted, float(getattr(trajectory, "span", trajectory.period)))
     pieces = path_pieces(trajectory)
     lengths = path_lengths(pieces)
     if not np.all(lengths > 0):
