@@ -36,7 +36,14 @@ def add_within_limits_options(p: argparse.ArgumentParser, retime: bool) -> None:
 
 def add_optimize_command(sub: Any, c: Any) -> None:
     """``optimize``: an optimal trajectory through the reference's via points."""
-    from twolink_pin.trajectory.optimal import COSTS, ENDS, MAX_ITERATIONS, REGULARISER_WEIGHT, REGULARISERS
+    from twolink_pin.trajectory.optimal import (
+        COSTS,
+        DEFAULT_REGULARISER,
+        ENDS,
+        MAX_ITERATIONS,
+        REGULARISER_WEIGHT,
+        REGULARISERS,
+    )
 
     p = sub.add_parser(
         "optimize",
@@ -59,16 +66,18 @@ def add_optimize_command(sub: Any, c: Any) -> None:
     p.add_argument(
         "--regulariser",
         choices=REGULARISERS,
-        default="velocity",
-        help="effort: add w ∫‖q̇‖² dt to ∫τᵀτ dt (velocity, default: keeps the joints the task barely needs "
-        "from racing to save a little torque elsewhere) or minimise the effort alone (none)",
+        default=DEFAULT_REGULARISER,
+        help="effort: add w ∫‖q − q_ref(t)‖² dt (path, default: near the reference's path, for via poses its "
+        "straight SE(3) path), w ∫‖q̇‖² dt (velocity: the least motion) or minimise the effort alone (none: "
+        "joints that cost little torque may swing far and fast)",
     )
     p.add_argument(
         "--regulariser-weight",
         type=bounded(0.0, 1e6, unit=""),
         default=REGULARISER_WEIGHT,
         metavar="K",
-        help=f"the regulariser's weight, stated as its worth on the reference: K times the reference's ∫τᵀτ dt "
+        help="the regulariser's weight as a fraction of the reference's ∫τᵀτ dt: path, one joint 0.1 rad off the "
+        "path for the whole motion costs K times it; velocity, the reference's own motion costs K times it "
         f"(default {REGULARISER_WEIGHT:g})",
     )
     add_trajectory_option(p)

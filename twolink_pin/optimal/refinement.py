@@ -35,6 +35,9 @@ from twolink_pin.optimal.transcription import TrajectoryProblem
 
 FINE = 25
 """The fine grid has this many times the check grid's points per knot interval."""
+LOCAL = 17
+"""Points at which a peak's neighbourhood on the fine grid (its two neighbours and between) is
+evaluated again: 8 times finer."""
 ROUNDS = 12
 """Most solves (the first and those after adding points)."""
 DAMPING_FLOOR = 1e-6
@@ -74,11 +77,12 @@ def _excess_points(
 ) -> tuple[Points, float]:
     """Where a limit row peaks beyond the limit itself (not the margin-tightened bound) by more
     than ``tolerance``, and the largest excess [fraction of the limit]. A peak is a local
-    maximum in time of one joint's row of one kind on the fine grid, moved to the vertex of the
-    parabola through it and its two neighbours (the peak between the fine points: a velocity
-    that rode its limit with a jerk of 140 rad/s³ rose 1.5e-5 of it above the fine grid's
-    values); the row is evaluated there, and the point kept where it is beyond (at a kink —
-    a torque whose derivative jumps with the jerk at a via point — the parabola overshoots)."""
+    maximum in time of one joint's row of one kind on the fine grid whose neighbourhood may
+    rise beyond the limit (the parabola through it and its two neighbours does); the row is
+    evaluated there on :data:`LOCAL` points between its neighbours and its largest value kept
+    when it is beyond (a velocity that rode its limit with a jerk of 140 rad/s³ rose 1.5e-5 of
+    it above the fine grid's values; at a kink — a torque whose derivative jumps with the jerk
+    at a via point — the parabola overshoots, the points do not)."""
     layout = problem.layout
     empty = layout.points(np.zeros(0, dtype=int), np.zeros(0))
     E = _row_excess(problem, x, fine)
@@ -94,15 +98,17 @@ def _excess_points(
     if not k.size:
         return empty, worst
     t = layout.times(x, fine)
-    step = np.where(shift[k, column] >= 0, t[k + 2] - t[k + 1], t[k + 1] - t[k])
-    at = layout.points(*layout.locate(x, t[k + 1] + shift[k, column] * step))
-    value = _row_excess(problem, x, at)[np.arange(k.size), column]
-    worst = max(worst, float(value.max()))
-    keep = value > tolerance
-    beyond = inner[k, column] > tolerance  # a fine point beyond: kept too, whatever the vertex
-    segment = np.concatenate([at.segment[keep], fine.segment[k[beyond] + 1]])
-    sigma = np.concatenate([at.sigma[keep], fine.sigma[k[beyond] + 1]])
-    return layout.points(segment, sigma), worst
+    offsets = np.linspace(-1.0, 1.0, LOCAL)  # from the left neighbour to the right one
+    before, after = (t[k + 1] - t[k])[:, None], (t[k + 2] - t[k + 1])[:, None]
+    local = t[k + 1][:, None] + np.where(offsets[None, :] < 0, before, after) * offsets[None, :]
+    at = layout.points(*layout.locate(x, local.ravel()))
+    value = _row_excess(problem, x, at)[np.arange(at.size), np.repeat(column, LOCAL)].reshape(k.size, LOCAL)
+    best = np.argmax(value, axis=1)
+    peak = value[np.arange(k.size), best]
+    worst = max(worst, float(peak.max()))
+    keep = np.flatnonzero(peak > tolerance)
+    chosen = keep * LOCAL + best[keep]
+    return layout.points(at.segment[chosen], at.sigma[chosen]), worst
 
 
 def _blocks(problem: TrajectoryProblem, rows: np.ndarray, k: int) -> list[np.ndarray]:

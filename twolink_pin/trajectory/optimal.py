@@ -36,6 +36,7 @@ from twolink_pin.model import RobotModel
 from twolink_pin.optimal.sqp import SQPOptions
 from twolink_pin.trajectory.base import Trajectory
 from twolink_pin.trajectory.optimal_effort import (
+    DEFAULT_REGULARISER,
     ENDS,
     REGULARISER_WEIGHT,
     REGULARISERS,
@@ -116,7 +117,7 @@ def optimize(
     friction: Friction | None = None,
     max_iterations: int = MAX_ITERATIONS,
     ends: str = "smooth",
-    regulariser: str = "velocity",
+    regulariser: str = DEFAULT_REGULARISER,
     regulariser_weight: float = REGULARISER_WEIGHT,
 ) -> OptimalTrajectory:
     """The trajectory through ``via``'s via points that minimises ``cost`` within every limit
@@ -134,9 +135,10 @@ def optimize(
         max_iterations: Most SQP iterations per solve.
         ends: ``effort``: ``smooth`` (at rest, zero acceleration and jerk at both ends) or
             ``rest`` (at rest only) (:mod:`~twolink_pin.trajectory.optimal_effort`).
-        regulariser: ``effort``: ``velocity`` (``w_v ∫ ‖q̇‖² dt`` added) or ``none``.
-        regulariser_weight: ``κ``: on the reference, the regulariser would cost this fraction
-            of its effort.
+        regulariser: ``effort``: ``path`` (``w_q ∫ ‖q − q_ref(t)‖² dt`` added: near the
+            reference's path), ``velocity`` (``w_v ∫ ‖q̇‖² dt``) or ``none`` (the effort alone).
+        regulariser_weight: ``κ``, the regulariser's weight as a fraction of the reference's
+            effort (:mod:`~twolink_pin.trajectory.optimal_effort`).
 
     Raises:
         InvalidParameterError: an unknown cost, end condition or regulariser, a reference
@@ -205,6 +207,7 @@ def _report(
 
 __all__ = [
     "COSTS",
+    "DEFAULT_REGULARISER",
     "ENDS",
     "MAX_ITERATIONS",
     "REGULARISERS",

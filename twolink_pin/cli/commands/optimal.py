@@ -243,8 +243,14 @@ def _cost_line(result: Any) -> str:
         f"both over {result.duration:g} s; ends {result.ends}"
     )
     reg = result.regulariser
-    if reg is None or reg.kind == "none":
+    if reg is None or reg.kind == "none" or reg.weight == 0:
         return line + "; no regulariser (the effort alone)"
+    if reg.kind == "path":
+        return (
+            line
+            + f"; regulariser {reg.weight:.4g} ∫‖q − q_ref‖² dt (near the reference's path, κ = {reg.kappa:g}), "
+            f"∫‖q − q_ref‖² dt = {reg.value:.3g} rad²·s"
+        )
     return (
         line + f"; regulariser {reg.weight:.4g} ∫‖q̇‖² dt (κ = {reg.kappa:g} of the reference's effort), "
         f"∫‖q̇‖² dt = {reg.value:.4g} rad²/s"
