@@ -37,7 +37,9 @@ def test_daqp_answers_proxqps_qp_to_its_kkt_conditions(seed: int, n: int, m: int
     objective equals ProxQP's to 1e-8 of its size."""
     qp = _random_qp(seed, n, min(m, n - 1), k)
     ours = solve_qp_active_set(qp)
-    theirs = solve_qp(qp, eps=1e-10, infeasibility_eps=1e-12)  # its default 1e-4 calls some of these infeasible
+    theirs = solve_qp(
+        qp, eps=1e-10, infeasibility_eps=1e-12
+    )  # its default 1e-4 calls some of these infeasible
     assert kkt_residual(qp, ours) <= 1e-7 * max(1.0, float(np.abs(qp.g).max()))
 
     def f(x: np.ndarray) -> float:

@@ -7,6 +7,8 @@ Kept apart from ``cases.py`` (same form, same ids' classes); ``tests/test_corpus
 
 from __future__ import annotations
 
+import json
+
 from corpus.cases import C, via
 from corpus.spec import SIGINT, SIGTERM, Case, LibCase, cli, text, twolink
 
@@ -16,9 +18,11 @@ OUTSIDE = '{"times": [0, 1, 2], "joints": [[0, 0], [3.5, 0.3], [0, 0]]}\n'
 """A via point beyond joint 1's range [-3.14159, 3.14159] rad."""
 TOO_FAST = '{"times": [0, 0.01, 0.02], "joints": [[0, 0], [1.5, 0.3], [0, 0]]}\n'
 """Via points 10 ms apart, 1.5 rad away: no spline within 10 rad/s can pass them."""
-MANY = '{"times": [%s], "joints": [%s]}\n' % (
-    ", ".join(repr(round(0.01 * k, 2)) for k in range(40_000)),
-    ", ".join("[0.1, 0.2]" if k % 4 < 2 else "[0.0, 0.2]" for k in range(39_999)) + ", [0.1, 0.2]",
+MANY = json.dumps(
+    {
+        "times": [round(0.01 * k, 2) for k in range(40_000)],
+        "joints": [[0.1, 0.2] if k % 4 < 2 else [0.0, 0.2] for k in range(39_999)] + [[0.1, 0.2]],
+    }
 )
 """A joint trajectory file with 40 000 via points (at most 24 are read)."""
 EFFORTS = ('effort="40" velocity="10"',)

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.errors import OptimizationError
-from twolink_pin.optimal.qp import QP, QPSolution, _infeasible_reason, solve_qp
+from twolink_pin.optimal.qp import QP, QPSolution, infeasible_reason, solve_qp
 
 PRIMAL_TOLERANCE = 1e-9
 """Largest violation of a row DAQP accepts (its default, 1e-6, is the SQP's own feasibility
@@ -114,12 +114,12 @@ def _elastic_reason(
         primal_tol=PRIMAL_TOLERANCE, iter_limit=ITERATION_LIMIT, rho_soft=1e-6,
     )  # fmt: skip
     if flag not in (OPTIMAL, SOFT_OPTIMAL) or qp.C is None or qp.l is None or qp.u is None:
-        return _infeasible_reason(qp, 1e-9, 10_000, flagged=True)
+        return infeasible_reason(qp, 1e-9, 10_000, flagged=True)
     cx = qp.C @ np.asarray(x, dtype=float)
     excess = np.maximum(qp.l - cx, cx - qp.u)
     i = int(np.argmax(excess))
     if not excess[i] > 0:
-        return _infeasible_reason(qp, 1e-9, 10_000, flagged=True)
+        return infeasible_reason(qp, 1e-9, 10_000, flagged=True)
     row = qp.labels[i] if qp.labels is not None and i < len(qp.labels) else f"inequality row {i}"
     return (
         f"the constraints cannot all hold: with the equalities kept, {row} is missed by {excess[i]:.3g} "
