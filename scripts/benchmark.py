@@ -38,6 +38,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
+    .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -1478,6 +1479,12 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
     )
     parser.add_argument(
+        "--equations-only",
+        action="store_true",
+        help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
+        "scaling table (scripts/equations_benchmark.py)",
+    )
+    parser.add_argument(
         "--contention-only",
         action="store_true",
         help="only the contention row: two batches at once, and one alone (default threads against 1)",
@@ -1513,6 +1520,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.equations_only:
+        from equations_benchmark import equations_section  # scripts/: the script's own folder
+
+        results.update(equations_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0
@@ -1685,7 +1699,9 @@ def main(argv: list[str] | None = None) -> int:
     if not quick:  # the smoke test runs --big-arms-only --quick on its own
         results.update(big_arms_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))
-    results.update(optimal_section(quick))
+    from bench_optimal import optimal_section
+
+    results.update(optimal_section(quick, lambda: _timed(baseline) * scale))
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)
