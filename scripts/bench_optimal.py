@@ -46,8 +46,12 @@ ANCHOR_GOAL = 1.05
 GOALS_BASELINE = 0.110
 """The baseline's 30-s time on the machine the goals were set on [s] (benchmark.py's)."""
 ROOT = Path(__file__).resolve().parents[1]
-OPTCTL = ROOT.parent / "shared" / "bench" / "optctl"
-"""The anchor's scripts (beside the repository)."""
+OPTCTL = next(
+    (p / "shared" / "bench" / "optctl" for p in (ROOT.parent, ROOT.parent.parent) if (p / "shared").is_dir()),
+    ROOT.parent / "shared" / "bench" / "optctl",
+)
+"""The anchor's scripts: ``../shared/bench/optctl`` of the repository (or of the folder of its
+worktrees)."""
 
 _COLD = """
 import json, time
@@ -140,6 +144,8 @@ def optimal_section(quick: bool, baseline: Callable[[], float], croc: str | None
     from twolink_pin import default_trajectory, load_robot
     from twolink_pin.trajectory import optimize, read_trajectory_file, time_optimal
 
+    if croc and not (OPTCTL / "croc_effort.py").is_file():
+        raise SystemExit(f"--croc: the anchor's scripts are not in {OPTCTL}")
     repeats = 1 if quick else 5
     base = min(baseline() for _ in range(1 if quick else 3))
     norm = GOALS_BASELINE / base
