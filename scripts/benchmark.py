@@ -38,6 +38,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
+    .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
     .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
@@ -1223,6 +1224,12 @@ def _tune_page_latency(
                 lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
             )
             if not playing:
+                driver.find_element("xpath", "//*[text()='playback']").click()  # its folder starts closed
+                WebDriverWait(driver, 600).until(
+                    lambda d: d.execute_script(
+                        "return Array.from(document.querySelectorAll('label')).some(e => e.textContent === 'play')"
+                    )
+                )
                 driver.execute_script(
                     "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
                     "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"
@@ -1474,6 +1481,12 @@ def main(argv: list[str] | None = None) -> int:
         help="with --optimal-only: a python with pin 4.0 and crocoddyl 3.2.1 (a scratch venv) to run the anchor beside",
     )
     parser.add_argument(
+        "--mujoco-only",
+        action="store_true",
+        help="only issue 44's goals: the MuJoCo plant's time per run and its equality with Pinocchio's "
+        "(scripts/benchmark_mujoco.py)",
+    )
+    parser.add_argument(
         "--optimal-only",
         action="store_true",
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
@@ -1520,6 +1533,18 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.mujoco_only:
+        sys.path.insert(0, str(HERE))
+        from benchmark_mujoco import main as mujoco_main
+
+        results.update(
+            mujoco_main(
+                [*(["--quick"] if quick else []), "--repeats", str(args.repeats or (1 if quick else 5))]
+            )
+        )
         if args.json:
             print(json.dumps(results))
         return 0
