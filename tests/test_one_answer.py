@@ -161,3 +161,17 @@ def test_the_sampled_references_grid_takes_both_sides_of_each_jump() -> None:
         assert at.size == 2
         np.testing.assert_allclose(motion.a[at], retimed.a[[i, i + 1]], rtol=1e-9, atol=1e-9)
     assert np.diff(motion.t).max() <= 1e-3 + 1e-12
+
+
+def test_a_run_past_its_range_and_speed_says_so_in_text_and_json(capsys: pytest.CaptureFixture[str]) -> None:
+    """``simulate pd`` from 3.5 rad off on joint 1 (past its ±π range, then faster than 10
+    rad/s): the JSON's within_limits is false, the conjunction of the crossings, not the effort
+    alone; the text names the position range and the velocity limit crossed (on main a run's
+    JSON had no within_limits)."""
+    argv = ("simulate", "pd", "--duration", "0.4", "--q0-offset", "3.5", "0", "--saturate")
+    text, data = _run(capsys, *argv)
+    crossed = {kind: any(v["crossed"]) for kind, v in data["crossings"].items()}
+    assert crossed["position"] and crossed["velocity"]
+    assert data["within_limits"] is False
+    assert "joint 1 (joint1) passed its position range" in text
+    assert "joint 1 (joint1) exceeded its 10 rad/s velocity limit" in text
