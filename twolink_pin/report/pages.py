@@ -221,15 +221,18 @@ def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
     ]
     track_headers = ["controller", "reference", "run [s]"]
     track_headers += [f"RMS e{j + 1} [rad]" for j in range(nv)] + [f"max |e{j + 1}| [rad]" for j in range(nv)]
+    track_headers += [f"last period max |e{j + 1}| [rad]" for j in range(nv)]
     track_headers += [f"max |τ{j + 1}| [N·m]" for j in range(nv)] + ["limits crossed"]
     track_rows = []
     for row in section["tracking"]:
         head = [row["law"], refs[row["reference"]]["short"], fmt(row["duration_s"])]
         if not row["finished"]:
-            track_rows.append(head + ["—"] * (3 * nv) + [f"did not finish: {row['failed']}"])
+            track_rows.append(head + ["—"] * (4 * nv) + [f"did not finish: {row['failed']}"])
             continue
         m = row["metrics"]
-        cells = [fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["max"]["tau"]]
+        cells = [
+            fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["final_period_max_abs_e"] + m["max"]["tau"]
+        ]
         track_rows.append(head + cells + [_crossed(row["crossings"]) or "none"])
     return {
         "reference_headers": ref_headers,
