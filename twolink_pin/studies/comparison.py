@@ -106,6 +106,7 @@ class ComparisonTable:
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
             "contact_metrics": {name: m.as_dict() for name, m in self.contact.items()},
             "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
+            "within_limits": {name: m.crossings.within_limits for name, m in self.metrics.items()},
         }
 
     def crossing_rows(self) -> list[tuple[str, str, int, float, float, str]]:
