@@ -38,6 +38,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
+    .venv/bin/python scripts/benchmark.py --contact-only [--quick] # issue 46: the contact lab, contact's cost
     .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
     .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
@@ -89,7 +90,7 @@ from twolink_pin import (  # first, before pinocchio loads: OpenMP's passive wai
 )
 from twolink_pin.openmp import available_cores
 from twolink_pin.simulation import default_threads
-from twolink_pin.trajectory import JointTrajectory
+from twolink_pin.trajectory import JointTrajectory, with_force
 
 FULL = 30.0
 """The job's simulated time [s]."""
@@ -649,13 +650,14 @@ SINGLE_RUN_ROBOTS = ("twolink", "ur5")
 
 
 def _built_in_laws() -> list[str]:
-    """The names of the package's own laws, in registry order (plugins and files left out)."""
+    """The names of the package's own laws that run in free space, in registry order (plugins and
+    files left out; ``force`` and ``hybrid`` press on a surface: ``--contact-only``)."""
     from twolink_pin.controllers.loading import available_controllers
 
     return [
         n
         for n, cls in available_controllers().items()
-        if cls.__module__.startswith("twolink_pin.controllers")
+        if cls.__module__.startswith("twolink_pin.controllers") and not cls.force_control
     ]
 
 
@@ -1432,6 +1434,105 @@ def ur5_commands_section(quick: bool) -> dict[str, Any]:
     return rows
 
 
+CONTACT_GOALS = {"hybrid_force_rms_error_N": 0.5, "contact_cost_ratio": 1.5}
+"""Issue 46's goals: the twolink's contact lab, force RMS error of ``hybrid`` after 0.5 s in
+contact [N]; a run against the wall over the same run without it (time ratio)."""
+
+
+CONTACT_PLANTS = ("pinocchio", "mujoco")
+"""The plants the contact lab and its cost run on (``PlantOptions.engine``)."""
+CONTACT_LAWS = (("hybrid", {}), ("force", {}), ("impedance", {"k": 1000.0, "d": 300.0}))
+"""The lab's laws and their gains (impedance's stiffness: with the wall in series, about 10 N)."""
+
+
+def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
+    """Issue 46: the contact lab on the twolink (examples/wall.toml, examples/wall_slide.toml;
+    scripts/contact_lab.py) on each plant — each law's contact metrics, ``hybrid``'s force RMS
+    error against its goal; then the cost of the contact on each plant: the lab's run with the
+    wall and the same run without it on the same plant (the law, reference and step alike; the
+    wall's scene left out), interleaved, the fastest of ``repeats`` each, as a ratio (impedance:
+    the lab's law that runs either way; pd: the cheapest law, the contact's share largest)."""
+    from twolink_pin.contact import read_scene
+    from twolink_pin.trajectory import read_trajectory_file
+
+    robot = load_robot()
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    scene = read_scene(examples / "wall.toml")
+    lab = read_trajectory_file(examples / "wall_slide.toml", robot)
+    config = SimulationConfig(duration=2.0 if quick else 6.0, q0_offset=0.0)
+    metrics = {engine: _contact_lab(robot, scene, lab, config, engine) for engine in CONTACT_PLANTS}
+    reference = with_force(lab, None)  # the force column means nothing to the laws of the cost's runs
+    cost = {
+        engine: _contact_cost(robot, scene, reference, config, engine, repeats) for engine in CONTACT_PLANTS
+    }
+    return {"contact": {"lab": metrics, "cost": cost, "goals": CONTACT_GOALS}}
+
+
+def _contact_lab(robot: Any, scene: Any, lab: Any, config: SimulationConfig, engine: str) -> dict[str, Any]:
+    """The lab's laws against the wall on the plant ``engine``: their contact metrics (printed)."""
+    from twolink_pin.contact_metrics import contact_metrics
+    from twolink_pin.plant import PlantOptions
+    from twolink_pin.run_spec import RunSpec
+
+    print(
+        f"\ncontact lab on the twolink, {engine} plant ({config.duration:g} s; goal: hybrid's force RMS "
+        "error <= 0.5 N)"
+    )
+    metrics: dict[str, Any] = {}
+    for law, gains in CONTACT_LAWS:
+        plant = PlantOptions(scene=scene, engine=engine)
+        spec = RunSpec(law=law, gains=tuple(gains.items()), plant=plant, simulation=config)
+        m = contact_metrics(simulate(*spec.build(robot), lab, config), robot)
+        assert m is not None
+        metrics[law] = m.as_dict()
+        print(
+            f"  {law:10s} force RMS error {m.force_rms_error:.3g} N, max {m.force_max_error:.3g} N, peak impact "
+            f"{m.peak_impact_force:.3g} N, along the wall RMS {m.tangent_rms_mm:.3g} mm, max penetration "
+            f"{m.max_penetration_mm:.3g} mm"
+        )
+    rms = metrics["hybrid"]["force_rms_error"]
+    verdict = "met" if rms is not None and rms <= CONTACT_GOALS["hybrid_force_rms_error_N"] else "NOT met"
+    print(f"  hybrid's force RMS error {rms:.3g} N (goal <= 0.5 N: {verdict})")
+    return metrics
+
+
+def _contact_cost(
+    robot: Any, scene: Any, reference: Any, config: SimulationConfig, engine: str, repeats: int
+) -> dict[str, Any]:
+    """The lab's run with the wall over the same run without it, both on the plant ``engine``."""
+    from twolink_pin.plant import PlantOptions
+    from twolink_pin.run_spec import RunSpec
+
+    cost: dict[str, Any] = {}
+    print(
+        f"contact's cost on the {engine} plant: the lab's run with the wall / without it (fastest of {repeats}, interleaved)"
+    )
+    for law, gains in (("impedance", {"k": 1000.0, "d": 300.0}), ("pd", {})):
+        walled = PlantOptions(scene=scene, engine=engine)
+        free = PlantOptions(engine=engine)
+        specs = {
+            key: RunSpec(law=law, gains=tuple(gains.items()), plant=plant, simulation=config)
+            for key, plant in (("wall", walled), ("free", free))
+        }
+        times: dict[str, list[float]] = {"wall": [], "free": []}
+        for _ in range(repeats):
+            for key, spec in specs.items():
+                scenario = spec.build(robot)
+                times[key].append(_timed(lambda s=scenario: simulate(*s, reference, config)))
+        ratio = min(times["wall"]) / min(times["free"])
+        cost[law] = {"wall_seconds": min(times["wall"]), "free_seconds": min(times["free"]), "ratio": ratio}
+        goal = f"goal <= {CONTACT_GOALS['contact_cost_ratio']:g}x: {'met' if ratio <= 1.5 else 'NOT met'}"
+        print(
+            f"  {law:10s} {min(times['wall']):.3f} s / {min(times['free']):.3f} s = {ratio:.2f}x"
+            + (
+                f" ({goal})"
+                if law == "impedance"
+                else " (the cheapest law: the contact's share at its largest)"
+            )
+        )
+    return cost
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="short runs and few repeats (smoke test)")
@@ -1492,6 +1593,11 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
     )
     parser.add_argument(
+        "--contact-only",
+        action="store_true",
+        help="only issue 46's goals: the twolink's contact lab, a run with the wall against one without",
+    )
+    parser.add_argument(
         "--equations-only",
         action="store_true",
         help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
@@ -1533,6 +1639,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.contact_only:
+        results.update(contact_section(quick, args.repeats or (1 if quick else 5)))
+        results["machine"]["load_average_end"] = [round(x, 2) for x in os.getloadavg()]
+        print(f"load average at the end {results['machine']['load_average_end']}")
         if args.json:
             print(json.dumps(results))
         return 0

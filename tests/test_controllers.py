@@ -244,7 +244,7 @@ def test_registry_lists_the_five_built_in_laws_first_in_the_reports_order() -> N
     then the laws beyond the report."""
     built_in = [n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers.")]
     assert built_in[:5] == ["pd", "computed-torque", "robust", "adaptive", "adaptive-friction"]
-    assert built_in[5:] == ["pd-gravity", "pid", "osc", "impedance", "qp-osc", "mpc"]
+    assert built_in[5:] == ["pd-gravity", "pid", "osc", "impedance", "qp-osc", "mpc", "force", "hybrid"]
     assert all(cls.name == name and cls.title for name, cls in CONTROLLERS.items())
 
 

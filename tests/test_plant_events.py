@@ -226,7 +226,7 @@ def test_cli_options_give_the_librarys_run(capsys: pytest.CaptureFixture[str]) -
         ("--wrench", "1,2,3@2:1"),
         ("--payload-step", "2"),
         ("--payload-step", "-1@2"),
-        ("--sensor-noise", "1,2,3"),
+        ("--sensor-noise", "1,2,3,4"),
         ("--sensor-noise", "-0.1"),
         ("--delay", "-2"),
     ],
@@ -250,3 +250,35 @@ def test_compare_takes_the_plants_events(capsys: pytest.CaptureFixture[str], tmp
     for law in ("pd", "pid"):
         expected = compute_metrics(simulate(_law(law), plant, TRAJECTORY, SimulationConfig(duration=0.2)))
         np.testing.assert_allclose(payload["controllers"][law]["rms"]["e"], expected.rms.e, rtol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("engine", "integrator"), [("pinocchio", "rk4"), ("mujoco", "rk4"), ("mujoco", "euler")]
+)
+def test_saturation_clips_the_motors_torque_never_the_wrench(engine: str, integrator: str) -> None:
+    """With ``--saturate`` and a wrench whose ``Jᵀ F`` is beyond the effort limits, each plant's
+    ``q̈`` is Pinocchio's ABA on ``clip(τ) + Jᵀ F`` (the wrench is the world's, not a motor's):
+    at an RK4 stage, and over a step that MuJoCo's Euler takes itself (``v ← v + dt q̈``)."""
+    import pinocchio as pin
+
+    from twolink_pin.plant import PlantOptions
+    from twolink_pin.simulation.engine import _Steps
+    from twolink_pin.simulation.events import PlantEvents
+
+    force = np.array([0.0, 800.0, 0.0, 0.0, 0.0, 30.0])  # [N, N·m]: beyond both limits
+    extra = {"integrator": integrator} if engine == "mujoco" else {}
+    options = PlantOptions(engine=engine, saturate=True, wrench=Wrench(tuple(force), 0.0, 1.0), **extra)  # type: ignore[arg-type]
+    plant = options.plant(ROBOT, estimates_friction=False)
+    q, v, tau = np.array([[0.3, 0.8]]), np.array([[0.1, -0.2]]), np.array([[500.0, -90.0]])
+    model, data = ROBOT.model, ROBOT.model.createData()
+    J = pin.computeFrameJacobian(model, data, q[0], ROBOT.ee_frame_id, pin.LOCAL_WORLD_ALIGNED)
+    pushed = J.T @ force
+    assert (np.abs(pushed) > plant.limits).all()  # the wrench alone is beyond every limit
+    expected = pin.aba(model, data, q[0], v[0], np.clip(tau[0], -plant.limits, plant.limits) + pushed)
+    accel = PlantEvents(plant, 1, None, ROBOT.nv).accel_at(0.1)
+    if integrator == "euler":
+        dt = 1e-4
+        _, v1, _ = accel.held_step(q, v, np.zeros((1, 0)), tau, np.zeros((1, 0)), _Steps.of(dt, 2, 0), 0)  # type: ignore[attr-defined]
+        np.testing.assert_allclose((v1[0] - v[0]) / dt, expected, rtol=1e-8, atol=1e-8)
+    else:
+        np.testing.assert_allclose(accel(q, v, tau)[0], expected, rtol=1e-10, atol=1e-8)

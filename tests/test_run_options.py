@@ -45,6 +45,8 @@ SAMPLES = {
     "--sensor-noise": ["--sensor-noise", "0.001"],
     "--noise-seed": ["--sensor-noise", "0.001", "--noise-seed", "5"],
     "--delay": ["--delay", "2"],
+    "--scene": ["--scene", str(Path(__file__).resolve().parents[1] / "examples" / "wall.toml")],
+    "--wall": ["--wall", "0.9,0,0:-1,0,0"],
     "--plant": ["--plant", "mujoco"],
     "--armature": ["--armature", "0.1"],
     "--joint-damping": ["--joint-damping", "0.5"],

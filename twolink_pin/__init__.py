@@ -22,6 +22,8 @@ from twolink_pin import openmp as _openmp  # noqa: F401  # first: sets the wait 
 # isort: split
 
 from twolink_pin import mujoco_plant as _mujoco_plant  # noqa: F401  # registers the engine 'mujoco' (--plant mujoco)
+from twolink_pin.contact import Scene, Surface, read_scene
+from twolink_pin.contact_metrics import ContactMetrics, contact_metrics
 from twolink_pin.controllers import (
     CONTROLLERS,
     Adaptive,
@@ -82,6 +84,7 @@ from twolink_pin.scenario import Scenario
 from twolink_pin.simulation import SimulationConfig, SimulationResult, simulate, terms_for
 from twolink_pin.studies.batch import BatchResult, simulate_batch
 from twolink_pin.trajectory import (
+    ForceReference,
     FourierTrajectory,
     JointTrajectory,
     OptimalTrajectory,
@@ -96,6 +99,7 @@ from twolink_pin.trajectory import (
     optimize,
     read_trajectory_file,
     time_optimal,
+    with_force,
 )
 from twolink_pin.twolink import excitation as _twolink_excitation  # noqa: F401  # registers its stored excitation
 from twolink_pin.twolink import profile as _twolink_profile  # noqa: F401  # registers the twolink in the catalog
@@ -110,9 +114,11 @@ __all__ = [
     "BatchMetrics",
     "BatchResult",
     "ComputedTorque",
+    "ContactMetrics",
     "Controller",
     "ControllerError",
     "ControllerSpecError",
+    "ForceReference",
     "FourierTrajectory",
     "Friction",
     "Gains",
@@ -138,11 +144,13 @@ __all__ = [
     "RunningMetrics",
     "SampledTrajectory",
     "Scenario",
+    "Scene",
     "SimulationConfig",
     "SimulationDivergedError",
     "SimulationResult",
     "SlotineLiGains",
     "StateVariable",
+    "Surface",
     "Terms",
     "TimeOptimal",
     "Trajectory",
@@ -155,6 +163,7 @@ __all__ = [
     "build_trajectory",
     "cartesian_trajectory",
     "compute_metrics",
+    "contact_metrics",
     "coriolis_matrix",
     "default_trajectory",
     "example_robot_urdf",
@@ -171,6 +180,7 @@ __all__ = [
     "optimise_excitation",
     "optimize",
     "read_log",
+    "read_scene",
     "read_trajectory_file",
     "regressor",
     "simulate",
@@ -179,4 +189,5 @@ __all__ = [
     "terms_for",
     "time_optimal",
     "twolink_urdf_path",
+    "with_force",
 ]

@@ -8,7 +8,8 @@ report uses none):
 * :class:`PayloadStep` — a point mass picked up at the end effector at a time (the law is
   not told: its model stays what it believed);
 * :class:`SensorNoise` — Gaussian noise on the ``q`` and ``q̇`` the law sees (the plant
-  moves on the true state), seeded, independent per run;
+  moves on the true state), and on the force its sensor reads (a scene's contact), seeded,
+  independent per run;
 * ``delay`` (on the plant) — steps between a measurement and the torque it produces.
 
 **Timing.** Events act on whole steps of the engine's grid ``t_k = k dt``: the wrench is
@@ -141,12 +142,16 @@ class SensorNoise:
         sigma_v: Standard deviation on each ``q̇`` [rad/s], >= 0.
         seed: Seed of the noise; run r of a batch draws from ``default_rng([seed, stream + r])``.
         stream: The first run's stream (a single run is run ``stream`` of a batch).
+        sigma_f: Standard deviation on each force component [N] of the wrench the force sensor
+            reads (a scene's contact, :mod:`twolink_pin.contact`; the moments are read exactly),
+            >= 0; run r draws it from ``default_rng([seed, stream + r, 1])``.
     """
 
     sigma_q: float
     sigma_v: float = 0.0
     seed: int = 0
     stream: int = 0
+    sigma_f: float = 0.0
 
     def __post_init__(self) -> None:
         expected = "a standard deviation >= 0 [rad or rad/s]"
@@ -156,6 +161,11 @@ class SensorNoise:
         object.__setattr__(
             self, "sigma_v", _finite("sensor_noise.sigma_v", self.sigma_v, expected, nonnegative=True)
         )
+        object.__setattr__(
+            self,
+            "sigma_f",
+            _finite("sensor_noise.sigma_f", self.sigma_f, "a standard deviation >= 0 [N]", nonnegative=True),
+        )
         for name in ("seed", "stream"):
             value = getattr(self, name)
             if not (isinstance(value, int) and not isinstance(value, bool) and value >= 0):
@@ -164,6 +174,10 @@ class SensorNoise:
     def generators(self, runs: int) -> list[np.random.Generator]:
         """One generator per run of a batch of ``runs``."""
         return [np.random.default_rng([self.seed, self.stream + r]) for r in range(runs)]
+
+    def force_generators(self, runs: int) -> list[np.random.Generator]:
+        """One generator of the force sensor's noise per run of a batch of ``runs``."""
+        return [np.random.default_rng([self.seed, self.stream + r, 1]) for r in range(runs)]
 
 
 def check_delay(delay: Any) -> int:

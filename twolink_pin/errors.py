@@ -126,6 +126,26 @@ class SimulationDivergedError(TwolinkPinError):
         super().__init__(f"simulation with controller '{controller}' diverged at t = {time:.6g} s: {detail}")
 
 
+class ContactError(SimulationDivergedError):
+    """A contact the run cannot integrate: a surface too stiff (or too damped) for the step.
+    A failed run (exit status 1), caught wherever a diverged run is.
+
+    Attributes:
+        surface: The surface's name.
+        time: Simulated time [s] of the contact.
+        detail: The stiffness, the largest stable one for the step and what to change.
+    """
+
+    _fields = ("surface", "time", "detail")
+
+    def __init__(self, surface: str, time: float, detail: str) -> None:
+        self.surface = surface
+        self.controller = ""
+        self.time = time
+        self.detail = detail
+        TwolinkPinError.__init__(self, f"contact with surface '{surface}' at t = {time:.6g} s: {detail}")
+
+
 class ControllerError(TwolinkPinError):
     """A control law that raised, or returned something other than it must, during a run.
 

@@ -4,8 +4,8 @@
 no MJCF kept beside it) and edits the result with ``MjSpec``, so that both engines model the
 same arm and nothing else:
 
-* every ``<visual>`` and ``<collision>`` is dropped (MuJoCo would load the meshes; the toolkit's
-  plant has no contacts) and inertias never come from geoms (``inertiafromgeom`` false): a link
+* every ``<visual>`` and ``<collision>`` is dropped (MuJoCo would load the meshes; only a
+  scene's surfaces and the arm's contact ball collide: :mod:`twolink_pin.mujoco_contact`) and inertias never come from geoms (``inertiafromgeom`` false): a link
   without ``<inertial>`` is massless in both; a scene adds its own geoms to the spec
   (:func:`compile_model`'s ``scene``) — where contact attaches;
 * every ``<dynamics>`` is dropped: MuJoCo would read its ``damping`` and ``friction`` as joint

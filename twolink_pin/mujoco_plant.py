@@ -47,6 +47,7 @@ import numpy as np
 from twolink_pin.arm_effects import MUJOCO_ONLY, SOLIMP, SOLREF, per_joint
 from twolink_pin.dynamics import smooth_sign
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.mujoco_contact import MujocoContact, add_scene, set_contact_properties
 from twolink_pin.mujoco_model import compile_model, require_mujoco
 from twolink_pin.plant import Plant, register_engine
 
@@ -99,7 +100,10 @@ class MujocoPlant(Plant):
             saturate=self.saturate,
             payload=self.carried,
             integrator=self.integrator,
+            scene=None if self.scene is None else add_scene(self.robot, self.scene),
         )
+        if self.scene is not None:
+            set_contact_properties(require_mujoco(), model, self.scene)
         object.__setattr__(self, "mj_model", model)
 
     @property
@@ -114,6 +118,15 @@ class MujocoPlant(Plant):
             return SteppedDynamics(self) if stepped else MujocoDynamics(self).fast()
         return (
             SteppedBatchDynamics(self, runs, threads) if stepped else MujocoBatchDynamics(self, runs, threads)
+        )
+
+    def contact_model(self, runs: int, step: float | None = None) -> MujocoContact | None:  # type: ignore[override]
+        """MuJoCo's own contact with the scene, read from the runs' ``MjData``
+        (:class:`~twolink_pin.mujoco_contact.MujocoContact`; MuJoCo applies it: no ``tau``)."""
+        if self.scene is None:
+            return None
+        return MujocoContact(
+            self.mj_model, self.robot, self.scene, runs, step if self.law_per_stage else None
         )
 
     def after_payload(self) -> MujocoPlant:
@@ -162,6 +175,7 @@ class MujocoDynamics:
         self._forward = mujoco.mj_forward
         self.model = model = copy.copy(plant.mj_model)  # its own options (the step)
         self.data = data = mujoco.MjData(model)
+        self._datas = [data]
         nv = model.nv
         self._qpos, self._qvel = data.qpos.reshape(1, nv), data.qvel.reshape(1, nv)
         self._qacc, self._applied = data.qacc.reshape(1, nv), data.qfrc_applied.reshape(1, nv)
@@ -172,8 +186,12 @@ class MujocoDynamics:
         )
         self._smoothing = 0.0 if friction is None else friction.smoothing
 
-    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        self._load(q, v, tau)
+    def __call__(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> np.ndarray:
+        """``external``: a joint torque [N·m] from outside the motors (a wrench's ``Jᵀ F``), never
+        clamped by the motors' force range, (1, nv) or None."""
+        self._load(q, v, tau, external)
         self._forward(self.model, self.data)
         return self._qacc.copy()
 
@@ -186,21 +204,30 @@ class MujocoDynamics:
         qpos, qvel, applied, qacc = self._qpos, self._qvel, self._applied, self._qacc
         forward, model, data = self._forward, self.model, self.data
 
-        def accel(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        def accel(
+            q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+        ) -> np.ndarray:
             qpos[...] = q
             qvel[...] = v
-            applied[...] = tau
+            applied[...] = tau if external is None else tau + external
             forward(model, data)
             return qacc.copy()
 
         accel.failure = self.failure  # type: ignore[attr-defined]
+        accel.datas = self.datas  # type: ignore[attr-defined]
+        accel.model = model  # type: ignore[attr-defined]
+        accel.inputs = self.inputs  # type: ignore[attr-defined]
+        accel.resume = self.resume  # type: ignore[attr-defined]
         return accel
 
-    def _load(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
+    def _load(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> None:
         """The state and the torque into ``MjData``: with saturation the motors take ``τ`` (their
         force range clamps it) and ``0·τ`` goes into ``qfrc_applied``, so that a non-finite
         torque, which MuJoCo would replace by 0 (``mjWARN_BADCTRL``), fails the run as on the
-        Pinocchio plant; the toolkit's friction ``−f(q̇)`` goes into ``qfrc_applied`` too."""
+        Pinocchio plant; the toolkit's friction ``−f(q̇)`` and the ``external`` torque (never
+        clamped) go into ``qfrc_applied`` too."""
         self._qpos[...] = q
         self._qvel[...] = v
         ctrl = self._ctrl
@@ -212,7 +239,22 @@ class MujocoDynamics:
         if self._friction is not None:
             viscous, coulomb = self._friction
             applied = applied - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
-        self._applied[...] = applied
+        self._applied[...] = applied if external is None else applied + external
+
+    def datas(self) -> list[Any]:
+        """The run's ``MjData`` (its contacts: :class:`~twolink_pin.mujoco_contact.MujocoContact`)."""
+        return self._datas
+
+    def inputs(self) -> tuple[np.ndarray, ...]:
+        """The last call's ``qpos``, ``qvel``, ``qfrc_applied`` and ``ctrl`` rows, (1, ·) each."""
+        data = self.data
+        return data.qpos[None], data.qvel[None], data.qfrc_applied[None], data.ctrl[None]
+
+    def resume(self, previous: Any) -> None:
+        """Take over from ``previous`` (the plant before a payload step): its last call's inputs
+        evaluated here, so that the contact read before this plant's first call is its own."""
+        _resume(self.data.qpos, self.data.qvel, self.data.qfrc_applied, self.data.ctrl, previous)
+        self._forward(self.model, self.data)
 
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of a failed run: its warnings, or its last ``q̈`` if non-finite or huge."""
@@ -231,12 +273,14 @@ class SteppedDynamics(MujocoDynamics):
         dz: np.ndarray,
         steps: Any,
         nz: int,
+        external: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """One ``mj_step`` of ``steps.dt`` [s] from ``(q, v)`` under the held torque; ``z ← z + dt ż``."""
+        """One ``mj_step`` of ``steps.dt`` [s] from ``(q, v)`` under the held torque (and the held
+        ``external`` torque, never clamped); ``z ← z + dt ż``."""
         model = self.model
         if model.opt.timestep != steps.dt:
             model.opt.timestep = steps.dt
-        self._load(q, v, tau)
+        self._load(q, v, tau, external)
         self._mujoco.mj_step(model, self.data)
         return self._qpos.copy(), self._qvel.copy(), (z + steps.hz * dz if nz else z)
 
@@ -249,20 +293,30 @@ class MujocoBatchDynamics:
         from mujoco import batch
 
         self.model = model = copy.copy(plant.mj_model)
-        self.batch = b = batch.Batch(model, nsim=runs, nthread=max(1, threads or 1))
+        # persistent: each run's whole MjData kept, its contacts read by get_data (a scene)
+        self.batch = b = batch.Batch(
+            model, nsim=runs, nthread=max(1, threads or 1), persistent=plant.scene is not None
+        )
         self._qpos, self._qvel, self._applied = b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied")
         self._ctrl = b.bind("ctrl") if plant.saturate else None
         self._qacc = b.bind("qacc")
         self._plant = plant
+        self._datas: list[Any] | None = None
+        self._ncon: np.ndarray | None = None
         friction = plant.friction
         self._friction = friction
 
-    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        self._load(q, v, tau)
+    def __call__(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> np.ndarray:
+        """As :meth:`MujocoDynamics.__call__`, (N, nv) rows."""
+        self._load(q, v, tau, external)
         self.batch.forward()
         return self._qacc.copy()
 
-    def _load(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> None:
+    def _load(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> None:
         """As :meth:`MujocoDynamics._load`, every run's row at once."""
         self._qpos[...] = q
         self._qvel[...] = v
@@ -273,7 +327,29 @@ class MujocoBatchDynamics:
             applied = tau
         if self._friction is not None:
             applied = applied - self._friction.torque(v)
-        self._applied[...] = applied
+        self._applied[...] = applied if external is None else applied + external
+
+    def datas(self) -> list[Any]:
+        """Each run's ``MjData`` after the batch's last call, None for a run without contacts (its
+        contacts: :class:`~twolink_pin.mujoco_contact.MujocoContact`; copied out of the batch)."""
+        b = self.batch
+        if self._datas is None:
+            self._datas = [self._mujoco.MjData(self.model) for _ in range(b.nsim)]
+            self._ncon = b.bind("ncon")
+        ncon = self._ncon
+        assert ncon is not None
+        return [b.get_data(i, data) if n else None for i, (n, data) in enumerate(zip(ncon, self._datas))]
+
+    def inputs(self) -> tuple[np.ndarray, ...]:
+        """The last call's ``qpos``, ``qvel``, ``qfrc_applied`` and ``ctrl`` rows, (N, ·) each."""
+        b = self.batch
+        return b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied"), b.bind("ctrl")
+
+    def resume(self, previous: Any) -> None:
+        """As :meth:`MujocoDynamics.resume`, every run."""
+        qpos, qvel, applied, ctrl = self.inputs()
+        _resume(qpos, qvel, applied, ctrl, previous)
+        self.batch.forward()
 
     def failure(self, run: int) -> str | None:
         """MuJoCo's own cause of run ``run``'s failure (its warnings, or its last ``q̈``)."""
@@ -292,8 +368,10 @@ class SteppedBatchDynamics(MujocoBatchDynamics):
         dz: np.ndarray,
         steps: Any,
         nz: int,
+        external: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """One step of ``steps.dt`` [s] of every run under its held torque; ``z ← z + dt ż``."""
+        """One step of ``steps.dt`` [s] of every run under its held torque (and ``external``);
+        ``z ← z + dt ż``."""
         model = self.model
         if model.opt.timestep != steps.dt:
             model.opt.timestep = steps.dt
@@ -302,16 +380,23 @@ class SteppedBatchDynamics(MujocoBatchDynamics):
             self._qpos, self._qvel, self._applied = b.bind("qpos"), b.bind("qvel"), b.bind("qfrc_applied")
             self._ctrl = b.bind("ctrl") if self._ctrl is not None else None
             self._qacc = b.bind("qacc")
-        self._load(q, v, tau)
+            self._datas = None  # the contacts' reads bound to the new batch
+        self._load(q, v, tau, external)
         self.batch.step()
         return self._qpos.copy(), self._qvel.copy(), (z + steps.hz * dz if nz else z)
+
+
+def _resume(qpos: np.ndarray, qvel: np.ndarray, applied: np.ndarray, ctrl: np.ndarray, previous: Any) -> None:
+    """``previous``'s last inputs written into these arrays (the same arm: the same sizes)."""
+    for target, source in zip((qpos, qvel, applied, ctrl), previous.inputs(), strict=True):
+        target[...] = source.reshape(target.shape)
 
 
 def _rebuilt(old: Any, model: Any) -> Any:
     """A batch of ``model`` (its options changed) carrying ``old``'s state rows."""
     from mujoco import batch
 
-    new = batch.Batch(model, nsim=old.nsim, nthread=old.nthread)
+    new = batch.Batch(model, nsim=old.nsim, nthread=old.nthread, persistent=old.persistent)
     new.state[...] = old.state
     return new
 

@@ -8,7 +8,9 @@ clips to the URDF torque limits when ``saturate`` is on (off by default, as in t
 A plant may also push back (:mod:`twolink_pin.disturbances`: a wrench, a payload step,
 sensor noise, a delay; none by default), and may make each joint's position range a hard
 stop (``position_stops``: :mod:`twolink_pin.simulation.stops`, off by default: a joint then
-passes its range and the run records the crossing); the engine then runs
+passes its range and the run records the crossing), and may touch the surfaces of a scene
+(``scene``: :mod:`twolink_pin.contact`, none by default; the Pinocchio plant's contact is
+:class:`~twolink_pin.contact.CompliantContact`); the engine then runs
 :mod:`twolink_pin.simulation.events`.
 
 :class:`Plant` is one frozen value; a variant is :func:`dataclasses.replace` of it.
@@ -46,6 +48,8 @@ from twolink_pin.arm_effects import (
     per_joint,
     resolve_effect,
 )
+from twolink_pin.contact.compliant import CompliantContact
+from twolink_pin.contact.scene import Scene
 from twolink_pin.disturbances import PayloadStep, SensorNoise, Wrench, check_delay
 from twolink_pin.dynamics import ABA_CONVENTION, Friction
 from twolink_pin.errors import InvalidParameterError
@@ -96,6 +100,7 @@ class Plant:
         delay: Steps between a measurement and the torque it produces.
         position_stops: Make each joint's position range a hard, perfectly inelastic stop
             (:mod:`twolink_pin.simulation.stops`); joints without a range have none.
+        scene: The surfaces the arm may touch (:class:`~twolink_pin.contact.Scene`), or None.
         model: The Pinocchio model integrated (default ``robot.model``, with ``armature`` in
             its ``model.armature``; the model after a payload step in :meth:`after_payload`).
         friction_source: Where ``friction`` comes from, in words (the summaries show it).
@@ -119,6 +124,7 @@ class Plant:
     sensor_noise: SensorNoise | None = None
     delay: int = 0
     position_stops: bool = False
+    scene: Scene | None = None
     model: pin.Model = field(default=None, repr=False)
     friction_source: str = ""
     armature: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # None: zeros
@@ -150,6 +156,15 @@ class Plant:
             if value is not None and not isinstance(value, kind):
                 raise InvalidParameterError(
                     name, value, f"a twolink_pin.disturbances.{kind.__name__} or None"
+                )
+        if self.scene is not None:
+            if not isinstance(self.scene, Scene):
+                raise InvalidParameterError("scene", self.scene, "a twolink_pin.contact.Scene or None")
+            if self.scene.frame is not None and not robot.model.existFrame(self.scene.frame):
+                raise InvalidParameterError(
+                    "scene.frame",
+                    self.scene.frame,
+                    f"a frame of {robot.name}: {[f.name for f in robot.model.frames]}",
                 )
         wrench = self.wrench
         if wrench is not None and wrench.frame is not None and not robot.model.existFrame(wrench.frame):
@@ -193,13 +208,22 @@ class Plant:
 
     @property
     def has_events(self) -> bool:
-        """Whether the plant pushes back: a wrench, a payload step, sensor noise, a delay or
-        joint stops."""
+        """Whether the plant pushes back: a wrench, a payload step, sensor noise, a delay,
+        joint stops or a scene to touch."""
         return (
-            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise))
+            any(x is not None for x in (self.wrench, self.payload_step, self.sensor_noise, self.scene))
             or self.delay > 0
             or self.position_stops
         )
+
+    def contact_model(self, runs: int, step: float | None = None) -> CompliantContact | None:
+        """This plant's contact with its scene for ``runs`` runs advanced together (None without a
+        scene): the Pinocchio plant's spring–damper (:class:`~twolink_pin.contact.CompliantContact`),
+        checked against the RK4 ``step`` [s]. The engine asks it ``(q, q̇) -> ContactForces`` at
+        every stage: the force sensor reads ``wrench``, the plant's ABA adds ``tau``. A plant of
+        another engine answers with its own contact (``tau`` zero where its engine applies the
+        contact itself)."""
+        return None if self.scene is None else CompliantContact(self.robot, self.scene, runs, step)
 
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
         """Motor torque actually applied [N·m]: ``tau`` clipped to the limits if saturating."""
@@ -254,6 +278,8 @@ class Plant:
             parts.append(f"delay {self.delay} steps")
         if self.position_stops:
             parts.append("joint stops")
+        if self.scene is not None:
+            parts.append(self.scene.describe() if values else "contact")
         parts.extend(self.effects_described(values))
         return ", ".join(parts)
 
@@ -315,6 +341,8 @@ class PlantOptions:
         position_stops: Each joint's position range a hard stop (``--joint-stops``;
             :mod:`twolink_pin.simulation.stops`): off, a joint may pass its range, and the run
             says so.
+        scene: The surfaces the arm may touch and their contact properties (``--scene FILE``,
+            ``--wall …``; :mod:`twolink_pin.contact`), or None (free space).
         engine: The plant's engine: ``pinocchio`` (default) or ``mujoco``
             (:mod:`twolink_pin.mujoco_plant`: the same URDF compiled by MuJoCo).
         armature: Rotor inertia [kg·m²]: ``arm``, one value or one per joint; None: none.
@@ -340,6 +368,7 @@ class PlantOptions:
     sensor_noise: SensorNoise | None = None
     delay: int = 0
     position_stops: bool = False
+    scene: Scene | None = None
     engine: str = DEFAULT_ENGINE
     armature: tuple[float, ...] | str | None = None
     joint_damping: tuple[float, ...] | str | None = None
@@ -352,6 +381,10 @@ class PlantOptions:
     def __post_init__(self) -> None:
         if not isinstance(self.position_stops, bool):
             raise InvalidParameterError("position_stops", self.position_stops, "True or False")
+        if isinstance(self.scene, Mapping):  # from_dict: the scene comes back from JSON as a mapping
+            object.__setattr__(self, "scene", Scene(**self.scene))
+        elif self.scene is not None and not isinstance(self.scene, Scene):
+            raise InvalidParameterError("scene", self.scene, "a twolink_pin.contact.Scene or None")
         # as_dict / from_dict: the events come back from JSON as mappings
         for name, kind in (("wrench", Wrench), ("payload_step", PayloadStep), ("sensor_noise", SensorNoise)):
             value = getattr(self, name)
@@ -455,6 +488,7 @@ class PlantOptions:
             sensor_noise=self.sensor_noise,
             delay=self.delay,
             position_stops=self.position_stops,
+            scene=self.scene,
             friction_source=source,
             effect_sources=tuple(sources),
             **values,

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from twolink_pin.arm_effects import believe_effects, refuse_idle
+from twolink_pin.contact_checks import check_contact
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.law_variant import Variant
@@ -46,6 +47,7 @@ from twolink_pin.simulation import SimulationConfig
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
     from twolink_pin.identification import IdentifiedParameters
+    from twolink_pin.trajectory import Trajectory
 
 PARAMETER_USES = ("p0", "model")
 """How identified parameters are used: the estimates start there (``p0``), or the law's
@@ -221,10 +223,17 @@ class RunSpec:
             return robot_friction(robot, self.friction_smoothing)[0]
         return None
 
-    def check_effective(self, robot: RobotModel, laws: Sequence[str | type[Controller]] = ()) -> None:
+    def check_effective(
+        self,
+        robot: RobotModel,
+        laws: Sequence[str | type[Controller]] = (),
+        trajectory: Trajectory | None = None,
+    ) -> None:
         """Refuse an option that would do nothing on ``robot`` for this spec's law, or for every
         one of ``laws`` (a shared spec): a silent no-op is a wrong answer. The commands call it
-        once, before their runs (λ and gains a law lacks are refused when it is built).
+        once, before their runs (λ and gains a law lacks are refused when it is built), with the
+        ``trajectory`` the runs follow (its force reference checked against the scene and the
+        laws: :func:`~twolink_pin.contact_checks.check_contact`).
 
         Raises:
             InvalidParameterError: the option, its value and why it would do nothing.
@@ -281,6 +290,7 @@ class RunSpec:
                 "--p0", self.parameters, f"a law that estimates parameters among those that run ({names})"
             )
         self._check_events(sim)
+        check_contact(plant, sim, classes, trajectory)
 
     def _check_events(self, sim: SimulationConfig) -> None:
         """Refuse a plant event that acts on no step of the run (steps ``t_k = k dt``,
@@ -308,9 +318,9 @@ class RunSpec:
                 f"a time within the run (before its last step at {(steps - 1) * dt:g} s; --duration {sim.duration:g} s)",
             )
         noise = plant.sensor_noise
-        if noise is not None and noise.sigma_q == 0 and noise.sigma_v == 0:
+        if noise is not None and noise.sigma_q == 0 and noise.sigma_v == 0 and noise.sigma_f == 0:
             raise InvalidParameterError(
-                "--sensor-noise", "0,0", "a standard deviation > 0 on q or q̇ (0,0 adds no noise)"
+                "--sensor-noise", "0,0,0", "a standard deviation > 0 on q, q̇ or the force (0 adds no noise)"
             )
 
     def _check_stops(self, robot: RobotModel) -> None:

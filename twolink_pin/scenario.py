@@ -45,12 +45,18 @@ def law_class(law: str | type[Controller]) -> type[Controller]:
     )
 
 
-def builtin_laws() -> tuple[str, ...]:
+def builtin_laws(force_control: bool = False) -> tuple[str, ...]:
     """Names of the laws twolink-pin defines (not a user's nor a package's), in registry order:
-    what ``compare`` and ``report`` run when no law is named."""
+    what ``compare`` and ``report`` run when no law is named; those that control a contact
+    force (:attr:`~twolink_pin.controllers.Controller.force_control`) only with ``force_control``
+    (a run against a surface with a force reference: they run nowhere else)."""
     from twolink_pin.controllers import CONTROLLERS
 
-    return tuple(n for n, cls in CONTROLLERS.items() if cls.__module__.startswith("twolink_pin.controllers."))
+    return tuple(
+        n
+        for n, cls in CONTROLLERS.items()
+        if cls.__module__.startswith("twolink_pin.controllers.") and (force_control or not cls.force_control)
+    )
 
 
 def _reference(cls: type[Controller]) -> str:

@@ -190,6 +190,12 @@ def _placed(rotation: np.ndarray, position: np.ndarray, placement: pin.SE3) -> t
     return rotation, position
 
 
+def frame_positions(robot: RobotModel, q: np.ndarray, frame_id: int) -> np.ndarray:
+    """The frame's origin [m] at the configurations ``q`` (K, nq) [rad], shape (K, 3): the
+    forward kinematics the task metrics use, for all K at once."""
+    return _poses(robot, np.asarray(q, dtype=float), frame_id)[0]
+
+
 def _chain_poses(
     model: pin.Model, chain: list[Link], q: np.ndarray, frame_id: int
 ) -> tuple[np.ndarray, np.ndarray]:

@@ -58,21 +58,29 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm (Pinocchio's and MuJoCo's), the effects a real arm has, what pushes back on it, a law "
-        "with its plant, a law's variants, the run description, and the engine.",
+        "The simulated arm (Pinocchio's and MuJoCo's), the effects a real arm has, what pushes back on it, the "
+        "surfaces it touches, a law with its plant, a law's variants, the run description, and the engine.",
         (
             "plant",
             "arm_effects",
             "mujoco_model",
             "mujoco_plant",
+            "mujoco_contact",
             "disturbances",
+            "contact",
             "scenario",
             "law_variant",
             "run_spec",
+            "contact_checks",
             "simulation",
         ),
     ),
-    ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
+    (
+        "metrics",
+        "Metrics",
+        "RMS, L2 and max norms of a run or a batch; the end effector's errors; the contact's.",
+        ("metrics", "task_metrics", "contact_metrics"),
+    ),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),
     (
         "identification",

@@ -1,5 +1,6 @@
 """The options of a plant that pushes back: ``--wrench``, ``--payload-step``,
-``--sensor-noise``, ``--noise-seed``, ``--delay`` (:mod:`twolink_pin.disturbances`).
+``--sensor-noise``, ``--noise-seed``, ``--delay`` (:mod:`twolink_pin.disturbances`), and the
+scene it touches (``--scene``, ``--wall``: :mod:`twolink_pin.cli.contact_options`).
 
 Each value type raises :class:`argparse.ArgumentTypeError` naming the value and the expected
 form (one line on stderr, exit 2); :func:`plant_events` gives them to the run's
@@ -14,6 +15,7 @@ from typing import Any
 
 from twolink_pin.cli.arguments import MAX_TEXT, finite, whole
 from twolink_pin.cli.common_options import run_group
+from twolink_pin.cli.contact_options import add_contact_options, scene_of
 from twolink_pin.disturbances import PayloadStep, Wrench
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 
@@ -74,11 +76,14 @@ def payload_step(text: str) -> PayloadStep:
     return PayloadStep(value, when)
 
 
-def sensor_noise(text: str) -> tuple[float, float]:
-    """``SIGMA_Q[,SIGMA_V]`` [rad, rad/s] (σ_v default 0)."""
-    expected = f"SIGMA_Q[,SIGMA_V]: standard deviations >= 0 in rad and rad/s, got {_shown(text)}"
+def sensor_noise(text: str) -> tuple[float, float, float]:
+    """``SIGMA_Q[,SIGMA_V[,SIGMA_F]]`` [rad, rad/s, N] (σ_v, σ_F default 0; σ_F: the force sensor's,
+    with a scene)."""
+    expected = (
+        f"SIGMA_Q[,SIGMA_V[,SIGMA_F]]: standard deviations >= 0 in rad, rad/s and N, got {_shown(text)}"
+    )
     parts = text.split(",")
-    if len(parts) not in (1, 2):
+    if len(parts) not in (1, 2, 3):
         raise argparse.ArgumentTypeError(f"expected {expected}")
     try:
         values = [finite(x) for x in parts]
@@ -86,7 +91,8 @@ def sensor_noise(text: str) -> tuple[float, float]:
         raise argparse.ArgumentTypeError(f"expected {expected}") from None
     if any(not 0 <= x <= 1e3 for x in values):
         raise argparse.ArgumentTypeError(f"expected {expected} (at most 1000)")
-    return values[0], values[1] if len(values) == 2 else 0.0
+    values += [0.0] * (3 - len(values))
+    return values[0], values[1], values[2]
 
 
 def scale_range(text: str) -> tuple[float, float]:
@@ -122,8 +128,9 @@ def add_disturbance_options(p: argparse.ArgumentParser) -> None:
     group.add_argument(
         "--sensor-noise",
         type=sensor_noise,
-        metavar="SIGMA_Q[,SIGMA_V]",
-        help="Gaussian noise [rad, rad/s] on the q and q̇ the law measures (seeded: --noise-seed)",
+        metavar="SIGMA_Q[,SIGMA_V[,SIGMA_F]]",
+        help="Gaussian noise [rad, rad/s] on the q and q̇ the law measures, and [N] on the force its "
+        "sensor reads with a scene (seeded: --noise-seed)",
     )
     group.add_argument(
         "--noise-seed",
@@ -138,6 +145,7 @@ def add_disturbance_options(p: argparse.ArgumentParser) -> None:
         metavar="STEPS",
         help="steps between a measurement and the torque it produces (default 0)",
     )
+    add_contact_options(p)  # the world the arm touches: a run option beside the events
 
 
 def plant_events(args: Any) -> dict[str, Any]:
@@ -156,6 +164,9 @@ def plant_events(args: Any) -> dict[str, Any]:
     return {
         "wrench": getattr(args, "wrench", None),
         "payload_step": getattr(args, "payload_step", None),
-        "sensor_noise": None if noise is None else SensorNoise(noise[0], noise[1], seed=seed or 0),
+        "sensor_noise": None
+        if noise is None
+        else SensorNoise(noise[0], noise[1], seed=seed or 0, sigma_f=noise[2]),
         "delay": getattr(args, "delay", 0) or 0,
+        **scene_of(args),
     }

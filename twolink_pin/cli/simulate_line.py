@@ -45,7 +45,11 @@ def _plant_tokens(spec: RunSpec) -> list[str]:
         tokens.append(f"--payload-step={_number(plant.payload_step.mass)}@{_number(plant.payload_step.time)}")
     if plant.sensor_noise is not None:
         n = plant.sensor_noise
-        tokens += [f"--sensor-noise={_number(n.sigma_q)},{_number(n.sigma_v)}", f"--noise-seed={n.seed}"]
+        force = f",{_number(n.sigma_f)}" if n.sigma_f else ""
+        tokens += [
+            f"--sensor-noise={_number(n.sigma_q)},{_number(n.sigma_v)}{force}",
+            f"--noise-seed={n.seed}",
+        ]
     if plant.delay:
         tokens.append(f"--delay={plant.delay}")
     if plant.position_stops:
@@ -78,6 +82,39 @@ def _effect_tokens(spec: RunSpec) -> list[str]:
     return tokens
 
 
+def _scene_tokens(spec: RunSpec, scene: str | None) -> list[str]:
+    """``--scene FILE`` (the file the scene was read from), or ``--wall …`` for a scene that is
+    one plane with ``--wall``'s defaults otherwise; none without a scene.
+
+    Raises:
+        ValueError: a scene from no file that ``--wall`` cannot say.
+    """
+    from twolink_pin.contact.scene import DEFAULT_RADIUS, DEFAULT_SLIP_VELOCITY
+
+    given = spec.plant.scene
+    if given is None:
+        return []
+    if scene is not None:
+        return [f"--scene={scene}"]
+    (s,) = given.surfaces if len(given.surfaces) == 1 else (None,)
+    plain = (
+        given.radius == DEFAULT_RADIUS
+        and given.slip_velocity == DEFAULT_SLIP_VELOCITY
+        and given.frame is None
+    )
+    if (
+        s is None
+        or not plain
+        or s.size is not None
+        or s.solref is not None
+        or s.solimp is not None
+        or s.name != "wall"
+    ):
+        raise ValueError("a scene read from no file and beyond one --wall plane has no command line")
+    wall = f"{_numbers(s.point)}:{_numbers(s.normal)}:{_number(s.stiffness)}:{_number(s.damping)}:{_number(s.friction)}"
+    return [f"--wall={wall}"]
+
+
 def _simulation_tokens(sim: SimulationConfig) -> list[str]:
     tokens = [f"--duration={_number(sim.duration)}"]
     if sim.dt != _DEFAULTS.dt:
@@ -93,11 +130,16 @@ def _simulation_tokens(sim: SimulationConfig) -> list[str]:
 
 
 def simulate_argv(
-    spec: RunSpec, robot: str | None = None, payload: float = 0.0, trajectory: str | None = None
+    spec: RunSpec,
+    robot: str | None = None,
+    payload: float = 0.0,
+    trajectory: str | None = None,
+    scene: str | None = None,
 ) -> list[str]:
     """The arguments of ``twolink-pin simulate`` (after the program name) for ``spec`` on the
-    robot ``robot`` (a catalog name or URDF path, None: the default) with ``payload`` [kg]
-    and the reference file ``trajectory`` (None: the robot's own)."""
+    robot ``robot`` (a catalog name or URDF path, None: the default) with ``payload`` [kg],
+    the reference file ``trajectory`` (None: the robot's own) and the scene file ``scene`` the
+    spec's scene was read from (None: ``--wall``, or no scene)."""
     if not isinstance(spec.law, str):
         raise ValueError("a law given by reference (name, file.py:Class) has a command line; a class has not")
     tokens = ["simulate", spec.law]
@@ -113,7 +155,7 @@ def simulate_argv(
     tokens += [f"--gain={name}={_numbers(value)}" for name, value in spec.gains]
     if spec.parameters is not None:
         tokens.append(f"--{spec.parameters_use}={spec.parameters}")
-    return tokens + _plant_tokens(spec)
+    return tokens + _plant_tokens(spec) + _scene_tokens(spec, scene)
 
 
 def command_line(argv: Sequence[str]) -> str:

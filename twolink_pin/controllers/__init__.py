@@ -3,6 +3,7 @@
 =====================  ============================================================
 ``base.py``            :class:`Controller` (the contract), ``LawInput``/``LawOutput``,
                        the ``Terms`` protocol, the registry :data:`CONTROLLERS`
+``contact_input.py``   ``ContactInput``: the force sensor's wrench and the force reference
 ``gains.py``           :class:`Gains` and :func:`gain`: validated gains with units
 ``loading.py``         :func:`load_controller`: a name, ``file.py:Class``, ``module:Class``
 ``pd.py``              ``pd`` — :class:`PDFeedforward` (report eq. 8)
@@ -17,6 +18,9 @@
 ``impedance.py``       ``impedance`` — :class:`Impedance` (Cartesian impedance + ĝ)
 ``qp_osc.py``          ``qp-osc`` — :class:`QPOperationalSpace` (``osc`` as a QP within the limits)
 ``mpc.py``             ``mpc`` — :class:`ModelPredictive` (a plan within the limits, replanned)
+``force_loop.py``      what the force laws share: the sensor's normal force, its PI, anti-windup
+``force.py``           ``force`` — :class:`ForceControl` (ĝ + Jᵀ(f_d + PI on the force error) − K_d q̇)
+``hybrid.py``          ``hybrid`` — :class:`Hybrid` (Raibert–Craig: position along a surface, force across)
 =====================  ============================================================
 """
 
@@ -33,6 +37,7 @@ from twolink_pin.controllers.base import (
     StateVariable,
     Terms,
 )
+from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.pd import PDFeedforward, PDGains
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
@@ -45,6 +50,8 @@ from twolink_pin.controllers.osc import OperationalSpace, OSCGains
 from twolink_pin.controllers.impedance import Impedance, ImpedanceGains
 from twolink_pin.controllers.qp_osc import QPOperationalSpace, QPOSCGains
 from twolink_pin.controllers.mpc import MPCGains, ModelPredictive
+from twolink_pin.controllers.force import ForceControl, ForceGains
+from twolink_pin.controllers.hybrid import Hybrid, HybridGains
 from twolink_pin.controllers.loading import available_controllers, load_controller
 
 __all__ = [
@@ -56,9 +63,14 @@ __all__ = [
     "AdaptiveFrictionGains",
     "AdaptiveGains",
     "ComputedTorque",
+    "ContactInput",
     "Controller",
+    "ForceControl",
+    "ForceGains",
     "FrameTerms",
     "Gains",
+    "Hybrid",
+    "HybridGains",
     "Impedance",
     "ImpedanceGains",
     "LawInput",

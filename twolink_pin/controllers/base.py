@@ -41,6 +41,7 @@ from typing import Any, ClassVar, Generic, NamedTuple, Protocol, TypeVar
 
 import numpy as np
 
+from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.controllers.gains import Gains as GainsBase
 from twolink_pin.controllers.gains import as_matrix, check_width, gain_spec, runs_of
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
@@ -128,6 +129,10 @@ class LawInput(NamedTuple):
     accel_des: np.ndarray | None = None
     """Desired spatial (classical) acceleration ``[p̈; ω̇]`` [m/s²; rad/s²], world-aligned,
     linear rows first, shape (1, 6)."""
+    contact: ContactInput | None = None
+    """The force sensor's wrench, the force reference and its surface's normal
+    (:class:`~twolink_pin.controllers.contact_input.ContactInput`) when the plant's scene has
+    surfaces (``--scene``, ``--wall``), else None."""
 
 
 class LawOutput(NamedTuple):
@@ -289,6 +294,9 @@ class Controller(abc.ABC, Generic[G]):
     """True for a law on the end effector's pose: the engine fills ``LawInput.x_des``,
     ``R_des``, ``twist_des`` and ``accel_des`` for it, and the commands show its task-space
     errors (mm, deg)."""
+    force_control: ClassVar[bool] = False
+    """True for a law that controls a contact force (it reads ``LawInput.contact.force_des``):
+    it runs only against a scene's surface, and only such a law takes a force reference."""
 
     def __init_subclass__(cls, register: bool = True, **kwargs: Any) -> None:
         """Register the class under its ``name`` (``class X(Controller, register=False)``

@@ -26,6 +26,9 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
                      to the desired one
 ``task.py``          :func:`save_task_error_figure`: a task-space law's position [mm] and
                      orientation [deg] errors over time
+``contact.py``       :func:`~twolink_pin.plotting.contact.save_contact_figure`: runs against a
+                     surface, the force with the desired force, the position along it, the
+                     penetration
 ``overlay.py``       :func:`~twolink_pin.plotting.overlay.save_overlay_figure`: the runs of one
                      law's variants on the same axes (error envelope, torque)
 ``limits.py``        :func:`save_limits_figure`: several runs against one joint's range and

@@ -25,6 +25,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from twolink_pin import interrupts
+from twolink_pin.contact_metrics import contact_metrics
 from twolink_pin.errors import (
     ControllerError,
     InvalidURDFError,
@@ -66,7 +67,11 @@ def laws_to_run(options: ReportOptions, robot: Any) -> tuple[Variant, ...]:
     if options.controllers is not None:
         return parse_variants(options.controllers)
     laws = robot.profile.report.laws
-    return parse_variants(tuple(laws) if laws is not None else builtin_laws())
+    pressing = (
+        options.run.plant.scene is not None
+        and reference_trajectory(robot, options).force_reference is not None
+    )
+    return parse_variants(tuple(laws) if laws is not None else builtin_laws(pressing))
 
 
 def build_report(
@@ -90,7 +95,7 @@ def build_report(
     variants = laws_to_run(options, robot)
     laws = [v.law for v in variants]
     options.run.check_law_gains(laws)
-    options.run.check_effective(robot, laws)
+    options.run.check_effective(robot, laws, reference_trajectory(robot, options))
     rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
     steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
     steps += 1 if options.sim_to_sim else 0
@@ -134,6 +139,7 @@ def _build(
     cfg = options.run.simulation
     q0_offset = joint_offsets("q0_offset", cfg.q0_offset, robot.profile.q0_offset, robot.nv)
     task = {n: task_metrics(r[0], robot) for n, r in runs.items()}  # every law moves the end effector
+    contact = {n: m for n, r in runs.items() if (m := contact_metrics(r[0], robot)) is not None}  # a scene
     table = ComparisonTable(
         {n: r[1] for n, r in runs.items()},
         {n: r[3] for n, r in runs.items()},
@@ -142,8 +148,9 @@ def _build(
         plants={n: plant_description(rows[n].scenario) for n in names},
         gains={n: gains_used(rows[n].scenario.controller) for n in names},
         task=task,
+        contact=contact,
     )
-    controllers, lams = _law_entries(runs, rows, task)
+    controllers, lams = _law_entries(runs, rows, task, contact)
     errata: list[dict[str, Any]] = []
     if sections:
         done_runs = {n: r[0] for n, r in runs.items()}
@@ -168,6 +175,7 @@ def _build(
         "failed": table.failed,
         "comparison": table.as_dict(),
         "comparison_markdown": table.markdown(),
+        "contact_figure": _contact_figure(stage, robot, {n: runs[n][0] for n in contact}),
         "comparison_csv": table.csv(),
         "overlays": ran.overlays,
         "animation": ran.animation,
@@ -348,7 +356,7 @@ def _write_animation(
             result.q_des,
             path=stage / "animation.html",
             via_points=points,
-            **run_overlays(options.run.plant.wrench, result.t),
+            **run_overlays(options.run.plant.wrench, result.t, options.run.plant.scene, result.wrench),
         )
     except InvalidURDFError as exc:  # a missing mesh: the report without its animation
         warnings.append(f"no animation: {exc}")
@@ -360,9 +368,10 @@ def _law_entries(
     runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
     rows: dict[str, Row],
     task: dict[str, Any],
+    contact: dict[str, Any],
 ) -> tuple[dict[str, dict[str, Any]], dict[str, float]]:
     """Each row that ran as ``results.json`` shows it (its law, gains, metrics, figures,
-    estimates, limits), and the λ [1/s] of those that have one."""
+    estimates, limits, contact), and the λ [1/s] of those that have one."""
     controllers = {}
     lams: dict[str, float] = {}
     for name, (result, metrics, figures, seconds) in runs.items():
@@ -378,6 +387,7 @@ def _law_entries(
             "gains": controller.gains.describe(),
             "metrics": metrics.as_dict(),
             "task_metrics": task[name].as_dict() if name in task else None,
+            "contact_metrics": contact[name].as_dict() if name in contact else None,
             "figures": figures,
             "seconds": seconds,
             "p_hat_final": None if result.p_hat is None else result.p_hat[-1].tolist(),
@@ -391,14 +401,26 @@ def _law_entries(
     return controllers, lams
 
 
+def _contact_figure(stage: Path, robot: Any, results: dict[str, SimulationResult]) -> str | None:
+    """``figures/contact.png``: the runs against the scene drawn together (None without a scene)."""
+    if not results:
+        return None
+    from twolink_pin.plotting.contact import save_contact_figure
+
+    save_contact_figure(results, robot, stage / "figures" / "contact.png")
+    return "contact.png"
+
+
 def _trajectory_facts(trajectory: Any, via: Any, figures: list[str]) -> dict[str, Any]:
     """The reference as ``results.json`` shows it: via times [s] and joints [rad], the
-    end effector's via points [m] (the robot's default reference), period [s], coefficients."""
+    end effector's via points [m] (the robot's default reference), period [s], coefficients
+    (None for a reference without: via poses, the straight lines of ``path = "lines"``)."""
+    coefficients = getattr(trajectory, "coefficients", None)
     return {
         "times": trajectory.times.tolist(),
         "via_q": trajectory.via_q.tolist(),
         "via_xy": None if via is None else [list(p) for p in via.xy],
         "period_s": trajectory.period,
-        "coefficients": trajectory.coefficients.tolist(),
+        "coefficients": None if coefficients is None else coefficients.tolist(),
         "figures": figures,
     }

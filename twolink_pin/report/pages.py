@@ -17,6 +17,7 @@ import jinja2
 import markupsafe
 import numpy as np
 
+from twolink_pin.contact_metrics import CONTACT_TITLES, CONTACT_UNITS
 from twolink_pin.files import atomic_write, write_json
 from twolink_pin.mathml import docstring_html, latex_to_mathml
 from twolink_pin.metrics import NORMS, SIGNALS
@@ -135,6 +136,7 @@ def html(r: dict[str, Any], captions: dict[str, str] | None = None) -> str:
             r=r,
             tables=tables,
             task_table=_task_table(r),
+            contact_table=_contact_table(r),
             discussion=_discussion(r),
             nv=nv,
             limits=_limits_tables(r, nv),
@@ -253,6 +255,27 @@ def _task_table(r: dict[str, Any]) -> dict[str, Any] | None:
         return None
     return {
         "headers": ["controller", *(f"{TASK_TITLES[k]} [{u}]" for k, u in TASK_UNITS.items())],
+        "rows": rows,
+    }
+
+
+def _contact_table(r: dict[str, Any]) -> dict[str, Any] | None:
+    """The runs' contact metrics, one row per law (None without a scene)."""
+    rows = [
+        [
+            name,
+            *(
+                "—" if entry["contact_metrics"][key] is None else fmt(entry["contact_metrics"][key])
+                for key in CONTACT_UNITS
+            ),
+        ]
+        for name, entry in r["controllers"].items()
+        if entry.get("contact_metrics")
+    ]
+    if not rows:
+        return None
+    return {
+        "headers": ["controller", *(f"{CONTACT_TITLES[k]} [{u}]" for k, u in CONTACT_UNITS.items())],
         "rows": rows,
     }
 

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
-from twolink_pin.errors import ControllerError, InvalidParameterError
+from twolink_pin.errors import ContactError, ControllerError, InvalidParameterError
 from twolink_pin.simulation.deadline import PROGRESS
 from twolink_pin.user_code import HardExit, restore_baseline
 
@@ -181,7 +181,11 @@ def update_steps(controller: Controller, dt: float) -> int | None:
 
 
 def raised_by(exc: BaseException, compute: Callable[..., object]) -> bool:
-    """Whether ``exc`` was raised inside the law (its ``compute`` is on the traceback)."""
+    """Whether ``exc`` was raised inside the law (its ``compute`` is on the traceback): never a
+    plant's failed contact (:class:`~twolink_pin.errors.ContactError`, raised as the law's force
+    sensor reads it)."""
+    if isinstance(exc, ContactError):
+        return False
     code = getattr(getattr(compute, "__func__", compute), "__code__", None)
     tb = exc.__traceback__
     while tb is not None:

@@ -42,7 +42,7 @@ naming the law and the simulated time.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, NamedTuple, Protocol
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -62,46 +62,14 @@ from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
 from twolink_pin.simulation.divergence import flag_block, late_divergence, law_reason
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
+from twolink_pin.simulation.samples import Observer, Outputs, Samples
+from twolink_pin.simulation.sensing import ForceSensor
 from twolink_pin.simulation.task_reference import reference_rows
 from twolink_pin.simulation.terms import terms_for
-from twolink_pin.trajectory import Trajectory
+from twolink_pin.trajectory import ForceReference, Trajectory
 
 BLOCK = 128
 """Steps per block: how often states are checked and unrecorded samples handed on."""
-
-
-class Samples(NamedTuple):
-    """A block of consecutive output samples of N runs (B samples)."""
-
-    start: int
-    """Index of the first sample (sample k is at ``t = k dt``)."""
-    t: np.ndarray
-    """Times [s], shape (B,)."""
-    q: np.ndarray
-    """Joint positions [rad], shape (B, N, nv)."""
-    v: np.ndarray
-    """Joint velocities [rad/s], shape (B, N, nv)."""
-    z: np.ndarray
-    """The law's state, shape (B, N, nz)."""
-    tau_command: np.ndarray
-    """Commanded torque [N·m], shape (B, N, nv) (the law's output at the sample)."""
-    q_des: np.ndarray
-    """Reference positions [rad], shape (B, 1, nv)."""
-    v_des: np.ndarray
-    """Reference velocities [rad/s], shape (B, 1, nv)."""
-    a_des: np.ndarray
-    """Reference accelerations [rad/s²], shape (B, 1, nv)."""
-    q_measured: np.ndarray | None = None
-    """The positions the law measured [rad] (``q`` + sensor noise), shape (B, N, nv); None
-    without sensor noise (the law measures ``q``) or outside the full record."""
-    v_measured: np.ndarray | None = None
-    """The velocities the law measured [rad/s], as ``q_measured``."""
-
-
-class Observer(Protocol):
-    """Receives every block of samples as the engine writes it."""
-
-    def add(self, samples: Samples) -> None: ...
 
 
 class EngineRun(NamedTuple):
@@ -151,7 +119,7 @@ def integrate(
             run instead of parking it.
         progress: Called as ``progress(steps_done, steps_total)`` after each block.
     """
-    run = _Run(controller, plant, config, q0, v0, z0, record, threads)
+    run = _Run(controller, plant, config, q0, v0, z0, record, threads, trajectory.force_reference)
     n, dt, clock, events = run.n, run.dt, run.clock, run.events
     watcher = run_watcher()
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
@@ -162,7 +130,7 @@ def integrate(
     ):
         for k0 in range(0, run.total, BLOCK):
             k1 = min(k0 + BLOCK, run.total)
-            rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt)
+            rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt, run.sensor)
             if events is not None:
                 events.draw(k0, k1)
             run.advance(k0, k1, ref)
@@ -180,45 +148,6 @@ def integrate(
     return EngineRun(run.times, recorded, run.z, run.diverged_at, tuple(run.detail))
 
 
-class _Outputs(NamedTuple):
-    """The buffers samples are written into: every sample (``record``) or one block's.
-    Shapes (S, N, ·), the reference's (S, 1, nv); ``MQ``, ``MV`` (what the law measured)
-    only when the full record is kept under sensor noise."""
-
-    Q: np.ndarray
-    V: np.ndarray
-    T: np.ndarray
-    Z: np.ndarray
-    RQ: np.ndarray
-    RV: np.ndarray
-    RA: np.ndarray
-    MQ: np.ndarray | None
-    MV: np.ndarray | None
-
-    @classmethod
-    def empty(cls, size: int, runs: int, nv: int, nz: int, measured: bool) -> _Outputs:
-        """Uninitialised buffers of ``size`` samples."""
-        Q, V, T = (np.empty((size, runs, nv)) for _ in range(3))
-        Z = np.empty((size, runs, nz))
-        RQ, RV, RA = (np.empty((size, 1, nv)) for _ in range(3))
-        MQ, MV = (np.empty((size, runs, nv)) for _ in range(2)) if measured else (None, None)
-        return cls(Q, V, T, Z, RQ, RV, RA, MQ, MV)
-
-    def reference(self, rows: slice, rq: np.ndarray, rv: np.ndarray, ra: np.ndarray) -> None:
-        """Write the block's reference (its half-step rows ``rq``, ``rv``, ``ra``) at its samples."""
-        count = rows.stop - rows.start
-        self.RQ[rows], self.RV[rows], self.RA[rows] = (x[: 2 * count : 2] for x in (rq, rv, ra))
-
-    def block(self, start: int, t: np.ndarray, rows: slice) -> Samples:
-        """The samples of buffer ``rows`` (the first is sample ``start``, at times ``t``)."""
-        Q, V, Z, T, RQ, RV, RA = self.Q, self.V, self.Z, self.T, self.RQ, self.RV, self.RA
-        return Samples(start, t, Q[rows], V[rows], Z[rows], T[rows], RQ[rows], RV[rows], RA[rows])
-
-    def everything(self, times: np.ndarray) -> Samples:
-        """The full record (``record=True``)."""
-        return Samples(0, times, self.Q, self.V, self.Z, self.T, self.RQ, self.RV, self.RA, self.MQ, self.MV)
-
-
 class _Run:
     """One call of :func:`integrate`: what is fixed for the run (the law as the loop calls it,
     the plant's events, the step's factors, the output buffers) and what is carried from block
@@ -234,6 +163,7 @@ class _Run:
         z0: np.ndarray,
         record: bool,
         threads: int | None,
+        force_reference: ForceReference | None = None,
     ) -> None:
         self.controller = controller
         self.runs, self.nv = runs, nv = q0.shape
@@ -243,22 +173,28 @@ class _Run:
         hold = config.hold_steps
         self.record = record
         self.terms = terms_for(controller, runs, threads)
-        # A plant that pushes back (wrench, payload step, sensor noise, delay): its events
+        # A plant that pushes back (wrench, payload step, sensor noise, delay, contact): its events
         # choose the dynamics of each step, offset what the law measures, delay its torque.
-        self.events = events = PlantEvents(plant, runs, threads, nv) if plant.has_events else None
+        self.events = events = PlantEvents(plant, runs, threads, nv, dt) if plant.has_events else None
+        contact = None if events is None else events.contact
+        self.sensor = (
+            None
+            if events is None or contact is None
+            else ForceSensor(contact, force_reference, events.force_noise)
+        )
         self.line = line = DelayLine(plant.delay) if plant.delay > 0 else None
         self.stop = events.stop if events is not None and events.stops is not None else None
         self.accel = dynamics_for(plant, runs, threads) if events is None else events.accel_at(0.0)
         noisy = events is not None and events.noise is not None
         self.noise: list[np.ndarray] = []  # the current step's offsets on (q, q̇) with sensor noise
-        self.compute = law_call(controller, self.noise if noisy else None)
+        self.compute = self.sensed(law_call(controller, self.noise if noisy else None))
         # the configured step, as for the control period: a duration that is not a whole number of
         # steps stretches each step a little (dt above) and the period counts steps alike
         self.update_every = update_steps(controller, config.dt)
         self.update = (
             None
             if self.update_every is None
-            else law_call(controller, self.noise if noisy else None, "update")
+            else self.sensed(law_call(controller, self.noise if noisy else None, "update"))
         )
         # the law evaluated once per step or period: sampled, delayed, or a plant whose own
         # integrator steps it (MuJoCo's Euler and implicitfast evaluate their forces once per step)
@@ -267,7 +203,9 @@ class _Run:
         self.plant_why = events.failure if events is not None else getattr(self.accel, "failure", None)
         self.every = hold if hold is not None else 1
         self.total = total = n + 1
-        self.out = _Outputs.empty(total if record else min(total, BLOCK), runs, nv, nz, record and noisy)
+        felt = record and self.sensor is not None and noisy and plant.sensor_noise.sigma_f > 0  # type: ignore[union-attr]
+        size = total if record else min(total, BLOCK)
+        self.out = Outputs.empty(size, runs, nv, nz, record and noisy, contact is not None, felt)
         self.times = np.arange(total) * dt
         self.diverged_at = np.full(runs, np.nan)
         self.detail: list[str | None] = [None] * runs
@@ -276,6 +214,8 @@ class _Run:
         self.q, self.v, self.z = np.array(q0, dtype=float), np.array(v0, dtype=float), self.z_start.copy()
         if self.stop is not None:  # a joint that starts beyond its stop starts on it
             self.q, self.v = self.stop(0.0, self.q, self.v)
+        if events is not None:  # none starts inside a surface
+            events.check_start(self.q)
         self.steps = _Steps.of(dt, nv, nz)
         self.no_state = np.zeros((runs, 0))
         # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
@@ -283,6 +223,10 @@ class _Run:
         self.dz1: Any = None
         self.first = True
         self.clock = _Clock()  # time of the law evaluation under way (for error messages)
+
+    def sensed(self, law: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
+        """``law`` with the force sensor's reading in ``LawInput.contact`` (a scene), else itself."""
+        return law if self.sensor is None else self.sensor.wrap(law)
 
     def rows(self, k0: int, k1: int) -> slice:
         """The buffer rows of samples ``k0 … k1 − 1``."""
@@ -315,7 +259,7 @@ class _Run:
         )
         Q, V, T, Z, MQ, MV = self.out.Q, self.out.V, self.out.T, self.out.Z, self.out.MQ, self.out.MV
         q, v, z, accel, tau1, dz1, first = self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first
-        update, update_every = self.update, self.update_every or 1
+        update, update_every, touched = self.update, self.update_every or 1, self.sensor is not None
         # LawInput(...) through tuple.__new__: the NamedTuple's own __new__ is a Python
         # function that costs twice as much, four times a step.
         new = tuple.__new__
@@ -348,6 +292,8 @@ class _Run:
                 Q[b], V[b], T[b] = q, v, tau_k
                 if MQ is not None and MV is not None:
                     MQ[b], MV[b] = q + noise[0], v + noise[1]  # as the law measured it
+                if touched:  # a scene: the contact at this sample
+                    self.record_contact(b, q, v)
                 if nz:
                     Z[b] = z
                 filled = b + 1
@@ -367,6 +313,16 @@ class _Run:
             self.failed(exc, k0 - off, filled, off)
             raise
         self.q, self.v, self.z, self.accel, self.tau1, self.dz1, self.first = q, v, z, accel, tau1, dz1, first
+
+    def record_contact(self, b: int, q: np.ndarray, v: np.ndarray) -> None:
+        """Write the contact at sample row ``b`` (state ``q``, ``v``): its wrench, penetration and,
+        with force noise, what the sensor read."""
+        sensor, out = self.sensor, self.out
+        assert sensor is not None and out.W is not None and out.P is not None
+        forces = sensor.contact(q, v)  # the law's sensor asked at this state already: kept
+        out.W[b], out.P[b] = forces.wrench, forces.penetration
+        if out.MW is not None:
+            out.MW[b] = sensor.measure(q, v)
 
     def failed(self, exc: Exception, start: int, filled: int, off: int) -> None:
         """An exception raised inside the law (its ``compute`` or ``update``) as a
@@ -414,10 +370,17 @@ class _Run:
 
 
 def _block_reference(
-    controller: Controller, trajectory: Trajectory, k0: int, k1: int, n: int, dt: float
+    controller: Controller,
+    trajectory: Trajectory,
+    k0: int,
+    k1: int,
+    n: int,
+    dt: float,
+    sensor: ForceSensor | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
     """The reference of steps ``k0 … k1 − 1`` on the half-step grid: ``q_des``, ``q̇_des``,
-    ``q̈_des`` as read-only (H, 1, nv) rows and the law's input rows (task fields included)."""
+    ``q̈_des`` as read-only (H, 1, nv) rows and the law's input rows (task fields included, and
+    the force reference's with a ``sensor``)."""
     last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
     half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
     half = trajectory.sample(half_t)
@@ -425,7 +388,8 @@ def _block_reference(
     # sample column-major, and a strided (1, nv) row takes numpy's slow broadcasting
     # path in every operation of the law and the Terms that touches it.
     rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
-    return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra)
+    contact = None if sensor is None else sensor.rows(half_t)
+    return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra, contact)
 
 
 class _Clock:

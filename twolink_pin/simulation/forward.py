@@ -33,7 +33,11 @@ class SingleRunDynamics:
         # np.clip's cost
         self._saturate = (-plant.limits[None], plant.limits[None]) if plant.saturate else None
 
-    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    def __call__(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> np.ndarray:
+        """``external``: a joint torque [N·m] the world adds (a wrench's or a contact's ``Jᵀ f``), never
+        saturated, (1, nv) or None."""
         # plant.motor_torque, spelled out with the rows above: this runs four times per step.
         saturate = self._saturate
         u = tau if saturate is None else np.minimum(np.maximum(tau, saturate[0]), saturate[1])
@@ -42,6 +46,8 @@ class SingleRunDynamics:
             u = u - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
         if self._damping is not None:
             u = u - self._damping * v
+        if external is not None:
+            u = u + external
         return pin.aba(self._model, self._data, q[0], v[0], u[0], ABA_CONVENTION)[None]
 
 
@@ -58,9 +64,14 @@ class BatchDynamics:
         self._next = 0
         self._plain = plant.friction is None and not plant.saturate and not plant.joint_damping.any()
 
-    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-        """The result is valid until the fourth call after this one."""
+    def __call__(
+        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> np.ndarray:
+        """The result is valid until the fourth call after this one; ``external`` as in
+        :meth:`SingleRunDynamics.__call__`, (N, nv)."""
         u = tau if self._plain else self._plant.motor_torque(v, tau)
+        if external is not None:
+            u = u + external
         out = self._outs[self._next]
         self._next = (self._next + 1) % 4
         pin.abaInParallel(

@@ -78,6 +78,28 @@ class SimulationResult:
     """The joints, in the order of ``q`` (empty in an older saved result)."""
     position_stops: bool = False
     """Whether the plant made each position range a hard stop (``--joint-stops``)."""
+    wrench: np.ndarray | None = field(repr=False, default=None)
+    """The contact wrench the end effector applied to the surfaces [N; N·m], world axes, about
+    its frame's origin, shape (K, 6); None without a scene (:mod:`twolink_pin.contact`)."""
+    penetration: np.ndarray | None = field(repr=False, default=None)
+    """The deepest penetration into a surface [m], shape (K,) (0 out of contact); None without
+    a scene."""
+    wrench_measured: np.ndarray | None = field(repr=False, default=None)
+    """The wrench the law's force sensor read (``wrench`` + its noise) [N; N·m], shape (K, 6);
+    None without force noise."""
+    force_des: np.ndarray | None = field(repr=False, default=None)
+    """The reference's desired normal force [N], shape (K,); None without a force reference."""
+    contact_normal: np.ndarray | None = field(repr=False, default=None)
+    """The outward normal of the surface the force is measured on (the force reference's, else
+    the scene's first), world axes, shape (3,); None without a scene."""
+
+    @property
+    def normal_force(self) -> np.ndarray | None:
+        """The normal force the end effector pressed on :attr:`contact_normal`'s surface [N],
+        ``−n·F``, shape (K,); None without a scene."""
+        if self.wrench is None or self.contact_normal is None:
+            return None
+        return -(np.asarray(self.wrench)[:, :3] @ np.asarray(self.contact_normal))
 
     @property
     def duration(self) -> float:

@@ -14,6 +14,7 @@ from twolink_pin.simulation.adaptive_step import integrate_adaptive
 from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, joint_offsets
 from twolink_pin.simulation.engine import Samples, integrate
 from twolink_pin.simulation.result import SimulationResult
+from twolink_pin.simulation.sensing import check_contact_setup
 from twolink_pin.trajectory import Trajectory
 
 
@@ -37,6 +38,7 @@ def check_setup(controller: Controller, plant: Plant, trajectory: Trajectory) ->
         raise InvalidParameterError(
             "trajectory", f"{trajectory.nv} joints", f"a trajectory for the plant's {nv} joints"
         )
+    check_contact_setup(controller, plant, trajectory)
 
 
 def initial_state(
@@ -131,7 +133,9 @@ def _recorded_run(
         return samples
     if plant.has_events:
         raise InvalidParameterError(
-            "method", config.method, "'rk4' with a wrench, payload step, sensor noise, delay or joint stops"
+            "method",
+            config.method,
+            "'rk4' with a wrench, payload step, sensor noise, delay, joint stops or a scene",
         )
     if controller.update_period() is not None:
         raise InvalidParameterError(
@@ -152,12 +156,26 @@ def _single_result(
     rows: dict[str, np.ndarray | None] = {"t": samples.t}
     for name in SAMPLED:
         x = getattr(samples, name)
-        rows[name] = None if x is None else x[:, 0, :]
+        rows[name] = None if x is None else x[:, 0]
     return run_result(controller, plant, trajectory, config, rows)
 
 
-SAMPLED = ("q", "v", "tau_command", "q_des", "v_des", "a_des", "z", "q_measured", "v_measured")
+SAMPLED = (
+    "q", "v", "tau_command", "q_des", "v_des", "a_des", "z", "q_measured", "v_measured",
+    "wrench", "penetration", "wrench_measured",
+)  # fmt: skip
 """The per-sample rows of one run :func:`run_result` reads (besides ``t``), each (K, ·)."""
+
+
+def contact_rows(plant: Plant, trajectory: Trajectory, t: np.ndarray) -> dict[str, np.ndarray | None]:
+    """A run's contact fields of :class:`SimulationResult` that are not samples of the engine: the
+    force reference at the sample times ``t`` [s] and the normal the force is measured along."""
+    scene, reference = plant.scene, trajectory.force_reference
+    if scene is None:
+        return {"force_des": None, "contact_normal": None}
+    surface = scene.surfaces[scene.index(reference.surface) if reference is not None else 0]
+    force = None if reference is None else readonly(reference.sample(t))
+    return {"force_des": force, "contact_normal": readonly(surface.unit_normal)}
 
 
 def run_result(
@@ -214,4 +232,6 @@ def run_result(
         velocity_limits=readonly(limits.velocity),
         joint_names=limits.joint_names,
         position_stops=plant.position_stops,
+        **{name: readonly_or_none(rows.get(name)) for name in ("wrench", "penetration", "wrench_measured")},
+        **contact_rows(plant, trajectory, np.asarray(rows["t"])),
     )

@@ -27,6 +27,7 @@ import numpy as np
 import pinocchio as pin
 
 from twolink_pin.controllers import Controller, LawInput
+from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.simulation.containment import read_only
 from twolink_pin.trajectory import Trajectory, TrajectorySample
 from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory
@@ -97,14 +98,17 @@ def law_input(
     v_des: np.ndarray,
     a_des: np.ndarray,
     trajectory: Trajectory | None = None,
+    contact: ContactInput | None = None,
 ) -> LawInput:
     """The :class:`~twolink_pin.controllers.LawInput` the engine would build at time ``t`` [s]
     (to evaluate a law by itself, e.g. in a test): the reference ``q_des``, ``v_des``,
     ``a_des`` of shape (1, nv) and, for a task-space law, the desired frame from
-    ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics."""
+    ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics;
+    ``contact``: what the force sensor reads (None: no scene)."""
     joint = TrajectorySample(q_des, v_des, a_des, np.zeros_like(a_des))
     task = task_reference(controller, trajectory, np.array([t]), joint)
-    return LawInput(t, q, v, z, q_des, v_des, a_des, *(x[0] for x in task))
+    x_des, R_des, twist_des, accel_des = (x[0] for x in task)
+    return LawInput(t, q, v, z, q_des, v_des, a_des, x_des, R_des, twist_des, accel_des, contact)
 
 
 def reference_rows(
@@ -115,13 +119,17 @@ def reference_rows(
     rq: np.ndarray,
     rv: np.ndarray,
     ra: np.ndarray,
+    contact: Sequence[ContactInput] | None = None,
 ) -> list[tuple[Any, ...]]:
-    """Per sample time ``t`` [s], the seven reference fields of a
-    :class:`~twolink_pin.controllers.LawInput` after ``(t, q, v, z)``: ``q_des``, ``v_des``,
-    ``a_des`` (the rows of the read-only ``rq``, ``rv``, ``ra``, each (K, 1, nv)) and the
-    four task fields of :func:`task_reference` (None for a law that is not task-space)."""
+    """Per sample time ``t`` [s], the eight fields of a :class:`~twolink_pin.controllers.LawInput`
+    after ``(t, q, v, z)``: ``q_des``, ``v_des``, ``a_des`` (the rows of the read-only ``rq``,
+    ``rv``, ``ra``, each (K, 1, nv)), the four task fields of :func:`task_reference` (None for a
+    law that is not task-space) and the contact's reference part (``contact``, one per time:
+    :meth:`~twolink_pin.simulation.sensing.ForceSensor.rows`, whose wrench the sensor fills in;
+    None without a scene)."""
     px, pr, pw, pa = task_reference(controller, trajectory, t, joint)
+    touch = contact if contact is not None else [None] * len(t)
     # Rows by iteration (the same read-only views as rq[i]; no Python __getitem__ of NONES per row)
     if px is NONES:
-        return [(q, v, a, None, None, None, None) for q, v, a in zip(rq, rv, ra, strict=True)]
-    return list(zip(rq, rv, ra, px, pr, pw, pa, strict=True))
+        return [(q, v, a, None, None, None, None, c) for q, v, a, c in zip(rq, rv, ra, touch, strict=True)]
+    return list(zip(rq, rv, ra, px, pr, pw, pa, touch, strict=True))

@@ -11,6 +11,7 @@ O(N) unless ``record=True``: the engine hands each block of samples to
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from twolink_pin.arrays import readonly, readonly_or_none
+from twolink_pin.contact_metrics import ContactMetrics, contact_observer
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.metrics import Metrics, RunningMetrics
@@ -89,6 +91,9 @@ class BatchResult:
     task_metrics: TaskMetrics | None = field(repr=False, default=None)
     """Each run's task-space metrics (position error [mm], angle [deg] of the end effector; arrays
     (N,), NaN for diverged runs), whatever the law (None only in a result built by hand)."""
+    contact_metrics: ContactMetrics | None = field(repr=False, default=None)
+    """Each run's contact metrics (force errors, impact, penetration, …; arrays (N,), NaN for
+    diverged runs) when the plant has a scene, else None (:mod:`twolink_pin.contact_metrics`)."""
     trajectory: Trajectory | None = field(repr=False, default=None)
     """The reference every run tracked (``trajectory.sample(t)`` gives ``q_d``, ``q̇_d``,
     ``q̈_d`` at the output times ``t``)."""
@@ -195,8 +200,9 @@ def simulate_batch(
     used = threads_for(n, threads) if n > 1 else 1
     samples, dt = config.steps + 1, config.duration / config.steps
     observer = RunningMetrics(n, nv, dt, samples, trajectory.period, plant.joint_limits, plant.applied_torque)
-    # Every law moves the end effector: its rows carry the task errors too.
+    # Every law moves the end effector: its rows carry the task errors too (and the contact's, with a scene).
     task = RunningTaskMetrics(plant.robot, n, dt, samples, trajectory.period)
+    contact = contact_observer(plant, trajectory, n, dt)
     with progress_callback(progress, n) as shown:
         run = integrate(
             controller,
@@ -207,15 +213,18 @@ def simulate_batch(
             ref0.v + v0_off,
             z0,
             record=record,
-            observer=_Both(observer, task),
+            observer=_Both(observer, task, contact),
             threads=used,
             progress=shown,
         )
     dead = ~np.isnan(run.diverged_at)
     metrics, task_metrics = observer.result(dead), task.result(dead)
-    return _batch_result(
+    result = _batch_result(
         controller, plant, trajectory, config, run, q0_off, v0_off, metrics, task_metrics, used
     )
+    if contact is None:
+        return result
+    return dataclasses.replace(result, contact_metrics=contact.result(dead))
 
 
 def _offsets(
@@ -299,11 +308,12 @@ def _batch_result(
 
 
 class _Both:
-    """Two engine observers fed the same blocks (the joint and the task metrics)."""
+    """Engine observers fed the same blocks (the joint, the task and, with a scene, the contact
+    metrics)."""
 
-    def __init__(self, first: Any, second: Any) -> None:
-        self.first, self.second = first, second
+    def __init__(self, *observers: Any) -> None:
+        self.observers = [o for o in observers if o is not None]
 
     def add(self, samples: Any) -> None:
-        self.first.add(samples)
-        self.second.add(samples)
+        for observer in self.observers:
+            observer.add(samples)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from twolink_pin.contact_metrics import CONTACT_TITLES, CONTACT_UNITS, SETTLE, ContactMetrics
 from twolink_pin.controllers.gains import format_gain
 from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
@@ -28,6 +29,10 @@ TASK_COLUMNS = TaskMetrics._fields
 """Columns of the task-space rows (CSV), in :class:`~twolink_pin.task_metrics.TaskMetrics` order."""
 TASK_HEADERS = tuple(f"{TASK_TITLES[name]} [{TASK_UNITS[name]}]" for name in TASK_COLUMNS)
 """Markdown headers of the task-space table (no "|" inside a cell: ‖·‖ for the norm)."""
+CONTACT_COLUMNS = ContactMetrics._fields
+"""Columns of the contact rows (CSV), in :class:`~twolink_pin.contact_metrics.ContactMetrics` order."""
+CONTACT_HEADERS = tuple(f"{CONTACT_TITLES[name]} [{CONTACT_UNITS[name]}]" for name in CONTACT_COLUMNS)
+"""Markdown headers of the contact table."""
 
 
 def gains_text(gains: dict[str, Any]) -> str:
@@ -79,6 +84,8 @@ class ComparisonTable:
     """The gains each law ran with, by law name."""
     task: dict[str, TaskMetrics] = field(default_factory=dict)
     """Task-space metrics (mm, deg) of the task-space laws, by law name."""
+    contact: dict[str, ContactMetrics] = field(default_factory=dict)
+    """Contact metrics (force errors, impact, penetration, …) of runs against a scene, by law name."""
 
     @property
     def nv(self) -> int:
@@ -97,6 +104,7 @@ class ComparisonTable:
             "plants": dict(self.plants),
             "gains": dict(self.gains),
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
+            "contact_metrics": {name: m.as_dict() for name, m in self.contact.items()},
             "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
             "within_limits": {name: m.crossings.within_limits for name, m in self.metrics.items()},
         }
@@ -131,6 +139,10 @@ class ComparisonTable:
             writer.writerow(["controller", "task_metric", *TASK_COLUMNS])
             for name, t in self.task.items():
                 writer.writerow([name, "task", *(f"{x:.6g}" for x in t)])
+        if self.contact:
+            writer.writerow(["controller", "contact_metric", *CONTACT_COLUMNS])
+            for name, c in self.contact.items():
+                writer.writerow([name, "contact", *(f"{x:.6g}" for x in c)])
         crossings = self.crossing_rows()
         if crossings:
             writer.writerow(["controller", "crossed", "joint", "first_time_s", "largest_excess", "unit"])
@@ -160,6 +172,14 @@ class ComparisonTable:
             out.append("|---|" + "---:|" * len(TASK_HEADERS))
             for name, t in self.task.items():
                 out.append(f"| {name} | " + " | ".join(t.text()) + " |")
+        if self.contact:
+            out.append(
+                f"\n### contact: the force held (from {SETTLE:g} s after the first contact), the impact\n"
+            )
+            out.append("| controller | " + " | ".join(CONTACT_HEADERS) + " |")
+            out.append("|---|" + "---:|" * len(CONTACT_HEADERS))
+            for name, c in self.contact.items():
+                out.append(f"| {name} | " + " | ".join(c.text()) + " |")
         crossings = self.crossing_rows()
         if crossings:
             out.append("\n### position and velocity limits crossed by the motion\n")

@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from twolink_pin.contact_metrics import CONTACT_UNITS
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
@@ -46,13 +47,21 @@ TASK_COLUMNS = {f"task_{name}": unit for name, unit in TASK_UNITS.items()}
 one definition: the end effector's errors, whatever the law), with their units."""
 
 
-def metric_columns(nv: int, parameter_names: Sequence[str] = ()) -> list[str]:
+CONTACT_COLUMNS = {f"contact_{name}": unit for name, unit in CONTACT_UNITS.items()}
+"""The contact metric columns of a sweep whose plant has a scene (:data:`twolink_pin.contact_metrics.CONTACT_UNITS`,
+the one definition), with their units."""
+
+
+def metric_columns(nv: int, parameter_names: Sequence[str] = (), contact: bool = False) -> list[str]:
     """Names of the metric columns of a row, in order: the per-joint metrics, the task metrics
-    (every law moves the end effector), the final estimates."""
+    (every law moves the end effector), the contact metrics (``contact``: a scene), the final
+    estimates."""
     columns: list[str] = []
     for stem in METRIC_UNITS:
         columns += joint_columns(stem, nv)
     columns += list(TASK_COLUMNS)
+    if contact:
+        columns += list(CONTACT_COLUMNS)
     columns += [f"p_hat_final_{name}" for name in parameter_names]
     return columns
 
@@ -119,12 +128,17 @@ def _chunk_rows(
     parts = [metric_array(m, stem) for stem in METRIC_UNITS]
     assert result.task_metrics is not None  # simulate_batch gives every law its task errors
     parts.append(np.column_stack(list(result.task_metrics)))
+    if result.contact_metrics is not None:  # a scene: the contact's columns
+        parts.append(np.column_stack(list(result.contact_metrics)))
     if result.p_hat_final is not None:
         parts.append(result.p_hat_final)
     return np.hstack(inputs), flags, np.hstack(parts), exceeded
 
 
 def percentile_stats(column: np.ndarray) -> dict[str, float | None]:
+    """Median, 5th and 95th percentiles of ``column`` over its defined (non-NaN) values: a contact
+    metric is NaN for a run never in contact, or without a force reference; None for none."""
+    column = column[~np.isnan(column)]
     if column.size == 0:
         return {"median": None, "p5": None, "p95": None}
     p5, p50, p95 = np.percentile(column, PERCENTILES)
@@ -248,7 +262,8 @@ class PreparedSweep:
         estimated = law.parameter_names if law.estimates else ()
         self.input_columns = input_columns(config, nv, self.parameter_names)
         self.task = bool(cls.task_space)  # the law's class declares it: its figure shows them first
-        self.metric_columns = metric_columns(nv, estimated)
+        self.contact = config.run.plant.scene is not None
+        self.metric_columns = metric_columns(nv, estimated, self.contact)
         self.outcome_columns = outcome_columns(nv)
         # the reason a run ended early (text) right after when it did
         after = self.outcome_columns.index("diverged_at") + 1
@@ -270,6 +285,8 @@ class PreparedSweep:
         for stem, unit in METRIC_UNITS.items():
             units.update({c: unit for c in joint_columns(stem, nv)})
         units.update(TASK_COLUMNS)
+        if self.contact:
+            units.update(CONTACT_COLUMNS)
         if law.estimates:
             units.update(
                 {f"p_hat_final_{n}": u for n, u in zip(law.parameter_names, law.parameter_units, strict=True)}

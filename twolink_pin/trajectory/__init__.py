@@ -20,7 +20,9 @@
 ``optimal_measures.py``     ``∫τᵀτ dt``, pose errors, the end effector's excursion from the via points' hull
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)
+``file_extras.py``          what a via file adds: straight lines between its points, a force column
 ``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)
+``force.py``                :class:`ForceReference`: a desired normal force on a surface over time, :func:`with_force`
 ==========================  ================================================================
 """
 
@@ -43,6 +45,7 @@ from twolink_pin.trajectory.file import (
     read_trajectory_file,
     write_trajectory_file,
 )
+from twolink_pin.trajectory.force import ForceReference, with_force
 from twolink_pin.trajectory.fourier import FourierTrajectory
 from twolink_pin.trajectory.optimal import OptimalTrajectory, effort_integral, optimize
 from twolink_pin.trajectory.polynomial import JointTrajectory
@@ -53,6 +56,7 @@ from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory, pose_trajecto
 
 __all__ = [
     "NEUTRAL_AMPLITUDE",
+    "ForceReference",
     "FourierTrajectory",
     "JointTrajectory",
     "OptimalTrajectory",
@@ -77,5 +81,6 @@ __all__ = [
     "read_trajectory_file",
     "solve_pose",
     "time_optimal",
+    "with_force",
     "write_trajectory_file",
 ]

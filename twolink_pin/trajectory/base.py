@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import abc
-from typing import NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from twolink_pin.trajectory.force import ForceReference
 
 
 class TrajectorySample(NamedTuple):
@@ -31,6 +34,9 @@ class Trajectory(abc.ABC):
 
     t0: float
     period: float
+    force_reference: ForceReference | None = None
+    """The normal force [N] the end effector should press on a surface over time, or None
+    (:mod:`twolink_pin.trajectory.force`; set by :func:`~twolink_pin.trajectory.force.with_force`)."""
 
     @property
     @abc.abstractmethod

@@ -13,6 +13,17 @@ or through end-effector positions of the robot's end-effector frame (solved by
     positions = [[0.45, 0.10, 0.40], ...]       # m: (x, y, z), or (x, y) for a planar arm
     seed = [0.0, -1.57, 1.57, -1.57, -1.57, 0.0]   # rad, optional IK seed (default: home)
 
+A ``positions`` file may ask for straight lines between its points, ``path = "lines"``
+(default ``"polynomial"``, as above): the end effector then moves along each line with a
+rest-to-rest time scaling and stops at every via point (the SE(3) reference's position path,
+for any arm, its joint path solved by the position's inverse kinematics).
+
+A via file (``joints`` or ``positions``) may also carry a force reference: ``force``, one
+normal force [N] per time, pressed on the scene's surface ``force_surface`` (optional: the
+scene's only surface) — :mod:`~twolink_pin.trajectory.force`::
+
+    force = [0.0, 10.0, 10.0, 10.0, 0.0]        # N, linear between the via times
+
 or through end-effector poses: ``positions`` (3 coordinates) and, per row, the orientation
 as roll, pitch, yaw [rad] (``R = Rz(yaw) Ry(pitch) Rx(roll)``, the URDF's ``rpy``, what
 Pinocchio's ``rpy.rpyToMatrix`` builds; chosen over a quaternion because three angles are
@@ -67,6 +78,7 @@ from twolink_pin.limits import POSITION, joint_limits
 from twolink_pin.limits.check import check_grid
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.cartesian import cartesian_via_q
+from twolink_pin.trajectory.file_extras import carrying, line_file, path_kind
 from twolink_pin.trajectory.file_values import (
     MAX_ANGLE,
     MAX_TIME,
@@ -93,7 +105,7 @@ MIN_TIME_STEP = 1e-3
 CLOSURE_TOLERANCE = 1e-6
 """How far [rad] the last via point may be from the first (in joint space)."""
 
-KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed"})
+KEYS = frozenset({"times", "joints", "positions", "rpy", "period", "seed", "force", "force_surface", "path"})
 FOURIER_KEYS = frozenset({"period", "harmonics", "a", "b", "offset"})
 """Keys of a ``fourier`` table."""
 
@@ -171,7 +183,11 @@ def read_trajectory_file(
     else:
         points, seed = _position_rows(file, document, rows, robot)
         if "rpy" in document:
-            return _pose_file(file, document, robot, times, points, seed, period)
+            return carrying(
+                _pose_file(file, document, robot, times, points, seed, period), file, document, times
+            )
+        if path_kind(file, document) == "lines":
+            return carrying(line_file(file, robot, times, points, seed, period), file, document, times)
         try:
             via_q = cartesian_via_q(robot, points, seed)
         except InverseKinematicsError as err:
@@ -191,7 +207,7 @@ def read_trajectory_file(
     except InvalidParameterError as err:
         raise InvalidParameterError(f"{file}: {err.name}", err.value, err.expected) from None
     check_trajectory_limits(robot, trajectory, f"{file}")
-    return trajectory
+    return carrying(trajectory, file, document, times)
 
 
 def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:

@@ -29,12 +29,19 @@ B-spline in ``s``; then ``q̇ = Q' ṡ/h``, ``q̈ = Q'' (ṡ/h)² + Q' s̈/h²``
 by the chain rule, exactly zero at the via poses like the pose path's. Its forward
 kinematics equals the pose path to the interpolation error (see :attr:`PoseTrajectory.ik_error`,
 below 1e-6 m and 1e-6 rad for the examples' paths).
+
+**Position only** (``position_rows`` 2 or 3: an arm of fewer than 6 joints, e.g. the planar
+twolink, a via file's ``path = "lines"``): the IK is the position's alone
+(:func:`~twolink_pin.kinematics.solve_position`, on the first 2 or 3 coordinates); the position
+path is the same straight lines, and the orientation :meth:`PoseTrajectory.pose` reports is the
+geodesic between the via orientations given (the forward kinematics there) — a task on the
+position rows alone (the twolink's) never reads it.
 """
 
 from __future__ import annotations
 
 import itertools
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -211,11 +218,13 @@ def pose_trajectory(
     rotations: np.ndarray,
     period: float | None = None,
     seed: np.ndarray | None = None,
+    position_rows: int | None = None,
 ) -> PoseTrajectory:
     """The SE(3) reference of ``robot``'s end-effector frame through the via poses
     ``positions`` [m] (n, 3) and ``rotations`` (n, 3, 3) at ``times`` [s], repeated every
     ``period`` [s] (default the span; the frame rests at the last pose for the rest), its
-    joint path solved from ``seed`` [rad] (default the robot's home).
+    joint path solved from ``seed`` [rad] (default the robot's home); ``position_rows`` 2 or 3:
+    the path's positions alone are solved for (the module docstring's "position only").
 
     Raises:
         InvalidParameterError: times, shapes, rotations or the closure are wrong.
@@ -231,8 +240,9 @@ def pose_trajectory(
     _check_via_poses(P, R, n)
     posture = robot.home if seed is None else np.asarray(seed, dtype=float)
     q = posture
+    ik = _ik(robot, posture, position_rows)
     try:
-        q = solve_pose(robot, P[0], R[0], q, posture=posture)
+        q = ik(P[0], R[0], q)
     except InverseKinematicsError as err:
         raise InverseKinematicsError(err.target, f"via pose 0: {err.reason}", err.q) from None
     paths = []
@@ -240,12 +250,10 @@ def pose_trajectory(
     worst_p = worst_r = 0.0
     data = robot.model.createData()
     for k in range(n - 1):
-        path, q, seg_p, seg_r = _segment_path(
-            robot, data, P, R, k, q, posture, via_q[0] if k == n - 2 else None
-        )
+        path, q, seg_p, seg_r = _segment_path(robot, data, P, R, k, q, ik, via_q[0] if k == n - 2 else None)
         paths.append(path)
         via_q.append(q)
-        worst_p, worst_r = max(worst_p, seg_p), max(worst_r, seg_r)
+        worst_p, worst_r = max(worst_p, seg_p), max(worst_r, seg_r if position_rows is None else 0.0)
     span = times_t[-1] - times_t[0]
     return PoseTrajectory(
         np.array(times_t),
@@ -256,6 +264,23 @@ def pose_trajectory(
         span if period is None else period,
         (worst_p, worst_r),
     )
+
+
+IK = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
+"""``(position [m], rotation, seed [rad]) -> q [rad]``: a segment's inverse kinematics."""
+
+
+def _ik(robot: RobotModel, posture: np.ndarray, position_rows: int | None) -> IK:
+    """The 6-D pose IK (``position_rows`` None), or the position IK on the first 2 or 3 coordinates."""
+    if position_rows is None:
+        return lambda p, R, q: solve_pose(robot, p, R, q, posture=posture)
+    if position_rows not in (2, 3):
+        raise InvalidParameterError(
+            "position_rows", position_rows, "2 (x, y), 3 (x, y, z) or None (the pose)"
+        )
+    from twolink_pin.kinematics import solve_position
+
+    return lambda p, R, q: solve_position(robot, p[:position_rows], q)
 
 
 def _check_via_poses(P: np.ndarray, R: np.ndarray, n: int) -> None:
@@ -286,7 +311,7 @@ def _segment_path(
     R: np.ndarray,
     k: int,
     q: np.ndarray,
-    posture: np.ndarray,
+    ik: IK,
     closing: np.ndarray | None,
 ) -> tuple[BSpline, np.ndarray, float, float]:
     """Segment k's joint path (via pose k → k + 1, the pose interpolated on SE(3)) from ``q``
@@ -298,7 +323,7 @@ def _segment_path(
     qs = []
     for s in grid:
         try:
-            q = solve_pose(robot, P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q, posture=posture)
+            q = ik(P[k] + s * (P[k + 1] - P[k]), R[k] @ pin.exp3(s * phi), q)
         except InverseKinematicsError as err:
             raise InverseKinematicsError(
                 err.target, f"segment {k} (via pose {k} → {k + 1}) at s = {s:.3g}: {err.reason}", err.q

@@ -15,6 +15,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
 from twolink_pin.tuning.knobs import choices_of, knob_changes, knobs_of, matrices_of
@@ -349,7 +351,8 @@ class Tuner:
             self.status.content = (
                 f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s{suffix}"
             )
-        self.scene.show(result.t, result.q, result.q_des)
+        force = None if result.wrench is None else -np.asarray(result.wrench)[:, :3]  # on the arm
+        self.scene.show(result.t, result.q, result.q_des, done.request.spec.plant.scene, force)
         self.scene.hold(False, RESUME_AFTER)
 
     def _keep_latest(self) -> None:

@@ -92,7 +92,9 @@ class CommandFolder:
                 result.q_des,
                 path=path,
                 via_points=points,
-                **run_overlays(done.request.spec.plant.wrench, result.t),
+                **run_overlays(
+                    done.request.spec.plant.wrench, result.t, done.request.spec.plant.scene, result.wrench
+                ),
             )
             self._offer(client, path)
             self.saved.content = f"animation written to `{path}` (and offered as a download)"

@@ -11,7 +11,9 @@ still scene. (Viser's client renders on demand, each scene update opening a 250-
 continuous frames: with software WebGL a playing arm keeps the browser's main thread busy.)
 An arm whose visual meshes are heavy (more than :data:`TRIANGLES` triangles: the UR5's and
 the Panda's hold about 10⁵) is drawn with its URDF's collision geometry, about 50 times
-lighter, when it has one (:func:`light_model`)."""
+lighter, when it has one (:func:`light_model`). A run against a scene (:mod:`twolink_pin.contact`)
+adds its surfaces as translucent boxes (an unbounded plane: a slab about the motion) and the
+contact's force on the arm as an arrow from the end effector, :data:`FORCE_SCALE` m per N."""
 
 from __future__ import annotations
 
@@ -27,6 +29,7 @@ from twolink_pin.tuning.typed import Channel, read_number
 from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visual_model
 
 if TYPE_CHECKING:
+    from twolink_pin.contact.scene import Scene
     from twolink_pin.model import RobotModel
 
 FPS = 10.0
@@ -41,6 +44,10 @@ TRIANGLES = 20_000
 """The most triangles of visual meshes the tuner draws (twice: the arm and its ghost)."""
 ARM_RGBA = (0.62, 0.66, 0.72, 1.0)
 """The colour of an arm drawn with its collision geometry (which has none of its own)."""
+FORCE_SCALE = 0.01
+"""Length of the contact force's arrow per newton [m/N]."""
+FORCE_RGB = (112, 72, 232)
+SURFACE_RGB = (134, 142, 150)
 TRAIL_RGB = (194, 37, 92)
 DESIRED_RGB = (43, 138, 62)
 
@@ -135,6 +142,9 @@ class ArmScene:
         self._t = np.zeros(1)
         self._q = np.array([robot.home])
         self._q_des = self._q
+        self._arrows: np.ndarray | None = None  # per sample: the contact force's arrow, (K, 2, 3)
+        self._arrow: Any = None
+        self._surface_handles: list[Any] = []
         self._now = 0.0
         self._stop = threading.Event()
         self._framed = False
@@ -144,9 +154,18 @@ class ArmScene:
         self._thread = threading.Thread(target=self._play, name="twolink-pin-tune-playback", daemon=True)
         self._thread.start()
 
-    def show(self, t: np.ndarray, q: np.ndarray, q_des: np.ndarray) -> None:
-        """Play the run ``q`` [rad] against ``q_des`` [rad] at the times ``t`` [s]."""
+    def show(
+        self,
+        t: np.ndarray,
+        q: np.ndarray,
+        q_des: np.ndarray,
+        surfaces: Scene | None = None,
+        force: np.ndarray | None = None,
+    ) -> None:
+        """Play the run ``q`` [rad] against ``q_des`` [rad] at the times ``t`` [s]; with a scene,
+        its ``surfaces`` and the contact's ``force`` on the arm [N] (K, 3) at each time."""
         ee = joint_positions(self._robot, q)[:, -1, :]
+        self._surfaces(surfaces, ee)
         ee_des = joint_positions(self._robot, q_des)[:, -1, :]
         scene = self._server.scene
         scene.add_line_segments("trail", _segments(ee), TRAIL_RGB, thickness=3.0, thickness_units="screen")
@@ -162,9 +181,41 @@ class ArmScene:
             self._server.initial_camera.up = (0.0, 0.0, 1.0)
         with self._lock:
             self._t, self._q, self._q_des = t, q, q_des
+            self._arrows = None if force is None else np.stack([ee, ee + FORCE_SCALE * force], axis=1)
             self._now = min(self._now, float(t[-1]))
         self.time.max = float(t[-1])
         self._draw()
+
+    def _surfaces(self, surfaces: Scene | None, ee: np.ndarray) -> None:
+        """Draw ``surfaces`` as boxes (an unbounded plane: a slab of twice the motion's extent
+        about it); remove those of an earlier run."""
+        import pinocchio as pin
+
+        scene = self._server.scene
+        for handle in self._surface_handles:
+            handle.remove()
+        self._surface_handles = []
+        if surfaces is None:
+            return
+        extent = float(max(np.max(np.ptp(ee, axis=0)), 0.2))
+        for surface in surfaces.surfaces:
+            u, w = surface.axes()
+            n = surface.unit_normal
+            point = np.array(surface.point)
+            size = surface.size or (2 * extent, 2 * extent, 0.01)
+            if surface.size is None:
+                point = ee.mean(axis=0) - ((ee.mean(axis=0) - point) @ n) * n
+            rotation = pin.Quaternion(np.column_stack([u, w, n])).coeffs()  # x, y, z, w
+            self._surface_handles.append(
+                scene.add_box(
+                    f"surfaces/{surface.name}",
+                    SURFACE_RGB,
+                    tuple(size),
+                    opacity=0.45,
+                    wxyz=(rotation[3], rotation[0], rotation[1], rotation[2]),
+                    position=point - 0.5 * size[2] * n,
+                )
+            )
 
     def hold(self, held: bool, resume_after: float = 0.0, why: str = "run") -> None:
         """Stop drawing frames (True), or go on ``resume_after`` seconds from now (False),
@@ -221,9 +272,23 @@ class ArmScene:
         with self._lock:
             i = int(np.searchsorted(self._t, self._now).clip(0, len(self._t) - 1))
             q, q_des = self._q[i], self._q_des[i]
+            arrow = None if self._arrows is None else self._arrows[i : i + 1]
         with self._server.atomic():
             self.arm.display(q)
             self.ghost.display(q_des)
+            if arrow is not None or self._arrow is not None:
+                self._draw_arrow(arrow)
+
+    def _draw_arrow(self, arrow: np.ndarray | None) -> None:
+        """The contact force's arrow (1, 2, 3) [m], hidden when there is none or no force."""
+        visible = arrow is not None and float(np.linalg.norm(arrow[0, 1] - arrow[0, 0])) > 1e-4
+        if visible:
+            assert arrow is not None
+            self._arrow = self._server.scene.add_arrows(
+                "contact_force", arrow, FORCE_RGB, shaft_radius=0.004, head_radius=0.01, head_length=0.02
+            )
+        elif self._arrow is not None:
+            self._arrow.visible = False
 
     def _play(self) -> None:
         last = scrubbed = time.monotonic()

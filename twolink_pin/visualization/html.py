@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy.typing as npt
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.files import atomic_write
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import import_meshcat
@@ -137,6 +138,7 @@ def scene_page(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
+    surfaces: Scene | None = None,
 ) -> str:
     """The self-contained HTML page of the animated scene, as text (what :func:`write_html`
     writes and :func:`~twolink_pin.visualization.notebook.inline_animation` embeds).
@@ -156,6 +158,7 @@ def scene_page(
         wrench=wrench,
         wrench_frame=wrench_frame,
         desired_frame=desired_frame,
+        surfaces=surfaces,
     )
     scene = scene_commands(robot, motion, loop=loop)
     encoded = ",\n".join(f'"{base64.b64encode(pack(c)).decode("ascii")}"' for c in scene.commands)
@@ -187,6 +190,7 @@ def write_html(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
+    surfaces: Scene | None = None,
 ) -> Path:
     """Write the animated scene as one self-contained HTML file.
 
@@ -219,6 +223,8 @@ def write_html(
         desired_frame: Draw the desired end-effector frame as a triad: ``True`` at the
             forward kinematics of ``q_des``, or the desired poses per sample (world, shape
             (N, 4, 4): a task-space reference); ``False`` for none.
+        surfaces: A scene's surfaces (:class:`~twolink_pin.contact.Scene`), drawn as
+            translucent slabs (:mod:`.overlays`); or ``None``.
 
     Returns:
         ``path`` as a :class:`~pathlib.Path`.
@@ -242,6 +248,7 @@ def write_html(
         wrench=wrench,
         wrench_frame=wrench_frame,
         desired_frame=desired_frame,
+        surfaces=surfaces,
     )
     with atomic_write(target) as f:
         f.write(page)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -38,6 +39,8 @@ class Motion:
     """The frame the force acts on (None: the end effector)."""
     desired_poses: np.ndarray | None = None
     """Desired pose of the end effector at the frames (world), shape (F, 4, 4), or ``None``."""
+    surfaces: Scene | None = None
+    """The surfaces the arm may touch (:class:`~twolink_pin.contact.Scene`), drawn still; or ``None``."""
 
 
 def _finite_array(name: str, value: npt.ArrayLike, unit: str) -> np.ndarray:
@@ -160,12 +163,14 @@ def prepare_motion(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
+    surfaces: Scene | None = None,
 ) -> Motion:
     """Check the caller's arrays against ``robot`` and resample them at ``fps`` [1/s].
 
     ``wrench`` (per sample, shape (N, 3) or (N, 6) [N, N·m]) and ``desired_frame`` (poses
     per sample, shape (N, 4, 4), or True: the FK of ``q_des``) are held from each sample
-    to the next: a force that starts at a sample is drawn from that sample's frame on.
+    to the next: a force that starts at a sample is drawn from that sample's frame on;
+    ``surfaces`` (a :class:`~twolink_pin.contact.Scene`) are drawn as they are.
 
     Raises:
         InvalidParameterError: a shape mismatch, a non-finite value, times not strictly
@@ -198,4 +203,13 @@ def prepare_motion(
         wrench=None if forces is None else _held(t_arr, forces, times),
         wrench_frame=wrench_frame,
         desired_poses=desired,
+        surfaces=_check_surfaces(surfaces),
     )
+
+
+def _check_surfaces(surfaces: Scene | None) -> Scene | None:
+    if surfaces is not None and not isinstance(surfaces, Scene):
+        raise InvalidParameterError(
+            "surfaces", type(surfaces).__name__, "a twolink_pin.contact.Scene or None"
+        )
+    return surfaces

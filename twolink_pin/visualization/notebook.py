@@ -14,6 +14,7 @@ import html
 
 import numpy.typing as npt
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization.html import scene_page
@@ -57,6 +58,7 @@ def inline_animation(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
+    surfaces: Scene | None = None,
 ) -> InlineAnimation:
     """The animated scene of a run, for display in a notebook cell.
 
@@ -74,8 +76,8 @@ def inline_animation(
         fps: Animation frames per second of motion [1/s], > 0.
         loop: Repeat the animation forever.
         height: Height of the frame in the notebook [px], 100 to 2000.
-        wrench, wrench_frame, desired_frame: the force arrow and the desired frame's triad,
-            as :func:`~twolink_pin.visualization.write_html`.
+        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's
+            triad and a scene's surfaces, as :func:`~twolink_pin.visualization.write_html`.
 
     Returns:
         The animation; its ``_repr_html_`` is the ``<iframe srcdoc=…>``.
@@ -99,5 +101,6 @@ def inline_animation(
         wrench=wrench,
         wrench_frame=wrench_frame,
         desired_frame=desired_frame,
+        surfaces=surfaces,
     )
     return InlineAnimation(page, height)

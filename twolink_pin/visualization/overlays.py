@@ -1,4 +1,5 @@
-"""What the scene draws beside the arm: the external force as an arrow, the desired frame as a triad.
+"""What the scene draws beside the arm: the external force as an arrow, the desired frame as a
+triad, the surfaces of a scene as slabs.
 
 * **The wrench** (``wrench/``): the force ``F`` [N] of an external wrench (world axes, at a
   frame's origin: :class:`~twolink_pin.disturbances.Wrench`) drawn as an arrow from that
@@ -11,7 +12,13 @@
   (a task-space reference) or the forward kinematics of ``q_des`` (which, for the
   built-in task-space laws, is the pose they are told to reach).
 
-Both are animated with the arm (meshcat tracks of ``position``, ``quaternion``, ``scale``
+* **The surfaces** (``surfaces/``) of a run's scene (:mod:`twolink_pin.contact`): a bounded
+  surface as its box (the face the arm touches is the box's top), an unbounded plane as a thin
+  slab :data:`SURFACE_SPAN` × the motion's extent wide, centred where the motion is, behind the
+  plane; translucent grey. The contact's force on the arm is drawn by the force arrow (with any
+  external wrench: their sum), from the end effector.
+
+The arrow and the triad are animated with the arm (meshcat tracks of ``position``, ``quaternion``, ``scale``
 and ``visible``); their sizes follow the motion's extent ``E`` [m] so that they read the
 same on a 0.5-m arm and on a 2-m one.
 """
@@ -24,6 +31,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.disturbances import Wrench
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
@@ -32,6 +40,13 @@ WRENCH_NODE = "wrench"
 """Node of the force arrow (children ``shaft`` and ``head``; the arrow is the node's +x)."""
 DESIRED_FRAME_NODE = "desired_frame"
 """Node of the desired frame's triad (children ``x``, ``y``, ``z``)."""
+SURFACES_NODE = "surfaces"
+"""Node of the scene's surfaces (one child per surface, by name)."""
+SURFACE_COLOR = 0x868E96
+"""The surfaces' colour (0xRRGGBB), drawn with :data:`SURFACE_OPACITY`."""
+SURFACE_OPACITY = 0.45
+SURFACE_SPAN = 1.5
+"""An unbounded plane is drawn this many times the motion's extent wide."""
 WRENCH_COLOR = 0x7048E8
 """Force arrow (0xRRGGBB)."""
 AXIS_COLORS = (0xE03131, 0x2F9E44, 0x1971C2)
@@ -196,14 +211,59 @@ def add_desired_frame(vis: Any, animation: Any, keys: list[Any], poses: np.ndarr
     return length
 
 
-def run_overlays(wrench: Wrench | None, t: np.ndarray) -> dict[str, Any]:
+def add_surfaces(vis: Any, scene: Scene, extent: float, centre: np.ndarray) -> list[np.ndarray]:
+    """Draw ``scene``'s surfaces (see the module docstring) around the motion of extent ``extent``
+    [m] centred at ``centre`` [m]; returns the corners [m] of the bounded ones (the view frames them)."""
+    import meshcat.geometry as mg
+
+    material = mg.MeshPhongMaterial(color=SURFACE_COLOR, opacity=SURFACE_OPACITY, transparent=True)
+    corners = []
+    for surface in scene.surfaces:
+        u, w = surface.axes()
+        n = surface.unit_normal
+        point = np.array(surface.point)
+        size: tuple[float, ...]
+        if surface.size is None:
+            span = SURFACE_SPAN * extent
+            size = (span, span, 0.01 * extent)
+            point = centre - ((centre - point) @ n) * n  # the motion's centre, on the plane
+        else:
+            size = surface.size
+        rotation = np.column_stack([u, w, n])
+        middle = point - 0.5 * size[2] * n
+        vis[f"{SURFACES_NODE}/{surface.name}"].set_object(mg.Box(list(size)), material)
+        vis[f"{SURFACES_NODE}/{surface.name}"].set_transform(pin.SE3(rotation, middle).homogeneous)
+        if surface.size is not None:
+            signs = np.array([[a, b, c] for a in (-0.5, 0.5) for b in (-0.5, 0.5) for c in (-0.5, 0.5)])
+            corners.append(middle + (signs * np.array(size)) @ rotation.T)
+    return corners
+
+
+def run_overlays(
+    wrench: Wrench | None,
+    t: np.ndarray,
+    scene: Scene | None = None,
+    contact: np.ndarray | None = None,
+) -> dict[str, Any]:
     """The keyword arguments of :func:`~twolink_pin.visualization.write_html` (and
     ``scene_page``, ``serve``) that draw a run's overlays: the desired end-effector frame
-    (forward kinematics of ``q_des``) always, and the plant's external force (``wrench``:
+    (forward kinematics of ``q_des``) always, the plant's external force (``wrench``:
     :attr:`~twolink_pin.run_spec.PlantOptions.wrench`, None for none) at the sample times
-    ``t`` [s] where it acts, zero elsewhere. One definition for ``animate`` and the report."""
-    if wrench is None:
-        return {"desired_frame": True}
-    acting = np.array([wrench.active(float(tk)) for tk in np.asarray(t, dtype=float)])
-    forces = np.where(acting[:, None], np.asarray(wrench.force[:3], dtype=float), 0.0)
-    return {"desired_frame": True, "wrench": forces, "wrench_frame": wrench.frame}
+    ``t`` [s] where it acts, zero elsewhere, plus, with a ``scene``, its surfaces and the
+    contact's force on the arm (``contact``: the run's
+    :attr:`~twolink_pin.simulation.SimulationResult.wrench`, the wrench the end effector applied
+    to the surfaces, (K, 6); its force reversed). One definition for ``animate`` and the report."""
+    out: dict[str, Any] = {"desired_frame": True}
+    forces = None
+    if wrench is not None:
+        acting = np.array([wrench.active(float(tk)) for tk in np.asarray(t, dtype=float)])
+        forces = np.where(acting[:, None], np.asarray(wrench.force[:3], dtype=float), 0.0)
+        out["wrench_frame"] = wrench.frame
+    if scene is not None:
+        out["surfaces"] = scene
+        if contact is not None:
+            on_arm = -np.asarray(contact, dtype=float)[:, :3]
+            forces = on_arm if forces is None else forces + on_arm
+    if forces is not None:
+        out["wrench"] = forces
+    return out

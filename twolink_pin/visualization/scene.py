@@ -474,8 +474,9 @@ def _add_overlays(
     joints: np.ndarray,
     framing: list[np.ndarray],
 ) -> tuple[float | None, float | None]:
-    """The force arrow and the desired frame's triad (:mod:`.overlays`), if the motion has
-    them: their scale [m/N] and axis length [m]; the arrow's tips join ``framing``."""
+    """The force arrow, the desired frame's triad and the surfaces (:mod:`.overlays`), if the
+    motion has them: the arrow's scale [m/N] and the axis length [m]; the arrow's tips and the
+    bounded surfaces' corners join ``framing``."""
     from twolink_pin.visualization import overlays
 
     extent = float(max(np.max(np.ptp(joints, axis=0)), 1e-3))  # the motion's size [m]
@@ -487,4 +488,6 @@ def _add_overlays(
         framing.append(tips)
     if motion.desired_poses is not None:
         length = overlays.add_desired_frame(vis, animation, keys, motion.desired_poses, extent)
+    if motion.surfaces is not None:
+        framing.extend(overlays.add_surfaces(vis, motion.surfaces, extent, joints.mean(axis=0)))
     return scale, length

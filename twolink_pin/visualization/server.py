@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy.typing as npt
 
+from twolink_pin.contact.scene import Scene
 from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.model import RobotModel
 from twolink_pin.visualization._meshcat_bridge import Bridge, start_bridge
@@ -113,6 +114,7 @@ def serve(
     wrench: npt.ArrayLike | None = None,
     wrench_frame: str | None = None,
     desired_frame: bool | npt.ArrayLike = False,
+    surfaces: Scene | None = None,
 ) -> LiveViewer:
     """Serve the animated scene live with meshcat, on ``host`` only.
 
@@ -134,8 +136,8 @@ def serve(
         loop: Repeat the motion forever.
         open_browser: Open :attr:`LiveViewer.url` with :mod:`webbrowser`.
         quiet: Do not print the URL on stdout.
-        wrench, wrench_frame, desired_frame: the force arrow and the desired frame's triad,
-            as :func:`~twolink_pin.visualization.write_html` (the live page has no legend:
+        wrench, wrench_frame, desired_frame, surfaces: the force arrow, the desired frame's
+            triad and a scene's surfaces, as :func:`~twolink_pin.visualization.write_html` (the live page has no legend:
             the arrow's scale is :func:`~twolink_pin.visualization.overlays.wrench_scale`).
 
     Raises:
@@ -158,6 +160,7 @@ def serve(
         wrench=wrench,
         wrench_frame=wrench_frame,
         desired_frame=desired_frame,
+        surfaces=surfaces,
     )
     scene = scene_commands(robot, motion, loop=loop)
     viewer = LiveViewer(start_bridge(host, port))

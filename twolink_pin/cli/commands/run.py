@@ -19,6 +19,7 @@ from twolink_pin.cli.commands.common import (
     run_spec,
     trajectory_from_args,
 )
+from twolink_pin.cli.contact_summary import ContactRuns, contact_summary, save_run_contact_figure
 from twolink_pin.cli.output import emit, fmt, progress_bar
 from twolink_pin.cli.task_space import is_task_space, save_task_figure, task_lines, task_summary
 from twolink_pin.errors import InvalidParameterError
@@ -62,15 +63,17 @@ def cmd_simulate(args: argparse.Namespace) -> int:
 
     robot = robot_from_args(args)
     spec = run_spec(args, args.controller)
-    spec.check_effective(robot)
+    reference = trajectory_from_args(args, robot)
+    spec.check_effective(robot, trajectory=reference)
     scenario = spec.build(robot, identified_parameters(spec, robot))
-    result = simulate(*scenario, trajectory_from_args(args, robot), spec.simulation)
+    result = simulate(*scenario, reference, spec.simulation)
     metrics = compute_metrics(result)
     for warning in position_warnings(result.controller, result):
         print(warning, file=sys.stderr)
     payload = _result_payload(result, metrics)
     task = task_summary(result, robot)  # every law: the end effector's errors
     payload["task_metrics"] = task.as_dict()
+    payload["contact_metrics"], contact = contact_summary(result, robot)  # a scene: the force held
     q0_offset = joint_offsets("q0_offset", spec.simulation.q0_offset, robot.profile.q0_offset, robot.nv)
     gains, gains_text = gains_echo(scenario.controller)
     payload |= {
@@ -92,6 +95,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             figures = [str(p) for p in save_simulation_figures(result, folder, spans=spans)]
             if is_task_space(scenario.controller):
                 figures.append(str(save_task_figure(robot, result, folder, result.controller, spans=spans)))
+            figures += save_run_contact_figure(result, robot, folder, result.controller)
     if args.save:
         from twolink_pin.simulation.storage import save_result
 
@@ -111,6 +115,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
             else ""
         ),
         *task_lines(task),
+        *contact,
     ]
     lines += _limit_and_estimate_lines(result, metrics)
     lines += [f"  figure {f}" for f in figures]
@@ -184,18 +189,20 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from twolink_pin.studies.comparison import run_comparison
 
     robot = robot_from_args(args)
-    variants = parse_variants(args.controllers or list(builtin_laws()))  # LAW or LAW@KEY=VALUE…
-    laws = [v.law for v in variants]
     shared = run_spec(args)
-    shared.check_law_gains(laws)
-    shared.check_effective(robot, laws)
-    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     reference = trajectory_from_args(args, robot)
+    pressing = shared.plant.scene is not None and reference.force_reference is not None  # the force laws too
+    variants = parse_variants(args.controllers or list(builtin_laws(pressing)))  # LAW or LAW@KEY=VALUE…
+    laws = [v.law for v in variants]
+    shared.check_law_gains(laws)
+    shared.check_effective(robot, laws, reference)
+    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(rows), "run", "compare")
         figures = _ComparisonFigures(args, shared, rows, robot, stage / "figures")
         tasks: dict[str, TaskMetrics] = {}
+        contacts = ContactRuns(robot)  # a scene: each law's force held, drawn together
 
         def run(key: str) -> SimulationResult:
             from twolink_pin.simulation import simulate
@@ -204,6 +211,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
             row = rows[key]
             result = simulate(*row.scenario, reference, row.spec.simulation)
             tasks[key] = task_metrics(result, robot)  # every law moves the same end effector
+            contacts.add(key, result)
             return result
 
         def on_result(key: str, result: SimulationResult) -> None:
@@ -219,6 +227,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
         try:
             table = run_comparison(run, list(rows), progress, on_result)
             figures.overlay()
+            contacts.figure(stage / "figures", figures.on)
         finally:
             bar.close()
             for warning in warnings:
@@ -228,6 +237,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
             plants={k: plant_description(r.scenario) for k, r in rows.items()},
             gains={k: gains_used(r.scenario.controller) for k, r in rows.items()},
             task=tasks,
+            contact=contacts.metrics,
         )
         files = [Path(args.out) / p.name for p in table.write(stage)]
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
@@ -295,9 +305,11 @@ def _say_failed(failed: dict[str, str], where: str) -> None:
 def cmd_animate(args: argparse.Namespace) -> int:
     robot, reference, result, spec, controller = _run_to_animate(args)
     gains, gains_text = gains_echo(controller) if controller is not None else (None, "not recorded")
+    from twolink_pin.plant import PlantOptions
     from twolink_pin.visualization.overlays import run_overlays
 
-    overlays = run_overlays(None if spec is None else spec.plant.wrench, result.t)
+    plant = PlantOptions() if spec is None else spec.plant  # a saved run without its record: none
+    overlays = run_overlays(plant.wrench, result.t, plant.scene, result.wrench)
     from twolink_pin.kinematics import joint_positions
 
     via_q = getattr(reference, "via_q", None)  # a Fourier excitation has no via points
@@ -350,7 +362,7 @@ def _run_to_animate(args: argparse.Namespace) -> tuple[Any, Any, Any, Any, Any]:
     robot = robot_from_args(args)
     reference = trajectory_from_args(args, robot)
     spec = run_spec(args, args.controller)
-    spec.check_effective(robot)
+    spec.check_effective(robot, trajectory=reference)
     scenario = spec.build(robot, identified_parameters(spec, robot))
     result = simulate(*scenario, reference, spec.simulation)
     return robot, reference, result, spec, scenario.controller

@@ -37,7 +37,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         chunk=args.chunk,
         threads=args.threads,
     )
-    config.run.check_effective(robot)
+    config.run.check_effective(robot, trajectory=trajectory)
     bars: list[Any] = []  # shown from the first runs on: its rate and ETA leave out a cluster's start
 
     def progress(done: int, total: int) -> None:

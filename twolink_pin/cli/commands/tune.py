@@ -51,12 +51,15 @@ def _check_watch(args: argparse.Namespace) -> None:
 def cmd_tune(args: argparse.Namespace) -> int:
     from twolink_pin.cli.commands.run import run_record
     from twolink_pin.cli.simulate_line import command_line, simulate_argv
+    from twolink_pin.contact_checks import check_contact
     from twolink_pin.tuning import Tuner
 
     _check_watch(args)
     _duration(args)
     spec = run_spec(args, args.controller)
-    identified_parameters(spec, robot_from_args(args))  # the parameter file's notes, once
+    robot = robot_from_args(args)
+    identified_parameters(spec, robot)  # the parameter file's notes, once
+    check_contact(spec.plant, spec.simulation, [spec.law_class()], trajectory_from_args(args, robot))
 
     def arm(payload: float) -> tuple[RobotModel, Trajectory]:
         at = argparse.Namespace(**(vars(args) | {"payload": payload}))
@@ -64,7 +67,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         return robot, trajectory_from_args(at, robot)
 
     def command_of(run: RunSpec, payload: float) -> str:
-        return command_line(simulate_argv(run, args.robot, payload, args.trajectory))
+        return command_line(simulate_argv(run, args.robot, payload, args.trajectory, args.scene))
 
     def record_of(run: RunSpec, payload: float) -> dict[str, Any]:
         return run_record(argparse.Namespace(**(vars(args) | {"payload": payload})), run)
