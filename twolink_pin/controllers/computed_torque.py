@@ -5,15 +5,18 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.gains import Gains, gain
-from twolink_pin.dynamics import joint_inertia
+from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.dynamics import joint_space_inertia
+from twolink_pin.model import RobotModel
 
 DEFAULT_LAMBDA = 5.0
 """λ [1/s]. The report never states its λ; 5 s⁻¹ is our documented default."""
 SLIDING_RATE = 50.0
-"""κ [1/s] of the robot-derived default ``K = κ diag M(q₀)``: each joint's ``s`` decays at
-about κ on its own inertia."""
+"""κ [1/s] of the robot-derived default ``K = κ M(q₀)``: at the home ``q₀`` every mode of
+``M ṡ + K s = 0`` decays at exactly κ (the generalised eigenvalues of ``(K, M(q₀))``)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -21,11 +24,12 @@ class SlotineLiGains(Gains):
     r"""Gains of :class:`ComputedTorque` (report: $K = \operatorname{diag}(40, 50)$, equal to PD's $K_d$).
 
     Attributes:
-        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        k: Sliding gain $K$ [N·m·s/rad], an nv × nv symmetric positive-definite matrix (a
+            number, nv numbers for a diagonal, nv² row by row); default $\kappa M(q_0)$.
         lam: $\lambda$ [1/s] in $s = \dot e + \lambda e$ (not in the report; our default 5).
     """
 
-    k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
+    k: Any = gain(None, per="joint", matrix=True, unit="N·m·s/rad", doc="sliding gain K")
     lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
 
 
@@ -46,11 +50,20 @@ class ComputedTorque(Controller[SlotineLiGains]):
     title = "modified computed torque, Slotine–Li"
     Gains = SlotineLiGains
 
+    def __init__(self, robot: RobotModel, gains: SlotineLiGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        self._k = applied_form(self.gains.k)
+
     def scaled_gains(self) -> dict[str, Any]:
-        return {"k": SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)}
+        return {"k": sliding_gain(self.robot)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         g = self.gains
         lam_e, edot = g.lam * (x.q - x.q_des), x.v - x.v_des
         tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - g.lam * edot)
-        return LawOutput(tau - g.k * (edot + lam_e))
+        return LawOutput(tau - apply_gain(self._k, edot + lam_e))
+
+
+def sliding_gain(robot: RobotModel) -> np.ndarray:
+    """``K = κ M(q₀)`` [N·m·s/rad] at the robot's home (κ: :data:`SLIDING_RATE`), (nv, nv)."""
+    return SLIDING_RATE * joint_space_inertia(robot.model, robot.home)

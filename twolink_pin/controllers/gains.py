@@ -259,6 +259,25 @@ def as_matrix(value: Any, k: int, name: str = "gain", unit: str = "") -> np.ndar
     return array
 
 
+def applied_form(matrix: np.ndarray) -> np.ndarray:
+    """A matrix gain ``(1 or N, k, k)`` (:func:`as_matrix`) as a law applies it
+    (:func:`apply_gain`): its diagonals ``(1 or N, k)`` when every matrix is diagonal — applied
+    element-wise, the same operations (and bits) as a per-joint gain —, else the matrices."""
+    array = np.asarray(matrix, dtype=float)
+    k = array.shape[-1]
+    if not np.any(array * (1.0 - np.eye(k))):
+        diagonal = np.ascontiguousarray(array.diagonal(0, 1, 2))
+        diagonal.setflags(write=False)
+        return diagonal
+    return array
+
+
+def apply_gain(gain: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``K x`` for N runs: ``gain`` from :func:`applied_form` (rows: element-wise; matrices:
+    ``np.matvec``), ``x`` (N, k)."""
+    return gain * x if gain.ndim == 2 else np.matvec(gain, x)
+
+
 def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     if value is not None and spec.matrix:
         return _validate_matrix(name, value, spec)
@@ -314,7 +333,8 @@ class Gains:
 
     def describe(self, digits: int = 4) -> str:
         """``kp = (350, 300) N·m/rad, kd = ...``: every field with its unit; a matrix gain as
-        its rows, ``kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]] 1/s²``."""
+        its rows, ``kp = [[1500, 20, 0], [20, 1500, 0], [0, 0, 800]] 1/s²`` (a diagonal one as
+        its diagonal)."""
         parts = []
         for f in fields(self):
             value, spec = getattr(self, f.name), gain_spec(f)
@@ -335,12 +355,17 @@ class Gains:
 
 def gain_as_json(value: Any) -> Any:
     """A gain value JSON-ready: a number, a list (per joint, axis or estimate), a matrix as its
-    rows (a list of lists), one of these per run for per-run values; None stays None."""
+    rows (a list of lists) — a diagonal matrix as its diagonal, k numbers, and ``s I`` as the
+    number s, as ``--gain`` takes them —, one of these per run for per-run values; None stays None."""
     if value is None or isinstance(value, (bool, str)):
         return value
     array = np.asarray(value, dtype=float)
     if array.ndim in (2, 3) and array.shape[0] == 1:  # one row or matrix for every run
         array = array[0]
+        if array.ndim == 2 and not np.any(array - np.diag(np.diag(array))):
+            array = np.diag(array)
+            if array.size > 1 and not np.any(array - array[0]):  # s I: the number s
+                array = array[0]
     return float(array) if array.ndim == 0 else array.tolist()
 
 
@@ -357,8 +382,9 @@ def default_as_json(gains_type: type[Gains], name: str) -> Any:
 
 
 def format_gain(value: Any, digits: int = 4) -> str:
-    """A gain value as text: ``350``, ``(350, 300)``, a matrix as its rows
-    ``[[1500, 0, 0], [0, 1500, 0], [0, 0, 800]]``; per-run values (N of them) shortened."""
+    """A gain value as text: ``350`` (a number, or ``350 I``), ``(350, 300)`` (per joint, or a
+    diagonal matrix), a matrix as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
+    shortened."""
     shown = gain_as_json(value)
     if isinstance(shown, float):
         return f"{shown:.{digits}g}"
@@ -367,7 +393,7 @@ def format_gain(value: Any, digits: int = 4) -> str:
     def numbers(row: np.ndarray) -> str:
         return ", ".join(f"{x:.{digits}g}" for x in row)
 
-    if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1:  # one matrix
+    if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1 and array.ndim == 2:  # one matrix
         return "[" + ", ".join(f"[{numbers(row)}]" for row in array) + "]"
     flat = array.ravel()
     text = "(" + numbers(flat[:12]) + (", …)" if flat.size > 12 else ")")
