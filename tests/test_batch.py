@@ -66,7 +66,8 @@ def _batched(spec: str, robot: RobotModel = ROBOT) -> tuple[Controller, Plant, l
     changes: dict[str, Any] = {}
     for name in ("kp", "kd", "k"):
         if g.get(name) is not None:
-            changes[name] = np.asarray(g[name]) * scale
+            value = np.asarray(g[name])  # a matrix gain (1, k, k): one matrix per run
+            changes[name] = value * (scale[:, :, None] if value.ndim == 3 else scale)
     if "lam" in g:
         changes["lam"] = np.array([5.0, 3.0, 8.0, 5.0])
     p = np.asarray(robot.p) * np.array([1.0, 1.2, 0.8, 1.1])[:, None]
@@ -76,7 +77,7 @@ def _batched(spec: str, robot: RobotModel = ROBOT) -> tuple[Controller, Plant, l
     for i in range(4):
         row = {
             k: np.asarray(v)[i]
-            if np.ndim(v) == 2
+            if np.ndim(v) in (2, 3)
             else (float(np.asarray(v)[i]) if np.ndim(v) == 1 and k == "lam" else v)
             for k, v in changes.items()
         }
@@ -146,8 +147,13 @@ def test_a_diverging_run_is_flagged_at_simulates_time_and_the_others_finish() ->
     law = ComputedTorque(ROBOT, SlotineLiGains(k=k))
     plant = Plant(ROBOT)
     batch = simulate_batch(law, plant, TRAJECTORY, SHORT, record=True)
-    with pytest.raises(SimulationDivergedError) as info:
-        simulate(ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9))), plant, TRAJECTORY, SHORT)
+    with pytest.raises(SimulationDivergedError) as info:  # the step check would refuse it: run it anyway
+        simulate(
+            ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9))),
+            plant,
+            TRAJECTORY,
+            replace(SHORT, check_step=False),
+        )
     np.testing.assert_array_equal(batch.diverged, [False, True, False])
     assert batch.diverged_at[1] == pytest.approx(info.value.time, abs=1e-12)
     assert batch.divergence[1] is not None and batch.divergence[0] is None
@@ -272,7 +278,7 @@ def test_the_adaptive_step_method_and_per_run_gains_in_simulate_are_refused() ->
         simulate_batch(PDFeedforward(ROBOT), Plant(ROBOT), TRAJECTORY, replace(SHORT, method="adaptive"))
     with pytest.raises(InvalidParameterError, match="simulate_batch runs N"):
         simulate(
-            PDFeedforward(ROBOT, PDGains(kp=np.full((2, 2), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
+            PDFeedforward(ROBOT, PDGains(kp=np.full((3, 2), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
         )
 
 

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
+import scipy.linalg
 from conftest_sim import ROBOT, adaptive_lyapunov, evaluate, pendulum, run, slotine_li_s
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -216,7 +217,9 @@ def test_laws_with_gravity_equal_their_closed_form_on_the_double_pendulum(name: 
         v_des, a_des = state[3], state[4]
         tau, _ = evaluate(controller, *state)
         if name == "pd":
-            expected = _pinocchio_model_torque(robot, q, v, v_des, a_des) - _times(g.kp, e) - _times(g.kd, edot)
+            expected = (
+                _pinocchio_model_torque(robot, q, v, v_des, a_des) - _times(g.kp, e) - _times(g.kd, edot)
+            )
         else:
             s = edot + g.lam * e
             model = _pinocchio_model_torque(robot, q, v, v_des - g.lam * e, a_des - g.lam * edot)
@@ -267,8 +270,9 @@ def test_what_each_law_declares() -> None:
 
 def test_the_twolink_gets_the_reports_gains_and_other_robots_derived_ones() -> None:
     """The twolink profile presets the report's gains (diagonal matrices); the double pendulum gets
-    Kp = ω² M, Kd = 2ω M (ω = 10 rad/s, M = M(q₀) at the robot's home, a full matrix) and K = κ M
-    (κ = 50 1/s)."""
+    Kp = ω² M, Kd = 2ω M (ω = 10 rad/s, M = M(q₀) at the robot's home, a full matrix) and a K whose
+    modes at home are the joint-wise design's (κ diag M, κ = 50 1/s) clipped into [κ, 20 κ]: its
+    fast mode (18.5 κ) kept, its slow one (0.51 κ) raised to κ."""
     pd = PDFeedforward(ROBOT)
     np.testing.assert_array_equal(pd.gains.kp, [np.diag([350.0, 300.0])])  # one matrix for every run
     np.testing.assert_array_equal(pd.gains.kd, [np.diag([40.0, 50.0])])
@@ -279,7 +283,10 @@ def test_the_twolink_gets_the_reports_gains_and_other_robots_derived_ones() -> N
     assert abs(inertia[0, 1]) > 0.1 * inertia[1, 1]  # coupled: a diagonal gain would not do
     np.testing.assert_allclose(PDFeedforward(robot).gains.kp, [100.0 * inertia], rtol=1e-12)
     np.testing.assert_allclose(PDFeedforward(robot).gains.kd, [20.0 * inertia], rtol=1e-12)
-    np.testing.assert_allclose(ComputedTorque(robot).gains.k, [50.0 * inertia], rtol=1e-12)
+    joint_wise = scipy.linalg.eigvalsh(50.0 * np.diag(np.diag(inertia)), inertia)
+    assert joint_wise[0] < 50.0 and 50.0 < joint_wise[1] < 1000.0
+    modes = scipy.linalg.eigvalsh(np.asarray(ComputedTorque(robot).gains.k)[0], inertia)
+    np.testing.assert_allclose(modes, [50.0, joint_wise[1]], rtol=1e-9)
     adaptive = Adaptive(robot)
     assert np.all(np.isfinite(adaptive.gains.gamma)) and np.all(np.asarray(adaptive.gains.gamma) > 0)
     assert np.asarray(adaptive.gains.gamma).shape == (1, adaptive.state_size)

@@ -167,7 +167,9 @@ def test_impedance_settles_at_the_stiffness_inverse_times_the_wrench() -> None:
         r,
         dataclasses.replace(
             defaults,
-            **{name: float(np.trace(getattr(defaults, name)[0])) / 3 for name in ("k", "d", "k_rot", "d_rot")},
+            **{
+                name: float(np.trace(getattr(defaults, name)[0])) / 3 for name in ("k", "d", "k_rot", "d_rot")
+            },
         ),
     )
     plant = Plant(r, wrench=Wrench(tuple(force)))

@@ -41,10 +41,12 @@ from twolink_pin.model import RobotModel
 from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, PlantOptions, robot_friction
 from twolink_pin.scenario import Scenario, law_class, make_controller
 from twolink_pin.simulation import SimulationConfig
+from twolink_pin.simulation.step_check import require_stable_step
 
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
     from twolink_pin.identification import IdentifiedParameters
+    from twolink_pin.trajectory import Trajectory
 
 PARAMETER_USES = ("p0", "model")
 """How identified parameters are used: the estimates start there (``p0``), or the law's
@@ -382,6 +384,7 @@ def build_rows(
     variants: Sequence[Variant],
     robot: RobotModel,
     read: Callable[[RunSpec], IdentifiedParameters | None] | None = None,
+    trajectory: Trajectory | None = None,
 ) -> dict[str, Row]:
     """Every variant's run built before any runs, keyed by its row's name
     (:attr:`~twolink_pin.law_variant.Variant.key`): a bad gain of the third law is refused
@@ -393,9 +396,13 @@ def build_rows(
         robot: The arm.
         read: Reads a spec's parameter file (default :meth:`RunSpec.read_parameters`); each
             file is read once.
+        trajectory: The reference the rows will run: each row's step is then checked against
+            the fastest mode of its start (:mod:`~twolink_pin.simulation.step_check`), before
+            any row runs.
 
     Raises:
         InvalidParameterError: a value a law refuses, named ``ROW: NAME``.
+        StepTooLargeError: a row's step beyond the integrator's bound, named ``ROW: --dt``.
     """
     files: dict[str, IdentifiedParameters | None] = {}
     rows: dict[str, Row] = {}
@@ -405,8 +412,10 @@ def build_rows(
             files[spec.parameters] = read(spec) if read is not None else spec.read_parameters(robot)
         try:
             scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
+            if trajectory is not None:
+                require_stable_step(scenario.controller, scenario.plant, trajectory, spec.simulation)
         except InvalidParameterError as exc:
-            raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
+            raise type(exc)(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
         rows[variant.key] = Row(variant, spec, scenario)
     return rows
 

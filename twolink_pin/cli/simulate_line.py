@@ -64,6 +64,8 @@ def _simulation_tokens(sim: SimulationConfig) -> list[str]:
         tokens += ["--q0-offset", *(_number(x) for x in offsets)]
     if sim.control_period is not None:
         tokens.append(f"--control-period={_number(sim.control_period)}")
+    if not sim.check_step:
+        tokens.append("--no-step-check")
     return tokens
 
 

@@ -139,6 +139,8 @@ class RobotProfile:
             model, from the maker's data sheet (a URDF has no acceleration limit); ``None``:
             none (:mod:`twolink_pin.limits`).
         report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
+        repair_inertias: Load the URDF with its triangle-breaking inertias replaced by the nearest
+            consistent ones (:mod:`~twolink_pin.model.inertia_repair`).
     """
 
     name: str
@@ -156,6 +158,7 @@ class RobotProfile:
     home: tuple[float, ...] | None = None
     acceleration_limits: tuple[float, ...] | None = None
     report: ReportProfile = field(default_factory=ReportProfile)
+    repair_inertias: bool = False
 
 
 DEFAULT_Q0_OFFSET = 0.05

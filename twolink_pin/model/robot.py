@@ -26,9 +26,10 @@ from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.catalog import example_robot_urdf, resolve
+from twolink_pin.model.inertia_repair import InertiaRepair
 from twolink_pin.model.parameters import ParameterMap
 from twolink_pin.model.profile import RobotProfile, default_q0_offset
-from twolink_pin.model.urdf_validation import validate_urdf_file
+from twolink_pin.model.urdf_validation import CheckedURDF, check_urdf_file
 
 DEFAULT_EE_FRAME = "ee_link"
 
@@ -66,6 +67,14 @@ class RobotModel:
     """True parameters of the map (for the twolink p1, p2, p3 [kg·m²])."""
     profile: RobotProfile = field(repr=False, default_factory=lambda: RobotProfile("robot"))
     """The robot's name and defaults (gain presets, trajectory, plant friction)."""
+    notes: tuple[str, ...] = field(repr=False, default=())
+    """What the loader accepted with a note (a static link's mass 0, a thin rod's zero moment,
+    how the home was chosen): the commands print them."""
+    repairs: tuple[InertiaRepair, ...] = field(repr=False, default=())
+    """The inertias ``repair_inertias`` replaced (:mod:`~twolink_pin.model.inertia_repair`)."""
+    urdf_text: str = field(repr=False, default="")
+    """The URDF document the model was built from (repaired inertias written in): what a second
+    engine compiles, so that both plants simulate the same arm."""
 
     @property
     def name(self) -> str:
@@ -228,7 +237,7 @@ def _revolute_continuous(text: str) -> tuple[str, tuple[str, ...]]:
     return ET.tostring(root, encoding="unicode"), tuple(names)
 
 
-def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
+def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> pin.Model:
     """The Pinocchio model of the checked URDF at ``path``, for tracking control:
 
     * a continuous joint becomes a revolute joint without position limits: one angle
@@ -239,8 +248,7 @@ def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
     * the profile's ``locked_joints`` are fixed at ``locked_positions``
       (``pin.buildReducedModel``: their links ride on the link before them).
     """
-    text = validate_urdf_file(path)
-    text, continuous = _revolute_continuous(text)
+    text, continuous = _revolute_continuous(checked.text)
     try:
         model = pin.buildModelFromXML(text)
     except (ValueError, RuntimeError) as exc:  # validated already; keep any surprise readable
@@ -306,6 +314,7 @@ def load_robot(
     payload: float = 0.0,
     ee_frame: str | None = None,
     parameter_map: Callable[[pin.Model], ParameterMap] | None = None,
+    repair_inertias: bool | None = None,
 ) -> RobotModel:
     """Load an arm by name or from a URDF file.
 
@@ -317,6 +326,9 @@ def load_robot(
         parameter_map: Parameter-map class (called with the model); default the profile's
             (the twolink's lumped p1..p3), else the model's identifiable base parameters
             (:class:`~twolink_pin.model.base_parameters.BaseParameterMap`).
+        repair_inertias: Replace each link inertia that breaks the triangle inequality by the
+            nearest one that satisfies it (``RobotModel.repairs`` lists each change) instead of
+            refusing the file; default the profile's (``repair_inertias`` of a profile file), else no.
 
     Raises:
         InvalidURDFError: unknown name, missing file, or a file that gives no sound model.
@@ -334,7 +346,9 @@ def load_robot(
             "robot", type(robot).__name__, "a robot name (twolink-pin robots) or a path to a URDF file"
         )
     path, profile = resolve(robot)
-    model = _build_model(path, profile)
+    repair = profile.repair_inertias if repair_inertias is None else bool(repair_inertias)
+    checked = check_urdf_file(path, repair)
+    model = _build_model(path, profile, checked)
     _check_home(model, profile, path)
     ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
@@ -357,4 +371,7 @@ def load_robot(
         torque_limits=readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
         p=readonly(pmap.values(model)),
         profile=profile,
+        notes=checked.notes,
+        repairs=checked.repairs,
+        urdf_text=checked.text,
     )

@@ -188,8 +188,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
     shared = run_spec(args)
     shared.check_law_gains(laws)
     shared.check_effective(robot, laws)
-    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
     reference = trajectory_from_args(args, robot)
+    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot), reference)
     warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(rows), "run", "compare")
@@ -412,6 +412,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         identification=not args.no_identification,
         limits_section=not args.no_limits_section,
         trajectory=args.trajectory,
+        repair_inertias=args.repair_inertias or None,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
     bar = progress_bar(1, "step", "report")
