@@ -70,11 +70,15 @@ def _simulation_tokens(sim: SimulationConfig) -> list[str]:
 
 
 def simulate_argv(
-    spec: RunSpec, robot: str | None = None, payload: float = 0.0, trajectory: str | None = None
+    spec: RunSpec,
+    robot: str | None = None,
+    payload: float = 0.0,
+    trajectory: str | None = None,
+    repair_inertias: bool = False,
 ) -> list[str]:
     """The arguments of ``twolink-pin simulate`` (after the program name) for ``spec`` on the
-    robot ``robot`` (a catalog name or URDF path, None: the default) with ``payload`` [kg]
-    and the reference file ``trajectory`` (None: the robot's own)."""
+    robot ``robot`` (a catalog name, a URDF or profile path, None: the default) with ``payload``
+    [kg], the reference file ``trajectory`` (None: the robot's own) and ``--repair-inertias``."""
     if not isinstance(spec.law, str):
         raise ValueError("a law given by reference (name, file.py:Class) has a command line; a class has not")
     tokens = ["simulate", spec.law]
@@ -82,6 +86,8 @@ def simulate_argv(
         tokens.append(f"--robot={robot}")
     if payload:
         tokens.append(f"--payload={_number(payload)}")
+    if repair_inertias:
+        tokens.append("--repair-inertias")
     if trajectory is not None:
         tokens.append(f"--trajectory={trajectory}")
     tokens += _simulation_tokens(spec.simulation)

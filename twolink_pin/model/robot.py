@@ -26,6 +26,7 @@ from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.catalog import example_robot_urdf, resolve
+from twolink_pin.model.home import choose_home
 from twolink_pin.model.inertia_repair import InertiaRepair
 from twolink_pin.model.parameters import ParameterMap
 from twolink_pin.model.profile import RobotProfile, default_q0_offset
@@ -89,8 +90,9 @@ class RobotModel:
     @property
     def home(self) -> np.ndarray:
         """A configuration [rad] inside the joint limits that default trajectories swing about
-        and robot-derived gains are scaled at: the profile's ``home``, else the middle of each
-        joint's range (0 rad for a joint without limits)."""
+        and robot-derived gains are scaled at: the profile's ``home``, else the one the loader
+        chose (dexterous, near the middle of the ranges: ``profile.home_source`` says how,
+        :mod:`~twolink_pin.model.home`); the middle of each range for a model built by hand."""
         if self.profile.home is not None:
             return np.array(self.profile.home, dtype=float)
         lower, upper = np.array(self.model.lowerPositionLimit), np.array(self.model.upperPositionLimit)
@@ -128,11 +130,22 @@ class RobotModel:
         return self.model.createData()
 
 
-def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path) -> int:
+def _refusal(
+    profile: RobotProfile, path: Path, key: str, element: str, value: object, reason: str
+) -> Exception:
+    """A profile value the model refuses: named ``FILE: key`` for a profile file's
+    (:class:`InvalidParameterError`), else as the URDF's element (:class:`InvalidURDFError`)."""
+    if profile.file is not None:
+        return InvalidParameterError(f"{profile.file}: {key}", value, reason)
+    return InvalidURDFError(str(path), element, reason)
+
+
+def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path, profile: RobotProfile) -> int:
     if ee_frame is not None:
         if not model.existFrame(ee_frame):
             names = [f.name for f in model.frames]
-            raise InvalidURDFError(str(path), f"frame '{ee_frame}'", f"no such frame; frames are {names}")
+            reason = f"a frame of {path.name}; no such frame, frames are {names}"
+            raise _refusal(profile, path, "end_effector", f"frame '{ee_frame}'", ee_frame, reason)
         matches = [i for i, f in enumerate(model.frames) if f.name == ee_frame]
         bodies = [i for i in matches if model.frames[i].type == pin.FrameType.BODY]
         return (bodies or matches)[0]  # a link's frame before a fixed joint of the same name
@@ -262,6 +275,15 @@ def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> pin
     if profile.locked_joints:
         model = _lock(model, profile, path)
     if model.nv == 0:
+        if profile.locked_joints and profile.file is not None:
+            raise _refusal(
+                profile,
+                path,
+                "locked",
+                "<robot>",
+                list(profile.locked_joints),
+                f"at least one joint of {path.name} left free; these lock every one",
+            )
         raise InvalidURDFError(str(path), "<robot>", "expected at least one moving joint, found none")
     if model.nq != model.nv:
         kinds = sorted({model.joints[j].shortname() for j in range(1, model.njoints) if model.nqs[j] != 1})
@@ -278,9 +300,9 @@ def _lock(model: pin.Model, profile: RobotProfile, path: Path) -> pin.Model:
     ids = []
     for name in profile.locked_joints:
         if not model.existJointName(name):
-            raise InvalidURDFError(
-                str(path), f"joint '{name}'", f"no such joint to lock; joints are {list(model.names)[1:]}"
-            )
+            joints = list(model.names)[1:]
+            reason = f"a joint of {path.name} to lock; no such joint, joints are {joints}"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
         ids.append(int(model.getJointId(name)))
     q = np.zeros(model.nq)
     positions = profile.locked_positions or (0.0,) * len(ids)
@@ -295,18 +317,17 @@ def _check_home(model: pin.Model, profile: RobotProfile, path: Path) -> None:
         return
     home = np.array(profile.home, dtype=float)
     if home.shape != (model.nq,) or not np.all(np.isfinite(home)):
-        raise InvalidURDFError(
-            str(path), "home", f"{profile.home} must be {model.nq} finite joint positions [rad]"
-        )
+        free = [str(model.names[j]) for j in range(1, model.njoints)]
+        reason = f"{model.nq} finite joint positions [rad or m], one per free joint ({', '.join(free)})"
+        raise _refusal(profile, path, "home", "home", list(profile.home), reason)
     outside = np.flatnonzero((home < model.lowerPositionLimit) | (home > model.upperPositionLimit))
     if outside.size:
         j = int(outside[0])
-        raise InvalidURDFError(
-            str(path),
-            "home",
-            f"joint {j + 1} at {home[j]:g} rad is outside its limits "
-            f"[{model.lowerPositionLimit[j]:g}, {model.upperPositionLimit[j]:g}] rad",
+        reason = (
+            f"positions within the joints' ranges; joint {j + 1} ({model.names[j + 1]}) at {home[j]:g} is "
+            f"outside [{model.lowerPositionLimit[j]:g}, {model.upperPositionLimit[j]:g}] rad"
         )
+        raise _refusal(profile, path, "home", "home", list(profile.home), reason)
 
 
 def load_robot(
@@ -350,7 +371,7 @@ def load_robot(
     checked = check_urdf_file(path, repair)
     model = _build_model(path, profile, checked)
     _check_home(model, profile, path)
-    ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
+    ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path, profile)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
         profile = dataclasses.replace(profile, q0_offset=default_q0_offset(model.nv))
     if payload > 0:
@@ -359,6 +380,9 @@ def load_robot(
         model.inertias[frame.parentJoint] = model.inertias[frame.parentJoint] + frame.placement.act(point)
     _check_inertias(model, path, payload)
     _check_moves_inertia(model, path)
+    if profile.home is None:  # a dexterous home near the middle of the ranges (model/home.py)
+        chosen = choose_home(model, ee_id)
+        profile = dataclasses.replace(profile, home=tuple(chosen.q.tolist()), home_source=chosen.describe())
     factory = parameter_map if parameter_map is not None else profile.parameter_map
     pmap: ParameterMap = factory(model) if factory is not None else BaseParameterMap(model)
     return RobotModel(

@@ -60,9 +60,12 @@ class ReportOptions:
 
     def load_robot(self) -> Any:
         """The robot these options name (a :class:`~twolink_pin.model.RobotModel`), loaded here."""
+        from twolink_pin.controllers.loading import check_profile_gains
         from twolink_pin.model import load_robot
 
-        return load_robot(self.robot, payload=self.payload, repair_inertias=self.repair_inertias)
+        robot = load_robot(self.robot, payload=self.payload, repair_inertias=self.repair_inertias)
+        check_profile_gains(robot)
+        return robot
 
     def __post_init__(self) -> None:
         if self.workers is None:

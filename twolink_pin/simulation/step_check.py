@@ -152,8 +152,8 @@ def initial_law_input(
     q0, v0 = initial_state(plant, trajectory, config)
     ref = trajectory.sample(np.array([0.0]))
     z0 = np.atleast_2d(np.asarray(controller.initial_state(), dtype=float))[:1]
-    rows = [np.ascontiguousarray(np.atleast_2d(x)) for x in (ref.q, ref.v, ref.a)]
-    return law_input(controller, 0.0, q0[None], v0[None], z0, *rows, trajectory=trajectory)
+    q_des, v_des, a_des = (np.ascontiguousarray(np.atleast_2d(x)) for x in (ref.q, ref.v, ref.a))
+    return law_input(controller, 0.0, q0[None], v0[None], z0, q_des, v_des, a_des, trajectory=trajectory)
 
 
 def _copy(controller: Controller) -> Controller:

@@ -20,10 +20,12 @@ if TYPE_CHECKING:
 def robot_from_args(args: argparse.Namespace) -> RobotModel:
     """The robot of ``--robot``, ``--payload`` and ``--repair-inertias``; what the loader accepted
     with a note, and each inertia it repaired, said once on stderr."""
+    from twolink_pin.controllers.loading import check_profile_gains
     from twolink_pin.model import load_robot
 
     repair = getattr(args, "repair_inertias", False) or None  # None: the profile's choice
     robot = load_robot(args.robot, payload=getattr(args, "payload", 0.0), repair_inertias=repair)
+    check_profile_gains(robot)
     said = getattr(args, "notes_said", None)
     if said is None or robot.name not in said:
         for note in robot.notes:

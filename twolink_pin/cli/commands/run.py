@@ -447,12 +447,13 @@ def run_record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
     from pathlib import Path as _Path
 
     robot = args.robot
-    if robot is not None and (robot.endswith(".urdf") or "/" in robot):
+    if robot is not None and (robot.endswith((".urdf", ".toml")) or "/" in robot):
         robot = str(_Path(robot).resolve())
     trajectory = getattr(args, "trajectory", None)
     return {
         "robot": robot,
         "payload": args.payload,
+        "repair_inertias": bool(getattr(args, "repair_inertias", False)),
         "trajectory": None if trajectory is None else str(_Path(trajectory).resolve()),
         "run": spec.as_dict(),
     }
@@ -474,7 +475,8 @@ def _saved_run(args: argparse.Namespace) -> tuple[RobotModel, Trajectory, Simula
         source = record.get("robot") or (result.robot if result.robot in catalog.CATALOG else None)
         if "payload" in record and payload == 0.0:
             payload = float(record["payload"])
-    robot = load_robot(source, payload=payload)
+    repair = bool(getattr(args, "repair_inertias", False) or record.get("repair_inertias", False))
+    robot = load_robot(source, payload=payload, repair_inertias=repair or None)
     if result.q.shape[1] != robot.nq:
         raise InvalidParameterError(
             "--from",

@@ -64,7 +64,7 @@ def cmd_tune(args: argparse.Namespace) -> int:
         return robot, trajectory_from_args(at, robot)
 
     def command_of(run: RunSpec, payload: float) -> str:
-        return command_line(simulate_argv(run, args.robot, payload, args.trajectory))
+        return command_line(simulate_argv(run, args.robot, payload, args.trajectory, args.repair_inertias))
 
     def record_of(run: RunSpec, payload: float) -> dict[str, Any]:
         return run_record(argparse.Namespace(**(vars(args) | {"payload": payload})), run)
