@@ -41,7 +41,8 @@ from twolink_pin.trajectory import (
 )
 from twolink_pin.twolink.reference import REPORT_P
 
-NAMED = ("twolink", "double_pendulum", "asr_twodof", "ur5", "panda", "kinova", "z1")
+NAMED = ("twolink", "asr_twodof", "double_pendulum", "kinova", "panda", "ur5", "z1")
+"""The catalog: the twolink first, then its profile files (robots/*.toml) by name."""
 
 
 @pytest.fixture(scope="module", params=NAMED)

@@ -143,7 +143,7 @@ def test_a_run_does_not_depend_on_its_batch_nor_on_threads() -> None:
 
 def test_a_diverging_run_is_flagged_at_simulates_time_and_the_others_finish() -> None:
     """Run 1 has K = 1e9 (unstable at dt = 1 ms): it diverges at the time simulate reports; runs 0 and 2 match simulate."""
-    k = np.array([[40.0, 50.0], [1e9, 1e9], [40.0, 50.0]])
+    k = np.stack([np.diag(row) for row in ([40.0, 50.0], [1e9, 1e9], [40.0, 50.0])])  # a matrix per run
     law = ComputedTorque(ROBOT, SlotineLiGains(k=k))
     plant = Plant(ROBOT)
     batch = simulate_batch(law, plant, TRAJECTORY, SHORT, record=True)
@@ -256,7 +256,7 @@ def test_law_evaluated_on_a_batch_equals_its_rows() -> None:
 
 def test_inconsistent_run_counts_are_refused_naming_each() -> None:
     """Gains for 3 runs and offsets for 4: InvalidParameterError listing both counts."""
-    law = PDFeedforward(ROBOT, PDGains(kp=np.full((3, 2), 100.0), kd=10.0))
+    law = PDFeedforward(ROBOT, PDGains(kp=np.full((3, 1), 100.0), kd=10.0))  # 100 I per run
     with pytest.raises(InvalidParameterError, match="one number of runs N") as info:
         simulate_batch(law, Plant(ROBOT), TRAJECTORY, SHORT, q0_offsets=OFFSETS)
     assert info.value.value == {"offsets[0]": 4, "the controller's per-run gains": 3}
@@ -278,7 +278,7 @@ def test_the_adaptive_step_method_and_per_run_gains_in_simulate_are_refused() ->
         simulate_batch(PDFeedforward(ROBOT), Plant(ROBOT), TRAJECTORY, replace(SHORT, method="adaptive"))
     with pytest.raises(InvalidParameterError, match="simulate_batch runs N"):
         simulate(
-            PDFeedforward(ROBOT, PDGains(kp=np.full((3, 2), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
+            PDFeedforward(ROBOT, PDGains(kp=np.full((2, 1), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
         )
 
 

@@ -6,7 +6,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import scipy.linalg
 
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
 from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
@@ -83,6 +82,8 @@ def sliding_gain(robot: RobotModel) -> np.ndarray:
     inertial (gravity), and ``K = κ M`` is then soft along the arm's light directions — on the
     double pendulum ``robust`` tracked to 0.99 rad with it, to 0.02 rad with this ``K``.
     """
+    import scipy.linalg  # here: importing the CLI stays light (tests/test_startup.py)
+
     M = joint_space_inertia(robot.model, robot.home)
     w, V = scipy.linalg.eigh(np.diag(np.diag(M)), M)
     MV = M @ V

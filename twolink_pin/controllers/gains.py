@@ -25,9 +25,8 @@ A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size
 ``(N, 1)``: a sweep's draws) — checked (shape, symmetry to 1e-12 relative, Cholesky; a
 refusal names the check and the numbers), and stored as ``(1, k, k)`` or ``(N, k, k)`` once
 the law knows k (k or k² numbers of a per-joint or per-estimate gain wait for it: 4 numbers
-are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one; so do N rows of them, one
-per run, ``(N, k)`` or ``(N, k²)`` with N ≠ the row's length — a square array is one matrix):
-the law applies it with ``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
+are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one): the law applies it
+with ``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
 :func:`gain_as_json`).
 
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
@@ -219,14 +218,6 @@ def _validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
         array = array[:, :, None]
     if array.ndim == 2 and array.shape[0] == 1 and spec.per != "axis":  # numbers awaiting k, validated again
         array = array[0]
-    if array.ndim == 2 and 1 < array.shape[0] != array.shape[1] > 1:  # a row of numbers per run, awaiting k
-        if not np.all(np.isfinite(array)) or not np.all(np.abs(array) <= GAIN_RANGE[1]):
-            raise InvalidParameterError(
-                name, array.tolist() if array.size <= 36 else f"shape {array.shape}", expected
-            )
-        rows = np.array(array)
-        rows.setflags(write=False)
-        return rows
     if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
         raise InvalidParameterError(
             name,
@@ -259,15 +250,9 @@ def as_matrix(value: Any, k: int, name: str = "gain", unit: str = "") -> np.ndar
     if isinstance(value, float):
         value = np.array(value).reshape(1, 1, 1)
     array = np.asarray(value)
-    if array.ndim == 2:  # numbers whose reading needed k: one row, or one row per run
+    if array.ndim == 2:  # numbers whose reading needed k
         expected = MATRIX_EXPECTED.format(unit=f" [{unit}]" if unit else "")
-        if array.shape[0] == 1:
-            return _from_numbers(name, array[0], k, expected)
-        stack = np.concatenate(
-            [_from_numbers(f"{name}[{i}]", row, k, expected) for i, row in enumerate(array)]
-        )
-        stack.setflags(write=False)
-        return stack
+        return _from_numbers(name, array[0], k, expected)
     if array.shape[1:] == (1, 1) and k != 1:
         array = array * np.eye(k)
         array.setflags(write=False)
@@ -285,6 +270,20 @@ def applied_form(matrix: np.ndarray) -> np.ndarray:
         diagonal.setflags(write=False)
         return diagonal
     return array
+
+
+def gain_solve(gain: Any, Y: np.ndarray) -> np.ndarray:
+    """``K⁻¹ Y`` for one value set of a gain ``K`` (a number, per-joint values, or a matrix
+    ``(1, k, k)``) and ``Y`` (k, …): a diagonal ``K`` divides row by row — the same operations
+    (and bits) as a per-joint gain —, a full one is a linear solve."""
+    array = np.asarray(gain, dtype=float)
+    if array.ndim == 3:
+        matrix = array[0]
+        if np.any(matrix - np.diag(np.diag(matrix))):
+            return np.linalg.solve(matrix, Y)
+        array = np.diag(matrix)
+    diagonal = np.broadcast_to(array.reshape(-1), (Y.shape[0],))
+    return Y / diagonal.reshape((-1,) + (1,) * (Y.ndim - 1))
 
 
 def apply_gain(gain: np.ndarray, x: np.ndarray) -> np.ndarray:

@@ -125,9 +125,11 @@ class Impedance(Controller[ImpedanceGains]):
         $(2 + \sqrt 2)\,\omega$, never stiffer however light the wrist."""
         robot = self.robot
         model, data, q = robot.model, robot.model.createData(), robot.home
-        J = pin.computeFrameJacobian(
-            model, data, q, robot.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        )
+        J = np.array(
+            pin.computeFrameJacobian(
+                model, data, q, robot.ee_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            )
+        ).reshape(6, robot.nv)  # one joint: Pinocchio gives a vector
         M = joint_space_inertia(model, q)
         rows = task_rows(robot)
         w, wn = STIFFNESS_FREQUENCY, POSTURE_FREQUENCY

@@ -25,7 +25,6 @@ from typing import NamedTuple
 
 import numpy as np
 import pinocchio as pin
-from scipy.stats import qmc
 
 CANDIDATES = 256
 """Configurations tried besides the middle."""
@@ -75,7 +74,8 @@ def _reach(model: pin.Model, frame: int) -> float:
 def _singular_values(model: pin.Model, data: pin.Data, frame: int, q: np.ndarray, reach: float) -> np.ndarray:
     """Singular values of the end-effector Jacobian at ``q``: all six rows (orientation × reach)
     first, then the position rows alone, (6 + 3,) descending each."""
-    J = pin.computeFrameJacobian(model, data, q, frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).copy()
+    J = np.array(pin.computeFrameJacobian(model, data, q, frame, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED))
+    J = J.reshape(6, model.nv)  # one joint: Pinocchio gives a vector
     J[3:] *= reach
     full = np.zeros(6)
     full[: min(6, model.nv)] = np.linalg.svd(J, compute_uv=False)[:6]
@@ -116,6 +116,8 @@ def _height(model: pin.Model, data: pin.Data, frame: int, q: np.ndarray) -> floa
 
 def choose_home(model: pin.Model, frame: int) -> Home:
     """The home of an arm whose profile gives none (module docstring)."""
+    from scipy.stats import qmc  # here: importing the CLI stays light (tests/test_startup.py)
+
     data = model.createData()
     middle, half = _middle(model)
     reach = _reach(model, frame)

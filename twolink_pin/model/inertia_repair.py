@@ -15,7 +15,7 @@ analysis on the Hermitian matrices", SIAM J. Optim. 6(1), 1996): with the moment
 ``μ₃ ≤ μ₁ + μ₂`` is ``μ = (λ₁ + δ/3, λ₂ + δ/3, λ₃ − δ/3)``, which meets every other inequality
 (``μ₁ ≤ μ₂ + μ₃``, ``μ ≥ 0``), so it is the projection onto the whole set: the repaired inertia
 ``U diag(μ) Uᵀ`` is on the boundary (a flat body), at Frobenius distance ``δ/√3`` [kg·m²] from
-the original, with the same principal axes, trace, mass and centre of mass. (MuJoCo's
+the original, with the same principal axes, mass and centre of mass (its trace grows by δ/3). (MuJoCo's
 ``balanceinertia`` instead sets all three moments to their mean: further from the original,
 and the principal axes' moments no longer differ.) This is the identification's LMI projection
 restricted to the one block that is broken, in closed form — no solver.

@@ -96,8 +96,8 @@ class _Reader:
     def fail(self, key: str, value: Any, expected: str) -> InvalidParameterError:
         return InvalidParameterError(f"{self.path}: {key}", value, expected)
 
-    def text(self, key: str, default: str | None = None) -> str | None:
-        value = self.data.get(key, default)
+    def text(self, key: str) -> str | None:
+        value = self.data.get(key)
         if value is not None and (not isinstance(value, str) or not value.strip()):
             raise self.fail(key, value, "a non-empty string")
         return value
@@ -249,7 +249,7 @@ def read_profile_file(path: str | os.PathLike[str], name: str | None = None) -> 
         raise reader.fail("repair_inertias", repair, "true or false")
     profile = RobotProfile(
         name=reader.text("name") or name or file.stem,
-        description=reader.text("description", "") or f"profile {file}",
+        description=reader.text("description") or f"profile {file}",
         gain_presets=_gains(reader),
         friction=_friction(reader),
         q0_offset=reader.numbers("q0_offset", unit=" [rad]"),

@@ -141,9 +141,15 @@ def _refusal(
 
 
 def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path, profile: RobotProfile) -> int:
+    """The end-effector frame's index: ``ee_frame`` (the caller's), else the profile's, else
+    ``ee_link``, else the last frame on the last joint."""
+    from_profile = ee_frame is None
+    ee_frame = ee_frame if ee_frame is not None else profile.ee_frame
     if ee_frame is not None:
         if not model.existFrame(ee_frame):
             names = [f.name for f in model.frames]
+            if not from_profile:
+                raise InvalidURDFError(str(path), f"frame '{ee_frame}'", f"no such frame; frames are {names}")
             reason = f"a frame of {path.name}; no such frame, frames are {names}"
             raise _refusal(profile, path, "end_effector", f"frame '{ee_frame}'", ee_frame, reason)
         matches = [i for i, f in enumerate(model.frames) if f.name == ee_frame]
@@ -371,7 +377,7 @@ def load_robot(
     checked = check_urdf_file(path, repair)
     model = _build_model(path, profile, checked)
     _check_home(model, profile, path)
-    ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path, profile)
+    ee_id = _end_effector_frame(model, ee_frame, path, profile)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
         profile = dataclasses.replace(profile, q0_offset=default_q0_offset(model.nv))
     if payload > 0:

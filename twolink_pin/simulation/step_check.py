@@ -356,7 +356,10 @@ def _cause(controller: Controller, lin: Linearisation, eigenvalue: complex, join
         name = min(close, key=lambda n: abs(math.log(close[n] / rate)))
         spec = gain_spec(next(f for f in dataclasses.fields(controller.gains) if f.name == name))
         unit = f" [{spec.unit}]" if spec.unit else ""
-        return f"the law's gain {name}{unit} (its rate on the arm's inertia M(q(0)): {close[name]:.3g} 1/s)"
+        against = " on the arm's inertia M(q(0))" if spec.unit.startswith("N·m") else ""
+        return f"the law's gain {name}{unit} (its rate{against}: {close[name]:.3g} 1/s)"
+    if not np.abs(lin.law[: lin.inertia.shape[0]]).any():  # the law feeds nothing back: the arm's own
+        return "the arm's own dynamics at the start (the law feeds nothing back)"
     kind = "velocity" if abs(eigenvalue.imag) < abs(eigenvalue.real) else "position"
     where = f" on joint {joint + 1}" if joint is not None else " on its state z"
     return f"the law's {kind} feedback{where} (its linearisation by finite differences)"
