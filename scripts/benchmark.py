@@ -140,8 +140,8 @@ def baseline_pd(
     rv1, rv2 = half.v[:, 0].tolist(), half.v[:, 1].tolist()
     ra1, ra2 = half.a[:, 0].tolist(), half.a[:, 1].tolist()
     p1, p2, p3 = (float(x) for x in p)
-    kp1, kp2 = (float(x) for x in np.ravel(gains.kp))
-    kd1, kd2 = (float(x) for x in np.ravel(gains.kd))
+    kp1, kp2 = (float(x) for x in np.diag(np.asarray(gains.kp)[0]))  # the report's: diagonal matrices
+    kd1, kd2 = (float(x) for x in np.diag(np.asarray(gains.kd)[0]))
     cos, sin = math.cos, math.sin
 
     def f(q1: float, q2: float, v1: float, v2: float, i: int) -> tuple[float, float, float, float]:

@@ -9,7 +9,8 @@ import argparse
 from twolink_pin.cli.arguments import bounded
 
 ROBOT_HELP = (
-    "robot: a catalog name (twolink-pin robots lists them) or a path to a .urdf file (default twolink)"
+    "robot: a catalog name or one of your profiles (twolink-pin robots lists them), a path to a .urdf file, "
+    "or a profile file .toml (one arm of a URDF, its home, gains: docs/your_arm.md) (default twolink)"
 )
 
 MAX_PAYLOAD = 1e4

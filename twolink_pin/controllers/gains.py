@@ -395,6 +395,16 @@ def default_as_json(gains_type: type[Gains], name: str) -> Any:
         return repr(default)
 
 
+MATRIX_ROWS_SHOWN = 3
+"""A matrix gain of at most this many rows is shown as its rows; a larger one by its diagonal and
+its largest off-diagonal entry (JSON keeps every row)."""
+
+
+MATRIX_ROWS_SHOWN = 3
+"""A matrix gain of at most this many rows is shown as its rows; a larger one by its diagonal and
+its largest off-diagonal entry (JSON keeps every row)."""
+
+
 def format_gain(value: Any, digits: int = 4) -> str:
     """A gain value as text: ``350`` (a number, or ``350 I``), ``(350, 300)`` (per joint, or a
     diagonal matrix), a matrix as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
@@ -407,9 +417,11 @@ def format_gain(value: Any, digits: int = 4) -> str:
     def numbers(row: np.ndarray) -> str:
         return ", ".join(f"{x:.{digits}g}" for x in row)
 
-    if (
-        isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1 and array.ndim == 2
-    ):  # one matrix
+    one_matrix = isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1 and array.ndim == 2
+    if one_matrix and array.shape[0] > MATRIX_ROWS_SHOWN:  # a 7 × 7 M(q₀)-scaled gain: diagonal, coupling
+        k, coupling = array.shape[0], float(np.abs(array - np.diag(np.diag(array))).max())
+        return f"{k} × {k} matrix, diagonal ({numbers(np.diag(array))}), off-diagonal up to {coupling:.{digits}g}"
+    if one_matrix:
         return "[" + ", ".join(f"[{numbers(row)}]" for row in array) + "]"
     flat = array.ravel()
     text = "(" + numbers(flat[:12]) + (", …)" if flat.size > 12 else ")")

@@ -142,6 +142,9 @@ class RobotProfile:
         report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
         repair_inertias: Load the URDF with its triangle-breaking inertias replaced by the nearest
             consistent ones (:mod:`~twolink_pin.model.inertia_repair`).
+        free_joints: The joints left free, every other one locked (at its ``locked_positions``
+            entry if ``locked_joints`` names it, else 0 clipped to its limits); ``None``: only
+            ``locked_joints`` are locked.
         amplitude: The largest swing [rad] of the default reference about home
             (:func:`~twolink_pin.trajectory.defaults.neutral_motion`); ``None``: its default.
         file: The profile file this profile was read from (:mod:`~twolink_pin.model.profile_file`);
@@ -166,6 +169,7 @@ class RobotProfile:
     acceleration_limits: tuple[float, ...] | None = None
     report: ReportProfile = field(default_factory=ReportProfile)
     repair_inertias: bool = False
+    free_joints: tuple[str, ...] | None = None
     amplitude: float | None = None
     file: Path | None = None
     home_source: str = ""

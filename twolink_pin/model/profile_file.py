@@ -20,7 +20,8 @@ Keys (every one optional but ``urdf``): ``name`` (default: the file's stem), ``d
 ``urdf`` (a path relative to the file, a catalog robot's name — its URDF, not its profile —, or
 ``example-robot-data:PATH`` below that package's ``robots`` folder), ``end_effector`` (a frame),
 ``locked`` (joint names held at 0 clipped to their limits, or a table name → position [rad or
-m]), ``home`` (one value per joint left free), ``amplitude`` [rad], ``q0_offset`` [rad, per
+m]), ``free`` (the joints left free, every other one locked — at its ``locked`` position if
+given, else 0 clipped to its limits: one arm of a tree in one line), ``home`` (one value per joint left free), ``amplitude`` [rad], ``q0_offset`` [rad, per
 joint], ``acceleration_limits`` [rad/s², per joint], ``repair_inertias`` (bool),
 ``friction = {viscous = [...], coulomb = [...]}`` [N·m·s/rad, N·m], ``trajectory = {times =
 [...], joint_points = [[...], ...]}`` or ``cartesian_points`` (with ``branch``, ``period``), and
@@ -59,6 +60,7 @@ KEYS = frozenset(
         "urdf",
         "end_effector",
         "locked",
+        "free",
         "home",
         "amplitude",
         "q0_offset",
@@ -244,6 +246,10 @@ def read_profile_file(path: str | os.PathLike[str], name: str | None = None) -> 
         raise reader.fail(unknown[0], data[unknown[0]], f"one of the profile keys {', '.join(sorted(KEYS))}")
     urdf, package_dirs = _urdf(reader)
     locked, positions = _locked(reader)
+    free = data.get("free")
+    if free is not None:
+        if not isinstance(free, list) or not free or not all(isinstance(x, str) and x for x in free):
+            raise reader.fail("free", free, "a non-empty list of joint names (every other joint is locked)")
     repair = data.get("repair_inertias", False)
     if not isinstance(repair, bool):
         raise reader.fail("repair_inertias", repair, "true or false")
@@ -259,6 +265,7 @@ def read_profile_file(path: str | os.PathLike[str], name: str | None = None) -> 
         source=str(file),
         locked_joints=locked,
         locked_positions=positions,
+        free_joints=None if free is None else tuple(free),
         home=reader.numbers("home", unit=" [rad or m]"),
         acceleration_limits=reader.numbers("acceleration_limits", unit=" [rad/s²]"),
         amplitude=reader.number("amplitude"),

@@ -256,8 +256,9 @@ def _revolute_continuous(text: str) -> tuple[str, tuple[str, ...]]:
     return ET.tostring(root, encoding="unicode"), tuple(names)
 
 
-def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> pin.Model:
-    """The Pinocchio model of the checked URDF at ``path``, for tracking control:
+def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> tuple[pin.Model, RobotProfile]:
+    """The Pinocchio model of the checked URDF at ``path``, for tracking control, and the profile
+    (its ``free_joints`` turned into locked ones):
 
     * a continuous joint becomes a revolute joint without position limits: one angle
       [rad] in ℝ instead of Pinocchio's (cos, sin) pair, so that ``nq == nv`` and a
@@ -278,6 +279,8 @@ def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> pin
         if model.names[j] in continuous or (n == 1 and lower[i] == upper[i]):
             lower[i : i + n], upper[i : i + n] = -np.inf, np.inf
     model.lowerPositionLimit, model.upperPositionLimit = lower, upper
+    if profile.free_joints is not None:
+        profile = _free(model, profile, path)
     if profile.locked_joints:
         model = _lock(model, profile, path)
     if model.nv == 0:
@@ -299,7 +302,23 @@ def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> pin
             f"expected joints of one coordinate each (revolute, continuous, prismatic), got nq = {model.nq}, "
             f"nv = {model.nv} ({', '.join(kinds)})",
         )
-    return model
+    return model, profile
+
+
+def _free(model: pin.Model, profile: RobotProfile, path: Path) -> RobotProfile:
+    """``profile`` with every joint but its ``free_joints`` among its locked ones."""
+    assert profile.free_joints is not None
+    joints = [str(model.names[j]) for j in range(1, model.njoints)]
+    for name in profile.free_joints:
+        if name not in joints:
+            raise _refusal(
+                profile, path, "free", f"joint '{name}'", name, f"a joint of {path.name}; joints are {joints}"
+            )
+    given = dict(zip(profile.locked_joints, profile.locked_positions or (0.0,) * len(profile.locked_joints)))
+    locked = [name for name in joints if name not in profile.free_joints]
+    return dataclasses.replace(
+        profile, locked_joints=tuple(locked), locked_positions=tuple(given.get(name, 0.0) for name in locked)
+    )
 
 
 def _lock(model: pin.Model, profile: RobotProfile, path: Path) -> pin.Model:
@@ -375,7 +394,7 @@ def load_robot(
     path, profile = resolve(robot)
     repair = profile.repair_inertias if repair_inertias is None else bool(repair_inertias)
     checked = check_urdf_file(path, repair)
-    model = _build_model(path, profile, checked)
+    model, profile = _build_model(path, profile, checked)
     _check_home(model, profile, path)
     ee_id = _end_effector_frame(model, ee_frame, path, profile)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)

@@ -377,6 +377,8 @@ def check_step(
             True, config.method, dt, math.inf, 0j, None, "an adaptive step has no stability bound"
         )
     lin = linearise(controller, plant, initial_law_input(controller, plant, trajectory, config))
+    if not np.isfinite(lin.A).all():  # e.g. a plan the law could not make at t = 0: the run says why
+        return StepCheck(True, "rk4", dt, math.inf, 0j, None, "not checked: the law is not finite near the start")
     eigenvalues = np.linalg.eigvals(lin.A)
     if period_steps is None:
         stage = dt * eigenvalues
