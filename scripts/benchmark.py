@@ -38,6 +38,13 @@ Usage::
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
+    .venv/bin/python scripts/benchmark.py --arms-only [--quick]    # issue 50: every arm × law at the defaults
+
+``--arms-only`` (issue 50, ``scripts/arms.py``): every profile of ``examples/arms`` — every
+fixed-base arm example-robot-data ships, each arm of its trees, a 5-link chain — with every
+built-in law for 3 s at its defaults; goals: 100 % of (arm × law) run, ``computed-torque`` on the
+exact model within 1e-3 rad at 3 s, the step check at most 5 ms per run (median). The single-run
+guards above (ratios to the baseline) are the step check's cost on the whole run.
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -1565,6 +1572,11 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
     )
     parser.add_argument(
+        "--arms-only",
+        action="store_true",
+        help="only issue 50's goals: every arm of examples/arms with every law at its defaults, the step check's cost",
+    )
+    parser.add_argument(
         "--contention-only",
         action="store_true",
         help="only the contention row: two batches at once, and one alone (default threads against 1)",
@@ -1593,6 +1605,14 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.arms_only:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from arms import arms_section  # scripts/arms.py
+
+        results.update(arms_section(quick))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.qp_osc_only:
         results.update(qp_osc_section(quick, args.repeats or (1 if quick else 5)))
         if args.json:
