@@ -52,9 +52,11 @@ import pinocchio as pin
 
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import gain_spec
-from twolink_pin.errors import StepTooLargeError
+from twolink_pin.errors import ControllerError, StepTooLargeError
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import SimulationConfig, initial_state
+from twolink_pin.simulation.containment import contained
+from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.task_reference import law_input
 from twolink_pin.simulation.terms import terms_for
 from twolink_pin.trajectory import Trajectory
@@ -166,7 +168,7 @@ def _evaluate(law: Controller, x: Any, rows: np.ndarray) -> np.ndarray:
     (N, nv + nz)."""
     n, nv, nz = rows.shape[0], x.q.shape[1], x.z.shape[1]
     q, v, z = (np.ascontiguousarray(rows[:, a:b]) for a, b in ((0, nv), (nv, 2 * nv), (2 * nv, 2 * nv + nz)))
-    out = law.compute(x._replace(q=q, v=v, z=z), terms_for(law, n, threads=1))
+    out = contained(law)(x._replace(q=q, v=v, z=z), terms_for(law, n, threads=1))
     tau = np.broadcast_to(np.asarray(out[0], dtype=float), (n, nv))
     dz = np.zeros((n, nz)) if out[1] is None else np.broadcast_to(np.asarray(out[1], dtype=float), (n, nz))
     return np.concatenate([tau, dz], axis=1)
@@ -204,7 +206,7 @@ def linearise(controller: Controller, plant: Plant, x: Any) -> Linearisation:
     """The closed loop of ``controller`` on ``plant`` linearised at the law input ``x`` (one run)."""
     law = _copy(controller)
     if law.update_period() is not None:  # the plan the engine makes at t = 0
-        x = x._replace(z=np.asarray(law.update(x, terms_for(law, 1)), dtype=float))
+        x = x._replace(z=np.asarray(contained(law, "update")(x, terms_for(law, 1)), dtype=float))
     nv, nz = x.q.shape[1], x.z.shape[1]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -378,7 +380,9 @@ def check_step(
         )
     lin = linearise(controller, plant, initial_law_input(controller, plant, trajectory, config))
     if not np.isfinite(lin.A).all():  # e.g. a plan the law could not make at t = 0: the run says why
-        return StepCheck(True, "rk4", dt, math.inf, 0j, None, "not checked: the law is not finite near the start")
+        return StepCheck(
+            True, "rk4", dt, math.inf, 0j, None, "not checked: the law is not finite near the start"
+        )
     eigenvalues = np.linalg.eigvals(lin.A)
     if period_steps is None:
         stage = dt * eigenvalues
@@ -425,6 +429,15 @@ def refusal(check: StepCheck, controller: Controller, dt: float) -> StepTooLarge
     return StepTooLargeError("--control-period" if sampled else "--dt", check.step, expected)
 
 
+class CheckTimeout(ControllerError):
+    """A law that did not return within the run's wall-clock bound while its step was checked."""
+
+    @classmethod
+    def of(cls, error: ControllerError) -> CheckTimeout:
+        """``error`` (:func:`~twolink_pin.simulation.deadline.timed_out`'s) as this class."""
+        return cls(error.controller, error.time, error.detail)
+
+
 def _rounded_down(x: float) -> float:
     """``x`` rounded down to 2 significant digits."""
     if not math.isfinite(x) or x <= 0:
@@ -441,9 +454,10 @@ def require_stable_step(
     or cannot be copied: the run itself then says what is wrong)."""
     if not config.check_step or config.method != "rk4":
         return None
-    try:
-        check = check_step(controller, plant, trajectory, config)
-    except StepTooLargeError:
+    try:  # within the run's wall-clock bound (--timeout): a law that never returns stops here
+        with bounded(lambda seconds: CheckTimeout.of(timed_out(controller, 0.0, seconds))):
+            check = check_step(controller, plant, trajectory, config)
+    except (StepTooLargeError, CheckTimeout):
         raise
     except Exception:  # a user's law the linearisation cannot evaluate: the run will say why
         return None
