@@ -160,18 +160,11 @@ def test_osc_posture_task_leaves_the_task_error_unchanged() -> None:
 def test_impedance_settles_at_the_stiffness_inverse_times_the_wrench() -> None:
     r = robot("panda")
     force = np.array([12.0, -6.0, 9.0, 0.5, -0.3, 0.2])
-    # K e = F at rest holds for any stiffness: isotropic blocks, which settle within the 6 s (the
-    # default's blocks, ω² times the Schur complements of Λ, leave a slow mode of 0.4 1/s here)
+    # K e = F at rest holds for any stiffness: isotropic blocks ω² m and 2 ω m (ω = 10 rad/s, m the
+    # mean diagonal of the Panda's Λ blocks at home, 6.8 kg and 0.23 kg·m²), which settle within
+    # the 6 s (the default's blocks, ω² times the Schur complements of Λ, leave a slow mode here)
     defaults = Impedance(r).gains
-    law = Impedance(
-        r,
-        dataclasses.replace(
-            defaults,
-            **{
-                name: float(np.trace(getattr(defaults, name)[0])) / 3 for name in ("k", "d", "k_rot", "d_rot")
-            },
-        ),
-    )
+    law = Impedance(r, dataclasses.replace(defaults, k=680.0, d=136.0, k_rot=23.0, d_rot=4.6))
     plant = Plant(r, wrench=Wrench(tuple(force)))
     result = simulate(law, plant, Hold(r.home), SimulationConfig(duration=6.0, q0_offset=0.0))
     e, _, e_o, _ = _task_errors(r, result)
