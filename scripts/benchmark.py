@@ -39,6 +39,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
     .venv/bin/python scripts/benchmark.py --arms-only [--quick]    # issue 50: every arm × law at the defaults
+    .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``--arms-only`` (issue 50, ``scripts/arms.py``): every profile of ``examples/arms`` — every
 fixed-base arm example-robot-data ships, each arm of its trees, a 5-link chain — with every
@@ -1577,6 +1578,12 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 50's goals: every arm of examples/arms with every law at its defaults, the step check's cost",
     )
     parser.add_argument(
+        "--equations-only",
+        action="store_true",
+        help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
+        "scaling table (scripts/equations_benchmark.py)",
+    )
+    parser.add_argument(
         "--contention-only",
         action="store_true",
         help="only the contention row: two batches at once, and one alone (default threads against 1)",
@@ -1620,6 +1627,13 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.equations_only:
+        from equations_benchmark import equations_section  # scripts/: the script's own folder
+
+        results.update(equations_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0

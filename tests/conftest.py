@@ -206,3 +206,15 @@ def _signals_left_as_found() -> Any:
     yield
     after = (signal.getsignal(signal.SIGINT), signal.pthread_sigmask(signal.SIG_BLOCK, []))
     assert after == before, f"SIGINT's handler or the signal mask changed: {before} -> {after}"
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _equations_cache_of_the_run(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    """The symbolic equations' cache (twolink_pin/symbolic/cache.py) in a folder of this test
+    run, not the user's ~/.cache: the report, the tutorial and the CLI tests derive through it
+    (subprocesses inherit the variable). A test that needs its own sets it again."""
+    import os
+
+    if "TWOLINK_PIN_CACHE" not in os.environ:
+        os.environ["TWOLINK_PIN_CACHE"] = str(tmp_path_factory.mktemp("equations-cache"))
+    return os.environ["TWOLINK_PIN_CACHE"]

@@ -87,3 +87,21 @@ def test_big_arms_rows_give_ratios_and_the_floor() -> None:
         assert row["seconds"] > 0 and row["ratio"] > 0, label
     for label in batches:
         assert 0 < rows[label]["floor"] < rows[label]["seconds"], label
+
+
+def test_quick_equations_section_prints_its_goals() -> None:
+    """``--equations-only --quick``: the goals' lines and the scaling table's rows (no timing asserted)."""
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), "--equations-only", "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=600,
+    )
+    lines = done.stdout.splitlines()
+    assert any(line.startswith("  twolink, M C g Y:") for line in lines)
+    assert any(line.startswith("  UR5's first 3 joints:") for line in lines)
+    assert len([line for line in lines if line.startswith("    n = ")]) == 3
+    results = json.loads(lines[-1])["equations"]
+    assert results["twolink_seconds"] > 0 and results["mass_matrix_seconds"]["crba"] > 0
+    assert [row["joints"] for row in results["scaling"]] == [1, 2, 3]

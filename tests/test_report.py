@@ -62,6 +62,25 @@ def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> 
     assert row is not None and "lam = 5," in row["gains"] and "k = (90, 90)" in row["gains"]
 
 
+def test_the_derived_equations_beside_the_courses(report_dir: Path) -> None:
+    """Issue 47: the model section shows M, C, g derived from the URDF (as MathML) and, for the
+    twolink, the derived M and C written in the p they find beside the report's, all equal."""
+    results = json.loads((report_dir / "results.json").read_text())
+    equations = results["robot"]["equations"]
+    assert equations["shown"] and equations["skew_symmetric"] and len(equations["M"]) == 3
+    course = results["twolink"]["course_equations"]
+    assert course["found"] == {"p1": "beta1 + beta4", "p2": "beta4", "p3": "beta2*l2x"}
+    assert course["M"] and course["C"] and course["Y"] and course["p_expressions"]
+    html = (report_dir / "index.html").read_text()
+    for section in ("equations-beta", "equations-M", "equations-C", "equations-g", "equations-course"):
+        assert f'id="{section}"' in html
+    table = html[
+        html.index('id="equations-course"') : html.index("</table>", html.index('id="equations-course"'))
+    ]
+    assert table.count("<tr>") == 7 and table.count("<math") == 14
+    assert "$$" in (report_dir / "report.md").read_text()
+
+
 def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:
     """No float printed with 15+ digits (e.g. "Peaks [4.093301855416829, ...]")."""
     text = (report_dir / "index.html").read_text()
@@ -155,7 +174,9 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
     )
     results = build_report(tmp_path / "r", options)
     assert results["twolink"] is None and results["errata"] == []
+    assert results["robot"]["equations"]["shown"]  # its own derived equations, no course beside them
     html = (tmp_path / "r" / "index.html").read_text()
+    assert 'id="equations-M"' in html and 'id="equations-course"' not in html
     assert "table1" not in html and "table2-report" not in html and "Errata" not in html
     # the sections it has are numbered 1, 2, 3 ... with no gap where the report's would be
     numbers = [int(n) for n in re.findall(r'<h2 id="[^"]+">(\d+)\. ', html)]

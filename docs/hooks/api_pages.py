@@ -43,6 +43,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
     (
+        "symbolic",
+        "Equations in closed form",
+        "M, C, g and the regressor derived with SymPy from the URDF's tree: text, LaTeX, JSON, a numpy module.",
+        ("symbolic",),
+    ),
+    (
         "optimal",
         "Optimisation",
         "The one optimisation core: QP solves, B-splines, transcriptions on Pinocchio's derivatives, SQP.",

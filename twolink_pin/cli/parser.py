@@ -14,6 +14,7 @@ from twolink_pin.cli.common_options import (
     run_option_strings,
 )
 from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
+from twolink_pin.cli.equations_parser import add_equations_command
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
@@ -198,6 +199,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run_commands(sub, c)
     _add_sweep_command(sub, c)
     add_identification_commands(sub, c)
+    add_equations_command(sub, c)
     return parser
 
 

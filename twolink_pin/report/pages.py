@@ -18,7 +18,7 @@ import markupsafe
 import numpy as np
 
 from twolink_pin.files import atomic_write, write_json
-from twolink_pin.mathml import docstring_html
+from twolink_pin.mathml import docstring_html, latex_to_mathml
 from twolink_pin.metrics import NORMS, SIGNALS
 from twolink_pin.studies.comparison import headers
 from twolink_pin.task_metrics import TASK_TITLES, TASK_UNITS
@@ -72,6 +72,8 @@ def _environment() -> jinja2.Environment:
     env.filters["fmt"] = fmt
     env.filters["evidence"] = evidence_text
     env.filters["docstring"] = lambda text: markupsafe.Markup(docstring_html(text))
+    env.filters["math"] = lambda tex: markupsafe.Markup(latex_to_mathml(tex, display=True))
+    env.filters["inline_math"] = lambda tex: markupsafe.Markup(latex_to_mathml(tex))
     return env
 
 
@@ -220,6 +222,7 @@ def markdown(r: dict[str, Any]) -> str:
             f"Closed-form check: max |ΔM| = {check['max_abs_dM']:.2e}, max |ΔC| = {check['max_abs_dC']:.2e}.",
             "",
         ]
+    lines += _equations_markdown(model.get("equations"), twolink)
     lines += [
         "## Torque check",
         "",
@@ -262,6 +265,26 @@ def markdown(r: dict[str, Any]) -> str:
                 "",
             ]
     return "\n".join(lines)
+
+
+def _equations_markdown(equations: dict[str, Any] | None, twolink: dict[str, Any] | None) -> list[str]:
+    """The derived equations as LaTeX (``$$…$$``), and the twolink's beside the course's."""
+    if not equations:
+        return []
+    if not equations["shown"]:
+        return ["## Equations of motion", "", equations["reason"], ""]
+    lines = ["## Equations of motion, derived from the URDF", ""]
+    lines += [f"$${b['latex']}$$ ({fmt(b['value'], 6)} {b['unit']})" for b in equations["base_parameters"]]
+    lines += [f"$${entry}$$" for key in ("M", "C", "g") for entry in equations[key]]
+    course = (twolink or {}).get("course_equations")
+    if course and course["latex"]:
+        lines += [
+            "",
+            "Written in the p they find (" + ", ".join(f"${p}$" for p in course["latex"]["p"]) + "):",
+        ]
+        same = all(course[k] for k in ("M", "C", "Y", "p_expressions"))
+        lines.append("the report's M, C and Y, and its p in masses and lengths: " + ("yes" if same else "NO"))
+    return [*lines, ""]
 
 
 def _limits_markdown(r: dict[str, Any]) -> list[str]:
