@@ -34,11 +34,11 @@ def test_nine_numbers_are_a_three_by_three_matrix_a_diagonal_one_shown_as_its_di
     shown as the diagonal (what ``--gain`` takes back)."""
     full = _json(capsys, [*RUN, "--gain", "kp=1500,0,0,0,1500,0,0,0,800"])
     diagonal = _json(capsys, [*RUN, "--gain", "kp=1500,1500,800"])
-    assert full["gains"]["kp"] == DIAGONAL and full["gains"]["kd"] == 20.0
+    assert full["gains"]["kp"] == DIAGONAL and full["gains"]["kd"] == [20.0, 20.0, 20.0]
     assert full["metrics"] == diagonal["metrics"] and full["task_metrics"] == diagonal["task_metrics"]
     assert main([*RUN, "--gain", "kp=1500,0,0,0,1500,0,0,0,800"]) == 0
     text = capsys.readouterr().out
-    assert "  gains kp = (1500, 1500, 800) 1/s², kd = 20 1/s," in text
+    assert "  gains kp = (1500, 1500, 800) 1/s², kd = (20, 20, 20) 1/s," in text
 
 
 def test_a_full_matrix_changes_the_run(capsys: pytest.CaptureFixture[str]) -> None:
@@ -122,7 +122,7 @@ def test_compare_tables_list_each_laws_gains_as_the_csv_does(
     kp = "kp = (1500, 1500, 800)"
     markdown = (out / "comparison.md").read_text()
     assert "| pd | kp = (350, 300), kd = (40, 50) | no friction | finished |" in markdown
-    assert f"| osc | {kp}, kd = 20," in markdown
+    assert f"| osc | {kp}, kd = (20, 20, 20)," in markdown
     assert 'pd,"kp = (350, 300), kd = (40, 50)"' in (out / "comparison.csv").read_text()
     assert json.loads((out / "comparison.json").read_text())["gains"]["osc"]["kp"] == DIAGONAL
 

@@ -167,11 +167,12 @@ def test_sweep_and_animate_echo_the_gains_they_used(
     assert (
         main(["animate", "pd", "--gain", "kp=200", "--duration", "0.02", "--html", str(html), "--json"]) == 0
     )
-    assert json.loads(capsys.readouterr().out)["gains"] == {"kp": 200.0, "kd": [40.0, 50.0]}
+    # kp=200 on a matrix gain is 200 I: shown by its diagonal, as --gain takes it back
+    assert json.loads(capsys.readouterr().out)["gains"] == {"kp": [200.0, 200.0], "kd": [40.0, 50.0]}
     assert main(["simulate", "pd", "--gain", "kp=210", "--duration", "0.02", "--save", str(saved)]) == 0
     capsys.readouterr()
     assert main(["animate", "--from", str(saved), "--html", str(html)]) == 0
-    assert "pd gains kp = 210 " in capsys.readouterr().out
+    assert "pd gains kp = (210, 210) " in capsys.readouterr().out  # 210 I: by its diagonal
 
 
 BLOWUP = """

@@ -369,8 +369,8 @@ class Gains:
 
 def gain_as_json(value: Any) -> Any:
     """A gain value JSON-ready: a number, a list (per joint, axis or estimate), a matrix as its
-    rows (a list of lists) — a diagonal matrix as its diagonal, k numbers, and ``s I`` as the
-    number s, as ``--gain`` takes them —, one of these per run for per-run values; None stays None."""
+    rows (a list of lists) — a diagonal matrix as its diagonal, k numbers, as ``--gain`` takes
+    them (the report's ``K = (90, 90)``) —, one of these per run for per-run values; None stays None."""
     if value is None or isinstance(value, (bool, str)):
         return value
     array = np.asarray(value, dtype=float)
@@ -378,8 +378,6 @@ def gain_as_json(value: Any) -> Any:
         array = array[0]
         if array.ndim == 2 and not np.any(array - np.diag(np.diag(array))):
             array = np.diag(array)
-            if array.size > 1 and not np.any(array - array[0]):  # s I: the number s
-                array = array[0]
     return float(array) if array.ndim == 0 else array.tolist()
 
 
@@ -406,8 +404,8 @@ its largest off-diagonal entry (JSON keeps every row)."""
 
 
 def format_gain(value: Any, digits: int = 4) -> str:
-    """A gain value as text: ``350`` (a number, or ``350 I``), ``(350, 300)`` (per joint, or a
-    diagonal matrix), a matrix as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
+    """A gain value as text: ``350``, ``(350, 300)`` (per joint, or a diagonal matrix), a matrix
+    as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
     shortened."""
     shown = gain_as_json(value)
     if isinstance(shown, float):
