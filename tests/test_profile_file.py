@@ -155,3 +155,46 @@ def test_a_urdf_without_a_home_gets_a_dexterous_one_near_the_middle_and_info_say
     np.testing.assert_array_equal(choose_home(robot.model, robot.ee_frame_id).q, robot.home)
     assert main(["info", "--robot", str(urdf)]) == 0
     assert "how      chosen: the most dexterous of 257 configurations" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("extra", "key", "expected"),
+    [
+        ("locked = {shoulder_pan_joint = 99.0}\n", "locked.shoulder_pan_joint", "range [-6.28319, 6.28319]"),
+        ('free = ["elbow_joint"]\nlocked = ["elbow_joint"]\n', "locked", "not also listed in free"),
+        ('free = ["elbow_joint"]\nlocked = ["elbow"]\n', "locked", "no such joint"),
+        ("q0_offset = [0.1, 0.2]\n", "q0_offset", "one value [rad], or 6"),
+        ("acceleration_limits = [10.0, 10.0]\n", "acceleration_limits", "6 values > 0"),
+        ("friction = {viscous = [0.1], coulomb = [0.0]}\n", "friction.viscous", "6 values >= 0"),
+        (
+            "trajectory = {times = [0, 1], joint_points = [[0, 0], [1, 1]]}\n",
+            "trajectory.joint_points",
+            "6 joint",
+        ),
+        ("[gains.pd]\nkp = [100, 100]\n", "gains.pd.kp", "2 numbers are neither 1, 6"),
+    ],
+)
+def test_a_profile_value_the_arm_cannot_take_is_one_line_naming_the_key_and_the_file(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], extra: str, key: str, expected: str
+) -> None:
+    """A per-joint value of the wrong count, a lock outside the range or contradicting ``free``:
+    refused when the arm is loaded, not when a run meets it (or never)."""
+    head, _, tail = CAMPAIGN.partition("home =")
+    text = head + extra + "home =" + tail if not extra.startswith("[") else CAMPAIGN + extra
+    if "free" in extra:
+        text = text.replace("home = [0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0]\n", "")
+    path = tmp_path / "mine.toml"
+    path.write_text(text)
+    assert main(["info", "--robot", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1, err
+    assert f"{path}: {key} = " in err[0] and expected in err[0], err[0]
+
+
+def test_one_q0_offset_in_a_profile_is_every_joints(tmp_path: Path) -> None:
+    path = tmp_path / "mine.toml"
+    path.write_text(CAMPAIGN + "q0_offset = [0.1]\n")
+    robot = load_robot(path)
+    from twolink_pin.simulation.config import joint_offsets
+
+    np.testing.assert_array_equal(joint_offsets("q0_offset", robot.profile.q0_offset, None, 6), [0.1] * 6)

@@ -22,6 +22,7 @@ import sys
 from pathlib import Path
 
 from twolink_pin.controllers.base import CONTROLLERS, Controller
+from twolink_pin.controllers.gains import check_count, check_width, spec_of
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.user_code import guarded
@@ -200,7 +201,16 @@ def check_profile_gains(robot: RobotModel) -> None:
             raise InvalidParameterError(
                 f"{file}: gains.{law}.{unknown[0]}", table[unknown[0]], f"a gain of {law}: {', '.join(names)}"
             )
+        widths = cls.gain_widths(robot)
         try:
-            cls.Gains(**table)
+            for name, value in table.items():  # the count of numbers before their values
+                spec = spec_of(cls.Gains, name)
+                if spec.per != "scalar":
+                    check_count(name, value, spec, *widths[spec.per])
+            gains = cls.Gains(**table)
+            for name in table:  # a matrix of the wrong size for this arm
+                spec = spec_of(cls.Gains, name)
+                if spec.per != "scalar":
+                    check_width(name, getattr(gains, name), *widths[spec.per])
         except InvalidParameterError as exc:
             raise InvalidParameterError(f"{file}: gains.{law}.{exc.name}", exc.value, exc.expected) from None

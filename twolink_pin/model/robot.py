@@ -279,6 +279,7 @@ def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> tup
         if model.names[j] in continuous or (n == 1 and lower[i] == upper[i]):
             lower[i : i + n], upper[i : i + n] = -np.inf, np.inf
     model.lowerPositionLimit, model.upperPositionLimit = lower, upper
+    _check_locked_positions(model, profile, path)
     if profile.free_joints is not None:
         profile = _free(model, profile, path)
     if profile.locked_joints:
@@ -314,11 +315,55 @@ def _free(model: pin.Model, profile: RobotProfile, path: Path) -> RobotProfile:
             raise _refusal(
                 profile, path, "free", f"joint '{name}'", name, f"a joint of {path.name}; joints are {joints}"
             )
+    for name in profile.locked_joints:
+        if name not in joints:
+            reason = f"a joint of {path.name} to lock; no such joint, joints are {joints}"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
+        if name in profile.free_joints:
+            reason = f"a joint not also listed in free (joint '{name}' is in both)"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
     given = dict(zip(profile.locked_joints, profile.locked_positions or (0.0,) * len(profile.locked_joints)))
     locked = [name for name in joints if name not in profile.free_joints]
     return dataclasses.replace(
         profile, locked_joints=tuple(locked), locked_positions=tuple(given.get(name, 0.0) for name in locked)
     )
+
+
+def _check_locked_positions(model: pin.Model, profile: RobotProfile, path: Path) -> None:
+    """Refuse a position the profile locks a joint at outside that joint's range."""
+    for name, value in zip(profile.locked_joints, profile.locked_positions or ()):
+        if not model.existJointName(name):
+            continue  # named by the lock itself
+        i = model.idx_qs[model.getJointId(name)]
+        lower, upper = model.lowerPositionLimit[i], model.upperPositionLimit[i]
+        if not lower <= value <= upper:
+            reason = f"a position within joint '{name}''s range [{lower:g}, {upper:g}] rad (m if prismatic)"
+            raise _refusal(profile, path, f"locked.{name}", f"joint '{name}'", value, reason)
+
+
+def _check_sizes(model: pin.Model, profile: RobotProfile, path: Path) -> None:
+    """Refuse a per-joint value of the profile whose count is not the free joints' (one value
+    also for ``q0_offset``), naming the key, before a run meets it."""
+    nv = model.nv
+    what = f"per free joint, nv = {nv}"
+    if profile.q0_offset is not None and len(profile.q0_offset) not in (1, nv):
+        reason = f"one value [rad], or {nv} ({what})"
+        raise _refusal(profile, path, "q0_offset", "q0_offset", list(profile.q0_offset), reason)
+    accel = profile.acceleration_limits
+    if accel is not None and (len(accel) != nv or not all(a > 0 for a in accel)):
+        reason = f"{nv} values > 0 [rad/s²] ({what})"
+        raise _refusal(profile, path, "acceleration_limits", "acceleration_limits", list(accel), reason)
+    if profile.friction is not None:
+        for key, values in zip(("viscous", "coulomb"), profile.friction):
+            if len(values) != nv or not all(v >= 0 for v in values):
+                reason = f"{nv} values >= 0 ({what})"
+                raise _refusal(profile, path, f"friction.{key}", "friction", list(values), reason)
+    trajectory = profile.trajectory
+    if trajectory is not None and trajectory.joint_points is not None:
+        for point in trajectory.joint_points:
+            if len(point) != nv:
+                reason = f"points of {nv} joint positions [rad or m] ({what})"
+                raise _refusal(profile, path, "trajectory.joint_points", "trajectory", list(point), reason)
 
 
 def _lock(model: pin.Model, profile: RobotProfile, path: Path) -> pin.Model:
@@ -396,6 +441,7 @@ def load_robot(
     checked = check_urdf_file(path, repair)
     model, profile = _build_model(path, profile, checked)
     _check_home(model, profile, path)
+    _check_sizes(model, profile, path)
     ee_id = _end_effector_frame(model, ee_frame, path, profile)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
         profile = dataclasses.replace(profile, q0_offset=default_q0_offset(model.nv))

@@ -144,8 +144,8 @@ def joint_offsets(name: str, value: float | tuple[float, ...] | None, default: A
     if chosen is None:
         return np.zeros(nv)
     array = (
-        np.broadcast_to(np.asarray(chosen, dtype=float), (nv,))
-        if np.ndim(chosen) == 0
+        np.broadcast_to(np.asarray(chosen, dtype=float).reshape(()), (nv,))
+        if np.size(chosen) == 1  # one value: a number, or a list of one (a profile's [0.1])
         else np.asarray(chosen, dtype=float)
     )
     if array.shape != (nv,):
