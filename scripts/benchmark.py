@@ -39,6 +39,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
     .venv/bin/python scripts/benchmark.py --arms-only [--quick]    # issue 50: every arm × law at the defaults
+    .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
     .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``--arms-only`` (issue 50, ``scripts/arms.py``): every profile of ``examples/arms`` — every
@@ -1230,6 +1231,12 @@ def _tune_page_latency(
                 lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
             )
             if not playing:
+                driver.find_element("xpath", "//*[text()='playback']").click()  # its folder starts closed
+                WebDriverWait(driver, 600).until(
+                    lambda d: d.execute_script(
+                        "return Array.from(document.querySelectorAll('label')).some(e => e.textContent === 'play')"
+                    )
+                )
                 driver.execute_script(
                     "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
                     "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"
@@ -1568,6 +1575,12 @@ def main(argv: list[str] | None = None) -> int:
         help="only mpc's goals: 30-s runs on the twolink and the UR5, demo (a)",
     )
     parser.add_argument(
+        "--mujoco-only",
+        action="store_true",
+        help="only issue 44's goals: the MuJoCo plant's time per run and its equality with Pinocchio's "
+        "(scripts/benchmark_mujoco.py)",
+    )
+    parser.add_argument(
         "--optimal-only",
         action="store_true",
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
@@ -1627,6 +1640,18 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.mujoco_only:
+        sys.path.insert(0, str(HERE))
+        from benchmark_mujoco import main as mujoco_main
+
+        results.update(
+            mujoco_main(
+                [*(["--quick"] if quick else []), "--repeats", str(args.repeats or (1 if quick else 5))]
+            )
+        )
         if args.json:
             print(json.dumps(results))
         return 0

@@ -48,6 +48,9 @@ GROUPS: dict[str, str] = {
     "test_controllers.py": "controllers",  # two 8-s adaptive runs (Lyapunov checks)
     "test_simulation.py": "simulation",  # the cached 3-s DOP853 reference runs (conftest_sim.run)
     "test_tune_browser.py": "tune",  # Chromium on two live tune servers
+    "test_tune_page.py": "tune_page",  # one Chromium page on a live tuner, its tests in order
+    "test_tune_layout.py": "tune_layout",  # Chromium at 1366x768 on a live mpc tuner
+    "test_tune_page_periods.py": "tune_page_periods",  # one Chromium for its tuners
 }
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 

@@ -114,6 +114,9 @@ def test_the_catalogs_own_profiles_are_files_and_the_twolinks_are_the_reports_nu
     assert tuple(twolink["trajectory"]["times"]) == reference.REPORT_TIMES
     friction = twolink["friction"]
     assert (tuple(friction["viscous"]), tuple(friction["coulomb"])) == reference.REPORT_FRICTION
+    effects = twolink["effects"]
+    assert tuple(effects["armature"]) == reference.ARMATURE
+    assert (tuple(effects["damping"]), tuple(effects["frictionloss"])) == reference.REPORT_FRICTION
 
 
 def test_robots_lists_the_profiles_of_the_users_folder(
@@ -172,6 +175,8 @@ def test_a_urdf_without_a_home_gets_a_dexterous_one_near_the_middle_and_info_say
             "6 joint",
         ),
         ("[gains.pd]\nkp = [100, 100]\n", "gains.pd.kp", "2 numbers are neither 1, 6"),
+        ("effects = {armature = [0.1, 0.1]}\n", "effects.armature", "6 values"),
+        ("effects = {armature = [-0.1]}\n", "effects.armature", ">= 0"),
     ],
 )
 def test_a_profile_value_the_arm_cannot_take_is_one_line_naming_the_key_and_the_file(

@@ -15,7 +15,9 @@ from twolink_pin.report import MARKER, ReportOptions, build_report
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
-SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False)
+SHORT = ReportOptions(
+    run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False, sim_to_sim=False
+)
 
 
 @pytest.fixture(scope="module")
@@ -146,6 +148,7 @@ def test_a_sixth_law_gets_its_own_section_and_the_errata_use_the_runs_lambda(tmp
         run=RunSpec(simulation=SimulationConfig(duration=1.0), lam=3.0),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,  # its table is the test above's
         controllers=("pd", "adaptive", "examples/sliding_mode.py:SlidingMode"),
@@ -169,6 +172,7 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
         run=RunSpec(simulation=SimulationConfig(duration=1.0)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         controllers=("pd",),
     )
@@ -210,6 +214,7 @@ def test_what_the_report_shows_of_a_robot_is_its_profiles_declaration(
         run=RunSpec(simulation=SimulationConfig(duration=0.5), plant=PlantOptions(friction="on")),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
     )
     results = build_report(tmp_path / "r", options)
@@ -229,6 +234,7 @@ def test_the_identification_section_can_be_left_out(tmp_path: Path, report_dir: 
         "run": RunSpec(simulation=SimulationConfig(duration=1.0)),
         "workers": 1,
         "limits_section": False,
+        "sim_to_sim": False,
         "animation": False,
         "controllers": ("pd",),
     }
@@ -273,6 +279,7 @@ def test_failure_midway_leaves_the_previous_report_whole(
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,
         controllers=("pd",),
@@ -290,6 +297,7 @@ def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp
         run=RunSpec(simulation=SimulationConfig(duration=0.5, check_step=False), lam=1e6),
         workers=2,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,
     )
@@ -315,6 +323,7 @@ def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> No
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         controllers=("pd",),
     )
     results = build_report(tmp_path / "r", options)

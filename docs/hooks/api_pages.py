@@ -58,9 +58,19 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, what pushes back on it, a law with its plant, a law's variants, the run description, "
-        "and the engine.",
-        ("plant", "disturbances", "scenario", "law_variant", "run_spec", "simulation"),
+        "The simulated arm (Pinocchio's and MuJoCo's), the effects a real arm has, what pushes back on it, a law "
+        "with its plant, a law's variants, the run description, and the engine.",
+        (
+            "plant",
+            "arm_effects",
+            "mujoco_model",
+            "mujoco_plant",
+            "disturbances",
+            "scenario",
+            "law_variant",
+            "run_spec",
+            "simulation",
+        ),
     ),
     ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),

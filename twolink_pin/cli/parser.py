@@ -18,6 +18,7 @@ from twolink_pin.cli.equations_parser import add_equations_command
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
+from twolink_pin.cli.plant_options import add_plant_options
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -115,6 +116,7 @@ def add_sim_options(parser: argparse.ArgumentParser) -> None:
         help="the robot's friction in the plant: of the laws that estimate friction (law, default), of every "
         "law (on), of none (off)",
     )
+    add_plant_options(parser)
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
@@ -407,6 +409,11 @@ def _add_report(sub: Any, c: Any) -> None:
     )
     p.add_argument(
         "--no-limits-section", action="store_true", help="skip the section 'The reference within the limits'"
+    )
+    p.add_argument(
+        "--no-sim-to-sim",
+        action="store_true",
+        help="skip the section 'Sim-to-sim': each law on Pinocchio and on MuJoCo with the arm's effects (docs/mujoco.md)",
     )
     add_robot_options(p)
     add_disturbance_options(p)

@@ -64,6 +64,9 @@ class GainSpec(NamedTuple):
     """One-line description."""
     matrix: bool = False
     """A matrix gain (see the module docstring)."""
+    multiple_of: str = ""
+    """The scalar gain this one is a whole multiple of (mpc's horizon: of its knot interval);
+    ``tune`` steps it by that gain's value."""
 
 
 def gain(
@@ -74,6 +77,7 @@ def gain(
     bound: str = "positive",
     doc: str = "",
     matrix: bool = False,
+    multiple_of: str = "",
 ) -> Any:
     """A gains field with its default, shape, unit and sign constraint.
 
@@ -87,6 +91,8 @@ def gain(
         doc: One-line description (shown by the CLI and the report).
         matrix: A symmetric positive-definite matrix gain of size k given by ``per``
             (``"joint"``, ``"estimate"`` or ``"axis"``); ``bound`` is then "positive".
+        multiple_of: The name of the scalar gain this scalar gain is a whole multiple of
+            (a horizon in knots of a knot interval): ``tune`` steps it by that gain's value.
     """
     if per not in SHAPES:
         raise ValueError(f"per must be one of {SHAPES}, got {per!r}")
@@ -96,7 +102,9 @@ def gain(
         raise ValueError("a scalar gain needs a default value")
     if matrix and (per == "scalar" or bound != "positive"):
         raise ValueError("a matrix gain is per joint, estimate or axis, and positive definite")
-    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc, matrix)})
+    if multiple_of and per != "scalar":
+        raise ValueError("a gain that is a multiple of another is a scalar gain")
+    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc, matrix, multiple_of)})
 
 
 def spec_of(gains_type: type[Gains] | Gains, name: str) -> GainSpec:

@@ -44,7 +44,7 @@ class MPCGains(Gains):
             use (headroom for the feedback; the position range is kept); default 0.95.
     """
 
-    horizon: Any = gain(0.2, unit="s", doc="length T of the plan")
+    horizon: Any = gain(0.2, unit="s", multiple_of="knot_interval", doc="length T of the plan")
     knot_interval: Any = gain(0.025, unit="s", doc="time h between the plan's knots")
     replan_period: Any = gain(0.01, unit="s", doc="time between replans (a multiple of the step)")
     weight_q: Any = gain(None, per="joint", unit="N·m/rad", doc="weight W_q of the position error")

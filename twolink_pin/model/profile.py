@@ -110,6 +110,24 @@ class ReportProfile:
 
 
 @dataclass(frozen=True)
+class ArmEffects:
+    """What a real arm adds to its rigid bodies, per joint, with where the values come from
+    (a plant models them on request: ``--armature arm``, :mod:`twolink_pin.arm_effects`).
+
+    Attributes:
+        armature: Rotor inertia reflected through the gearbox [kg·m²] per joint; None: none given.
+        damping: Joint damping [N·m·s/rad] per joint; None: none given.
+        frictionloss: Dry friction [N·m] per joint (MuJoCo's ``frictionloss``); None: none given.
+        source: Where each value comes from, cited (a data sheet, a published model).
+    """
+
+    armature: tuple[float, ...] | None = None
+    damping: tuple[float, ...] | None = None
+    frictionloss: tuple[float, ...] | None = None
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class RobotProfile:
     """A robot's name and the defaults the toolkit uses with it.
 
@@ -151,6 +169,9 @@ class RobotProfile:
             ``None`` for one written in code. Refusals of its values name it.
         home_source: How ``home`` was chosen when the profile gave none (set by the loader:
             :mod:`~twolink_pin.model.home`); ``""`` for a home the profile gives.
+        effects: The arm's armature, joint damping and dry friction with their sources
+            (:class:`ArmEffects`); ``None``: none given (a URDF's ``<dynamics>`` may give
+            damping and friction).
     """
 
     name: str
@@ -173,6 +194,7 @@ class RobotProfile:
     amplitude: float | None = None
     file: Path | None = None
     home_source: str = ""
+    effects: ArmEffects | None = None
 
 
 DEFAULT_Q0_OFFSET = 0.05

@@ -24,8 +24,10 @@ m]), ``free`` (the joints left free, every other one locked — at its ``locked`
 given, else 0 clipped to its limits: one arm of a tree in one line), ``home`` (one value per joint left free), ``amplitude`` [rad], ``q0_offset`` [rad, per
 joint], ``acceleration_limits`` [rad/s², per joint], ``repair_inertias`` (bool),
 ``friction = {viscous = [...], coulomb = [...]}`` [N·m·s/rad, N·m], ``trajectory = {times =
-[...], joint_points = [[...], ...]}`` or ``cartesian_points`` (with ``branch``, ``period``), and
-``[gains.LAW]`` tables. An unknown key, a value of the wrong kind, and — when the robot is
+[...], joint_points = [[...], ...]}`` or ``cartesian_points`` (with ``branch``, ``period``),
+``[gains.LAW]`` tables, and ``effects = {armature = [...], damping = [...], frictionloss = [...],
+source = "..."}`` [kg·m², N·m·s/rad, N·m per joint] (the arm's effects a plant models on
+request: ``--armature arm``). An unknown key, a value of the wrong kind, and — when the robot is
 loaded — a joint or frame the URDF lacks, a lock of every joint, a home outside the ranges or a
 ``gains`` table of an unknown law are refused in one line naming the key and the file.
 """
@@ -43,7 +45,7 @@ import tomllib
 
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.files import read_input_file
-from twolink_pin.model.profile import RobotProfile, TrajectorySpec
+from twolink_pin.model.profile import ArmEffects, RobotProfile, TrajectorySpec
 
 PROFILE_SUFFIX = ".toml"
 """What a profile file's name ends with (``--robot FILE.toml``)."""
@@ -69,6 +71,7 @@ KEYS = frozenset(
         "friction",
         "trajectory",
         "gains",
+        "effects",
     }
 )
 """The keys a profile file may have."""
@@ -193,6 +196,34 @@ def _friction(reader: _Reader) -> tuple[tuple[float, ...], tuple[float, ...]] | 
     return viscous, coulomb
 
 
+def _effects(reader: _Reader) -> ArmEffects | None:
+    """What the real arm adds to its rigid bodies, per joint, with its source (``--armature arm``)."""
+    value = reader.data.get("effects")
+    if value is None:
+        return None
+    units = {"armature": " [kg·m²]", "damping": " [N·m·s/rad]", "frictionloss": " [N·m]"}
+    if not isinstance(value, dict) or not value or not set(value) <= {*units, "source"}:
+        raise reader.fail(
+            "effects",
+            value,
+            "a table {armature = [kg·m²], damping = [N·m·s/rad], frictionloss = [N·m], source = '...'}",
+        )
+    source = value.get("source", "")
+    if not isinstance(source, str):
+        raise reader.fail("effects.source", source, "a string citing where the values come from")
+    given = {}
+    for key, unit in units.items():
+        if key in value:
+            numbers = reader.numbers(f"effects.{key}", value[key], f" >= 0{unit}")
+            assert numbers is not None
+            if not all(x >= 0 for x in numbers):
+                raise reader.fail(
+                    f"effects.{key}", value[key], f"a non-empty list of finite numbers >= 0{unit}"
+                )
+            given[key] = numbers
+    return ArmEffects(**given, source=source)
+
+
 def _trajectory(reader: _Reader) -> TrajectorySpec | None:
     value = reader.data.get("trajectory")
     if value is None:
@@ -270,6 +301,7 @@ def read_profile_file(path: str | os.PathLike[str], name: str | None = None) -> 
         acceleration_limits=reader.numbers("acceleration_limits", unit=" [rad/s²]"),
         amplitude=reader.number("amplitude"),
         repair_inertias=repair,
+        effects=_effects(reader),
         file=file,
     )
     return urdf, profile

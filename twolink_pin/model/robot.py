@@ -358,6 +358,11 @@ def _check_sizes(model: pin.Model, profile: RobotProfile, path: Path) -> None:
             if len(values) != nv or not all(v >= 0 for v in values):
                 reason = f"{nv} values >= 0 ({what})"
                 raise _refusal(profile, path, f"friction.{key}", "friction", list(values), reason)
+    effects = profile.effects
+    for key in ("armature", "damping", "frictionloss"):
+        given: tuple[float, ...] | None = None if effects is None else getattr(effects, key)
+        if given is not None and len(given) != nv:
+            raise _refusal(profile, path, f"effects.{key}", "effects", list(given), f"{nv} values ({what})")
     trajectory = profile.trajectory
     if trajectory is not None and trajectory.joint_points is not None:
         for point in trajectory.joint_points:

@@ -39,6 +39,9 @@ class ReportOptions:
             (:mod:`twolink_pin.report.within_limits`: the reference, its time-optimal
             retiming and the minimum-effort trajectory, the laws tracking each; about
             a tenth of the report's CPU time, docs/performance.md).
+        sim_to_sim: Whether the report has its section "Sim-to-sim" (:mod:`twolink_pin.report.sim_to_sim`:
+            each law on the Pinocchio plant and on MuJoCo with the arm's effects, one effect at a
+            time; short runs of 2 periods).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
@@ -57,6 +60,7 @@ class ReportOptions:
     limits_section: bool = True
     trajectory: str | None = None
     repair_inertias: bool | None = None
+    sim_to_sim: bool = True
 
     def load_robot(self) -> Any:
         """The robot these options name (a :class:`~twolink_pin.model.RobotModel`), loaded here."""

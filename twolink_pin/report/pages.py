@@ -120,8 +120,43 @@ def html(r: dict[str, Any]) -> str:
             discussion=_discussion(r),
             nv=nv,
             limits=_limits_tables(r, nv),
+            s2s=sim_to_sim_table(r),
         )
     )
+
+
+def sim_to_sim_table(r: dict[str, Any]) -> dict[str, Any] | None:
+    """The section "Sim-to-sim" as one table (a row per law and plant) with its texts; None
+    without the section."""
+    section = r.get("sim_to_sim")
+    if not section:
+        return None
+    headers = [
+        "controller",
+        "plant",
+        "RMS ‖e‖ [rad]",
+        "max |e| [rad]",
+        "Δ RMS ‖e‖ [rad]",
+        "Δ max |e| [rad]",
+    ]
+    rows = []
+    for law in section["laws"]:
+        for row in law["rows"]:
+            if not row["finished"]:
+                rows.append([law["law"], row["row"], "—", "—", "—", f"did not finish: {row['failed']}"])
+                continue
+            deltas = [row.get("delta_rms_e"), row.get("delta_max_e")]
+            shown = ["" if row is law["rows"][0] else _signed(d) for d in deltas]
+            label = row["row"] + (" — cannot act here, not rerun" if row.get("derived") else "")
+            rows.append([law["law"], label, fmt(row["rms_e"]), fmt(row["max_e"]), *shown])
+    return section | {"headers": headers, "rows": rows}
+
+
+def _signed(x: float | None) -> str:
+    """A difference with its sign (``+1.2e-04``, ``−3.4e-05``); "—" for none."""
+    if x is None:
+        return "—"
+    return ("+" if x >= 0 else "−") + fmt(abs(x))
 
 
 RATIO_SYMBOLS = {"velocity": "q̇", "acceleration": "q̈", "effort": "τ"}
@@ -250,6 +285,7 @@ def markdown(r: dict[str, Any]) -> str:
             lines.append(f"| {row['title']} | " + " | ".join(fmt(x) for x in cells) + " |")
         lines.append("")
     lines += _limits_markdown(r)
+    lines += _sim_markdown(r)
     if r["errata"]:
         lines += ["## Errata", ""]
         for e in r["errata"]:
@@ -301,6 +337,21 @@ def _limits_markdown(r: dict[str, Any]) -> list[str]:
         lines += ["| " + " | ".join(escaped[0]) + " |", "|" + "---|" * len(heads)]
         lines += ["| " + " | ".join(row) + " |" for row in escaped[1:]] + [""]
     return lines + [f"- {note}" for note in r["within_limits"]["notes"]]
+
+
+def _sim_markdown(r: dict[str, Any]) -> list[str]:
+    """``report.md``'s lines of the section "Sim-to-sim" (none without it)."""
+    table = sim_to_sim_table(r)
+    if table is None:
+        return []
+    if not table["rows"]:
+        return ["## Sim-to-sim", "", table.get("note", ""), ""]
+    heads, rows = table["headers"], table["rows"]
+    lines = ["## Sim-to-sim", "", "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return (
+        [*lines, "", f"Sources of the effects: {table['sources']}", ""] if table["sources"] else [*lines, ""]
+    )
 
 
 def write_pages(stage: Path, r: dict[str, Any]) -> None:

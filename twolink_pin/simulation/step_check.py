@@ -31,6 +31,14 @@ The bound of each integrator (``z = λ dt``):
 * ``adaptive`` (DOP853): no bound — its step adapts to a stiff start (at the cost of
   evaluations), so nothing is checked.
 
+The MuJoCo plant (``--plant mujoco``) with its default integrator is advanced by the same RK4,
+the law at every stage: its start is checked as the Pinocchio plant's (the same ``M(q)`` with the
+armature, the same joint damping; MuJoCo's dry friction is not linear and its soft limits act
+only at a limit). With ``--mujoco-integrator euler`` or ``implicitfast`` MuJoCo steps the run
+itself, the law held over each step and the damping implicit: those stability regions are
+MuJoCo's, not modelled here, and such runs are not checked (a divergence is reported with
+MuJoCo's cause).
+
 Beyond the bound the run is refused (:class:`~twolink_pin.errors.StepTooLargeError`, exit 2)
 with the rate, the joint the mode moves most, what sets it (the plant's joint damping, or the
 law's gain whose rate on the arm's inertia matches it) and the largest stable step. The check
@@ -452,8 +460,8 @@ def require_stable_step(
     """:func:`check_step`, raising its refusal when the step is not stable; None when the check
     could not be made (a law that raises or returns something unusable on the perturbed states,
     or cannot be copied: the run itself then says what is wrong)."""
-    if not config.check_step or config.method != "rk4":
-        return None
+    if not config.check_step or config.method != "rk4" or not plant.law_per_stage:
+        return None  # DOP853 adapts; MuJoCo's own Euler/implicitfast steps are not the engine's RK4
     try:  # within the run's wall-clock bound (--timeout): a law that never returns stops here
         with bounded(lambda seconds: CheckTimeout.of(timed_out(controller, 0.0, seconds))):
             check = check_step(controller, plant, trajectory, config)
