@@ -98,6 +98,7 @@ class ComparisonTable:
             "gains": dict(self.gains),
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
             "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
+            "within_limits": {name: m.crossings.within_limits for name, m in self.metrics.items()},
         }
 
     def crossing_rows(self) -> list[tuple[str, str, int, float, float, str]]:

@@ -46,6 +46,7 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "limit_exceeded_at": result.first_exceeded_at,
         "limits": result.joint_limits.as_dict(),
         "crossings": metrics.crossings.summary(),
+        "within_limits": metrics.crossings.within_limits,  # every kind; limit_exceeded: the effort alone
         "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
         "p_true": None if result.p_true is None else result.p_true.tolist(),
