@@ -39,8 +39,15 @@ Usage::
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
     .venv/bin/python scripts/benchmark.py --contact-only [--quick] # issue 46: the contact lab, contact's cost
+    .venv/bin/python scripts/benchmark.py --arms-only [--quick]    # issue 50: every arm × law at the defaults
     .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
     .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
+
+``--arms-only`` (issue 50, ``scripts/arms.py``): every profile of ``examples/arms`` — every
+fixed-base arm example-robot-data ships, each arm of its trees, a 5-link chain — with every
+built-in law for 3 s at its defaults; goals: 100 % of (arm × law) run, ``computed-torque`` on the
+exact model within 1e-3 rad at 3 s, the step check at most 5 ms per run (median). The single-run
+guards above (ratios to the baseline) are the step check's cost on the whole run.
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -143,8 +150,8 @@ def baseline_pd(
     rv1, rv2 = half.v[:, 0].tolist(), half.v[:, 1].tolist()
     ra1, ra2 = half.a[:, 0].tolist(), half.a[:, 1].tolist()
     p1, p2, p3 = (float(x) for x in p)
-    kp1, kp2 = (float(x) for x in np.ravel(gains.kp))
-    kd1, kd2 = (float(x) for x in np.ravel(gains.kd))
+    kp1, kp2 = (float(x) for x in np.diag(np.asarray(gains.kp)[0]))  # the report's: diagonal matrices
+    kd1, kd2 = (float(x) for x in np.diag(np.asarray(gains.kd)[0]))
     cos, sin = math.cos, math.sin
 
     def f(q1: float, q2: float, v1: float, v2: float, i: int) -> tuple[float, float, float, float]:
@@ -1598,6 +1605,11 @@ def main(argv: list[str] | None = None) -> int:
         help="only issue 46's goals: the twolink's contact lab, a run with the wall against one without",
     )
     parser.add_argument(
+        "--arms-only",
+        action="store_true",
+        help="only issue 50's goals: every arm of examples/arms with every law at its defaults, the step check's cost",
+    )
+    parser.add_argument(
         "--equations-only",
         action="store_true",
         help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
@@ -1632,6 +1644,14 @@ def main(argv: list[str] | None = None) -> int:
         f"machine: {m['cpu']}, {m['cores']} cores, {m['system']}; Python {m['python']}, numpy {m['numpy']}, "
         f"pinocchio {m['pinocchio']}; load average {m['load_average']}"
     )
+    if args.arms_only:
+        sys.path.insert(0, str(Path(__file__).resolve().parent))
+        from arms import arms_section  # scripts/arms.py
+
+        results.update(arms_section(quick))
+        if args.json:
+            print(json.dumps(results))
+        return 0
     if args.qp_osc_only:
         results.update(qp_osc_section(quick, args.repeats or (1 if quick else 5)))
         if args.json:

@@ -124,6 +124,7 @@ CLUSTER_OPTIONS = ("--workers", "--scheduler")
 """A corpus case whose command has one of these starts Dask workers: marked ``cluster``."""
 
 FIRST: tuple[str, ...] = (
+    "test_arms.py",  # slow, ungrouped: 24 arms × 11 laws, 3 s each; 1014 s of run time at load 12-18 (2026-12)
     "test_identification.py",  # the "identification" group: 724 s of test time at load ~6
     "test_report.py",  # 624 s: report builds, Chromium
     "test_cluster.py",  # 449 s: Ctrl-C on a cluster, the sweep-throughput benchmark (140 s), ...

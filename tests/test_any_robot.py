@@ -41,7 +41,8 @@ from twolink_pin.trajectory import (
 )
 from twolink_pin.twolink.reference import REPORT_P
 
-NAMED = ("twolink", "double_pendulum", "asr_twodof", "ur5", "panda", "kinova", "z1")
+NAMED = ("twolink", "asr_twodof", "double_pendulum", "kinova", "panda", "ur5", "z1")
+"""The catalog: the twolink first, then its profile files (robots/*.toml) by name."""
 
 
 @pytest.fixture(scope="module", params=NAMED)
@@ -302,7 +303,7 @@ def test_a_via_file_whose_motion_leaves_the_limits_between_points_is_refused(tmp
 def _lyapunov(robot, result, controller) -> tuple[np.ndarray, np.ndarray]:
     """V = ½ sᵀ M(q) s + ½ p̃ᵀ Γ⁻¹ p̃ along the run, and −sᵀ K s (its derivative in theory)."""
     gains = controller.gains
-    lam, k = float(gains.lam), np.ravel(gains.k)
+    lam, k = float(gains.lam), np.asarray(gains.k)[0]  # K, (nv, nv)
     inv_gamma = np.ravel(gains.gamma)  # Γ = diag(1/γ): Γ⁻¹ = diag(γ)
     data = robot.create_data()
     e, edot = result.q - result.q_des, result.v - result.v_des
@@ -313,7 +314,7 @@ def _lyapunov(robot, result, controller) -> tuple[np.ndarray, np.ndarray]:
         M = pin.crba(robot.model, data, q)
         M = np.triu(M) + np.triu(M, 1).T
         V[i] = 0.5 * s[i] @ M @ s[i] + 0.5 * np.sum(inv_gamma * p_err[i] ** 2)
-    return V, -np.sum(k * s * s, axis=1)
+    return V, -np.einsum("ij,jk,ik->i", s, k, s)
 
 
 @pytest.mark.parametrize(("name", "duration"), [("double_pendulum", 6.0), ("ur5", 4.0)])

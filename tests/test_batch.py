@@ -66,7 +66,8 @@ def _batched(spec: str, robot: RobotModel = ROBOT) -> tuple[Controller, Plant, l
     changes: dict[str, Any] = {}
     for name in ("kp", "kd", "k"):
         if g.get(name) is not None:
-            changes[name] = np.asarray(g[name]) * scale
+            value = np.asarray(g[name])  # a matrix gain (1, k, k): one matrix per run
+            changes[name] = value * (scale[:, :, None] if value.ndim == 3 else scale)
     if "lam" in g:
         changes["lam"] = np.array([5.0, 3.0, 8.0, 5.0])
     p = np.asarray(robot.p) * np.array([1.0, 1.2, 0.8, 1.1])[:, None]
@@ -76,7 +77,7 @@ def _batched(spec: str, robot: RobotModel = ROBOT) -> tuple[Controller, Plant, l
     for i in range(4):
         row = {
             k: np.asarray(v)[i]
-            if np.ndim(v) == 2
+            if np.ndim(v) in (2, 3)
             else (float(np.asarray(v)[i]) if np.ndim(v) == 1 and k == "lam" else v)
             for k, v in changes.items()
         }
@@ -142,12 +143,17 @@ def test_a_run_does_not_depend_on_its_batch_nor_on_threads() -> None:
 
 def test_a_diverging_run_is_flagged_at_simulates_time_and_the_others_finish() -> None:
     """Run 1 has K = 1e9 (unstable at dt = 1 ms): it diverges at the time simulate reports; runs 0 and 2 match simulate."""
-    k = np.array([[40.0, 50.0], [1e9, 1e9], [40.0, 50.0]])
+    k = np.stack([np.diag(row) for row in ([40.0, 50.0], [1e9, 1e9], [40.0, 50.0])])  # a matrix per run
     law = ComputedTorque(ROBOT, SlotineLiGains(k=k))
     plant = Plant(ROBOT)
     batch = simulate_batch(law, plant, TRAJECTORY, SHORT, record=True)
-    with pytest.raises(SimulationDivergedError) as info:
-        simulate(ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9))), plant, TRAJECTORY, SHORT)
+    with pytest.raises(SimulationDivergedError) as info:  # the step check would refuse it: run it anyway
+        simulate(
+            ComputedTorque(ROBOT, SlotineLiGains(k=(1e9, 1e9))),
+            plant,
+            TRAJECTORY,
+            replace(SHORT, check_step=False),
+        )
     np.testing.assert_array_equal(batch.diverged, [False, True, False])
     assert batch.diverged_at[1] == pytest.approx(info.value.time, abs=1e-12)
     assert batch.divergence[1] is not None and batch.divergence[0] is None
@@ -250,7 +256,7 @@ def test_law_evaluated_on_a_batch_equals_its_rows() -> None:
 
 def test_inconsistent_run_counts_are_refused_naming_each() -> None:
     """Gains for 3 runs and offsets for 4: InvalidParameterError listing both counts."""
-    law = PDFeedforward(ROBOT, PDGains(kp=np.full((3, 2), 100.0), kd=10.0))
+    law = PDFeedforward(ROBOT, PDGains(kp=np.full((3, 1), 100.0), kd=10.0))  # 100 I per run
     with pytest.raises(InvalidParameterError, match="one number of runs N") as info:
         simulate_batch(law, Plant(ROBOT), TRAJECTORY, SHORT, q0_offsets=OFFSETS)
     assert info.value.value == {"offsets[0]": 4, "the controller's per-run gains": 3}
@@ -272,7 +278,7 @@ def test_the_adaptive_step_method_and_per_run_gains_in_simulate_are_refused() ->
         simulate_batch(PDFeedforward(ROBOT), Plant(ROBOT), TRAJECTORY, replace(SHORT, method="adaptive"))
     with pytest.raises(InvalidParameterError, match="simulate_batch runs N"):
         simulate(
-            PDFeedforward(ROBOT, PDGains(kp=np.full((2, 2), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
+            PDFeedforward(ROBOT, PDGains(kp=np.full((2, 1), 100.0), kd=10.0)), Plant(ROBOT), TRAJECTORY, SHORT
         )
 
 

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 import pytest
+import scipy.linalg
 from conftest_sim import ROBOT, adaptive_lyapunov, evaluate, pendulum, run, slotine_li_s
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -37,8 +38,7 @@ from twolink_pin.controllers import (
     WrongModelGains,
     gain,
 )
-from twolink_pin.controllers.gains import one_row
-from twolink_pin.dynamics import Friction, joint_inertia
+from twolink_pin.dynamics import Friction
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.run_spec import make_scenario
 from twolink_pin.twolink import closed_form
@@ -192,6 +192,13 @@ def _pinocchio_model_torque(
 GRAVITY_CASES = 25
 
 
+def _times(gain: Any, x: np.ndarray) -> np.ndarray:
+    """A validated gain times ``x`` (nv,): a matrix gain (1, nv, nv) by the product, per joint
+    (1, nv) or a number element-wise."""
+    gain = np.asarray(gain)
+    return gain[0] @ x if gain.ndim == 3 else np.ravel(gain * x)
+
+
 @pytest.mark.parametrize("name", ["pd", "computed-torque", "robust", "adaptive", "sliding-mode"])
 def test_laws_with_gravity_equal_their_closed_form_on_the_double_pendulum(name: str) -> None:
     """On a vertical arm (g ≠ 0) each law's torque is its formula with M, C, g from CRBA, the
@@ -210,7 +217,9 @@ def test_laws_with_gravity_equal_their_closed_form_on_the_double_pendulum(name: 
         v_des, a_des = state[3], state[4]
         tau, _ = evaluate(controller, *state)
         if name == "pd":
-            expected = _pinocchio_model_torque(robot, q, v, v_des, a_des) - g.kp * e - g.kd * edot
+            expected = (
+                _pinocchio_model_torque(robot, q, v, v_des, a_des) - _times(g.kp, e) - _times(g.kd, edot)
+            )
         else:
             s = edot + g.lam * e
             model = _pinocchio_model_torque(robot, q, v, v_des - g.lam * e, a_des - g.lam * edot)
@@ -218,7 +227,7 @@ def test_laws_with_gravity_equal_their_closed_form_on_the_double_pendulum(name: 
                 model = g.model_scale * model
             if name == "adaptive":
                 model = g.initial_estimate * model  # p̂ = 0.5 p: Y p̂ is half the model term
-            expected = model - g.k * s
+            expected = model - _times(g.k, s)
             if name == "sliding-mode":
                 expected = expected - g.ks * np.clip(s / g.phi, -1.0, 1.0)
         np.testing.assert_allclose(tau, np.ravel(expected), rtol=1e-10, atol=1e-9)
@@ -260,16 +269,24 @@ def test_what_each_law_declares() -> None:
 
 
 def test_the_twolink_gets_the_reports_gains_and_other_robots_derived_ones() -> None:
-    """The twolink profile presets the report's gains; the double pendulum gets Kp = ω² I, Kd = 2ω I
-    (ω = 10 rad/s, I = diag M at the robot's home) and K = κ I (κ = 50 1/s)."""
+    """The twolink profile presets the report's gains (diagonal matrices); the double pendulum gets
+    Kp = ω² M, Kd = 2ω M (ω = 10 rad/s, M = M(q₀) at the robot's home, a full matrix) and a K whose
+    modes at home are the joint-wise design's (κ diag M, κ = 50 1/s) clipped into [κ, 20 κ]: its
+    fast mode (18.5 κ) kept, its slow one (0.51 κ) raised to κ."""
     pd = PDFeedforward(ROBOT)
-    np.testing.assert_array_equal(pd.gains.kp, [[350.0, 300.0]])  # one row: the same for every run
-    np.testing.assert_array_equal(pd.gains.kd, [[40.0, 50.0]])
+    np.testing.assert_array_equal(pd.gains.kp, [np.diag([350.0, 300.0])])  # one matrix for every run
+    np.testing.assert_array_equal(pd.gains.kd, [np.diag([40.0, 50.0])])
     robot = pendulum()
-    inertia = joint_inertia(robot.model, robot.home)
+    data = robot.model.createData()
+    inertia = pin.crba(robot.model, data, robot.home)
+    inertia = np.triu(inertia) + np.triu(inertia, 1).T
+    assert abs(inertia[0, 1]) > 0.1 * inertia[1, 1]  # coupled: a diagonal gain would not do
     np.testing.assert_allclose(PDFeedforward(robot).gains.kp, [100.0 * inertia], rtol=1e-12)
     np.testing.assert_allclose(PDFeedforward(robot).gains.kd, [20.0 * inertia], rtol=1e-12)
-    np.testing.assert_allclose(ComputedTorque(robot).gains.k, [50.0 * inertia], rtol=1e-12)
+    joint_wise = scipy.linalg.eigvalsh(50.0 * np.diag(np.diag(inertia)), inertia)
+    assert joint_wise[0] < 50.0 and 50.0 < joint_wise[1] < 1000.0
+    modes = scipy.linalg.eigvalsh(np.asarray(ComputedTorque(robot).gains.k)[0], inertia)
+    np.testing.assert_allclose(modes, [50.0, joint_wise[1]], rtol=1e-9)
     adaptive = Adaptive(robot)
     assert np.all(np.isfinite(adaptive.gains.gamma)) and np.all(np.asarray(adaptive.gains.gamma) > 0)
     assert np.asarray(adaptive.gains.gamma).shape == (1, adaptive.state_size)
@@ -330,15 +347,18 @@ def test_a_new_law_registers_itself_and_a_taken_name_is_refused() -> None:
     [
         (
             lambda: PDGains(kp=(-350.0, 300.0), kd=1.0),
-            "kp[0]",
-            "kp[0] = -350.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) [N·m/rad]",
+            "kp",
+            "kp = [-350.0, 300.0] is invalid: expected a symmetric positive-definite matrix gain [N·m/rad]",
         ),
         (
             lambda: PDGains(kp=1.0, kd=(40.0, 0.0)),
-            "kd[1]",
-            "kd[1] = 0.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) [N·m·s/rad]",
+            "kd",
+            "kd = [40.0, 0.0] is invalid: expected a symmetric positive-definite matrix gain [N·m·s/rad]: a "
+            "number s (s I), k numbers (a diagonal), k² numbers (a (k, k) matrix, row by row), a (k, k) matrix, "
+            "or one (k, k) matrix per run (N, k, k); the positive-definite check failed: a diagonal entry is "
+            "not > 0 (smallest 0)",
         ),
-        (lambda: SlotineLiGains(k=(-40.0, 50.0)), "k[0]", "k[0] = -40.0 is invalid"),
+        (lambda: SlotineLiGains(k=(-40.0, 50.0)), "k", "k = [-40.0, 50.0] is invalid"),
         (
             lambda: SlotineLiGains(lam=float("nan")),
             "lam",
@@ -366,7 +386,7 @@ def test_a_new_law_registers_itself_and_a_taken_name_is_refused() -> None:
         (
             lambda: PDFeedforward(ROBOT, PDGains(kp=(1.0, 2.0, 3.0), kd=1.0)),
             "kp",
-            "kp = [1.0, 2.0, 3.0] is invalid: expected one value or 2 (per joint, nv = 2)",
+            "kp = 'matrices of shape (3, 3)' is invalid: expected (2, 2) matrices (per joint, nv = 2)",
         ),
         (
             lambda: Adaptive(ROBOT, AdaptiveGains(k=1.0, gamma=(0.5, 0.15))),
@@ -457,7 +477,7 @@ def test_adaptive_lyapunov_derivative_is_minus_s_k_s(lyapunov_run: tuple[Any, An
     """
     controller, result, V = lyapunov_run
     s = slotine_li_s(result, float(controller.gains.lam))
-    power = np.einsum("ij,j,ij->i", s, one_row(controller.gains.k, 2), s)
+    power = np.einsum("ij,jk,ik->i", s, np.asarray(controller.gains.k)[0], s)
     dV = (V[2:] - V[:-2]) / (2 * result.dt)
     after = result.t[1:-1] >= 0.1
     scale = power[1:-1][after].max()

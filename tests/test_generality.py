@@ -76,12 +76,14 @@ def test_a_catalog_urdf_by_path_gets_its_profile_and_the_base_parameters(robot) 
 
 
 def test_a_urdf_outside_the_catalog_gets_the_generic_profile(tmp_path: Path) -> None:
-    """A copy of the double pendulum's URDF elsewhere: named after its file, no presets, no
-    home (the middle of its unlimited joints: 0), its base parameters; p = π on request."""
+    """A copy of the double pendulum's URDF elsewhere: named after its file, no presets, a home the
+    loader chose (hanging: as dexterous as anywhere, at the middle of its unlimited joints: 0),
+    its base parameters; p = π on request."""
     path = tmp_path / "my_pendulum.urdf"
     path.write_bytes(example_robot_urdf(ROBOTS[0]).read_bytes())
     robot = load_robot(path)
-    assert robot.name == "my_pendulum" and robot.gain_presets == {} and robot.profile.home is None
+    assert robot.name == "my_pendulum" and robot.gain_presets == {}
+    assert robot.profile.home_source.startswith("chosen")
     np.testing.assert_array_equal(robot.home, [0.0, 0.0])
     assert isinstance(robot.parameter_map, BaseParameterMap) and robot.parameter_map.size == 6
     full = load_robot(path, parameter_map=InertialParameterMap)

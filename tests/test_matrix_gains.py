@@ -18,7 +18,8 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import load_robot
 
 RUN = ["simulate", "osc", "--duration", "0.05"]
-ROWS = [[1500.0, 0.0, 0.0], [0.0, 1500.0, 0.0], [0.0, 0.0, 800.0]]
+DIAGONAL = [1500.0, 1500.0, 800.0]
+"""``kp=1500,0,0,0,1500,0,0,0,800`` as the results show it: a diagonal matrix as its diagonal."""
 
 
 def _json(capsys: pytest.CaptureFixture[str], argv: list[str]) -> dict[str, Any]:
@@ -26,15 +27,18 @@ def _json(capsys: pytest.CaptureFixture[str], argv: list[str]) -> dict[str, Any]
     return json.loads(capsys.readouterr().out)
 
 
-def test_nine_numbers_are_a_three_by_three_matrix_printed_as_rows(capsys: pytest.CaptureFixture[str]) -> None:
-    """``kp=1500,0,0,0,1500,0,0,0,800`` runs exactly as the diagonal ``kp=1500,1500,800``."""
+def test_nine_numbers_are_a_three_by_three_matrix_a_diagonal_one_shown_as_its_diagonal(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """``kp=1500,0,0,0,1500,0,0,0,800`` runs exactly as the diagonal ``kp=1500,1500,800``, and is
+    shown as the diagonal (what ``--gain`` takes back)."""
     full = _json(capsys, [*RUN, "--gain", "kp=1500,0,0,0,1500,0,0,0,800"])
     diagonal = _json(capsys, [*RUN, "--gain", "kp=1500,1500,800"])
-    assert full["gains"]["kp"] == ROWS and full["gains"]["kd"] == (20 * np.eye(3)).tolist()
+    assert full["gains"]["kp"] == DIAGONAL and full["gains"]["kd"] == [20.0, 20.0, 20.0]
     assert full["metrics"] == diagonal["metrics"] and full["task_metrics"] == diagonal["task_metrics"]
     assert main([*RUN, "--gain", "kp=1500,0,0,0,1500,0,0,0,800"]) == 0
     text = capsys.readouterr().out
-    assert "  gains kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]] 1/s², kd = [[20, 0, 0]," in text
+    assert "  gains kp = (1500, 1500, 800) 1/s², kd = (20, 20, 20) 1/s," in text
 
 
 def test_a_full_matrix_changes_the_run(capsys: pytest.CaptureFixture[str]) -> None:
@@ -115,12 +119,12 @@ def test_compare_tables_list_each_laws_gains_as_the_csv_does(
     argv = ["compare", "pd", "osc", "--duration", "0.05", "--no-plot", "--out", str(out)]
     assert main([*argv, "--gain", "osc.kp=1500,0,0,0,1500,0,0,0,800"]) == 0
     capsys.readouterr()
-    kp = "kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]]"
+    kp = "kp = (1500, 1500, 800)"
     markdown = (out / "comparison.md").read_text()
     assert "| pd | kp = (350, 300), kd = (40, 50) | no friction | finished |" in markdown
-    assert f"| osc | {kp}, kd = [[20, 0, 0], [0, 20, 0], [0, 0, 20]]," in markdown
+    assert f"| osc | {kp}, kd = (20, 20, 20)," in markdown
     assert 'pd,"kp = (350, 300), kd = (40, 50)"' in (out / "comparison.csv").read_text()
-    assert json.loads((out / "comparison.json").read_text())["gains"]["osc"]["kp"] == ROWS
+    assert json.loads((out / "comparison.json").read_text())["gains"]["osc"]["kp"] == DIAGONAL
 
 
 def test_controllers_says_which_gains_are_matrices(capsys: pytest.CaptureFixture[str]) -> None:

@@ -98,13 +98,31 @@ def test_an_unstable_mujoco_run_fails_at_its_time_with_mujocos_cause(
     warning or its non-finite q̈; no reset (the state never comes back), nothing on stdout, no file."""
     monkeypatch.chdir(tmp_path)
     argv = ["simulate", "pd", "--plant", "mujoco", "--mujoco-integrator", integrator, "--gain", "kp=1e9"]
-    assert main([*argv, "--duration", "1"]) == 1
+    assert main([*argv, "--duration", "1", "--no-step-check"]) == 1
     out, err = capsys.readouterr()
     line = _one_line(err)
     assert "diverged at t = 0.00" in line and "MuJoCo" in line and not out
     if integrator == "euler":
         assert "mjWARN_BADQACC" in line
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("integrator", ["euler", "implicitfast", "rk4"])
+def test_the_step_is_checked_on_the_mujoco_plant_the_engines_rk4_integrates(
+    integrator: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """MuJoCo's RK4 is the engine's (the law at every stage): a gain beyond RK4's region at 1 ms
+    is refused before anything runs, exit 2, as on the Pinocchio plant; MuJoCo's own Euler and
+    implicitfast step the run themselves (their regions are MuJoCo's): not checked, the run fails
+    at its time instead (exit 1)."""
+    monkeypatch.chdir(tmp_path)
+    argv = ["simulate", "pd", "--plant", "mujoco", "--mujoco-integrator", integrator, "--gain", "kp=1e9"]
+    code = main([*argv, "--duration", "0.2"])
+    line = _one_line(capsys.readouterr().err)
+    if integrator == "rk4":
+        assert code == 2 and "--dt = 0.001 is invalid: expected at most" in line and "kp" in line, line
+    else:
+        assert code == 1 and "diverged at t = " in line, line
 
 
 def test_simulate_compare_and_sweep_take_the_mujoco_plant(

@@ -46,7 +46,7 @@ def test_the_report_has_the_task_laws_task_errors_as_simulate_gives_them(
 def test_the_reports_comparison_lists_the_gains(report: Path) -> None:
     markdown = (report / "report.md").read_text()
     assert "| pd | kp = (350, 300), kd = (40, 50) | no friction, wrench | finished |" in markdown
-    assert "| osc | kp = [[100, 0, 0], [0, 100, 0], [0, 0, 100]], kd = [[20, 0, 0]," in markdown
+    assert "| osc | kp = (100, 100, 100), kd = (20, 20, 20)," in markdown
 
 
 def test_a_joint_space_laws_task_errors_are_fk_of_its_run(report: Path, tmp_path: Path) -> None:

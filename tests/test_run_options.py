@@ -35,6 +35,7 @@ SAMPLES = {
     "--joint-stops": ["--joint-stops"],
     "--method": ["--method", "adaptive"],
     "--control-period": ["--control-period", "0.01"],
+    "--no-step-check": ["--no-step-check"],
     "--friction-smoothing": ["--friction-smoothing", "0.01"],
     "--plant-friction": ["--plant-friction", "on"],
     "--gain": ["--gain", "k=3"],

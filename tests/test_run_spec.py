@@ -66,7 +66,8 @@ def test_a_gain_and_lambda_reach_the_law() -> None:
     """--gain and --lambda on the command line are the law's gains after build."""
     law = _spec("simulate", "pd", "--gain", "kp=200", "--gain", "kd=30,40")
     controller = law.build(ROBOT).controller
-    assert np.allclose(controller.gains.kp, 200.0) and np.allclose(controller.gains.kd, (30.0, 40.0))
+    assert np.allclose(controller.gains.kp, 200.0 * np.eye(2))  # matrix gains: 200 I, diag(30, 40)
+    assert np.allclose(controller.gains.kd, np.diag([30.0, 40.0]))
     adaptive = _spec("simulate", "adaptive", "--lambda", "3", law="adaptive").build(ROBOT).controller
     assert float(np.asarray(adaptive.gains.lam)) == 3.0
 
@@ -89,7 +90,7 @@ def test_a_shared_spec_gives_lambda_and_gains_to_the_laws_they_belong_to() -> No
     assert pd.lam is None and dict(pd.gains) == {"kp": 123.0}
     adaptive = shared.for_law("adaptive")
     assert adaptive.lam == 3.0 and adaptive.gains == ()
-    assert np.allclose(pd.build(ROBOT).controller.gains.kp, 123.0)
+    assert np.allclose(pd.build(ROBOT).controller.gains.kp, 123.0 * np.eye(2))
     with pytest.raises(InvalidParameterError, match="a law that runs here"):
         shared.check_law_gains(["adaptive", "computed-torque"])
 
@@ -166,11 +167,12 @@ def test_sweep_and_animate_echo_the_gains_they_used(
     assert (
         main(["animate", "pd", "--gain", "kp=200", "--duration", "0.02", "--html", str(html), "--json"]) == 0
     )
-    assert json.loads(capsys.readouterr().out)["gains"] == {"kp": 200.0, "kd": [40.0, 50.0]}
+    # kp=200 on a matrix gain is 200 I: shown by its diagonal, as --gain takes it back
+    assert json.loads(capsys.readouterr().out)["gains"] == {"kp": [200.0, 200.0], "kd": [40.0, 50.0]}
     assert main(["simulate", "pd", "--gain", "kp=210", "--duration", "0.02", "--save", str(saved)]) == 0
     capsys.readouterr()
     assert main(["animate", "--from", str(saved), "--html", str(html)]) == 0
-    assert "pd gains kp = 210 " in capsys.readouterr().out
+    assert "pd gains kp = (210, 210) " in capsys.readouterr().out  # 210 I: by its diagonal
 
 
 BLOWUP = """
@@ -199,6 +201,7 @@ def test_compare_keeps_the_laws_that_finished(tmp_path: Path, capsys: pytest.Cap
     (tmp_path / "blowup.py").write_text(BLOWUP)
     out = tmp_path / "cmp"
     argv = ["compare", "pd", "computed-torque", f"{tmp_path}/blowup.py:Blowup", "--duration", "0.2"]
+    argv += ["--no-step-check"]  # the step check would refuse blowup before any run (exit 2)
     assert main([*argv, "--no-plot", "--out", str(out), "--json"]) == 1
     captured = capsys.readouterr()
     said = [line for line in captured.err.split("\n") if "twolink-pin:" in line]

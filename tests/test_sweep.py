@@ -260,15 +260,16 @@ def test_cases_are_drawn_in_the_documented_ranges() -> None:
 
 
 def test_indexed_gains_change_one_entry_and_model_scale_reaches_robust() -> None:
-    """kp=LO:HI sets both joints' Kp per run; kd2 only the second Kd; model_scale is robust's β."""
+    """kp=LO:HI sets both joints' Kp per run (Kp = s I); kd2 only the second diagonal entry of Kd;
+    model_scale is robust's β."""
     study = _study(param_error=0.0)
     cases = Cases(study, ROBOT, 0, 12)
     law = chunk_law(study, ROBOT, cases, make_scenario("pd", ROBOT).controller)
-    np.testing.assert_array_equal(
-        np.broadcast_to(law.gains.kp, (12, 2)), np.repeat(cases.gains["kp"][:, None], 2, axis=1)
-    )
-    np.testing.assert_array_equal(law.gains.kd[:, 0], 40.0)
-    np.testing.assert_array_equal(law.gains.kd[:, 1], cases.gains["kd2"])
+    kp, kd = np.broadcast_to(law.gains.kp, (12, 2, 2)), np.broadcast_to(law.gains.kd, (12, 2, 2))
+    np.testing.assert_array_equal(kp, cases.gains["kp"][:, None, None] * np.eye(2))
+    np.testing.assert_array_equal(kd[:, 0, 0], 40.0)
+    np.testing.assert_array_equal(kd[:, 1, 1], cases.gains["kd2"])
+    np.testing.assert_array_equal(kd[:, 0, 1], 0.0)
     robust = replace(
         study, run=RunSpec(law="robust", simulation=SHORT), gains=(GainRange("model_scale", 0.2, 0.3),)
     )

@@ -203,8 +203,9 @@ def test_a_refused_gain_on_the_command_line_is_one_line_and_exit_2_before_servin
     assert done.returncode == 2
     assert done.stdout == ""  # no URL: nothing was served
     assert done.stderr.strip().splitlines() == [
-        "twolink-pin: error: kp = -1.0 is invalid: expected finite numbers > 0 (from 1e-12 to 1e+12) "
-        "[N·m/rad]: one for every joint or one per joint (or a row per run)"
+        "twolink-pin: error: kp = -1.0 is invalid: expected a symmetric positive-definite matrix gain "
+        "[N·m/rad]: a number s (s I), k numbers (a diagonal), k² numbers (a (k, k) matrix, row by row), "
+        "a (k, k) matrix, or one (k, k) matrix per run (N, k, k)"
     ]
 
 

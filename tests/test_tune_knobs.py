@@ -100,3 +100,29 @@ def test_what_a_box_shows_is_the_value_to_six_digits_and_short_values_exactly() 
         assert parse_typed("g", format_typed(exact), None) == exact
     assert format_typed(FULL) == "150, 20, 0; 20, 150, 0; 0, 0, 80"
     assert format_typed([1600.0, 159.99999999999997]) == "1600, 160"  # mpc's derived weight_q
+
+
+def test_the_page_shows_the_robot_derived_gains_of_the_arms_whole_inertia() -> None:
+    """On the UR5 the tuning page's pd controls start at the law's own defaults (issue 50 §1):
+    each kp slider at the diagonal of ω² M(q₀) (M from Pinocchio's CRBA here), its off-diagonal
+    terms kept, so that the untouched controls run the defaults' full matrix, not its diagonal."""
+    import pinocchio as pin
+
+    from twolink_pin.controllers import PDFeedforward
+    from twolink_pin.controllers.pd import NATURAL_FREQUENCY
+    from twolink_pin.model import load_robot
+    from twolink_pin.run_spec import gains_used
+
+    robot = load_robot("ur5")
+    M = pin.crba(robot.model, robot.model.createData(), robot.home)
+    M = np.triu(M) + np.triu(M, 1).T
+    law = PDFeedforward(robot)
+    used = gains_used(law)
+    knobs = knobs_of(type(law).Gains, used)
+    kp = [k.value for k in knobs if k.gain == "kp" and not k.scale]
+    np.testing.assert_allclose(kp, NATURAL_FREQUENCY**2 * np.diag(M), rtol=1e-9)
+    out = gains_from(knobs, {}, matrices_of(type(law).Gains, used))
+    np.testing.assert_allclose(np.reshape(out["kp"], (6, 6)), NATURAL_FREQUENCY**2 * M, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(
+        np.reshape(out["kd"], (6, 6)), 2 * NATURAL_FREQUENCY * M, rtol=1e-9, atol=1e-12
+    )

@@ -62,6 +62,13 @@ class InvalidParameterError(TwolinkPinError, ValueError):
         super().__init__(f"{name} = {value!r} is invalid: expected {expected}")
 
 
+class StepTooLargeError(InvalidParameterError):
+    """A step (``--dt``, or a sampled law's ``--control-period``) beyond the integrator's stability
+    bound on the fastest mode of a run's start (:mod:`twolink_pin.simulation.step_check`):
+    refused before the run, exit 2. ``name`` is the option, ``value`` the step [s], ``expected``
+    says the rate, the joint, what sets it and the largest stable step."""
+
+
 class UnreachableTargetError(TwolinkPinError, ValueError):
     """An end-effector target outside the reachable workspace.
 

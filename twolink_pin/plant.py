@@ -31,7 +31,7 @@ import dataclasses
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import numpy as np
 import pinocchio as pin
@@ -83,6 +83,22 @@ def robot_friction(robot: RobotModel, smoothing: float = 0.0) -> tuple[Friction,
         Friction((v,) * robot.nv, (c,) * robot.nv, smoothing=smoothing),
         "the default (no friction in the URDF)",
     )
+
+
+class LinearTerms(NamedTuple):
+    """The plant's joint-wise linear terms beyond the rigid bodies of ``plant.model``: what the
+    step check (:mod:`twolink_pin.simulation.step_check`) adds to the arm's inertia, damping and
+    stiffness when it finds the fastest mode of a run's start. A plant with effects of its own (a
+    second engine's armature and joint damping, a contact's stiffness) gives them here."""
+
+    armature: np.ndarray
+    """Inertia added to each joint [kg·m² or kg], shape (nv,): what ``M(q)`` of ``plant.model``
+    (Pinocchio's CRBA, its own ``armature`` included) does not hold."""
+    damping: np.ndarray
+    """``∂f/∂q̇`` of each joint's loss [N·m·s/rad], shape (nv,): the viscous friction (a URDF's
+    ``<dynamics damping>``); Coulomb friction is not linear (its smoothed sign is bounded)."""
+    stiffness: np.ndarray
+    """``∂f/∂q`` of each joint [N·m/rad], shape (nv,): zeros here (a contact's, once surfaces exist)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -228,6 +244,13 @@ class Plant:
     def applied_torque(self, tau: np.ndarray) -> np.ndarray:
         """Motor torque actually applied [N·m]: ``tau`` clipped to the limits if saturating."""
         return np.clip(tau, -self.limits, self.limits) if self.saturate else tau
+
+    def linear_terms(self) -> LinearTerms:
+        """The plant's linear terms beyond ``model``'s rigid bodies (:class:`LinearTerms`)."""
+        nv = self.robot.nv
+        damping = np.zeros(nv) if self.friction is None else np.array(self.friction.viscous, dtype=float)
+        # the armature is in self.model's own (its CRBA holds it); the joint damping D q̇ is not
+        return LinearTerms(np.zeros(nv), damping + self.joint_damping, np.zeros(nv))
 
     def motor_torque(self, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """What drives the rigid bodies [N·m]: ``sat(τ) − f(q̇) − D q̇``."""
@@ -518,6 +541,7 @@ __all__ = [
     "DEFAULT_FRICTION",
     "ENGINES",
     "FRICTION_CHOICES",
+    "LinearTerms",
     "Plant",
     "PlantOptions",
     "register_engine",

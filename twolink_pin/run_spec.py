@@ -26,6 +26,7 @@ parser's run options and the fields here agree).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import math
 from collections.abc import Callable, Mapping, Sequence
@@ -43,6 +44,7 @@ from twolink_pin.model import RobotModel
 from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, PlantOptions, robot_friction
 from twolink_pin.scenario import Scenario, law_class, make_controller
 from twolink_pin.simulation import SimulationConfig
+from twolink_pin.simulation.step_check import CheckTimeout, require_stable_step
 
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
@@ -415,6 +417,7 @@ def build_rows(
     variants: Sequence[Variant],
     robot: RobotModel,
     read: Callable[[RunSpec], IdentifiedParameters | None] | None = None,
+    trajectory: Trajectory | None = None,
 ) -> dict[str, Row]:
     """Every variant's run built before any runs, keyed by its row's name
     (:attr:`~twolink_pin.law_variant.Variant.key`): a bad gain of the third law is refused
@@ -426,9 +429,13 @@ def build_rows(
         robot: The arm.
         read: Reads a spec's parameter file (default :meth:`RunSpec.read_parameters`); each
             file is read once.
+        trajectory: The reference the rows will run: each row's step is then checked against
+            the fastest mode of its start (:mod:`~twolink_pin.simulation.step_check`), before
+            any row runs.
 
     Raises:
         InvalidParameterError: a value a law refuses, named ``ROW: NAME``.
+        StepTooLargeError: a row's step beyond the integrator's bound, named ``ROW: --dt``.
     """
     files: dict[str, IdentifiedParameters | None] = {}
     rows: dict[str, Row] = {}
@@ -440,8 +447,13 @@ def build_rows(
             if variant.plant:  # its own plant options: refused where they would do nothing
                 refuse_idle(spec.plant, robot, spec.simulation.method)
             scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
+            if trajectory is not None:
+                with contextlib.suppress(
+                    CheckTimeout
+                ):  # a law that never returns: its own run fails, the others go on
+                    require_stable_step(scenario.controller, scenario.plant, trajectory, spec.simulation)
         except InvalidParameterError as exc:
-            raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
+            raise type(exc)(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
         rows[variant.key] = Row(variant, spec, scenario)
     return rows
 

@@ -26,11 +26,11 @@ GAINS: list[Case] = [
     C("wrong-compare-gain-twice", f"compare pd computed-torque {SIM} --no-plot --out c --gain pd.kp=1 --gain pd.kp=2", 2, err=("pd.kp", "given twice"), absent=("c",)),
     C("wrong-report-gain-twice", f"report {REP} --out r --gain pd.kd=1 --gain pd.kd=2", 2, err=("pd.kd", "given twice"), absent=("r",)),
     # a count of numbers the gain cannot take: the count received and the counts expected, not an entry
-    C("unclear-simulate-gain-four-numbers-two-joints", f"simulate pd {SIM} --gain kp=1,0,0,4", 2, err=("kp", "1 or 2 numbers (per joint, nv = 2); got 4"), not_err=("kp[1]",)),
+    C("unclear-simulate-gain-three-numbers-two-joints", f"simulate pd {SIM} --gain kp=1,2,3", 2, err=("kp", "3 numbers are neither 1, 2 (a diagonal) nor 4 (a 2 × 2 matrix, row by row)"), not_err=("kp[1]",)),
     C("unclear-simulate-adaptive-gamma-two-of-three", f"simulate adaptive {SIM} --gain gamma=1,0", 2, err=("gamma", "1 or 3 numbers", "got 2"), not_err=("gamma[1]",)),
     C("unclear-simulate-osc-matrix-gain-two-numbers", f"simulate osc --robot ur5 {SIM} --gain kp=1,0", 2, err=("kp", "2 numbers are neither 1, 3 (a diagonal) nor 9 (a 3 × 3 matrix, row by row)"), not_err=("diagonal entry",)),
     # compare's gain error names the law (its row)
-    C("unclear-compare-gain-count-names-the-law", f"compare pd computed-torque {SIM} --no-plot --out c --gain computed-torque.k=1,2,3", 2, err=("computed-torque: k", "got 3"), absent=("c",)),
+    C("unclear-compare-gain-count-names-the-law", f"compare pd computed-torque {SIM} --no-plot --out c --gain computed-torque.k=1,2,3", 2, err=("computed-torque: k", "3 numbers are neither"), absent=("c",)),
     C("unclear-compare-gain-value-names-the-law", f"compare pd computed-torque {SIM} --no-plot --out c --gain pd.kp=-1", 2, err=("pd: kp = -1.0",), absent=("c",)),
     C("unclear-report-gain-value-names-the-law", f"report {REP} --out r --gain pd.kd=0", 2, err=("pd: kd = 0.0",), absent=("r",)),
     # sweep draws checked as simulate checks a value, before anything is written
@@ -47,7 +47,7 @@ GAINS: list[Case] = [
     C("wrong-compare-same-variant-twice", f"compare pd@kd=50@kp=100 pd@kp=100@kd=50 {SIM} --no-plot --out c", 2, err=("each variant once", "same run"), absent=("c",)),
     C("wrong-compare-same-law-twice", f"compare pd pd {SIM} --no-plot --out c", 2, err=("each variant once",), absent=("c",)),
     C("unclear-compare-variant-p0-on-pd", f"compare pd pd@p0=x.json {SIM} --no-plot --out c", 2, err=("'pd' estimates none",), absent=("c",)),
-    C("unclear-compare-variant-gain-count", f"compare pd pd@kp=1,2,3 {SIM} --no-plot --out c", 2, err=("pd@kp=1,2,3: kp", "got 3"), absent=("c",)),
+    C("unclear-compare-variant-gain-count", f"compare pd pd@kp=1,2,3 {SIM} --no-plot --out c", 2, err=("pd@kp=1,2,3: kp", "3 numbers are neither"), absent=("c",)),
     C("unclear-compare-variant-model-missing", f"compare computed-torque computed-torque@model=nothere.urdf {SIM} --no-plot --out c", 2, err=("nothere.urdf: file", "file not found"), absent=("c",)),
     C("unclear-compare-two-variants", f"compare pd pd@kp=200,150 {SIM} --no-plot --out c --json", 0, out=('"pd@kp=200,150"',), exists=("c/comparison.csv",)),
     C("unclear-report-variant", f"report {REP} --controller pd@kd=20 --out r", 0, exists=("r/figures/pd_variants.png",)),
@@ -55,7 +55,7 @@ GAINS: list[Case] = [
 ]
 
 GAINS_LIBRARY: list[LibCase] = [
-    LibCase("library-make_scenario-gain-four-numbers-two-joints", "tp.make_scenario('pd', robot, gains={'kp': (1.0, 0.0, 0.0, 4.0)})", ("kp", "1 or 2 numbers", "got 4")),
+    LibCase("library-make_scenario-gain-three-numbers-two-joints", "tp.make_scenario('pd', robot, gains={'kp': (1.0, 2.0, 3.0)})", ("kp", "3 numbers are neither 1, 2")),
     LibCase("library-parse_variant-unknown-key", "__import__('twolink_pin.law_variant').law_variant.parse_variant('pd@zeta=1')", ("zeta", "kp, kd")),
     LibCase("library-format_variant-model-and-p0", "__import__('twolink_pin.law_variant').law_variant.format_variant('adaptive', model='a.json', p0='b.json')", ("one parameter file per run",)),
 ]

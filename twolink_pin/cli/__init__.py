@@ -133,6 +133,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.error(str(exc))
     ready("parsed")
     args.argv = list(sys.argv[1:] if argv is None else argv)
+    args.notes_said = set()  # robots whose load notes were said (robot_from_args says them once)
     previous: dict[int, Any] = {}
     del _signalled[:]
     if threading.current_thread() is threading.main_thread():

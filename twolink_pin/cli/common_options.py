@@ -9,7 +9,8 @@ import argparse
 from twolink_pin.cli.arguments import bounded
 
 ROBOT_HELP = (
-    "robot: a catalog name (twolink-pin robots lists them) or a path to a .urdf file (default twolink)"
+    "robot: a catalog name or one of your profiles (twolink-pin robots lists them), a path to a .urdf file, "
+    "or a profile file .toml (one arm of a URDF, its home, gains: docs/your_arm.md) (default twolink)"
 )
 
 MAX_PAYLOAD = 1e4
@@ -23,6 +24,13 @@ def add_robot_options(p: argparse.ArgumentParser, json_flag: bool = True) -> Non
         type=bounded(0.0, MAX_PAYLOAD, unit="kg"),
         default=0.0,
         help="point mass at the end effector [kg] (0 to 1e4)",
+    )
+    p.add_argument(
+        "--repair-inertias",
+        action="store_true",
+        help="replace each URDF link inertia that breaks the triangle inequality by the nearest one that "
+        "satisfies it (same principal axes, mass and centre of mass), listing each change on stderr; "
+        "default: such a file is refused",
     )
     if json_flag:
         p.add_argument("--json", action="store_true", help="print JSON instead of text")
@@ -58,6 +66,18 @@ def run_option_strings(p: argparse.ArgumentParser) -> frozenset[str]:
     return frozenset(s for action in group._group_actions for s in action.option_strings)
 
 
+def add_step_check_option(p: argparse.ArgumentParser) -> None:
+    """``--no-step-check``: run even beyond the integrator's stability bound on the start's fastest
+    mode (:mod:`twolink_pin.simulation.step_check`), which is refused by default."""
+    run_group(p).add_argument(
+        "--no-step-check",
+        dest="check_step",
+        action="store_false",
+        help="run even when --dt (or --control-period) is beyond the integrator's stability bound on the "
+        "fastest mode of the start (refused by default, exit 2, with the largest stable step)",
+    )
+
+
 def add_trajectory_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--trajectory", "--via", dest="trajectory", metavar="FILE", help=TRAJECTORY_HELP)
 
@@ -68,6 +88,7 @@ __all__ = [
     "RUN_GROUP",
     "TRAJECTORY_HELP",
     "add_robot_options",
+    "add_step_check_option",
     "add_trajectory_option",
     "run_group",
     "run_option_strings",

@@ -18,6 +18,7 @@ from twolink_pin.cli.arguments import (
 )
 from twolink_pin.cli.common_options import (
     add_robot_options,
+    add_step_check_option,
     add_trajectory_option,
     run_group,
     run_option_strings,
@@ -97,6 +98,7 @@ def add_sim_options(parser: argparse.ArgumentParser) -> None:
         metavar="T",
         help="sample the law every T s (a multiple of --dt) and hold it; default: every RK4 stage",
     )
+    add_step_check_option(parser)
     parser.add_argument(
         "--timeout",
         type=bounded(0.0, 1e7, unit="s"),

@@ -126,6 +126,8 @@ def _simulation_tokens(sim: SimulationConfig) -> list[str]:
         tokens += ["--q0-offset", *(_number(x) for x in offsets)]
     if sim.control_period is not None:
         tokens.append(f"--control-period={_number(sim.control_period)}")
+    if not sim.check_step:
+        tokens.append("--no-step-check")
     return tokens
 
 
@@ -135,11 +137,12 @@ def simulate_argv(
     payload: float = 0.0,
     trajectory: str | None = None,
     scene: str | None = None,
+    repair_inertias: bool = False,
 ) -> list[str]:
     """The arguments of ``twolink-pin simulate`` (after the program name) for ``spec`` on the
-    robot ``robot`` (a catalog name or URDF path, None: the default) with ``payload`` [kg],
-    the reference file ``trajectory`` (None: the robot's own) and the scene file ``scene`` the
-    spec's scene was read from (None: ``--wall``, or no scene)."""
+    robot ``robot`` (a catalog name, a URDF or profile path, None: the default) with ``payload``
+    [kg], the reference file ``trajectory`` (None: the robot's own), the scene file ``scene`` the
+    spec's scene was read from (None: ``--wall``, or no scene) and ``--repair-inertias``."""
     if not isinstance(spec.law, str):
         raise ValueError("a law given by reference (name, file.py:Class) has a command line; a class has not")
     tokens = ["simulate", spec.law]
@@ -147,6 +150,8 @@ def simulate_argv(
         tokens.append(f"--robot={robot}")
     if payload:
         tokens.append(f"--payload={_number(payload)}")
+    if repair_inertias:
+        tokens.append("--repair-inertias")
     if trajectory is not None:
         tokens.append(f"--trajectory={trajectory}")
     tokens += _simulation_tokens(spec.simulation)

@@ -8,9 +8,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, SLIDING_RATE
-from twolink_pin.controllers.gains import Gains, gain
-from twolink_pin.dynamics import Friction, joint_inertia, regressor, smooth_sign
+from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
+from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.dynamics import Friction, regressor, smooth_sign
 from twolink_pin.model import RobotModel
 
 ADAPTATION_RATE = 5.0
@@ -22,14 +22,14 @@ class AdaptiveGains(Gains):
     r"""Gains of :class:`Adaptive` (report: $K = \operatorname{diag}(120, 120)$, $\gamma = (0.5, 0.15, 0.6)$).
 
     Attributes:
-        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        k: Sliding gain $K$ [N·m·s/rad], an nv × nv matrix; default $\kappa M(q_0)$.
         gamma: The report's $\gamma_i$, one per estimated parameter; the adaptation gain is
             $\Gamma = \operatorname{diag}(1/\gamma_i)$. Default: see :meth:`Adaptive.scaled_gains`.
         lam: $\lambda$ [1/s] (not in the report; our default 5).
         initial_estimate: $\hat p(0)$ = ``initial_estimate`` × $p$ (report: 50 % underestimated).
     """
 
-    k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
+    k: Any = gain(None, per="joint", matrix=True, unit="N·m·s/rad", doc="sliding gain K")
     gamma: Any = gain(None, per="estimate", doc="γ_i, adaptation gain Γ = diag(1/γ_i)")
     lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
     initial_estimate: Any = gain(0.5, bound="nonnegative", doc="p̂(0) = initial_estimate × p")
@@ -79,7 +79,7 @@ class Adaptive(Controller[AdaptiveGains]):
         self._inertial = "inertial" in self.estimates
         self._friction_start = self.robot.parameter_map.size if self._inertial else 0
         self._smoothing = 0.0 if friction is None else friction.smoothing
-        self._minus_k = -np.asarray(self.gains.k)
+        self._minus_k = -applied_form(self.gains.k)
         self._minus_rate = -1.0 / np.asarray(self.gains.gamma)
 
     def initial_state(self) -> np.ndarray:
@@ -99,17 +99,17 @@ class Adaptive(Controller[AdaptiveGains]):
         )
 
     def scaled_gains(self) -> dict[str, Any]:
-        """``K = κ diag M(q₀)`` and ``γ_i = G_ii / α``: ``G = Σ Yᵀ K⁻¹ Y`` over unit joint
+        """``K = κ M(q₀)`` and ``γ_i = G_ii / α``: ``G = Σ Yᵀ K⁻¹ Y`` over unit joint
         accelerations and gravity at 8 seeded configurations within the joint limits, so
         that each parameter alone adapts at about α (:data:`ADAPTATION_RATE`) under unit excitation."""
-        k = SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)
+        k = sliding_gain(self.robot)
         return {"k": k, "gamma": _gram_diagonal(self, k) / ADAPTATION_RATE}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         lam = self.gains.lam
         lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
         s = edot + lam_e
-        tau = self._minus_k * s
+        tau = apply_gain(self._minus_k, s)
         if self._inertial:
             Y = terms.regressor(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
             tau = tau + np.matvec(Y, x.z[:, : self._friction_start])
@@ -124,7 +124,10 @@ class Adaptive(Controller[AdaptiveGains]):
 
 
 def _gram_diagonal(law: Adaptive, k: np.ndarray) -> np.ndarray:
-    """``diag Σ Yᵀ K⁻¹ Y`` over unit accelerations (and gravity) at seeded configurations."""
+    """``diag Σ Yᵀ K⁻¹ Y`` over unit accelerations (and gravity) at seeded configurations
+    (``k``: K, (nv, nv), or its diagonal (nv,))."""
+    k = np.asarray(k, dtype=float)
+    diagonal = k if k.ndim == 1 else (np.diag(k) if not np.any(k - np.diag(np.diag(k))) else None)
     model = law.robot.model
     data = model.createData()
     nv = model.nv
@@ -143,6 +146,7 @@ def _gram_diagonal(law: Adaptive, k: np.ndarray) -> np.ndarray:
             if "friction" in law.estimates:
                 columns.append(np.hstack([np.eye(nv), np.eye(nv)]) if not a.any() else np.zeros((nv, 2 * nv)))
             Y = np.hstack(columns)
-            total += np.sum(Y * Y / k[:, None], axis=0)
+            weighted = Y * Y / diagonal[:, None] if diagonal is not None else Y * np.linalg.solve(k, Y)
+            total += np.sum(weighted, axis=0)
     floor = 1e-9 * max(float(total.max()), 1e-300)
     return np.maximum(total, floor)

@@ -15,7 +15,7 @@ class AdaptiveFrictionGains(AdaptiveGains):
     $\gamma = (0.5, 0.15, 0.6, 1.7, 1.4, 2.5, 2.5)$ for $p_1, p_2, p_3, V_1, V_2, C_1, C_2$).
 
     Attributes:
-        k: Sliding gain $K$ [N·m·s/rad], diagonal.
+        k: Sliding gain $K$ [N·m·s/rad], an nv × nv matrix; default $\kappa M(q_0)$.
         gamma: $\gamma_i$ per estimated parameter (inertial, then $V$ and $C$ per joint);
             $\Gamma = \operatorname{diag}(1/\gamma_i)$.
         lam: $\lambda$ [1/s].

@@ -25,8 +25,8 @@ A field declared ``matrix=True`` holds a **matrix** gain (``per`` gives its size
 ``(N, 1)``: a sweep's draws) — checked (shape, symmetry to 1e-12 relative, Cholesky; a
 refusal names the check and the numbers), and stored as ``(1, k, k)`` or ``(N, k, k)`` once
 the law knows k (k or k² numbers of a per-joint or per-estimate gain wait for it: 4 numbers
-are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one): the law applies it with
-``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
+are a 2 × 2 matrix on a 2-joint arm, a diagonal on a 4-joint one): the law applies it
+with ``np.matvec(K, e)``. Text and JSON show a matrix as its rows (:func:`format_gain`,
 :func:`gain_as_json`).
 
 A per-joint or per-estimate field may default to ``None``: the law then derives the value
@@ -267,6 +267,39 @@ def as_matrix(value: Any, k: int, name: str = "gain", unit: str = "") -> np.ndar
     return array
 
 
+def applied_form(matrix: np.ndarray) -> np.ndarray:
+    """A matrix gain ``(1 or N, k, k)`` (:func:`as_matrix`) as a law applies it
+    (:func:`apply_gain`): its diagonals ``(1 or N, k)`` when every matrix is diagonal — applied
+    element-wise, the same operations (and bits) as a per-joint gain —, else the matrices."""
+    array = np.asarray(matrix, dtype=float)
+    k = array.shape[-1]
+    if not np.any(array * (1.0 - np.eye(k))):
+        diagonal = np.ascontiguousarray(array.diagonal(0, 1, 2))
+        diagonal.setflags(write=False)
+        return diagonal
+    return array
+
+
+def gain_solve(gain: Any, Y: np.ndarray) -> np.ndarray:
+    """``K⁻¹ Y`` for one value set of a gain ``K`` (a number, per-joint values, or a matrix
+    ``(1, k, k)``) and ``Y`` (k, …): a diagonal ``K`` divides row by row — the same operations
+    (and bits) as a per-joint gain —, a full one is a linear solve."""
+    array = np.asarray(gain, dtype=float)
+    if array.ndim == 3:
+        matrix = array[0]
+        if np.any(matrix - np.diag(np.diag(matrix))):
+            return np.linalg.solve(matrix, Y)
+        array = np.diag(matrix)
+    diagonal = np.broadcast_to(array.reshape(-1), (Y.shape[0],))
+    return Y / diagonal.reshape((-1,) + (1,) * (Y.ndim - 1))
+
+
+def apply_gain(gain: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """``K x`` for N runs: ``gain`` from :func:`applied_form` (rows: element-wise; matrices:
+    ``np.matvec``), ``x`` (N, k)."""
+    return gain * x if gain.ndim == 2 else np.matvec(gain, x)
+
+
 def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     if value is not None and spec.matrix:
         return _validate_matrix(name, value, spec)
@@ -322,7 +355,8 @@ class Gains:
 
     def describe(self, digits: int = 4) -> str:
         """``kp = (350, 300) N·m/rad, kd = ...``: every field with its unit; a matrix gain as
-        its rows, ``kp = [[1500, 0, 0], [0, 1500, 0], [0, 0, 800]] 1/s²``."""
+        its rows, ``kp = [[1500, 20, 0], [20, 1500, 0], [0, 0, 800]] 1/s²`` (a diagonal one as
+        its diagonal)."""
         parts = []
         for f in fields(self):
             value, spec = getattr(self, f.name), gain_spec(f)
@@ -343,12 +377,15 @@ class Gains:
 
 def gain_as_json(value: Any) -> Any:
     """A gain value JSON-ready: a number, a list (per joint, axis or estimate), a matrix as its
-    rows (a list of lists), one of these per run for per-run values; None stays None."""
+    rows (a list of lists) — a diagonal matrix as its diagonal, k numbers, as ``--gain`` takes
+    them (the report's ``K = (90, 90)``) —, one of these per run for per-run values; None stays None."""
     if value is None or isinstance(value, (bool, str)):
         return value
     array = np.asarray(value, dtype=float)
     if array.ndim in (2, 3) and array.shape[0] == 1:  # one row or matrix for every run
         array = array[0]
+        if array.ndim == 2 and not np.any(array - np.diag(np.diag(array))):
+            array = np.diag(array)
     return float(array) if array.ndim == 0 else array.tolist()
 
 
@@ -364,9 +401,20 @@ def default_as_json(gains_type: type[Gains], name: str) -> Any:
         return repr(default)
 
 
+MATRIX_ROWS_SHOWN = 3
+"""A matrix gain of at most this many rows is shown as its rows; a larger one by its diagonal and
+its largest off-diagonal entry (JSON keeps every row)."""
+
+
+MATRIX_ROWS_SHOWN = 3
+"""A matrix gain of at most this many rows is shown as its rows; a larger one by its diagonal and
+its largest off-diagonal entry (JSON keeps every row)."""
+
+
 def format_gain(value: Any, digits: int = 4) -> str:
-    """A gain value as text: ``350``, ``(350, 300)``, a matrix as its rows
-    ``[[1500, 0, 0], [0, 1500, 0], [0, 0, 800]]``; per-run values (N of them) shortened."""
+    """A gain value as text: ``350``, ``(350, 300)`` (per joint, or a diagonal matrix), a matrix
+    as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
+    shortened."""
     shown = gain_as_json(value)
     if isinstance(shown, float):
         return f"{shown:.{digits}g}"
@@ -375,7 +423,11 @@ def format_gain(value: Any, digits: int = 4) -> str:
     def numbers(row: np.ndarray) -> str:
         return ", ".join(f"{x:.{digits}g}" for x in row)
 
-    if isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1:  # one matrix
+    one_matrix = isinstance(value, np.ndarray) and value.ndim == 3 and value.shape[0] == 1 and array.ndim == 2
+    if one_matrix and array.shape[0] > MATRIX_ROWS_SHOWN:  # a 7 × 7 M(q₀)-scaled gain: diagonal, coupling
+        k, coupling = array.shape[0], float(np.abs(array - np.diag(np.diag(array))).max())
+        return f"{k} × {k} matrix, diagonal ({numbers(np.diag(array))}), off-diagonal up to {coupling:.{digits}g}"
+    if one_matrix:
         return "[" + ", ".join(f"[{numbers(row)}]" for row in array) + "]"
     flat = array.ravel()
     text = "(" + numbers(flat[:12]) + (", …)" if flat.size > 12 else ")")

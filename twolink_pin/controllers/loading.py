@@ -22,7 +22,9 @@ import sys
 from pathlib import Path
 
 from twolink_pin.controllers.base import CONTROLLERS, Controller
-from twolink_pin.errors import ControllerSpecError
+from twolink_pin.controllers.gains import check_count, check_width, spec_of
+from twolink_pin.errors import ControllerSpecError, InvalidParameterError
+from twolink_pin.model import RobotModel
 from twolink_pin.user_code import guarded
 
 ENTRY_POINT_GROUP = "twolink_pin.controllers"
@@ -173,3 +175,42 @@ def reload_controller(spec: str) -> type[Controller]:
     if sep and (location.endswith(".py") or "/" in location or "\\" in location):
         sys.modules.pop(_file_module_name(Path(location)), None)
     return load_controller(spec)
+
+
+def check_profile_gains(robot: RobotModel) -> None:
+    """Refuse a robot profile file's ``[gains.LAW]`` table of a law that is not registered, or
+    with a gain the law does not have or a value it refuses, naming ``FILE: gains.LAW[.NAME]``
+    (a profile written in code is the catalog's own: not checked here).
+
+    Raises:
+        InvalidParameterError: the first such table or gain.
+    """
+    file = robot.profile.file
+    if file is None:
+        return
+    laws = available_controllers()
+    for law, table in robot.gain_presets.items():
+        cls = laws.get(law)
+        if cls is None:
+            raise InvalidParameterError(
+                f"{file}: gains.{law}", dict(table), f"a table of a registered law: {', '.join(laws)}"
+            )
+        names = cls.Gains.field_names()
+        unknown = [name for name in table if name not in names]
+        if unknown:
+            raise InvalidParameterError(
+                f"{file}: gains.{law}.{unknown[0]}", table[unknown[0]], f"a gain of {law}: {', '.join(names)}"
+            )
+        widths = cls.gain_widths(robot)
+        try:
+            for name, value in table.items():  # the count of numbers before their values
+                spec = spec_of(cls.Gains, name)
+                if spec.per != "scalar":
+                    check_count(name, value, spec, *widths[spec.per])
+            gains = cls.Gains(**table)
+            for name in table:  # a matrix of the wrong size for this arm
+                spec = spec_of(cls.Gains, name)
+                if spec.per != "scalar":
+                    check_width(name, getattr(gains, name), *widths[spec.per])
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"{file}: gains.{law}.{exc.name}", exc.value, exc.expected) from None

@@ -6,26 +6,29 @@ from dataclasses import dataclass
 from typing import Any
 
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.gains import Gains, gain
-from twolink_pin.dynamics import joint_inertia
+from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.dynamics import joint_space_inertia
+from twolink_pin.model import RobotModel
 
 NATURAL_FREQUENCY = 10.0
-"""ω [rad/s] of the robot-derived default gains ``Kp = ω² I``, ``Kd = 2 ω I`` (critical
-damping of each joint's inertia ``I = diag M(q₀)`` alone)."""
+"""ω [rad/s] of the robot-derived default gains ``Kp = ω² M(q₀)``, ``Kd = 2 ω M(q₀)``: at the
+home ``q₀`` every mode of the error dynamics ``M ë + K_d ė + K_p e = 0`` is critically damped
+at ω, however the joints are coupled (the generalised eigenvalues of ``(K_p, M)`` are all ω²)."""
 
 
 @dataclass(frozen=True, eq=False)
 class PDGains(Gains):
     r"""Gains of :class:`PDFeedforward` (report: $K_p = \operatorname{diag}(350, 300)$,
-    $K_d = \operatorname{diag}(40, 50)$).
+    $K_d = \operatorname{diag}(40, 50)$). Each is an nv × nv symmetric positive-definite matrix:
+    a number (times I), nv numbers (a diagonal) or nv² numbers (row by row).
 
     Attributes:
-        kp: Position gains $K_p$ [N·m/rad], diagonal; default $\omega^2 \operatorname{diag} M(q_0)$.
-        kd: Velocity gains $K_d$ [N·m·s/rad], diagonal; default $2 \omega \operatorname{diag} M(q_0)$.
+        kp: Position gain $K_p$ [N·m/rad]; default $\omega^2 M(q_0)$.
+        kd: Velocity gain $K_d$ [N·m·s/rad]; default $2 \omega M(q_0)$.
     """
 
-    kp: Any = gain(None, per="joint", unit="N·m/rad", doc="position gain Kp")
-    kd: Any = gain(None, per="joint", unit="N·m·s/rad", doc="velocity gain Kd")
+    kp: Any = gain(None, per="joint", matrix=True, unit="N·m/rad", doc="position gain Kp")
+    kd: Any = gain(None, per="joint", matrix=True, unit="N·m·s/rad", doc="velocity gain Kd")
 
 
 class PDFeedforward(Controller[PDGains]):
@@ -44,11 +47,19 @@ class PDFeedforward(Controller[PDGains]):
     title = "PD + model feedforward"
     Gains = PDGains
 
+    def __init__(self, robot: RobotModel, gains: PDGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        self._kp, self._kd = applied_form(self.gains.kp), applied_form(self.gains.kd)
+
     def scaled_gains(self) -> dict[str, Any]:
-        inertia = joint_inertia(self.robot.model, self.robot.home)
-        return {"kp": NATURAL_FREQUENCY**2 * inertia, "kd": 2.0 * NATURAL_FREQUENCY * inertia}
+        return pd_gains(self.robot)
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        g = self.gains
         tau = terms.model(x.q, x.v, x.v_des, x.a_des)
-        return LawOutput(tau - (g.kp * (x.q - x.q_des) + g.kd * (x.v - x.v_des)))
+        return LawOutput(tau - (apply_gain(self._kp, x.q - x.q_des) + apply_gain(self._kd, x.v - x.v_des)))
+
+
+def pd_gains(robot: RobotModel) -> dict[str, Any]:
+    """``Kp = ω² M(q₀)``, ``Kd = 2 ω M(q₀)`` at the robot's home (ω: :data:`NATURAL_FREQUENCY`)."""
+    inertia = joint_space_inertia(robot.model, robot.home)
+    return {"kp": NATURAL_FREQUENCY**2 * inertia, "kd": 2.0 * NATURAL_FREQUENCY * inertia}

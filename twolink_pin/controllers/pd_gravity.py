@@ -6,9 +6,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.gains import Gains, gain
-from twolink_pin.controllers.pd import NATURAL_FREQUENCY
-from twolink_pin.dynamics import joint_inertia
+from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.controllers.pd import pd_gains
+from twolink_pin.model import RobotModel
 
 
 @dataclass(frozen=True, eq=False)
@@ -16,12 +16,12 @@ class PDGravityGains(Gains):
     r"""Gains of :class:`PDGravity`.
 
     Attributes:
-        kp: Position gains $K_p$ [N·m/rad], diagonal; default $\omega^2 \operatorname{diag} M(q_0)$.
-        kd: Velocity gains $K_d$ [N·m·s/rad], diagonal; default $2 \omega \operatorname{diag} M(q_0)$.
+        kp: Position gain $K_p$ [N·m/rad], an nv × nv matrix; default $\omega^2 M(q_0)$.
+        kd: Velocity gain $K_d$ [N·m·s/rad], an nv × nv matrix; default $2 \omega M(q_0)$.
     """
 
-    kp: Any = gain(None, per="joint", unit="N·m/rad", doc="position gain Kp")
-    kd: Any = gain(None, per="joint", unit="N·m·s/rad", doc="velocity gain Kd")
+    kp: Any = gain(None, per="joint", matrix=True, unit="N·m/rad", doc="position gain Kp")
+    kd: Any = gain(None, per="joint", matrix=True, unit="N·m·s/rad", doc="velocity gain Kd")
 
 
 class PDGravity(Controller[PDGravityGains]):
@@ -33,18 +33,21 @@ class PDGravity(Controller[PDGravityGains]):
     $V = \tfrac12 \dot q^\top M \dot q + \tfrac12 e^\top K_p e$ gives $\dot V = -\dot q^\top K_d \dot q$ and LaSalle
     gives $e \to 0$ (Takegaki and Arimoto, "A new feedback method for dynamic control of
     manipulators", *J. Dyn. Sys., Meas., Control* 103(2), 1981). On a moving reference it
-    lags (no feedforward of $M \ddot q_d + C \dot q_d$): compare ``pd``. Gains: each joint
-    critically damped on its own inertia at ``home`` ($\omega$ = 10 rad/s), as ``pd``.
+    lags (no feedforward of $M \ddot q_d + C \dot q_d$): compare ``pd``. Gains: every mode
+    critically damped at ``home`` ($\omega$ = 10 rad/s: $K_p = \omega^2 M(q_0)$), as ``pd``.
     """
 
     name = "pd-gravity"
     title = "PD + gravity compensation"
     Gains = PDGravityGains
 
+    def __init__(self, robot: RobotModel, gains: PDGravityGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        self._kp, self._kd = applied_form(self.gains.kp), applied_form(self.gains.kd)
+
     def scaled_gains(self) -> dict[str, Any]:
-        inertia = joint_inertia(self.robot.model, self.robot.home)
-        return {"kp": NATURAL_FREQUENCY**2 * inertia, "kd": 2.0 * NATURAL_FREQUENCY * inertia}
+        return pd_gains(self.robot)
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        g = self.gains
-        return LawOutput(terms.gravity(x.q) - (g.kp * (x.q - x.q_des) + g.kd * (x.v - x.v_des)))
+        feedback = apply_gain(self._kp, x.q - x.q_des) + apply_gain(self._kd, x.v - x.v_des)
+        return LawOutput(terms.gravity(x.q) - feedback)

@@ -6,9 +6,9 @@ from dataclasses import dataclass
 from typing import Any
 
 from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, SLIDING_RATE
-from twolink_pin.controllers.gains import Gains, gain
-from twolink_pin.dynamics import joint_inertia
+from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
+from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.model import RobotModel
 
 
 @dataclass(frozen=True, eq=False)
@@ -16,12 +16,12 @@ class WrongModelGains(Gains):
     r"""Gains of :class:`WrongModel` (report: $K = \operatorname{diag}(40, 50)$, $\beta = 0.5$).
 
     Attributes:
-        k: Sliding gain $K$ [N·m·s/rad], diagonal; default $\kappa \operatorname{diag} M(q_0)$.
+        k: Sliding gain $K$ [N·m·s/rad], an nv × nv matrix; default $\kappa M(q_0)$.
         lam: $\lambda$ [1/s] in $s = \dot e + \lambda e$.
         model_scale: $\beta$, the factor on the model terms (report: 0.5), >= 0.
     """
 
-    k: Any = gain(None, per="joint", unit="N·m·s/rad", doc="sliding gain K")
+    k: Any = gain(None, per="joint", matrix=True, unit="N·m·s/rad", doc="sliding gain K")
     lam: Any = gain(DEFAULT_LAMBDA, unit="1/s", doc="λ in s = ė + λ e")
     model_scale: Any = gain(0.5, bound="nonnegative", doc="β: M̂ = β M, Ĉ = β C, ĝ = β g")
 
@@ -43,11 +43,15 @@ class WrongModel(Controller[WrongModelGains]):
     title = "Slotine–Li law with M̂ = β M, Ĉ = β C (report: β = 0.5)"
     Gains = WrongModelGains
 
+    def __init__(self, robot: RobotModel, gains: WrongModelGains | None = None, **kwargs: Any) -> None:
+        super().__init__(robot, gains, **kwargs)
+        self._k = applied_form(self.gains.k)
+
     def scaled_gains(self) -> dict[str, Any]:
-        return {"k": SLIDING_RATE * joint_inertia(self.robot.model, self.robot.home)}
+        return {"k": sliding_gain(self.robot)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         g = self.gains
         lam_e, edot = g.lam * (x.q - x.q_des), x.v - x.v_des
         tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - g.lam * edot)
-        return LawOutput(g.model_scale * tau - g.k * (edot + lam_e))
+        return LawOutput(g.model_scale * tau - apply_gain(self._k, edot + lam_e))

@@ -171,7 +171,16 @@ def regressor(
 def joint_inertia(model: pin.Model, q: np.ndarray | None = None) -> np.ndarray:
     """``diag M(q)`` [kg·m²] at ``q`` [rad] (default Pinocchio's neutral configuration),
     armature included: the inertia each joint moves, the scale robot-derived default gains
-    use (at the robot's home, :attr:`~twolink_pin.model.RobotModel.home`)."""
+    use on their own (a user's law; the built-in laws scale with the whole
+    :func:`joint_space_inertia`)."""
+    return np.array(np.diag(joint_space_inertia(model, q)), dtype=float)
+
+
+def joint_space_inertia(model: pin.Model, q: np.ndarray | None = None) -> np.ndarray:
+    """``M(q)`` [kg·m² for revolute joints], shape (nv, nv), symmetric, at ``q`` [rad] (default
+    Pinocchio's neutral configuration), armature included: the whole inertia robot-derived
+    default gains scale with (``K = κ M(q₀)`` at the robot's home: every mode of the closed loop
+    at ``q₀`` then at the stated rate κ, however strongly the joints are coupled)."""
     if not isinstance(model, pin.Model):
         raise InvalidParameterError("model", type(model).__name__, "a pinocchio.Model (robot.model)")
     if q is not None:
@@ -179,5 +188,5 @@ def joint_inertia(model: pin.Model, q: np.ndarray | None = None) -> np.ndarray:
         if q.shape != (model.nq,) or not np.all(np.isfinite(q)):
             raise InvalidParameterError("q", q.tolist(), f"{model.nq} finite joint positions [rad]")
     data = model.createData()
-    M = pin.crba(model, data, pin.neutral(model) if q is None else np.asarray(q, dtype=float))
-    return np.array(np.diag(M), dtype=float)
+    M = pin.crba(model, data, pin.neutral(model) if q is None else q)
+    return np.triu(M) + np.triu(M, 1).T

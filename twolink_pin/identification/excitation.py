@@ -226,7 +226,10 @@ class _Problem:
         self.controller = controller
         if controller is not None:
             self.P_law = np.ascontiguousarray(robot.parameter_map.matrix)
-            self.k = one_row(controller.gains.k, robot.nv)
+            k = np.asarray(controller.gains.k, dtype=float)  # K: a matrix (1, nv, nv) or per joint
+            full = k.ndim == 3 and bool(np.any(k[0] - np.diag(np.diag(k[0]))))
+            self.k_matrix = k[0] if full else None
+            self.k = np.diag(k[0]) if k.ndim == 3 and not full else one_row(k, robot.nv)
             self.root_rate = np.sqrt(1.0 / one_row(controller.gains.gamma, controller.state_size))
         self._key: bytes | None = None
         self._value: tuple[float, np.ndarray] = (0.0, np.zeros(0))
@@ -271,7 +274,8 @@ class _Problem:
             if "friction" in self.controller.estimates:
                 parts.append(W[:, :, nb:])
             Y = np.concatenate(parts, axis=2)
-            gram = np.einsum("kip,kiq->pq", Y / self.k[None, :, None], Y) / K
+            KinvY = Y / self.k[None, :, None] if self.k_matrix is None else np.linalg.solve(self.k_matrix, Y)
+            gram = np.einsum("kip,kiq->pq", KinvY, Y) / K
             smallest = float(np.linalg.eigvalsh(self.root_rate[:, None] * gram * self.root_rate[None, :])[0])
             value = -float(np.log(max(smallest, 1e-300)))
         self._key, self._value = key, (value, margins)

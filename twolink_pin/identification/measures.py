@@ -27,7 +27,7 @@ import numpy as np
 
 from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers import Controller
-from twolink_pin.controllers.gains import one_row
+from twolink_pin.controllers.gains import gain_solve, one_row
 from twolink_pin.dynamics import friction_regressor, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.identification.observation import ParameterSet
@@ -192,7 +192,6 @@ def averaged_adaptation(
             "controller", controller.name, "an adaptive law (estimates, gains k and gamma)"
         )
     robot = controller.robot
-    k = one_row(gains.k, robot.nv)
     rate = 1.0 / one_row(gains.gamma, controller.state_size)
     P = robot.parameter_map.matrix
     data = robot.create_data()
@@ -206,7 +205,7 @@ def averaged_adaptation(
         if "friction" in controller.estimates:
             columns.append(friction_regressor(ref.v[i], smoothing))
         Y = np.hstack(columns)
-        gram += Y.T @ (Y / k[:, None])
+        gram += Y.T @ gain_solve(gains.k, Y)  # Yᵀ K⁻¹ Y
     gram /= samples
     root = np.sqrt(rate)
     values, vectors = np.linalg.eigh(root[:, None] * gram * root[None, :])

@@ -3,18 +3,22 @@
 ==========================  ================================================================
 ``robot.py``                :class:`RobotModel`, :func:`load_robot` (URDF → Pinocchio model)
 ``catalog.py``              robots by name: the registry ``--robot NAME`` resolves
-``example_robots.py``       example-robot-data's arms in the catalog (UR5, Panda, ...)
 ``profile.py``              what a named robot brings beyond its URDF (home, gains, ...)
+``profile_file.py``         a profile as a TOML file: any URDF, one arm of it (the catalog's, a user's)
+``home.py``                 a home for an arm whose profile gives none (dexterous, mid-range)
 ``parameters.py``           parameter maps ``Y_p = Y_π P`` from Pinocchio's inertial parameters
 ``base_parameters.py``      the identifiable base parameters of any model (Gautier's QR)
 ``urdf_validation.py``      checks a URDF before Pinocchio sees it
 ``urdf_elements.py``        its checks of one link and one joint, and how URDF numbers are read
+``inertia_repair.py``       the nearest physically consistent inertia (``--repair-inertias``)
 ``payload.py``              payload variants written as URDF (yourdfpy)
 ``urdf_write.py``           a URDF with other inertias and joint friction written in
 ==========================  ================================================================
 """
 
-from twolink_pin.model import example_robots as _example_robots  # noqa: F401  # registers them
+from twolink_pin.model import catalog as _catalog
 from twolink_pin.model.robot import RobotModel, example_robot_urdf, load_robot, twolink_urdf_path
+
+_catalog.register_folder(_catalog.package_folder())  # the catalog's profiles: robots/*.toml
 
 __all__ = ["RobotModel", "example_robot_urdf", "load_robot", "twolink_urdf_path"]

@@ -17,7 +17,16 @@ from pathlib import Path
 
 from twolink_pin.errors import InvalidURDFError, require_type
 from twolink_pin.model.profile import RobotProfile, generic_profile
+from twolink_pin.model.profile_file import is_profile_path, read_profile_file, user_folder
 from twolink_pin.model.urdf_profile import declared_profile
+
+
+def share_folder(urdf: Path) -> Path:
+    """The folder ``package://example-robot-data/...`` mesh paths are relative to."""
+    for parent in urdf.parents:
+        if parent.name == "example-robot-data":
+            return parent.parent
+    return urdf.parent
 
 
 def example_robot_urdf(relative: str) -> Path:
@@ -77,13 +86,38 @@ def register(name: str, entry: Callable[[], tuple[Path, RobotProfile]]) -> None:
     CATALOG[name] = entry
 
 
+def register_folder(folder: Path) -> None:
+    """Add every profile file (``NAME.toml``, :mod:`~twolink_pin.model.profile_file`) of
+    ``folder`` under its name (read once, when the robot is first used)."""
+    for file in sorted(folder.glob("*.toml")):
+        register(file.stem, functools.cache(functools.partial(read_profile_file, file, file.stem)))
+
+
+def user_profiles() -> dict[str, Path]:
+    """The user's profile files (:func:`~twolink_pin.model.profile_file.user_folder`) by name:
+    ``--robot NAME`` finds them after the catalog's."""
+    folder = user_folder()
+    if not folder.is_dir():
+        return {}
+    return {file.stem: file for file in sorted(folder.glob("*.toml")) if file.is_file()}
+
+
+def package_folder() -> Path:
+    """The package's own profiles (``robots/*.toml``, installed as ``twolink_pin.robots``)."""
+    from importlib import resources
+
+    return Path(str(resources.files("twolink_pin.robots")))
+
+
 def names() -> tuple[str, ...]:
     """The catalog's robot names, the default robot first."""
     return tuple(sorted(CATALOG, key=lambda name: name != DEFAULT_ROBOT))
 
 
 def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
-    """The URDF path and profile of ``robot``: a catalog name, or a path to a URDF file.
+    """The URDF path and profile of ``robot``: a catalog name, a profile of the user's folder by
+    name, a profile file (``.toml``, :mod:`~twolink_pin.model.profile_file`), or a path to a URDF
+    file.
 
     A path to a catalog robot's own URDF gets that robot's profile, and so does a file that
     declares it (``<twolink_pin profile="NAME"/>``, written by ``--write-urdf``:
@@ -100,13 +134,19 @@ def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
         )
     if text in CATALOG:
         return CATALOG[text]()
+    if is_profile_path(text):
+        return read_profile_file(text)
+    mine = user_profiles().get(text)
+    if mine is not None:
+        return read_profile_file(mine)
     path = Path(text)
     looks_like_path = path.suffix.lower() in (".urdf", ".xml") or os.sep in text or path.exists()
     if not looks_like_path:
         raise InvalidURDFError(
             text,
             "robot",
-            f"no robot of that name; named robots are {', '.join(names())}, or give a path to a .urdf file",
+            f"no robot of that name; named robots are {', '.join(names() + tuple(user_profiles()))}, or give "
+            "a path to a .urdf or a profile .toml file",
         )
     for entry in CATALOG.values():
         own, profile = entry()

@@ -153,11 +153,23 @@ class RobotProfile:
             the link they hang from.
         locked_positions: Position of each locked joint [rad or m]; ``None``: 0 clipped to its limits.
         home: A configuration the default trajectory and the viewer start from [rad], one
-            per joint of the (reduced) model; ``None``: the middle of each joint's range.
+            per joint of the (reduced) model; ``None``: one the loader chooses near the middle
+            of the ranges, away from singularities (:func:`~twolink_pin.model.home.choose_home`).
         acceleration_limits: ``|q̈_j| <=`` these [rad/s²], one per joint of the (reduced)
             model, from the maker's data sheet (a URDF has no acceleration limit); ``None``:
             none (:mod:`twolink_pin.limits`).
         report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
+        repair_inertias: Load the URDF with its triangle-breaking inertias replaced by the nearest
+            consistent ones (:mod:`~twolink_pin.model.inertia_repair`).
+        free_joints: The joints left free, every other one locked (at its ``locked_positions``
+            entry if ``locked_joints`` names it, else 0 clipped to its limits); ``None``: only
+            ``locked_joints`` are locked.
+        amplitude: The largest swing [rad] of the default reference about home
+            (:func:`~twolink_pin.trajectory.defaults.neutral_motion`); ``None``: its default.
+        file: The profile file this profile was read from (:mod:`~twolink_pin.model.profile_file`);
+            ``None`` for one written in code. Refusals of its values name it.
+        home_source: How ``home`` was chosen when the profile gave none (set by the loader:
+            :mod:`~twolink_pin.model.home`); ``""`` for a home the profile gives.
         effects: The arm's armature, joint damping and dry friction with their sources
             (:class:`ArmEffects`); ``None``: none given (a URDF's ``<dynamics>`` may give
             damping and friction).
@@ -178,6 +190,11 @@ class RobotProfile:
     home: tuple[float, ...] | None = None
     acceleration_limits: tuple[float, ...] | None = None
     report: ReportProfile = field(default_factory=ReportProfile)
+    repair_inertias: bool = False
+    free_joints: tuple[str, ...] | None = None
+    amplitude: float | None = None
+    file: Path | None = None
+    home_source: str = ""
     effects: ArmEffects | None = None
 
 

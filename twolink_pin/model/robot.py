@@ -26,9 +26,11 @@ from twolink_pin.arrays import readonly
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.model.base_parameters import BaseParameterMap
 from twolink_pin.model.catalog import example_robot_urdf, resolve
+from twolink_pin.model.home import choose_home
+from twolink_pin.model.inertia_repair import InertiaRepair
 from twolink_pin.model.parameters import ParameterMap
 from twolink_pin.model.profile import RobotProfile, default_q0_offset
-from twolink_pin.model.urdf_validation import validate_urdf_file
+from twolink_pin.model.urdf_validation import CheckedURDF, check_urdf_file
 
 DEFAULT_EE_FRAME = "ee_link"
 
@@ -66,6 +68,14 @@ class RobotModel:
     """True parameters of the map (for the twolink p1, p2, p3 [kg·m²])."""
     profile: RobotProfile = field(repr=False, default_factory=lambda: RobotProfile("robot"))
     """The robot's name and defaults (gain presets, trajectory, plant friction)."""
+    notes: tuple[str, ...] = field(repr=False, default=())
+    """What the loader accepted with a note (a static link's mass 0, a thin rod's zero moment,
+    how the home was chosen): the commands print them."""
+    repairs: tuple[InertiaRepair, ...] = field(repr=False, default=())
+    """The inertias ``repair_inertias`` replaced (:mod:`~twolink_pin.model.inertia_repair`)."""
+    urdf_text: str = field(repr=False, default="")
+    """The URDF document the model was built from (repaired inertias written in): what a second
+    engine compiles, so that both plants simulate the same arm."""
 
     @property
     def name(self) -> str:
@@ -80,8 +90,9 @@ class RobotModel:
     @property
     def home(self) -> np.ndarray:
         """A configuration [rad] inside the joint limits that default trajectories swing about
-        and robot-derived gains are scaled at: the profile's ``home``, else the middle of each
-        joint's range (0 rad for a joint without limits)."""
+        and robot-derived gains are scaled at: the profile's ``home``, else the one the loader
+        chose (dexterous, near the middle of the ranges: ``profile.home_source`` says how,
+        :mod:`~twolink_pin.model.home`); the middle of each range for a model built by hand."""
         if self.profile.home is not None:
             return np.array(self.profile.home, dtype=float)
         lower, upper = np.array(self.model.lowerPositionLimit), np.array(self.model.upperPositionLimit)
@@ -119,11 +130,28 @@ class RobotModel:
         return self.model.createData()
 
 
-def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path) -> int:
+def _refusal(
+    profile: RobotProfile, path: Path, key: str, element: str, value: object, reason: str
+) -> Exception:
+    """A profile value the model refuses: named ``FILE: key`` for a profile file's
+    (:class:`InvalidParameterError`), else as the URDF's element (:class:`InvalidURDFError`)."""
+    if profile.file is not None:
+        return InvalidParameterError(f"{profile.file}: {key}", value, reason)
+    return InvalidURDFError(str(path), element, reason)
+
+
+def _end_effector_frame(model: pin.Model, ee_frame: str | None, path: Path, profile: RobotProfile) -> int:
+    """The end-effector frame's index: ``ee_frame`` (the caller's), else the profile's, else
+    ``ee_link``, else the last frame on the last joint."""
+    from_profile = ee_frame is None
+    ee_frame = ee_frame if ee_frame is not None else profile.ee_frame
     if ee_frame is not None:
         if not model.existFrame(ee_frame):
             names = [f.name for f in model.frames]
-            raise InvalidURDFError(str(path), f"frame '{ee_frame}'", f"no such frame; frames are {names}")
+            if not from_profile:
+                raise InvalidURDFError(str(path), f"frame '{ee_frame}'", f"no such frame; frames are {names}")
+            reason = f"a frame of {path.name}; no such frame, frames are {names}"
+            raise _refusal(profile, path, "end_effector", f"frame '{ee_frame}'", ee_frame, reason)
         matches = [i for i, f in enumerate(model.frames) if f.name == ee_frame]
         bodies = [i for i in matches if model.frames[i].type == pin.FrameType.BODY]
         return (bodies or matches)[0]  # a link's frame before a fixed joint of the same name
@@ -228,8 +256,9 @@ def _revolute_continuous(text: str) -> tuple[str, tuple[str, ...]]:
     return ET.tostring(root, encoding="unicode"), tuple(names)
 
 
-def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
-    """The Pinocchio model of the checked URDF at ``path``, for tracking control:
+def _build_model(path: Path, profile: RobotProfile, checked: CheckedURDF) -> tuple[pin.Model, RobotProfile]:
+    """The Pinocchio model of the checked URDF at ``path``, for tracking control, and the profile
+    (its ``free_joints`` turned into locked ones):
 
     * a continuous joint becomes a revolute joint without position limits: one angle
       [rad] in ℝ instead of Pinocchio's (cos, sin) pair, so that ``nq == nv`` and a
@@ -239,8 +268,7 @@ def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
     * the profile's ``locked_joints`` are fixed at ``locked_positions``
       (``pin.buildReducedModel``: their links ride on the link before them).
     """
-    text = validate_urdf_file(path)
-    text, continuous = _revolute_continuous(text)
+    text, continuous = _revolute_continuous(checked.text)
     try:
         model = pin.buildModelFromXML(text)
     except (ValueError, RuntimeError) as exc:  # validated already; keep any surprise readable
@@ -251,9 +279,21 @@ def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
         if model.names[j] in continuous or (n == 1 and lower[i] == upper[i]):
             lower[i : i + n], upper[i : i + n] = -np.inf, np.inf
     model.lowerPositionLimit, model.upperPositionLimit = lower, upper
+    _check_locked_positions(model, profile, path)
+    if profile.free_joints is not None:
+        profile = _free(model, profile, path)
     if profile.locked_joints:
         model = _lock(model, profile, path)
     if model.nv == 0:
+        if profile.locked_joints and profile.file is not None:
+            raise _refusal(
+                profile,
+                path,
+                "locked",
+                "<robot>",
+                list(profile.locked_joints),
+                f"at least one joint of {path.name} left free; these lock every one",
+            )
         raise InvalidURDFError(str(path), "<robot>", "expected at least one moving joint, found none")
     if model.nq != model.nv:
         kinds = sorted({model.joints[j].shortname() for j in range(1, model.njoints) if model.nqs[j] != 1})
@@ -263,16 +303,81 @@ def _build_model(path: Path, profile: RobotProfile) -> pin.Model:
             f"expected joints of one coordinate each (revolute, continuous, prismatic), got nq = {model.nq}, "
             f"nv = {model.nv} ({', '.join(kinds)})",
         )
-    return model
+    return model, profile
+
+
+def _free(model: pin.Model, profile: RobotProfile, path: Path) -> RobotProfile:
+    """``profile`` with every joint but its ``free_joints`` among its locked ones."""
+    assert profile.free_joints is not None
+    joints = [str(model.names[j]) for j in range(1, model.njoints)]
+    for name in profile.free_joints:
+        if name not in joints:
+            raise _refusal(
+                profile, path, "free", f"joint '{name}'", name, f"a joint of {path.name}; joints are {joints}"
+            )
+    for name in profile.locked_joints:
+        if name not in joints:
+            reason = f"a joint of {path.name} to lock; no such joint, joints are {joints}"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
+        if name in profile.free_joints:
+            reason = f"a joint not also listed in free (joint '{name}' is in both)"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
+    given = dict(zip(profile.locked_joints, profile.locked_positions or (0.0,) * len(profile.locked_joints)))
+    locked = [name for name in joints if name not in profile.free_joints]
+    return dataclasses.replace(
+        profile, locked_joints=tuple(locked), locked_positions=tuple(given.get(name, 0.0) for name in locked)
+    )
+
+
+def _check_locked_positions(model: pin.Model, profile: RobotProfile, path: Path) -> None:
+    """Refuse a position the profile locks a joint at outside that joint's range."""
+    for name, value in zip(profile.locked_joints, profile.locked_positions or ()):
+        if not model.existJointName(name):
+            continue  # named by the lock itself
+        i = model.idx_qs[model.getJointId(name)]
+        lower, upper = model.lowerPositionLimit[i], model.upperPositionLimit[i]
+        if not lower <= value <= upper:
+            reason = f"a position within joint '{name}''s range [{lower:g}, {upper:g}] rad (m if prismatic)"
+            raise _refusal(profile, path, f"locked.{name}", f"joint '{name}'", value, reason)
+
+
+def _check_sizes(model: pin.Model, profile: RobotProfile, path: Path) -> None:
+    """Refuse a per-joint value of the profile whose count is not the free joints' (one value
+    also for ``q0_offset``), naming the key, before a run meets it."""
+    nv = model.nv
+    what = f"per free joint, nv = {nv}"
+    if profile.q0_offset is not None and len(profile.q0_offset) not in (1, nv):
+        reason = f"one value [rad], or {nv} ({what})"
+        raise _refusal(profile, path, "q0_offset", "q0_offset", list(profile.q0_offset), reason)
+    accel = profile.acceleration_limits
+    if accel is not None and (len(accel) != nv or not all(a > 0 for a in accel)):
+        reason = f"{nv} values > 0 [rad/s²] ({what})"
+        raise _refusal(profile, path, "acceleration_limits", "acceleration_limits", list(accel), reason)
+    if profile.friction is not None:
+        for key, values in zip(("viscous", "coulomb"), profile.friction):
+            if len(values) != nv or not all(v >= 0 for v in values):
+                reason = f"{nv} values >= 0 ({what})"
+                raise _refusal(profile, path, f"friction.{key}", "friction", list(values), reason)
+    effects = profile.effects
+    for key in ("armature", "damping", "frictionloss"):
+        given: tuple[float, ...] | None = None if effects is None else getattr(effects, key)
+        if given is not None and len(given) != nv:
+            raise _refusal(profile, path, f"effects.{key}", "effects", list(given), f"{nv} values ({what})")
+    trajectory = profile.trajectory
+    if trajectory is not None and trajectory.joint_points is not None:
+        for point in trajectory.joint_points:
+            if len(point) != nv:
+                reason = f"points of {nv} joint positions [rad or m] ({what})"
+                raise _refusal(profile, path, "trajectory.joint_points", "trajectory", list(point), reason)
 
 
 def _lock(model: pin.Model, profile: RobotProfile, path: Path) -> pin.Model:
     ids = []
     for name in profile.locked_joints:
         if not model.existJointName(name):
-            raise InvalidURDFError(
-                str(path), f"joint '{name}'", f"no such joint to lock; joints are {list(model.names)[1:]}"
-            )
+            joints = list(model.names)[1:]
+            reason = f"a joint of {path.name} to lock; no such joint, joints are {joints}"
+            raise _refusal(profile, path, "locked", f"joint '{name}'", name, reason)
         ids.append(int(model.getJointId(name)))
     q = np.zeros(model.nq)
     positions = profile.locked_positions or (0.0,) * len(ids)
@@ -287,18 +392,17 @@ def _check_home(model: pin.Model, profile: RobotProfile, path: Path) -> None:
         return
     home = np.array(profile.home, dtype=float)
     if home.shape != (model.nq,) or not np.all(np.isfinite(home)):
-        raise InvalidURDFError(
-            str(path), "home", f"{profile.home} must be {model.nq} finite joint positions [rad]"
-        )
+        free = [str(model.names[j]) for j in range(1, model.njoints)]
+        reason = f"{model.nq} finite joint positions [rad or m], one per free joint ({', '.join(free)})"
+        raise _refusal(profile, path, "home", "home", list(profile.home), reason)
     outside = np.flatnonzero((home < model.lowerPositionLimit) | (home > model.upperPositionLimit))
     if outside.size:
         j = int(outside[0])
-        raise InvalidURDFError(
-            str(path),
-            "home",
-            f"joint {j + 1} at {home[j]:g} rad is outside its limits "
-            f"[{model.lowerPositionLimit[j]:g}, {model.upperPositionLimit[j]:g}] rad",
+        reason = (
+            f"positions within the joints' ranges; joint {j + 1} ({model.names[j + 1]}) at {home[j]:g} is "
+            f"outside [{model.lowerPositionLimit[j]:g}, {model.upperPositionLimit[j]:g}] rad"
         )
+        raise _refusal(profile, path, "home", "home", list(profile.home), reason)
 
 
 def load_robot(
@@ -306,6 +410,7 @@ def load_robot(
     payload: float = 0.0,
     ee_frame: str | None = None,
     parameter_map: Callable[[pin.Model], ParameterMap] | None = None,
+    repair_inertias: bool | None = None,
 ) -> RobotModel:
     """Load an arm by name or from a URDF file.
 
@@ -317,6 +422,9 @@ def load_robot(
         parameter_map: Parameter-map class (called with the model); default the profile's
             (the twolink's lumped p1..p3), else the model's identifiable base parameters
             (:class:`~twolink_pin.model.base_parameters.BaseParameterMap`).
+        repair_inertias: Replace each link inertia that breaks the triangle inequality by the
+            nearest one that satisfies it (``RobotModel.repairs`` lists each change) instead of
+            refusing the file; default the profile's (``repair_inertias`` of a profile file), else no.
 
     Raises:
         InvalidURDFError: unknown name, missing file, or a file that gives no sound model.
@@ -334,9 +442,12 @@ def load_robot(
             "robot", type(robot).__name__, "a robot name (twolink-pin robots) or a path to a URDF file"
         )
     path, profile = resolve(robot)
-    model = _build_model(path, profile)
+    repair = profile.repair_inertias if repair_inertias is None else bool(repair_inertias)
+    checked = check_urdf_file(path, repair)
+    model, profile = _build_model(path, profile, checked)
     _check_home(model, profile, path)
-    ee_id = _end_effector_frame(model, ee_frame if ee_frame is not None else profile.ee_frame, path)
+    _check_sizes(model, profile, path)
+    ee_id = _end_effector_frame(model, ee_frame, path, profile)
     if profile.q0_offset is None:  # never a run that starts on its reference (docs/any_robot.md)
         profile = dataclasses.replace(profile, q0_offset=default_q0_offset(model.nv))
     if payload > 0:
@@ -345,6 +456,9 @@ def load_robot(
         model.inertias[frame.parentJoint] = model.inertias[frame.parentJoint] + frame.placement.act(point)
     _check_inertias(model, path, payload)
     _check_moves_inertia(model, path)
+    if profile.home is None:  # a dexterous home near the middle of the ranges (model/home.py)
+        chosen = choose_home(model, ee_id)
+        profile = dataclasses.replace(profile, home=tuple(chosen.q.tolist()), home_source=chosen.describe())
     factory = parameter_map if parameter_map is not None else profile.parameter_map
     pmap: ParameterMap = factory(model) if factory is not None else BaseParameterMap(model)
     return RobotModel(
@@ -357,4 +471,7 @@ def load_robot(
         torque_limits=readonly(np.where(model.effortLimit > 0, model.effortLimit, np.inf)),
         p=readonly(pmap.values(model)),
         profile=profile,
+        notes=checked.notes,
+        repairs=checked.repairs,
+        urdf_text=checked.text,
     )

@@ -13,11 +13,12 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Iterable, Sequence
-from typing import Final
+from typing import Final, NamedTuple
 
 import numpy as np
 
 from twolink_pin.errors import InvalidURDFError
+from twolink_pin.model.inertia_repair import InertiaRepair, inertia_matrix, nearest_consistent
 
 JOINT_TYPES: Final[frozenset[str]] = frozenset(
     {"revolute", "continuous", "prismatic", "fixed", "floating", "planar"}
@@ -49,17 +50,41 @@ _DECIMAL = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 # --- links ----------------------------------------------------------------------------------
 
 
-def check_link(link: ET.Element, where: str, path: str) -> None:
+class LinkFindings(NamedTuple):
+    """What :func:`check_link` accepted with a note, and the repair it made (if asked to)."""
+
+    notes: tuple[str, ...] = ()
+    """One line each: what was accepted that a reader may want to know."""
+    repair: InertiaRepair | None = None
+    """The link's inertia replaced by the nearest consistent one (``repair=True``)."""
+
+
+REPAIR_HINT = (
+    "(--repair-inertias, or load_robot(..., repair_inertias=True), replaces it with the nearest inertia "
+    "that satisfies it and lists the change)"
+)
+"""What a triangle-inequality refusal offers."""
+ZERO_MOMENT = 1e-12
+"""A principal moment within this fraction of the largest (in magnitude) counts as 0: a thin rod's."""
+
+
+def check_link(
+    link: ET.Element, where: str, path: str, *, static: bool = False, repair: bool = False
+) -> LinkFindings:
+    """Check one ``<link>``. ``static``: the link never moves (the root link, or one fixed to it
+    through fixed joints only): its mass and inertia are then read but not required to be a
+    body's (a mass 0 with an inertia, as a static base is often written, is accepted with a
+    note). ``repair``: an inertia that breaks the triangle inequality is replaced in ``link``
+    by the nearest one that satisfies it (:mod:`~twolink_pin.model.inertia_repair`) instead of refused."""
     inertials = link.findall("inertial")
     if not inertials:
-        return  # A massless link (e.g. a base or an end-effector frame) is fine.
+        return LinkFindings()  # A massless link (e.g. a base or an end-effector frame) is fine.
     if len(inertials) > 1:
         raise InvalidURDFError(
             path, f"{where} <inertial>", f"appears {len(inertials)} times; expected at most one per link"
         )
     inertial = inertials[0]
-    where = f"{where} <inertial>"
-
+    name, where = where, f"{where} <inertial>"
     mass = inertial.find("mass")
     if mass is None:
         raise InvalidURDFError(
@@ -69,8 +94,27 @@ def check_link(link: ET.Element, where: str, path: str) -> None:
     if raw is None:
         raise InvalidURDFError(path, f"{where}<mass>", "value is missing; expected a finite number > 0 kg")
     value = _finite_float(raw)
-    if value == 0.0 and _is_zero_inertia(inertial.find("inertia")):
-        return  # An explicitly massless link (mass 0, inertia 0), common for frame links.
+    inertia = inertial.find("inertia")
+    _check_origin(inertial.find("origin"), f"{where}<origin>", path)
+    if static and value is not None and value >= 0.0:
+        if inertia is not None:
+            _inertia_values(inertia, f"{where}<inertia>", path)  # numbers Pinocchio reads, whatever they mean
+        try:
+            _check_body(value, raw, inertia, where, path, repair=False)
+        except InvalidURDFError as err:
+            return LinkFindings(
+                (f"{name} never moves (fixed to the root link): accepted although {err.reason}",)
+            )
+        return LinkFindings()
+    return _check_body(value, raw, inertia, where, path, repair=repair)
+
+
+def _check_body(
+    value: float | None, raw: str, inertia: ET.Element | None, where: str, path: str, *, repair: bool
+) -> LinkFindings:
+    """The mass ``value`` (as ``raw``) and ``<inertia>`` of a link that moves."""
+    if value == 0.0 and _is_zero_inertia(inertia):
+        return LinkFindings()  # An explicitly massless link (mass 0, inertia 0), common for frame links.
     if value is None or not value > 0.0:
         raise InvalidURDFError(path, f"{where}<mass>", f'mass value="{raw}" must be a finite number > 0 kg')
     if value > MAX_MASS:
@@ -79,11 +123,9 @@ def check_link(link: ET.Element, where: str, path: str) -> None:
             f"{where}<mass>",
             f'mass value="{raw}" is more than {MAX_MASS:g} kg; expected an arm\'s link',
         )
-
-    inertia = inertial.find("inertia")
-    if not (inertia is not None and _is_zero_inertia(inertia)):  # all zeros: a point mass, fine
-        _check_inertia(inertia, f"{where}<inertia>", path)
-    _check_origin(inertial.find("origin"), f"{where}<origin>", path)
+    if inertia is not None and _is_zero_inertia(inertia):  # all zeros: a point mass, fine
+        return LinkFindings()
+    return _check_inertia(inertia, f"{where}<inertia>", path, repair=repair)
 
 
 def _is_zero_inertia(inertia: ET.Element | None) -> bool:
@@ -93,7 +135,8 @@ def _is_zero_inertia(inertia: ET.Element | None) -> bool:
     return all(_finite_float(inertia.get(name, "0")) == 0.0 for name in _INERTIA_ATTRIBUTES)
 
 
-def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
+def _inertia_values(inertia: ET.Element | None, where: str, path: str) -> tuple[float, ...]:
+    """The six finite ``ixx … izz`` of ``<inertia>`` [kg·m²]."""
     if inertia is None:
         raise InvalidURDFError(
             path,
@@ -108,36 +151,42 @@ def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
             f"missing attribute(s) {', '.join(missing)}; "
             f"expected all six of {', '.join(_INERTIA_ATTRIBUTES)}",
         )
-    values = {}
+    values = []
     for name in _INERTIA_ATTRIBUTES:
         raw = inertia.get(name, "")
         value = _finite_float(raw)
         if value is None:
             raise InvalidURDFError(path, where, f'{name}="{raw}" must be a finite number (kg m^2)')
-        values[name] = value
+        values.append(value)
+    return tuple(values)
 
-    matrix = np.array(
-        [
-            [values["ixx"], values["ixy"], values["ixz"]],
-            [values["ixy"], values["iyy"], values["iyz"]],
-            [values["ixz"], values["iyz"], values["izz"]],
-        ]
-    )
+
+def _check_inertia(
+    inertia: ET.Element | None, where: str, path: str, *, repair: bool = False
+) -> LinkFindings:
+    values = _inertia_values(inertia, where, path)
+    assert inertia is not None
     with np.errstate(all="ignore"):
-        moments = np.linalg.eigvalsh(matrix)  # ascending
+        moments = np.linalg.eigvalsh(inertia_matrix(values))  # ascending
     shown = ", ".join(f"{m:.6g}" for m in moments)
     if not np.all(np.isfinite(moments)):
         raise InvalidURDFError(
             path, where, f"principal moments ({shown}) are not finite; expected moderate values in kg m^2"
         )
-    if not moments[0] > 0.0:
-        raise InvalidURDFError(
-            path,
-            where,
-            f"inertia matrix is not positive definite: its eigenvalues are ({shown}) kg m^2; "
-            "expected all > 0",
-        )
     small, middle, large = (float(m) for m in moments)
+    notes: tuple[str, ...] = ()
+    if not small > 0.0:
+        if small < -ZERO_MOMENT * max(abs(large), 1e-300) or not large > 0.0:
+            raise InvalidURDFError(
+                path,
+                where,
+                f"inertia matrix is not positive semidefinite: its eigenvalues are ({shown}) kg m^2; "
+                "expected all >= 0 (0 only for a thin rod's axis)",
+            )
+        notes = (
+            f"{where}: a principal moment is 0 ({shown} kg·m²: a thin rod); accepted, as the arm's M(q) "
+            "is positive definite",
+        )
     if large > MAX_INERTIA:
         raise InvalidURDFError(
             path,
@@ -145,12 +194,18 @@ def _check_inertia(inertia: ET.Element | None, where: str, path: str) -> None:
             f"principal moment {large:.6g} kg m^2 is more than {MAX_INERTIA:g}; expected an arm's link",
         )
     if large > (small + middle) * (1.0 + TRIANGLE_RTOL):
-        raise InvalidURDFError(
-            path,
-            where,
-            f"principal moments ({shown}) kg m^2 violate the triangle inequality: {large:.6g} > "
-            f"{small:.6g} + {middle:.6g}; expected each moment <= the sum of the other two",
-        )
+        if not repair:
+            raise InvalidURDFError(
+                path,
+                where,
+                f"principal moments ({shown}) kg m^2 violate the triangle inequality: {large:.6g} > "
+                f"{small:.6g} + {middle:.6g}; expected each moment <= the sum of the other two {REPAIR_HINT}",
+            )
+        fixed = nearest_consistent(where.split("'")[1] if "'" in where else where, values)
+        for name, number in zip(_INERTIA_ATTRIBUTES, fixed.after, strict=True):
+            inertia.set(name, repr(number))
+        return LinkFindings(notes, fixed)
+    return LinkFindings(notes)
 
 
 def _check_origin(origin: ET.Element | None, where: str, path: str) -> None:

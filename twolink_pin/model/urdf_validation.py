@@ -41,8 +41,15 @@ Checks, in order:
    (or exactly 0 with an all-zero inertia: an explicitly massless frame link; a mass > 0
    with an all-zero inertia is a point mass);
    ``<inertia>`` with the six attributes ``ixx ixy ixz iyy iyz izz`` finite [kg·m²], the
-   matrix positive definite and its principal moments satisfying the triangle
-   inequality; ``<origin xyz rpy>`` if present three finite numbers each [m], [rad];
+   matrix positive semidefinite (a zero principal moment — a thin rod — is accepted with a
+   note: the model's ``M(q)`` is checked positive definite when it is built) and its
+   principal moments satisfying the triangle inequality (refused, naming the link and
+   ``--repair-inertias``; with ``repair_inertias`` the nearest inertia that satisfies it is
+   written in instead, :mod:`~twolink_pin.model.inertia_repair`);
+   ``<origin xyz rpy>`` if present three finite numbers each [m], [rad]. A link that never
+   moves (the root link, and links fixed to it through fixed joints only: a static base)
+   needs finite numbers only: a mass 0 with an inertia, or an inertia that no body has, is
+   accepted with a note;
 5. every ``<joint>``: ``type`` one of :data:`JOINT_TYPES`; ``<origin xyz rpy>`` if present
    three finite numbers each; for revolute, continuous, prismatic and planar joints the
    ``<axis xyz>`` if present three finite numbers with a nonzero norm (URDF's default axis
@@ -65,10 +72,11 @@ import re
 import xml.etree.ElementTree as ET
 from collections import Counter
 from collections.abc import Sequence
-from typing import Final
+from typing import Final, NamedTuple
 
 from twolink_pin.errors import InputFileError, InvalidURDFError
 from twolink_pin.files import read_input_file
+from twolink_pin.model.inertia_repair import InertiaRepair
 from twolink_pin.model.urdf_elements import (
     AXIS_JOINT_TYPES,
     JOINT_TYPES,
@@ -84,6 +92,8 @@ __all__ = [
     "MAX_LINKS",
     "MAX_URDF_BYTES",
     "TRIANGLE_RTOL",
+    "CheckedURDF",
+    "check_urdf_file",
     "validate_urdf_file",
     "validate_urdf_string",
 ]
@@ -106,15 +116,28 @@ with lines on stderr, at a few hundred)."""
 _ROBOT = "<robot>"
 
 
-def validate_urdf_file(path: str | os.PathLike[str]) -> str:
-    """Check that a URDF file can safely be given to Pinocchio.
+class CheckedURDF(NamedTuple):
+    """A URDF document that passed the checks (:func:`check_urdf_file`)."""
+
+    text: str
+    """The document checked (UTF-8 text), repaired inertias written in: what Pinocchio builds."""
+    notes: tuple[str, ...]
+    """What was accepted with a note (a static link's mass 0, a thin rod's zero moment)."""
+    repairs: tuple[InertiaRepair, ...]
+    """The inertias replaced (``repair_inertias=True``), one per link."""
+
+
+def check_urdf_file(path: str | os.PathLike[str], repair_inertias: bool = False) -> CheckedURDF:
+    """Check that a URDF file can safely be given to Pinocchio, with what was accepted.
 
     Args:
         path: The URDF file.
+        repair_inertias: Replace each inertia that breaks the triangle inequality by the nearest
+            one that satisfies it (:mod:`~twolink_pin.model.inertia_repair`) instead of refusing it.
 
     Returns:
-        The document checked (UTF-8 text): give this to Pinocchio (``buildModelFromXML``),
-        not the file again, so that what is built is what was checked.
+        The document checked (give its ``text`` to Pinocchio's ``buildModelFromXML``, not the file
+        again, so that what is built is what was checked), its notes and repairs.
 
     Raises:
         InvalidURDFError: If the file is missing or unreadable (element ``file``), is not
@@ -126,8 +149,20 @@ def validate_urdf_file(path: str | os.PathLike[str]) -> str:
         data = read_input_file(name, MAX_URDF_BYTES, "a URDF file")
     except InputFileError as err:
         raise InvalidURDFError(name, "file", err.reason) from None
-    _validate_robot(_parse(data, name), name)
-    return data.decode("utf-8")
+    root = _parse(data, name)
+    notes, repairs = _validate_robot(root, name, repair_inertias)
+    text = ET.tostring(root, encoding="unicode") if repairs else data.decode("utf-8")
+    return CheckedURDF(text, notes, repairs)
+
+
+def validate_urdf_file(path: str | os.PathLike[str]) -> str:
+    """Check that a URDF file can safely be given to Pinocchio; the document checked (UTF-8
+    text), as :func:`check_urdf_file` without repairs.
+
+    Raises:
+        InvalidURDFError: see :func:`check_urdf_file`.
+    """
+    return check_urdf_file(path).text
 
 
 def validate_urdf_string(xml: str, path: str = "<string>") -> None:
@@ -203,7 +238,9 @@ def _depth(root: ET.Element) -> int:
     return deepest
 
 
-def _validate_robot(robot: ET.Element, path: str) -> None:
+def _validate_robot(
+    robot: ET.Element, path: str, repair: bool = False
+) -> tuple[tuple[str, ...], tuple[InertiaRepair, ...]]:
     if robot.tag != "robot":
         raise InvalidURDFError(path, f"<{robot.tag}>", f"root element is <{robot.tag}>; expected <robot>")
     links = robot.findall("link")
@@ -234,14 +271,35 @@ def _validate_robot(robot: ET.Element, path: str) -> None:
 
     link_names = _names(links, "link", path)
     joint_names = _names(joints, "joint", path)
-    for link, name in zip(links, link_names, strict=True):
-        check_link(link, f"link '{name}'", path)
     known = set(link_names)
     edges = [
         check_joint(joint, f"joint '{name}'", link_names, known, path)
         for joint, name in zip(joints, joint_names, strict=True)
     ]
-    _check_tree(link_names, joint_names, edges, path)
+    root = _check_tree(link_names, joint_names, edges, path)
+    static = _static_links(root, joints, edges)
+    notes: list[str] = []
+    repairs: list[InertiaRepair] = []
+    for link, name in zip(links, link_names, strict=True):
+        found = check_link(link, f"link '{name}'", path, static=name in static, repair=repair)
+        notes += found.notes
+        if found.repair is not None:
+            repairs.append(found.repair)
+    return tuple(notes), tuple(repairs)
+
+
+def _static_links(root: str, joints: Sequence[ET.Element], edges: Sequence[tuple[str, str]]) -> set[str]:
+    """The links that never move: the root link and those fixed to it through fixed joints only."""
+    fixed: dict[str, list[str]] = {}
+    for joint, (parent, child) in zip(joints, edges, strict=True):
+        if joint.get("type") == "fixed":
+            fixed.setdefault(parent, []).append(child)
+    static, stack = {root}, [root]
+    while stack:
+        for child in fixed.get(stack.pop(), []):
+            static.add(child)
+            stack.append(child)
+    return static
 
 
 def _names(elements: Sequence[ET.Element], kind: str, path: str) -> list[str]:
@@ -267,7 +325,8 @@ def _names(elements: Sequence[ET.Element], kind: str, path: str) -> list[str]:
 
 def _check_tree(
     link_names: Sequence[str], joint_names: Sequence[str], edges: Sequence[tuple[str, str]], path: str
-) -> None:
+) -> str:
+    """Check that the links form one tree; its root link."""
     parent_joint: dict[str, str] = {}
     children: dict[str, list[str]] = {name: [] for name in link_names}
     for joint_name, (parent, child) in zip(joint_names, edges, strict=True):
@@ -312,3 +371,4 @@ def _check_tree(
                 f"link '{name}'",
                 f"is not connected to root link '{root}': its joints form a cycle; expected a tree",
             )
+    return root

@@ -35,7 +35,6 @@ from twolink_pin.feasibility import check_torques
 from twolink_pin.files import output_directory
 from twolink_pin.law_variant import Variant, file_stem, parse_variants
 from twolink_pin.metrics import Metrics
-from twolink_pin.model import load_robot
 from twolink_pin.report import facts, sim_to_sim
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
@@ -90,13 +89,15 @@ def build_report(
     """
     options = options if options is not None else ReportOptions()
     started = time.perf_counter()
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     sections = robot.profile.report.sections  # the robot's own sections (the twolink's course report)
     variants = laws_to_run(options, robot)
     laws = [v.law for v in variants]
     options.run.check_law_gains(laws)
-    options.run.check_effective(robot, laws, reference_trajectory(robot, options))
-    rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
+    reference = reference_trajectory(robot, options)
+    options.run.check_effective(robot, laws, reference)
+    # every row's law built once, and its step checked, before any run
+    rows = build_rows(options.run, variants, robot, trajectory=reference)
     steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
     steps += 1 if options.sim_to_sim else 0
     steps += sections.steps(options, laws) if sections else 0

@@ -4,6 +4,7 @@ and the report's own options beside it)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.openmp import available_cores
@@ -45,6 +46,8 @@ class ReportOptions:
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
             the report's.
+        repair_inertias: Load the robot with its triangle-breaking inertias repaired
+            (``--repair-inertias``; None: the profile's choice).
     """
 
     run: RunSpec = field(default_factory=lambda: RunSpec(shared=True))
@@ -56,7 +59,17 @@ class ReportOptions:
     identification: bool = True
     limits_section: bool = True
     trajectory: str | None = None
+    repair_inertias: bool | None = None
     sim_to_sim: bool = True
+
+    def load_robot(self) -> Any:
+        """The robot these options name (a :class:`~twolink_pin.model.RobotModel`), loaded here."""
+        from twolink_pin.controllers.loading import check_profile_gains
+        from twolink_pin.model import load_robot
+
+        robot = load_robot(self.robot, payload=self.payload, repair_inertias=self.repair_inertias)
+        check_profile_gains(robot)
+        return robot
 
     def __post_init__(self) -> None:
         if self.workers is None:

@@ -11,7 +11,6 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.feasibility import check_torques
 from twolink_pin.law_variant import Variant, file_stem
 from twolink_pin.metrics import Metrics, compute_metrics
-from twolink_pin.model import load_robot
 from twolink_pin.report.options import ReportOptions
 from twolink_pin.simulation import SimulationResult, simulate
 from twolink_pin.trajectory import default_trajectory
@@ -47,7 +46,7 @@ def run_law(
     from twolink_pin.plotting.run import wrench_spans
 
     start = time.perf_counter()
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     cls, key = variant.law_class(), variant.key
     prefix, title = file_stem(key), cls.title if key == cls.name else f"{cls.title}, {key}"
     controller, plant = options.run.for_law(variant).build(robot)
@@ -71,7 +70,7 @@ def trajectory_figures(
     """Worker: the desired trajectory's figures (picklable arguments only)."""
     from twolink_pin.plotting import save_trajectory_figures
 
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     trajectory = reference_trajectory(robot, options)
     check = check_torques(robot, trajectory)
     paths = save_trajectory_figures(robot, trajectory, check, Path(fig_dir), figure_numbers=figure_numbers)

@@ -47,7 +47,6 @@ from twolink_pin.errors import ControllerError, InvalidParameterError, Simulatio
 from twolink_pin.law_variant import Variant, parse_variant
 from twolink_pin.limits import POSITION, joint_limits
 from twolink_pin.metrics import compute_metrics
-from twolink_pin.model import load_robot
 from twolink_pin.report.options import ReportOptions
 from twolink_pin.report.runs import reference_trajectory
 from twolink_pin.simulation import SimulationConfig, simulate
@@ -193,7 +192,7 @@ def inactive(key: str, robot: Any, plain: dict[str, Any]) -> str | None:
 def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[str, Any]:
     """Worker: the rows of one law of the report (module docstring)."""
     start, cpu = time.perf_counter(), time.process_time()
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     trajectory = reference_trajectory(robot, options)
     effects = arm_effects(robot, options)
     keys = {f"MuJoCo + {e['label']}": e["key"] for e in effects}

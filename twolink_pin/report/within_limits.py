@@ -55,7 +55,6 @@ from twolink_pin.errors import (
 from twolink_pin.law_variant import Variant
 from twolink_pin.limits import ACCELERATION, EFFORT, VELOCITY, LimitsCheck, check_limits, joint_limits
 from twolink_pin.metrics import compute_metrics
-from twolink_pin.model import load_robot
 from twolink_pin.report.options import ReportOptions
 from twolink_pin.report.runs import reference_trajectory
 from twolink_pin.simulation import simulate
@@ -169,7 +168,7 @@ def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stag
     from twolink_pin.trajectory.file import write_trajectory_file
 
     start = time.perf_counter()
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     designed, notes = _design(robot, reference_trajectory(robot, options))
     folder = Path(stage) / "references"
     folder.mkdir(exist_ok=True)

@@ -15,6 +15,7 @@
 ``containment.py``     a law's one door: read-only inputs, sys.exit / MemoryError named, its output checked
 ``deadline.py``        the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law
 ``result.py``          :class:`SimulationResult`
+``step_check.py``      the step checked before a run: the start's fastest mode against the integrator's bound
 ``run.py``             :func:`simulate` (N = 1, recorded)
 ``storage.py``         results as ``.npz``
 =====================  ======================================================================================

@@ -66,6 +66,9 @@ class SimulationConfig:
         control_period: Sampling period of the law [s], a whole multiple of ``dt``
             (``rk4`` only): τ and ż held over each period. ``None`` (default): the law
             is evaluated at every RK4 stage.
+        check_step: Check before the run that the step is within the integrator's stability
+            bound on the fastest mode of the start, and refuse it otherwise
+            (:mod:`twolink_pin.simulation.step_check`); False (``--no-step-check``): run anyway.
     """
 
     duration: float = 30.0
@@ -76,8 +79,11 @@ class SimulationConfig:
     rtol: float = 1.0e-9
     atol: float = 1.0e-11
     control_period: float | None = None
+    check_step: bool = True
 
     def __post_init__(self) -> None:
+        if not isinstance(self.check_step, bool):
+            raise InvalidParameterError("check_step", self.check_step, "True or False")
         _positive_finite("duration", self.duration, "s")
         _positive_finite("dt", self.dt, "s")
         _positive_finite("rtol", self.rtol, "")
@@ -138,8 +144,8 @@ def joint_offsets(name: str, value: float | tuple[float, ...] | None, default: A
     if chosen is None:
         return np.zeros(nv)
     array = (
-        np.broadcast_to(np.asarray(chosen, dtype=float), (nv,))
-        if np.ndim(chosen) == 0
+        np.broadcast_to(np.asarray(chosen, dtype=float).reshape(()), (nv,))
+        if np.size(chosen) == 1  # one value: a number, or a list of one (a profile's [0.1])
         else np.asarray(chosen, dtype=float)
     )
     if array.shape != (nv,):
@@ -147,3 +153,12 @@ def joint_offsets(name: str, value: float | tuple[float, ...] | None, default: A
             name, tuple(np.atleast_1d(chosen).tolist()), f"one value, or {nv} values (one per joint)"
         )
     return np.array(array)
+
+
+def initial_state(plant: Any, trajectory: Any, config: SimulationConfig) -> tuple[np.ndarray, np.ndarray]:
+    """``q(0) = q_d(0) + q0_offset`` and ``q̇(0) = q̇_d(0) + v0_offset``, shape (nv,) each."""
+    nv = plant.robot.nv
+    ref0 = trajectory.sample(0.0)
+    q0 = ref0.q + joint_offsets("q0_offset", config.q0_offset, plant.robot.profile.q0_offset, nv)
+    v0 = ref0.v + joint_offsets("v0_offset", config.v0_offset, None, nv)
+    return q0, v0

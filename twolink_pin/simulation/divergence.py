@@ -67,13 +67,37 @@ def with_plant(detail: str, plant_why: Callable[[int], str | None] | None, run: 
     return f"{detail}; {cause}" if cause else detail
 
 
-def state_detail(q: np.ndarray, v: np.ndarray, z: np.ndarray, mask: np.ndarray) -> str:
-    """What is wrong with the state of the runs in ``mask``: non-finite, or its largest entry."""
+def _entry(index: int, nv: int) -> str:
+    """The state entry ``index`` of ``(q, q̇, z)`` in words (joints 1-based)."""
+    if index < nv:
+        return f"q of joint {index + 1} [rad]"
+    if index < 2 * nv:
+        return f"q̇ of joint {index - nv + 1} [rad/s]"
+    return f"the law's state z[{index - 2 * nv}]"
+
+
+def state_detail(
+    q: np.ndarray,
+    v: np.ndarray,
+    z: np.ndarray,
+    mask: np.ndarray,
+    before: tuple[np.ndarray, ...] | None = None,
+) -> str:
+    """What is wrong with the state of the runs in ``mask``: its largest entry, named (the joint
+    whose mode grew: ``|state| = 4.5e+04 > 10000 (q̇ of joint 7 [rad/s])``), or non-finite — then
+    with the largest entry of the sound sample ``before`` it (its q, q̇, z), when given."""
+    nv = q.shape[-1]
     values = np.concatenate([np.abs(q[mask]).ravel(), np.abs(v[mask]).ravel(), np.abs(z[mask]).ravel()])
     worst = float(np.max(values)) if values.size else math.nan
     if not math.isfinite(worst) or np.isnan(values).any():
-        return "non-finite state"
-    return f"|state| = {worst:.3g} > {DIVERGENCE_LIMIT:g}"
+        if before is None:
+            return "non-finite state"
+        sound = np.concatenate([np.abs(x[mask]).ravel() for x in before])
+        if not sound.size or not np.isfinite(sound).all():
+            return "non-finite state"
+        i = int(np.argmax(sound))
+        return f"non-finite state (the sample before's largest entry: {_entry(i, nv)} = {sound[i]:.3g})"
+    return f"|state| = {worst:.3g} > {DIVERGENCE_LIMIT:g} ({_entry(int(np.argmax(values)), nv)})"
 
 
 def flag_block(
@@ -115,13 +139,17 @@ def flag_block(
             if raise_now:
                 raise ControllerError(name, t, what)
         else:
-            what = state_detail(
-                Q[start + first], V[start + first], Z[start + first], np.eye(len(alive), dtype=bool)[r]
-            )
             row = start + first
+            what = state_detail(
+                Q[row],
+                V[row],
+                Z[row],
+                np.eye(len(alive), dtype=bool)[r],
+                (Q[row - 1], V[row - 1], Z[row - 1]) if row > 0 else None,
+            )
             if (
                 row > 0
-                and what == "non-finite state"
+                and what.startswith("non-finite state")
                 and not (bad_rows(Q[row - 1 : row]) | bad_rows(V[row - 1 : row]))[0, r]
             ):
                 what += (

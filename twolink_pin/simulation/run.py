@@ -11,10 +11,11 @@ from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.adaptive_step import integrate_adaptive
-from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, joint_offsets
+from twolink_pin.simulation.config import SimulationConfig, check_recorded_size, initial_state
 from twolink_pin.simulation.engine import Samples, integrate
 from twolink_pin.simulation.result import SimulationResult
 from twolink_pin.simulation.sensing import check_contact_setup
+from twolink_pin.simulation.step_check import require_stable_step
 from twolink_pin.trajectory import Trajectory
 
 
@@ -39,17 +40,6 @@ def check_setup(controller: Controller, plant: Plant, trajectory: Trajectory) ->
             "trajectory", f"{trajectory.nv} joints", f"a trajectory for the plant's {nv} joints"
         )
     check_contact_setup(controller, plant, trajectory)
-
-
-def initial_state(
-    plant: Plant, trajectory: Trajectory, config: SimulationConfig
-) -> tuple[np.ndarray, np.ndarray]:
-    """``q(0) = q_d(0) + q0_offset`` and ``q̇(0) = q̇_d(0) + v0_offset``, shape (nv,) each."""
-    nv = plant.robot.nv
-    ref0 = trajectory.sample(0.0)
-    q0 = ref0.q + joint_offsets("q0_offset", config.q0_offset, plant.robot.profile.q0_offset, nv)
-    v0 = ref0.v + joint_offsets("v0_offset", config.v0_offset, None, nv)
-    return q0, v0
 
 
 def estimated_truth(controller: Controller, plant: Plant) -> np.ndarray | None:
@@ -87,6 +77,9 @@ def simulate(
         InvalidParameterError: the law, plant and trajectory disagree on nv, offsets of the
             wrong length, per-run gains (use :func:`twolink_pin.simulate_batch`), or exact-sign
             friction with the adaptive method.
+        StepTooLargeError: ``dt`` (or the control period) beyond the integrator's stability bound on
+            the fastest mode of the start (:mod:`~twolink_pin.simulation.step_check`; refused before
+            the run unless ``config.check_step`` is False).
         SimulationDivergedError: the state became non-finite or absurd (the time is given).
         ControllerError: the law raised, or returned the wrong shape or a non-finite torque.
     """
@@ -102,6 +95,7 @@ def simulate(
     q0, v0 = initial_state(plant, trajectory, config)
     z0 = np.atleast_2d(np.asarray(controller.initial_state(), dtype=float)).reshape(1, -1)
     check_recorded_size(config.steps, plant.robot.nv, z0.shape[1])
+    require_stable_step(controller, plant, trajectory, config)
     samples = _recorded_run(controller, plant, trajectory, config, q0, v0, z0)
     return _single_result(controller, plant, trajectory, config, samples)
 

@@ -27,6 +27,7 @@ from twolink_pin.plant import Plant
 from twolink_pin.simulation import EngineRun, SimulationConfig, estimated_truth, integrate
 from twolink_pin.simulation.config import check_recorded_size
 from twolink_pin.simulation.run import check_setup, initial_state, state_labels
+from twolink_pin.simulation.step_check import require_stable_step
 from twolink_pin.simulation.terms import check_parallel, threads_for
 from twolink_pin.studies.progress import Progress, progress_callback
 from twolink_pin.task_metrics import RunningTaskMetrics, TaskMetrics
@@ -182,6 +183,8 @@ def simulate_batch(
 
     Raises:
         InvalidParameterError: inconsistent N, bad offsets, ``method != "rk4"``.
+        StepTooLargeError: one gain set for every run, and ``dt`` beyond RK4's stability bound on
+            the fastest mode of the start (:mod:`~twolink_pin.simulation.step_check`).
         BatchUnavailableError: this Pinocchio has no parallel algorithms.
     """
     check_parallel()
@@ -197,6 +200,10 @@ def simulate_batch(
     z0 = np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
     if record:
         check_recorded_size(config.steps, nv, controller.state_size, n)
+    # one gain set: its step checked as a single run's (per-run gains are not: a run beyond its bound
+    # diverges and is flagged, the others go on)
+    if controller.runs is None:
+        require_stable_step(controller, plant, trajectory, config)
     used = threads_for(n, threads) if n > 1 else 1
     samples, dt = config.steps + 1, config.duration / config.steps
     observer = RunningMetrics(n, nv, dt, samples, trajectory.period, plant.joint_limits, plant.applied_torque)

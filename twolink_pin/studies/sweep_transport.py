@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import hashlib
+import json
 import shutil
 import tempfile
 import threading
@@ -64,6 +65,9 @@ class RobotSource:
     """End-effector frame name."""
     digest: str
     """:func:`_robot_digest` of the client's robot."""
+    profile: str | None = None
+    """The robot's profile file as text (None: the catalog's, or a plain URDF's generic one); its
+    ``urdf`` key is pointed at the URDF text shipped beside it."""
 
     @classmethod
     def of(cls, robot: RobotModel) -> RobotSource:
@@ -75,8 +79,10 @@ class RobotSource:
             with contextlib.suppress(Exception):
                 own = catalog.resolve(robot.name)[0]
                 in_catalog = own.exists() and Path(robot.urdf_path).samefile(own)
-        text = None if in_catalog else Path(robot.urdf_path).read_text(encoding="utf-8")
-        return cls(robot.name, text, float(robot.payload), robot.ee_frame, _robot_digest(robot))
+        text = None if in_catalog else (robot.urdf_text or Path(robot.urdf_path).read_text(encoding="utf-8"))
+        file = robot.profile.file
+        profile = None if in_catalog or file is None else Path(file).read_text(encoding="utf-8")
+        return cls(robot.name, text, float(robot.payload), robot.ee_frame, _robot_digest(robot), profile)
 
     def load(self) -> RobotModel:
         """The robot, rebuilt here (a URDF into this process's :func:`_stored` files).
@@ -89,6 +95,15 @@ class RobotSource:
         source: str | Path = self.name
         if self.urdf is not None:
             source = _stored(f"{self.name}.urdf", self.urdf)
+        if self.profile is not None and self.urdf is not None:  # the profile, its urdf the text shipped
+            import tomllib
+
+            data = tomllib.loads(self.profile)
+            lines = [line for line in self.profile.splitlines() if not line.strip().startswith("urdf")]
+            if "name" not in data:
+                lines.insert(0, f"name = {json.dumps(self.name)}")
+            lines.insert(0, f"urdf = {json.dumps(str(source))}")
+            source = _stored(f"{self.name}.toml", "\n".join(lines) + "\n")
         robot = load_robot(source, payload=self.payload)
         if robot.ee_frame != self.ee_frame or _robot_digest(robot) != self.digest:
             robot = load_robot(source, payload=self.payload, ee_frame=self.ee_frame)

@@ -50,11 +50,12 @@ def default_trajectory(robot: RobotModel) -> JointTrajectory:
 def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
     """A periodic reference for any arm: each joint leaves its home
     (:func:`home_configuration`), swings ``+a_j``, back, ``−a_j`` and back, odd joints out
-    of phase with even ones; ``a_j = min(NEUTRAL_AMPLITUDE, 25 % of the range,
+    of phase with even ones; ``a_j = min(A, 25 % of the range,
     LIMIT_MARGIN × the room from home to the nearer limit (allowing for the polynomial's
     overshoot of its via points), LIMIT_MARGIN × the amplitude at
-    which the peak speed reaches the URDF's velocity limit)`` (a velocity limit of 0, as
-    in a URDF that gives none, is no limit).
+    which the peak speed reaches the URDF's velocity limit)`` with ``A`` the profile's
+    ``amplitude``, else :data:`NEUTRAL_AMPLITUDE` (a velocity limit of 0, as in a URDF that
+    gives none, is no limit).
     """
     limits = joint_limits(robot)
     lower, upper = np.array(limits.position_lower), np.array(limits.position_upper)
@@ -71,7 +72,7 @@ def neutral_motion(robot: RobotModel, period: float = 4.0) -> JointTrajectory:
     speed_limit = limits.velocity
     amplitude = np.minimum.reduce(
         [
-            np.full(robot.nv, NEUTRAL_AMPLITUDE),
+            np.full(robot.nv, robot.profile.amplitude or NEUTRAL_AMPLITUDE),
             0.25 * span,
             LIMIT_MARGIN * room / unit_peak,
             LIMIT_MARGIN * speed_limit / unit_speed,

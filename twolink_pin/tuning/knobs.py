@@ -105,7 +105,7 @@ def _components(value: Any, matrix: bool) -> list[float] | None:
     array = np.asarray(value, dtype=float)
     if array.ndim == 0:
         return None
-    if matrix:
+    if matrix and array.ndim >= 2:  # a full matrix (a diagonal one comes as its k numbers)
         square = array.reshape(-1, array.shape[-1], array.shape[-1])[0]
         return [float(x) for x in np.diag(square)]
     return [float(x) for x in array.reshape(-1)]

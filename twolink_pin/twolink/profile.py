@@ -1,56 +1,51 @@
-"""The twolink's entry in the robot catalog: its URDF, the lumped map, the report's defaults.
+"""The twolink's entry in the robot catalog: ``robots/twolink.toml`` plus what only code can say.
 
-Importing this module registers the twolink in :mod:`twolink_pin.model.catalog` (the
-package's ``__init__`` does).
+Its profile file holds the data — the URDF, the report's gains, friction, initial offset and via
+points (checked against :mod:`twolink_pin.twolink.reference` by the tests); this module adds the
+lumped parameter map and the report's own sections, and registers the twolink in
+:mod:`twolink_pin.model.catalog` (the package's ``__init__`` imports it).
 """
 
 from __future__ import annotations
 
-from importlib import resources
+import dataclasses
+import functools
 from pathlib import Path
 from types import MappingProxyType
 
 from twolink_pin.model import catalog
-from twolink_pin.model.profile import ArmEffects, ReportProfile, RobotProfile, TrajectorySpec
+from twolink_pin.model.profile import ReportProfile, RobotProfile
+from twolink_pin.model.profile_file import read_profile_file
 from twolink_pin.twolink import reference
 from twolink_pin.twolink.course_report import ANIMATED_LAW, CourseReport
 from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
 
+PROFILE_FILE = "twolink.toml"
+"""The twolink's profile file in the package's ``robots`` folder."""
+
 
 def twolink_urdf_path() -> Path:
     """Path of the shipped ``twolink.urdf`` (works from a checkout and an installed wheel)."""
-    return Path(str(resources.files("twolink_pin.robots").joinpath("twolink.urdf")))
+    return catalog.package_folder() / "twolink.urdf"
 
 
-TWOLINK = RobotProfile(
-    name="twolink",
-    description="the course report's 2-link planar arm (horizontal, p = (3.4, 0.4, 0.3) kg·m²)",
-    parameter_map=TwoLinkLumpedMap,
-    gain_presets=MappingProxyType({k: MappingProxyType(v) for k, v in reference.REPORT_GAINS.items()}),
-    friction=reference.REPORT_FRICTION,
-    q0_offset=reference.Q0_OFFSET,
-    trajectory=TrajectorySpec(
-        times=reference.REPORT_TIMES, cartesian_points=reference.REPORT_VIA_XY, branch=0
-    ),
-    ee_frame="ee_link",
-    effects=ArmEffects(
-        armature=reference.ARMATURE,
-        damping=reference.REPORT_FRICTION[0],
-        frictionloss=reference.REPORT_FRICTION[1],
-        source="armature: the MuJoCo Menagerie's Panda (franka_emika_panda/panda.xml), the report giving no "
-        "drive data; damping and dry friction: the report's viscous V and Coulomb C friction",
-    ),
-    source="robots/twolink.urdf (this package)",
-    report=ReportProfile(
-        laws=reference.REPORT_CONTROLLERS,
-        animated_law=ANIMATED_LAW,
-        figure_numbers=MappingProxyType(
-            {k: MappingProxyType(v) for k, v in reference.REPORT_FIGURES.items()}
+@functools.cache
+def twolink_entry() -> tuple[Path, RobotProfile]:
+    """The twolink's URDF and profile: its profile file, the lumped map and the report's sections."""
+    urdf, profile = read_profile_file(catalog.package_folder() / PROFILE_FILE, "twolink")
+    return urdf, dataclasses.replace(
+        profile,
+        parameter_map=TwoLinkLumpedMap,
+        source="robots/twolink.urdf (this package)",
+        report=ReportProfile(
+            laws=reference.REPORT_CONTROLLERS,
+            animated_law=ANIMATED_LAW,
+            figure_numbers=MappingProxyType(
+                {k: MappingProxyType(v) for k, v in reference.REPORT_FIGURES.items()}
+            ),
+            sections=CourseReport(),
         ),
-        sections=CourseReport(),
-    ),
-)
-"""The twolink's profile: the report's gains, friction, initial offset, via points and what
-its report shows (the report's five laws, its figure numbers, its sections)."""
+    )
 
-catalog.register("twolink", lambda: (twolink_urdf_path(), TWOLINK))
+
+catalog.register("twolink", twolink_entry)

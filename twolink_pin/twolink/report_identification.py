@@ -11,8 +11,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.model import load_robot
-
 if TYPE_CHECKING:
     from twolink_pin.report.options import ReportOptions
 
@@ -62,7 +60,7 @@ def _excitation_run(options: ReportOptions, key: str) -> tuple[np.ndarray, np.nd
     """Worker: the report's adaptive law along the reference ``key``: ``(t [s], p̂)``."""
     from twolink_pin.twolink import excitation as twolink_excitation
 
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     result = twolink_excitation.adaptive_runs(robot, duration=options.run.simulation.duration, keys=(key,))[
         key
     ]
@@ -84,7 +82,7 @@ def _identification_fit(options: ReportOptions, fig_dir: str) -> tuple[list[str]
     from twolink_pin.plotting.identification import save_excitation_figures, save_identification_figures
     from twolink_pin.twolink import excitation as twolink_excitation
 
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     p = np.asarray(robot.p, dtype=float)
     log = simulate_log(
         robot, twolink_excitation.identification_excitation(), duration=options.run.simulation.duration
@@ -136,7 +134,7 @@ def _identification_section(
     from twolink_pin.plotting.identification import save_convergence_figure
     from twolink_pin.twolink import excitation as twolink_excitation
 
-    robot = load_robot(options.robot, payload=options.payload)
+    robot = options.load_robot()
     duration = options.run.simulation.duration
     section: dict[str, Any] = {
         "table": twolink_excitation.excitation_table(robot),

@@ -18,9 +18,23 @@ if TYPE_CHECKING:
 
 
 def robot_from_args(args: argparse.Namespace) -> RobotModel:
+    """The robot of ``--robot``, ``--payload`` and ``--repair-inertias``; what the loader accepted
+    with a note, and each inertia it repaired, said once on stderr."""
+    from twolink_pin.controllers.loading import check_profile_gains
     from twolink_pin.model import load_robot
 
-    return load_robot(args.robot, payload=getattr(args, "payload", 0.0))
+    repair = getattr(args, "repair_inertias", False) or None  # None: the profile's choice
+    robot = load_robot(args.robot, payload=getattr(args, "payload", 0.0), repair_inertias=repair)
+    check_profile_gains(robot)
+    said = getattr(args, "notes_said", None)
+    if said is None or robot.name not in said:
+        for note in robot.notes:
+            print(f"twolink-pin: note: {note}", file=sys.stderr, flush=True)
+        for change in robot.repairs:
+            print(f"twolink-pin: note: repaired inertia of {change.describe()}", file=sys.stderr, flush=True)
+        if said is not None:
+            said.add(robot.name)
+    return robot
 
 
 def trajectory_from_args(args: argparse.Namespace, robot: RobotModel) -> Trajectory:
@@ -41,6 +55,7 @@ def _config(args: argparse.Namespace) -> SimulationConfig:
         method=args.method,
         q0_offset=None if offset is None else (offset[0] if len(offset) == 1 else tuple(offset)),
         control_period=args.control_period,
+        check_step=getattr(args, "check_step", True),
     )
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from twolink_pin.cli.commands.common import robot_from_args, trajectory_from_args
 from twolink_pin.cli.output import emit, fmt, limits_check_lines, limits_payload, pose_lines
-from twolink_pin.errors import InvalidParameterError
+from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 
 if TYPE_CHECKING:
     from twolink_pin.limits import JointLimits
@@ -42,7 +42,11 @@ def cmd_info(args: argparse.Namespace) -> int:
         "joint_names": list(limits.joint_names),
         "limits": limits.as_dict(),
         "home": robot.home.tolist(),
+        "home_source": robot.profile.home_source or "the robot's profile",
         "home_pose": home_pose,
+        "profile": None if robot.profile.file is None else str(robot.profile.file),
+        "notes": list(robot.notes),
+        "repaired_inertias": [change._asdict() for change in robot.repairs],
         "parameter_names": list(robot.parameter_map.names),
         "p": robot.p.tolist(),
         "base_parameters": {
@@ -72,6 +76,7 @@ def cmd_info(args: argparse.Namespace) -> int:
             *limits_table(limits),
             f"home       q = [{', '.join(_exact(x) for x in robot.home)}] rad, end effector at",
             *home_lines,
+            f"  how      {robot.profile.home_source or 'given by the robot profile'}",
             f"payload    {robot.payload:g} kg",
             f"parameters {p_text}",
             f"base       {base.size} identifiable base parameters (twolink-pin info --json lists them)"
@@ -143,8 +148,14 @@ def cmd_robots(args: argparse.Namespace) -> int:
     from twolink_pin.model import catalog, load_robot
 
     rows = []
-    for name in catalog.names():
-        robot = load_robot(name)
+    mine = {name: file for name, file in catalog.user_profiles().items() if name not in catalog.CATALOG}
+    broken: dict[str, str] = {}
+    for name in (*catalog.names(), *mine):
+        try:
+            robot = load_robot(name if name not in mine else mine[name])
+        except TwolinkPinError as exc:  # a profile of the user's that does not load: said, not fatal
+            broken[name] = str(exc)
+            continue
         model = robot.model
         rows.append(
             {
@@ -163,6 +174,7 @@ def cmd_robots(args: argparse.Namespace) -> int:
                 "base_parameters": robot.parameter_map.size if name != "twolink" else 4,
                 "description": robot.profile.description,
                 "source": robot.profile.source,
+                "profile": None if robot.profile.file is None else str(robot.profile.file),
             }
         )
     lines = []
@@ -181,7 +193,14 @@ def cmd_robots(args: argparse.Namespace) -> int:
     lines.append(
         "effort limit 'none': the URDF gives none (or 0); no torque check or saturation on that joint"
     )
-    emit(args, {"robots": rows}, "\n".join(lines))
+    lines += [f"{name:16s} does not load: {why}" for name, why in broken.items()]
+    lines.append(
+        f"your profiles: {catalog.user_folder()} ({len(mine)} found; $TWOLINK_PIN_ROBOTS names another folder), "
+        "or --robot FILE.toml"
+    )
+    emit(
+        args, {"robots": rows, "broken": broken, "user_folder": str(catalog.user_folder())}, "\n".join(lines)
+    )
     return 0
 
 

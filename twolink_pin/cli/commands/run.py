@@ -196,7 +196,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     laws = [v.law for v in variants]
     shared.check_law_gains(laws)
     shared.check_effective(robot, laws, reference)
-    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot))
+    rows = build_rows(shared, variants, robot, lambda spec: identified_parameters(spec, robot), reference)
     warnings: list[str] = []  # printed once the progress bar is gone
     with output_directory(args.out, ".twolink-pin-compare") as stage:
         bar = progress_bar(len(rows), "run", "compare")
@@ -426,6 +426,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         limits_section=not args.no_limits_section,
         sim_to_sim=not args.no_sim_to_sim,
         trajectory=args.trajectory,
+        repair_inertias=args.repair_inertias or None,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))
     bar = progress_bar(1, "step", "report")
@@ -460,12 +461,13 @@ def run_record(args: argparse.Namespace, spec: RunSpec) -> dict[str, Any]:
     from pathlib import Path as _Path
 
     robot = args.robot
-    if robot is not None and (robot.endswith(".urdf") or "/" in robot):
+    if robot is not None and (robot.endswith((".urdf", ".toml")) or "/" in robot):
         robot = str(_Path(robot).resolve())
     trajectory = getattr(args, "trajectory", None)
     return {
         "robot": robot,
         "payload": args.payload,
+        "repair_inertias": bool(getattr(args, "repair_inertias", False)),
         "trajectory": None if trajectory is None else str(_Path(trajectory).resolve()),
         "run": spec.as_dict(),
     }
@@ -487,7 +489,8 @@ def _saved_run(args: argparse.Namespace) -> tuple[RobotModel, Trajectory, Simula
         source = record.get("robot") or (result.robot if result.robot in catalog.CATALOG else None)
         if "payload" in record and payload == 0.0:
             payload = float(record["payload"])
-    robot = load_robot(source, payload=payload)
+    repair = bool(getattr(args, "repair_inertias", False) or record.get("repair_inertias", False))
+    robot = load_robot(source, payload=payload, repair_inertias=repair or None)
     if result.q.shape[1] != robot.nq:
         raise InvalidParameterError(
             "--from",

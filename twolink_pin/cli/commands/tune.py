@@ -67,7 +67,16 @@ def cmd_tune(args: argparse.Namespace) -> int:
         return robot, trajectory_from_args(at, robot)
 
     def command_of(run: RunSpec, payload: float) -> str:
-        return command_line(simulate_argv(run, args.robot, payload, args.trajectory, args.scene))
+        return command_line(
+            simulate_argv(
+                run,
+                args.robot,
+                payload,
+                args.trajectory,
+                scene=args.scene,
+                repair_inertias=args.repair_inertias,
+            )
+        )
 
     def record_of(run: RunSpec, payload: float) -> dict[str, Any]:
         return run_record(argparse.Namespace(**(vars(args) | {"payload": payload})), run)
