@@ -181,6 +181,7 @@ def run_result(
     p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
     limits = plant.joint_limits
     measured = [rows.get(name) for name in ("q_measured", "v_measured")]
+    relaxed = controller.run_relaxations(0) if hasattr(controller, "run_relaxations") else None
     return SimulationResult(
         controller=controller.name,
         method=config.method,
@@ -214,4 +215,7 @@ def run_result(
         velocity_limits=readonly(limits.velocity),
         joint_names=limits.joint_names,
         position_stops=plant.position_stops,
+        relaxed_first_time=None if relaxed is None else readonly(relaxed.first_time),
+        relaxed_largest=None if relaxed is None else readonly(relaxed.largest),
+        relaxed_span=None if relaxed is None else readonly(np.array([relaxed.instants, relaxed.last_time])),
     )

@@ -28,6 +28,7 @@ import pinocchio as pin
 
 from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.simulation.containment import read_only
+from twolink_pin.simulation.preview import preview_offsets, previews
 from twolink_pin.trajectory import Trajectory, TrajectorySample
 from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory
 
@@ -101,10 +102,13 @@ def law_input(
     """The :class:`~twolink_pin.controllers.LawInput` the engine would build at time ``t`` [s]
     (to evaluate a law by itself, e.g. in a test): the reference ``q_des``, ``v_des``,
     ``a_des`` of shape (1, nv) and, for a task-space law, the desired frame from
-    ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics."""
+    ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics; for a
+    law that declares preview times, ``trajectory`` sampled there (None without a trajectory)."""
     joint = TrajectorySample(q_des, v_des, a_des, np.zeros_like(a_des))
     task = task_reference(controller, trajectory, np.array([t]), joint)
-    return LawInput(t, q, v, z, q_des, v_des, a_des, *(x[0] for x in task))
+    ahead = previews(preview_offsets(controller), trajectory, np.array([t]))[0]
+    px, pr, pw, pa = (x[0] for x in task)
+    return LawInput(t, q, v, z, q_des, v_des, a_des, px, pr, pw, pa, ahead)
 
 
 def reference_rows(
@@ -115,13 +119,18 @@ def reference_rows(
     rq: np.ndarray,
     rv: np.ndarray,
     ra: np.ndarray,
+    ahead: np.ndarray | None = None,
+    at: np.ndarray | None = None,
 ) -> list[tuple[Any, ...]]:
-    """Per sample time ``t`` [s], the seven reference fields of a
+    """Per sample time ``t`` [s], the eight reference fields of a
     :class:`~twolink_pin.controllers.LawInput` after ``(t, q, v, z)``: ``q_des``, ``v_des``,
-    ``a_des`` (the rows of the read-only ``rq``, ``rv``, ``ra``, each (K, 1, nv)) and the
-    four task fields of :func:`task_reference` (None for a law that is not task-space)."""
+    ``a_des`` (the rows of the read-only ``rq``, ``rv``, ``ra``, each (K, 1, nv)), the
+    four task fields of :func:`task_reference` (None for a law that is not task-space) and the
+    preview at the offsets ``ahead`` [s] (:mod:`twolink_pin.simulation.preview`; None without,
+    and at the times ``at`` (K,) bool leaves out)."""
     px, pr, pw, pa = task_reference(controller, trajectory, t, joint)
+    preview = previews(ahead, trajectory, t, at)
     # Rows by iteration (the same read-only views as rq[i]; no Python __getitem__ of NONES per row)
     if px is NONES:
-        return [(q, v, a, None, None, None, None) for q, v, a in zip(rq, rv, ra, strict=True)]
-    return list(zip(rq, rv, ra, px, pr, pw, pa, strict=True))
+        return [(q, v, a, None, None, None, None, p) for q, v, a, p in zip(rq, rv, ra, preview, strict=True)]
+    return list(zip(rq, rv, ra, px, pr, pw, pa, preview, strict=True))

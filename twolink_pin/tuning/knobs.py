@@ -1,7 +1,9 @@
 """The controls of a law's gains, read from its :class:`~twolink_pin.controllers.Gains`
 declaration: what each control sets, its label, range and step (no widget here).
 
-* a scalar gain: one control;
+* a scalar gain: one control; one declared a whole multiple of another
+  (:attr:`~twolink_pin.controllers.gains.GainSpec.multiple_of`, ``mpc``'s horizon of whole
+  knots) steps by that gain's value, from one of it;
 * a per-joint (per-axis, per-estimate) gain: one control per component and one that scales
   them all (the gain is component × scale);
 * a matrix gain: its diagonal, one control per entry, and an overall scale; its
@@ -96,6 +98,10 @@ def knobs_of(gains_type: Any, values: Mapping[str, Any]) -> list[Knob]:
         parts = _components(value, spec.matrix)
         if parts is None:
             low, high, step = _range(float(value), spec)
+            unit_step = values.get(spec.multiple_of) if spec.multiple_of else None
+            if isinstance(unit_step, float) and unit_step > 0:  # whole multiples (mpc's horizon: whole knots)
+                low, step = unit_step, unit_step
+                high = max(high, unit_step) // unit_step * unit_step
             knobs.append(Knob(name, None, False, f"{name}{unit}", low, high, step, float(value), spec.doc))
             continue
         what = {"joint": "joint", "axis": "axis", "estimate": "estimate"}.get(spec.per, "entry")

@@ -46,6 +46,7 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "limit_exceeded_at": result.first_exceeded_at,
         "limits": result.joint_limits.as_dict(),
         "crossings": metrics.crossings.summary(),
+        "relaxed": None if result.relaxed is None else result.relaxed.summary(),
         "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
         "p_true": None if result.p_true is None else result.p_true.tolist(),
@@ -133,6 +134,9 @@ def _limit_and_estimate_lines(result: Any, metrics: Metrics) -> list[str]:
     """The summary's lines on the limits (position range and velocity crossed; torque exceeded,
     clipped, absent) and, for an adaptive law, its estimates at the end against the truth."""
     out: list[str] = [f"  {s}" for s in metrics.crossings.sentences(result.joint_limits)]
+    relaxed = result.relaxed
+    if relaxed is not None and relaxed.relaxed:
+        out += [f"  {line}" for line in relaxed.text(result.joint_names or None).splitlines()]
     if result.position_stops:
         out.append("  joint stops: each position range a hard stop (--joint-stops)")
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
@@ -205,9 +209,13 @@ def cmd_compare(args: argparse.Namespace) -> int:
             tasks[key] = task_metrics(result, robot)  # every law moves the same end effector
             return result
 
+        relaxed: dict[str, Any] = {}
+
         def on_result(key: str, result: SimulationResult) -> None:
             warnings.extend(position_warnings(key, result))
             figures.add(key, result)
+            if result.relaxed is not None:
+                relaxed[key] = result.relaxed
 
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
@@ -227,6 +235,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
             plants={k: plant_description(r.scenario) for k, r in rows.items()},
             gains={k: gains_used(r.scenario.controller) for k, r in rows.items()},
             task=tasks,
+            relaxed=relaxed,
         )
         files = [Path(args.out) / p.name for p in table.write(stage)]
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest
