@@ -30,6 +30,10 @@ DEFAULT_EPS = 1e-9
 """Absolute tolerance on the primal and dual residuals (ProxQP's ``eps_abs``)."""
 DEFAULT_MAX_ITER = 10_000
 """Most ProxQP iterations of one solve."""
+BOUND_CAP = 1e12
+"""An equilibrated problem's bound beyond ±this (rows of unit largest coefficient, variables of
+unit curvature) is read as none on its side (±inf) or as this on the other (a bound no point
+of the problem's scale reaches: the problem stays infeasible, with sane numbers)."""
 
 
 class QP(NamedTuple):
@@ -113,6 +117,7 @@ def solve_qp(
     infeasibility_eps: float | None = None,
     scale: bool = False,
     gap_rel: float = 0.0,
+    max_inner: int | None = None,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -141,6 +146,9 @@ def solve_qp(
         gap_rel: ProxQP's relative duality-gap tolerance (the absolute one is ``eps``): a
             problem whose costs are large (a relaxed QP's penalties, 10⁶) cannot close its gap to
             1e-9 absolutely; it takes ``eps`` relative.
+        max_inner: Most of ProxQP's inner (Newton) iterations per outer one (None: its 1500):
+            ``max_iter`` bounds the outer ones only, and a problem that cannot hold took 1300
+            inner iterations per outer one, a second a solve, where a law asks for thousands.
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
@@ -154,8 +162,8 @@ def solve_qp(
     n = qp.g.shape[0]
     problem, back = equilibrate(qp) if scale else (qp, None)
     start = warm if back is None or warm is None else back.scaled(warm)
-    if rho is not None or infeasibility_eps is not None:
-        result = _solve_set(problem, start, eps, max_iter, rho, infeasibility_eps, gap_rel)
+    if rho is not None or infeasibility_eps is not None or max_inner is not None:
+        result = _solve_set(problem, start, eps, max_iter, rho, infeasibility_eps, gap_rel, max_inner)
     else:
         result = _solve_default(problem, start, eps, max_iter, gap_rel)
     _check_status(qp, result.info, accept, explain, eps, max_iter, what)
@@ -226,8 +234,9 @@ def equilibrate(qp: QP) -> tuple[QP, Equilibration]:
     """``qp`` scaled so that every variable has unit curvature and every constraint row a
     largest coefficient of 1 (Jacobi on the Hessian's diagonal, then each row by its
     ∞-norm): ``x = D x'`` with ``D = diag(H)^(−1/2)`` (1 where the curvature is 0), ``H' = D H D``,
-    ``g' = D g``, ``C' = R C D`` with ``l, u`` times ``R``. The minimiser and the active set are
-    the same; the solver's absolute tolerances then weigh every joint alike (an arm whose
+    ``g' = D g``, ``C' = R C D`` with ``l, u`` times ``R`` (beyond :data:`BOUND_CAP`: none, or the
+    cap). The minimiser and the active set are the same; the solver's absolute tolerances then
+    weigh every joint alike (an arm whose
     wrist inertia is 10⁻⁴ of its shoulder's has a Hessian whose diagonal spans eight decades,
     on which an absolute dual tolerance of 1e-9 is met for the shoulder long before the wrist)."""
     diagonal = np.diag(qp.H)
@@ -246,8 +255,12 @@ def equilibrate(qp: QP) -> tuple[QP, Equilibration]:
     A, S = rows(qp.A)
     C, R = rows(qp.C)
     b = None if qp.b is None else qp.b * S
-    lower = None if qp.l is None else qp.l * R
-    upper = None if qp.u is None else qp.u * R
+    # a bound beyond BOUND_CAP (a damper of horizon 1e-12 s asks for 1e24 rad/s²) is as good as
+    # none on one side and as impossible on the other: ProxQP took a second a solve on such numbers
+    lower = None if qp.l is None else np.clip(qp.l * R, -np.inf, BOUND_CAP)
+    lower = None if lower is None else np.where(lower < -BOUND_CAP, -np.inf, lower)
+    upper = None if qp.u is None else np.clip(qp.u * R, -BOUND_CAP, np.inf)
+    upper = None if upper is None else np.where(upper > BOUND_CAP, np.inf, upper)
     return QP(H, g, A, b, C, lower, upper, qp.labels), Equilibration(D, R, S)
 
 
@@ -274,6 +287,7 @@ def _solve_set(
     rho: float | None,
     infeasibility: float | None,
     gap_rel: float = 0.0,
+    max_inner: int | None = None,
 ) -> Any:
     """ProxQP's dense solver object with ``rho`` and the infeasibility tolerances set (the
     functional ``dense.solve`` takes neither), the duality gap checked; its results."""
@@ -291,6 +305,8 @@ def _solve_set(
         settings.eps_primal_inf = settings.eps_dual_inf = infeasibility
     if rho is not None:
         settings.default_rho = rho
+    if max_inner is not None:
+        settings.max_iter_in = max_inner
     solver.init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
     if warm is not None:
         settings.initial_guess = proxqp.InitialGuess.WARM_START

@@ -120,6 +120,7 @@ def solve_relaxed(
     eps: float = 1e-9,
     max_iter: int = 1000,
     accept: float | None = None,
+    max_inner: int | None = None,
 ) -> RelaxedSolution:
     """Solve ``qp`` with its rows of ``priority >= 0`` relaxed as little as they must be, in
     order (the module docstring's two levels).
@@ -130,7 +131,8 @@ def solve_relaxed(
         group: Per inequality row, the slack it shares with the rows of the same group (None:
             one each).
         what: The problem in words, for messages.
-        eps, max_iter, accept: As :func:`~twolink_pin.optimal.solve_qp`'s (on the scaled problems).
+        eps, max_iter, accept, max_inner: As :func:`~twolink_pin.optimal.solve_qp`'s (on the
+            scaled problems).
 
     Raises:
         OptimizationError: a level did not converge, or the hard rows alone cannot hold.
@@ -141,7 +143,7 @@ def solve_relaxed(
     first, slot = least_relaxation(scaled, priority, group)
     found = solve_qp(
         first, eps=eps, max_iter=max_iter, what=f"{what} (its least relaxation)", accept=max(accept or 0.0, FIRST_ACCEPT),
-        infeasibility_eps=eps, explain=False, gap_rel=eps,
+        infeasibility_eps=eps, explain=False, gap_rel=eps, max_inner=max_inner,
     )  # fmt: skip
     n = qp.g.shape[0]
     soft = np.flatnonzero(priority >= 0)
@@ -150,8 +152,9 @@ def solve_relaxed(
     room[soft] = np.where(given[slot] > SLACK_TOLERANCE, given[slot] + MARGIN, 0.0)
     widened = scaled._replace(l=scaled.l - room, u=scaled.u + room)
     solution = solve_qp(
-        widened, eps=eps, max_iter=max_iter, what=what, accept=accept, infeasibility_eps=eps, explain=False
-    )
+        widened, eps=eps, max_iter=max_iter, what=what, accept=accept, infeasibility_eps=eps, explain=False,
+        max_inner=max_inner,
+    )  # fmt: skip
     cx = scaled.C[soft] @ solution.x
     excess = np.maximum(np.maximum(scaled.l[soft] - cx, cx - scaled.u[soft]), 0.0)
     slack = np.zeros(priority.size)
