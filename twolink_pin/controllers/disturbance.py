@@ -49,6 +49,7 @@ class DisturbanceObserver:
         """Whether any run observes (else the law skips it: ``d̂`` stays 0)."""
         inertia = _believed_inertia(robot, parameters) if self.on else np.zeros((1, nv, nv))
         self._gain_e, self._gain_d = 2.0 * rate, (rate * rate)[:, :, None] * inertia
+        self._single = self._gain_d[0].T.copy() if self._gain_d.shape[0] == 1 else None  # Γᵀ for every run
         self.columns = (slice(first, first + nv), slice(first + nv, first + 2 * nv))
         """The columns of ``d̂`` and ``ê`` in ``z``."""
 
@@ -63,14 +64,18 @@ class DisturbanceObserver:
         """``d̂`` [N·m], (N, nv), from the law's state."""
         return z[:, self.columns[0]]
 
-    def derivative(
-        self, z: np.ndarray, v: np.ndarray, v_des: np.ndarray, a_des: np.ndarray, predicted: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """``(d̂̇, ê̇)``, each (N, nv), for the measured ``q̇`` (N, nv), the reference's ``q̇_d``,
-        ``q̈_d`` (1, nv) and the acceleration ``predicted`` = ``M̂⁻¹(τ − b̂ + d̂)`` (N, nv) of the
-        torque the law applies."""
-        gap = v - v_des - z[:, self.columns[1]]
-        return np.matvec(self._gain_d, gap), predicted - a_des + self._gain_e * gap
+    def derivative(self, gap: np.ndarray, relative: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(d̂̇, ê̇)``, each (N, nv), from the ``gap`` (N, nv) between the measured velocity
+        error and the estimate, ``q̇ − q̇_d − ê`` [rad/s] (:meth:`gap`), and the acceleration the
+        applied torque gives on the model with ``d̂``, relative to the reference's:
+        ``M̂⁻¹(τ − b̂ + d̂) − q̈_d`` [rad/s²] (N, nv)."""
+        single = self._single
+        drift = gap @ single if single is not None else np.matvec(self._gain_d, gap)  # 2-D: numpy's fast path
+        return drift, relative + self._gain_e * gap
+
+    def gap(self, z: np.ndarray, velocity_error: np.ndarray) -> np.ndarray:
+        """``q̇ − q̇_d − ê`` [rad/s], (N, nv), for the measured ``q̇ − q̇_d`` (N, nv)."""
+        return velocity_error - z[:, self.columns[1]]
 
 
 def _believed_inertia(robot: RobotModel, parameters: np.ndarray) -> np.ndarray:

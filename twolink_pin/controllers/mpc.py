@@ -37,6 +37,10 @@ RELAX_AFTER = 30
 """With ``on_infeasible = "relax"``, the ProxQP iterations a replan gets with its rows hard
 before it is solved relaxed: the relaxed QP has the hard one's solution whenever that exists
 (the penalty is exact), so this only spares the larger solve when the hard one converges."""
+MAX_INNER = 20
+"""Most of ProxQP's inner iterations per outer one (its default 1500): a QP that cannot hold,
+its bounds at 1e12 (a damper of horizon 1e-12 s), spent 1300 per outer iteration and a second a
+solve; a feasible one takes a few."""
 INFEASIBILITY_EPS = 1e-9
 """ProxQP's infeasibility tolerances: its default, 1e-4, declared feasible replans infeasible
 after 10 iterations (a problem that cannot hold is still told apart by the closest feasible point)."""
@@ -307,7 +311,7 @@ class ModelPredictive(Controller[MPCGains]):
         try:
             return solve_qp(
                 qp, what=what, max_iter=RELAX_AFTER if self._relax else MAX_ITER,
-                infeasibility_eps=INFEASIBILITY_EPS, scale=True, accept=ACCEPT, explain=not self._relax,
+                infeasibility_eps=INFEASIBILITY_EPS, scale=True, accept=ACCEPT, explain=not self._relax, max_inner=MAX_INNER,
             ).x  # fmt: skip
         except OptimizationError as exc:
             if not self._relax:  # this run ends here (run_failure says why), the others go on
@@ -316,7 +320,13 @@ class ModelPredictive(Controller[MPCGains]):
         hz = self.horizon
         try:
             relaxed = solve_relaxed(
-                qp, hz.priority, group=hz.group, what=what, max_iter=RELAXED_MAX_ITER, accept=ACCEPT
+                qp,
+                hz.priority,
+                group=hz.group,
+                what=what,
+                max_iter=RELAXED_MAX_ITER,
+                accept=ACCEPT,
+                max_inner=MAX_INNER,
             )
         except OptimizationError as exc:
             self._failures.setdefault(i, str(exc))
@@ -393,13 +403,13 @@ class ModelPredictive(Controller[MPCGains]):
             u = self._split(z)[2]
             qk = qk + (k * self._interval) * vk + np.matmul(self.horizon.sq_knots[k], u)
             vk = vk + np.matmul(self.horizon.sv_knots[k], u)
-        # the plan at t: the reference now plus the planned deviation
-        accel = (
-            x.a_des
-            + ak
-            + self._kp * (x.q_des + qk + (vk + (0.5 * r) * ak) * r - x.q)
-            + self._kd * (x.v_des + vk + ak * r - x.v)
+        # the plan at t: the reference now plus the planned deviation; its acceleration relative
+        # to the reference's, the deviation's plus the feedback toward it
+        ev = x.v - x.v_des
+        relative = (
+            ak + self._kp * (qk + (vk + (0.5 * r) * ak) * r - (x.q - x.q_des)) + self._kd * (vk + ak * r - ev)
         )
+        accel = x.a_des + relative
         wanted = terms.model(x.q, x.v, x.v, accel)
         if not self._observing:
             tau = np.minimum(wanted, self._effort)
@@ -409,20 +419,23 @@ class ModelPredictive(Controller[MPCGains]):
                 zeros = self._zeros[z.shape] = np.zeros(z.shape)
                 zeros.setflags(write=False)
             return LawOutput(tau, zeros)
-        return self._observed(x, terms, accel, wanted - z[:, dhat])
+        return self._observed(x, terms, relative, wanted - z[:, dhat], ev)
 
-    def _observed(self, x: LawInput, terms: Terms, accel: np.ndarray, wanted: np.ndarray) -> LawOutput:
+    def _observed(
+        self, x: LawInput, terms: Terms, relative: np.ndarray, wanted: np.ndarray, ev: np.ndarray
+    ) -> LawOutput:
         """The torque ``wanted`` (the missing torque compensated) clipped, and ż: zeros for the
-        plan, the observer's ``d̂̇`` and ``ê̇`` (:mod:`twolink_pin.controllers.disturbance`)."""
+        plan, the observer's ``d̂̇`` and ``ê̇`` (:mod:`twolink_pin.controllers.disturbance`);
+        ``relative``: the acceleration asked for less the reference's, ``ev``: ``q̇ − q̇_d``."""
         z = x.z
-        _, _, _, dhat, ehat = self._columns
         tau = np.minimum(wanted, self._effort)
         np.maximum(tau, self._lowest, out=tau)
         # M̂⁻¹(τ − b̂ + d̂) = accel + M̂⁻¹(τ − wanted): the clipped part only where it clipped
-        predicted = accel
         cut = tau - wanted
         if cut.any():
-            predicted = accel + terms.solve_mass(x.q, cut)
-        dz = np.zeros(z.shape)
-        dz[:, dhat], dz[:, ehat] = self.observer.derivative(z, x.v, x.v_des, x.a_des, predicted)
-        return LawOutput(tau, dz)
+            relative = relative + terms.solve_mass(x.q, cut)
+        drift, rate = self.observer.derivative(self.observer.gap(z, ev), relative)
+        plan = self._zeros.get(z.shape)
+        if plan is None:  # the plan's columns: they move only at a replan
+            plan = self._zeros[z.shape] = np.zeros((z.shape[0], self._columns[3].start))
+        return LawOutput(tau, np.concatenate((plan, drift, rate), axis=1))

@@ -41,6 +41,10 @@ RELAX_AFTER = 30
 """With ``on_infeasible = "relax"``, the ProxQP iterations a step's QP gets with its rows hard
 before it is solved relaxed (whose answer is the hard one's whenever that exists: the penalty
 is exact); a QP that cannot hold costs 30, not 200, iterations before its answer."""
+MAX_INNER = 20
+"""Most of ProxQP's inner iterations per outer one (its default 1500): a QP that cannot hold,
+its bounds at 1e12 (a damper of horizon 1e-12 s), spent 1300 per outer iteration and a second a
+solve; a feasible one takes a few."""
 INFEASIBILITY_EPS = 1e-9
 """ProxQP's infeasibility tolerances (its default, 1e-4, calls feasible steps infeasible)."""
 ACCEPT = 1e-6
@@ -261,8 +265,9 @@ class QPOperationalSpace(OperationalSpace):
             np.clip(tau, self._lowest, self._highest, out=tau)
         dz = np.zeros(x.z.shape)
         if self.observer.on:  # M̂⁻¹(τ − b̂ + d̂) is the QP's q̈ (the clip moved it by rounding only)
+            gap = self.observer.gap(x.z, x.v - x.v_des)
             dz[:, self.observer.columns[0]], dz[:, self.observer.columns[1]] = self.observer.derivative(
-                x.z, x.v, x.v_des, x.a_des, accel
+                gap, accel - x.a_des
             )
         return LawOutput(tau, dz)
 
@@ -275,7 +280,7 @@ class QPOperationalSpace(OperationalSpace):
         try:
             return solve_qp(
                 qp, what=what, unconstrained_first=True, max_iter=RELAX_AFTER if self._relax else MAX_ITER,
-                scale=True, accept=ACCEPT, infeasibility_eps=INFEASIBILITY_EPS, explain=not self._relax,
+                scale=True, accept=ACCEPT, infeasibility_eps=INFEASIBILITY_EPS, explain=not self._relax, max_inner=MAX_INNER,
             ).x  # fmt: skip
         except OptimizationError as exc:
             if not self._relax:
@@ -283,7 +288,7 @@ class QPOperationalSpace(OperationalSpace):
                 return np.full(qp.g.shape, np.nan)
         try:
             accel = solve_relaxed(
-                qp, self._priority, what=what, max_iter=RELAXED_MAX_ITER, accept=ACCEPT
+                qp, self._priority, what=what, max_iter=RELAXED_MAX_ITER, accept=ACCEPT, max_inner=MAX_INNER
             ).solution.x
         except OptimizationError:
             accel = self._saturated(qp, i, dynamics)
