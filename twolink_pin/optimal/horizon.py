@@ -34,12 +34,18 @@ the same linearisation (the reference's torque needs no further RNEA). With ``w_
 Hessian is positive definite.
 
 **Rows** (``f``: ``limit_scale``): ``|τ_k − d̂| ≤ f τ_max`` at knots 0 … K−1 (``d̂``: the
-torque the law estimates its model misses, 0 without), ``|a_k| ≤ f q̈_max`` (where the arm has
-one), ``|q̇_k| ≤ f q̇_max`` and ``q_min ≤ q_k ≤ q_max`` at knots 1 … K — the state bounds from
-the first knot on, not at the measured state (which the plan cannot change). A joint without a
-kind of limit has no row for it. Each row is labelled, and has a priority
-(:attr:`Horizon.priority`): the effort rows are hard, the position, velocity and acceleration
-rows give way in that order when they cannot all hold (:mod:`twolink_pin.optimal.relaxed`).
+torque the law estimates its model misses, 0 without); ``|q̈| ≤ f q̈_max`` (where the arm has
+one), ``|q̇| ≤ f q̇_max`` and ``q_min ≤ q ≤ q_max`` at the **row times** ``i h / S``
+(:data:`ROWS_PER_INTERVAL` = S per knot interval; the state bounds from the first row time on,
+not at the measured state, which the plan cannot change). Between knots the plan is the
+reference plus a deviation: a reference whose velocity has a corner between two row times would
+carry the plan past a bound between them, so the velocity and acceleration rows bound the
+deviation at a row time plus the reference's extreme over the row times either side (its
+envelope: the deviation is linear, constant, between them — the bound then holds over the whole
+interval). A joint without a kind of limit has no row for it. Each row is labelled, and has a
+priority (:attr:`Horizon.priority`): the effort rows are hard, the position, velocity and
+acceleration rows give way in that order when they cannot all hold, by one amount per kind and
+joint over the horizon (:attr:`Horizon.group`; :mod:`twolink_pin.optimal.relaxed`).
 """
 
 from __future__ import annotations
