@@ -39,6 +39,8 @@ def gains_text(gains: dict[str, Any]) -> str:
     def shown(value: Any) -> str:
         if value is None:
             return "from the robot"
+        if isinstance(value, str):  # a gain of choices
+            return value
         array = np.asarray(value, dtype=float)
         return format_gain(array[None] if array.ndim == 2 and array.shape[0] == array.shape[1] else array)
 
