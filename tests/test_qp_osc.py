@@ -264,6 +264,25 @@ def test_an_infeasible_first_qp_fails_within_the_iteration_cap() -> None:
     assert run.relaxed is not None and run.relaxed.first_time[~np.isnan(run.relaxed.first_time)].min() == 0.0
 
 
+def test_a_damper_of_horizon_1e_12_s_near_a_range_is_solved_within_the_caps() -> None:
+    """``position_horizon = 1e-12`` s with the Panda's elbow started 1 mrad inside its range (a
+    hostile run: it ran for more than 300 s). The damper then asks for bounds of order 1e21 rad/s²:
+    read as none on their loose side and as 1e12 on the other, and ProxQP's inner iterations capped,
+    each QP ends within its caps — the run finishes, its commanded torque within the effort limits,
+    the elbow inside its range to RK4's rounding."""
+    robot = load_robot("panda")
+    limits = joint_limits(robot)
+    reference = default_trajectory(robot)
+    offset = np.zeros(7)
+    offset[3] = limits.position_lower[3] + 1e-3 - reference.sample(0.0).q[3]
+    law = QPOperationalSpace(robot, QPOperationalSpace.Gains(position_horizon=1e-12))
+    plant = make_scenario("qp-osc", robot)[1]
+    run = simulate(law, plant, reference, SimulationConfig(duration=0.02, q0_offset=offset))
+    assert np.isfinite(run.q).all() and run.t[-1] == pytest.approx(0.02)
+    assert (np.abs(run.tau_command) <= limits.effort * (1 + 1e-9)).all()
+    assert run.q[:, 3].min() >= limits.position_lower[3] - 1e-6
+
+
 def test_a_run_whose_qp_cannot_hold_ends_alone_in_a_batch() -> None:
     """Three Panda runs with ``fail`` and per-run headroom (1, 0.01, 1): the middle one cannot
     hold and ends at t = 0 with the law's reason; the others equal their single runs (it used to
