@@ -195,6 +195,11 @@ _quiet_worker_start()
 # pool chosen passed, and 10 of 11 without). Set before pyarrow is imported, here or in a worker
 # this command spawns (they inherit it); a user's own value stays.
 os.environ.setdefault("ARROW_DEFAULT_MEMORY_POOL", "system")
+# That was not enough (the fork case failed so again, 1 run in 6 under load on 7 Dec): libarrow's
+# jemalloc starts its background thread when pyarrow is imported, whichever pool is chosen (a
+# process has 3 threads after `import pyarrow`, 2 with this), and its compiled-in conf asks for
+# that thread; jemalloc's own environment variable turns it off.
+os.environ.setdefault("JE_ARROW_MALLOC_CONF", "background_thread:false")
 
 
 def main() -> int:

@@ -6,7 +6,7 @@
 #       extension: .py
 #       format_name: percent
 #       format_version: '1.3'
-#       jupytext_version: 1.19.6
+#       jupytext_version: 1.19.7
 #   kernelspec:
 #     display_name: Python 3 (ipykernel)
 #     language: python
@@ -84,6 +84,30 @@ for _ in range(200):
 print(f"largest |M_pinocchio - M_report| = {worst_m:.1e} kg·m²")
 print(f"largest |C_pinocchio - C_report| = {worst_c:.1e} kg·m²/s")
 assert worst_m < 1e-12 and worst_c < 1e-12
+
+# %% [markdown]
+# The formulas above are typed from the report. `derive_equations` derives them instead,
+# with SymPy, from the URDF's tree and inertias: $M$, $C$ (from the Christoffel symbols),
+# $g$ and the regressor $Y$, in the arm's base parameters $\beta$ — combinations of the
+# links' masses, first moments and inertias and the length `l2x` (the report's $L_1$).
+# Written in the $p$ they find, they are the report's formulas, symbolically
+# ([equations in closed form](../docs/equations.md); `twolink-pin equations --python F.py`
+# writes them as a numpy module).
+
+# %%
+from twolink_pin.symbolic import derive_equations
+from twolink_pin.symbolic.formats import text_form
+from twolink_pin.twolink.course_equations import course_check
+
+equations = derive_equations(robot)
+M = equations.shown(equations.M)  # beta3 = mcy2 is 0 in this URDF: its terms are left out
+for name, definition in zip(equations.beta, equations.beta_definitions):
+    print(text_form(equations, name), "=", text_form(equations, definition))
+for r, c in ((0, 0), (0, 1), (1, 1)):
+    print(f"M{r + 1}{c + 1} =", text_form(equations, M[r, c]))
+check = course_check(equations)
+print("p in the base parameters:", check["found"])
+print("the report's M, C and regressor:", check["M"] and check["C"] and check["Y"])
 
 # %% [markdown]
 # ## 3. The reference trajectory

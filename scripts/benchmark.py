@@ -39,6 +39,8 @@ Usage::
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a);
                                                                    # issue 45: against crocoddyl's MPC (mpc_anchor.py)
+    .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
+    .venv/bin/python scripts/benchmark.py --equations-only [--quick]  # issue 47: symbolic equations, scaling
 
 ``tune`` (issue 29): the latency from a change of a gain to updated results (the run simulated,
 measured, the scene, plots and metrics table updated, its JSON line reported) for one period
@@ -1223,6 +1225,12 @@ def _tune_page_latency(
                 lambda d: d.execute_script("return Object.keys(window.twolinkShown).length")
             )
             if not playing:
+                driver.find_element("xpath", "//*[text()='playback']").click()  # its folder starts closed
+                WebDriverWait(driver, 600).until(
+                    lambda d: d.execute_script(
+                        "return Array.from(document.querySelectorAll('label')).some(e => e.textContent === 'play')"
+                    )
+                )
                 driver.execute_script(
                     "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'play');"
                     "var n = l; for (var i = 0; i < 12; i++) { n = n.parentElement;"
@@ -1562,9 +1570,21 @@ def main(argv: list[str] | None = None) -> int:
         "(CROCODDYL_PYTHON: a scratch venv's python with pin 4.0 and crocoddyl 3.2.1; skipped without)",
     )
     parser.add_argument(
+        "--mujoco-only",
+        action="store_true",
+        help="only issue 44's goals: the MuJoCo plant's time per run and its equality with Pinocchio's "
+        "(scripts/benchmark_mujoco.py)",
+    )
+    parser.add_argument(
         "--optimal-only",
         action="store_true",
         help="only issue 36's goals: the time-optimal retiming, the minimum-effort twolink, the UR5 through via poses",
+    )
+    parser.add_argument(
+        "--equations-only",
+        action="store_true",
+        help="only issue 47's goals: the symbolic equations' time, the module's M(q) against pin.crba, the "
+        "scaling table (scripts/equations_benchmark.py)",
     )
     parser.add_argument(
         "--contention-only",
@@ -1605,6 +1625,25 @@ def main(argv: list[str] | None = None) -> int:
         from mpc_anchor import anchor_section  # scripts/mpc_anchor.py, beside this file
 
         results.update(anchor_section(quick))
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.mujoco_only:
+        sys.path.insert(0, str(HERE))
+        from benchmark_mujoco import main as mujoco_main
+
+        results.update(
+            mujoco_main(
+                [*(["--quick"] if quick else []), "--repeats", str(args.repeats or (1 if quick else 5))]
+            )
+        )
+        if args.json:
+            print(json.dumps(results))
+        return 0
+    if args.equations_only:
+        from equations_benchmark import equations_section  # scripts/: the script's own folder
+
+        results.update(equations_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0

@@ -215,7 +215,7 @@ def tune() -> list[Path]:
         assert proc.stdout is not None
         url = json.loads(proc.stdout.readline())["url"]
         proc.stdout.readline()  # the first run
-        return [_photograph(url, IMAGES / "tune.png", 1280, 800, TUNE_READY)]
+        return [_photograph(url, IMAGES / "tune.png", 1366, 768, TUNE_READY)]  # a laptop's screen
     finally:
         proc.send_signal(signal.SIGINT)
         proc.wait(timeout=60)
@@ -359,6 +359,70 @@ def mpc() -> list[Path]:
     ]
 
 
+def mujoco() -> list[Path]:
+    """docs/mujoco.md's figures: the report's sim-to-sim section for the course's five laws (each
+    effect's difference from the Pinocchio plant, 2 periods), and computed torque on Pinocchio's
+    plant and on MuJoCo with each of the twolink's effects overlaid (12 s); prints the table."""
+    from twolink_pin.law_variant import parse_variant
+    from twolink_pin.plotting.sim_to_sim import save_sim_to_sim_figure
+    from twolink_pin.report import ReportOptions
+    from twolink_pin.report.sim_to_sim import sim_to_sim_law
+
+    options = ReportOptions(workers=1)
+    laws = [
+        sim_to_sim_law(law, parse_variant(law), options)
+        for law in ("pd", "computed-torque", "robust", "adaptive", "adaptive-friction")
+    ]
+    for law in laws:
+        for row in law["rows"]:
+            print(
+                f"mujoco: {law['law']:18s} {row['short']:18s} RMS {row['rms_e']:.5g} max {row['max_e']:.5g} "
+                f"Δ {row.get('delta_rms_e', 0):+.3e} {row.get('delta_max_e', 0):+.3e}"
+            )
+    out = [
+        save_sim_to_sim_figure(
+            laws, IMAGES / "mujoco_sim_to_sim.png", "twolink: what each effect on MuJoCo changes"
+        )
+    ]
+    return [*out, *mujoco_overlay()]
+
+
+def mujoco_overlay() -> list[Path]:
+    """docs/mujoco.md's second figure: computed torque on Pinocchio's plant and on MuJoCo with the
+    twolink's armature alone and with every effect, overlaid over 12 s (three runs: the legend's
+    one row)."""
+    from twolink_pin import PlantOptions, RunSpec, SimulationConfig, default_trajectory, simulate
+    from twolink_pin.plotting.overlay import save_overlay_figure
+
+    robot = load_robot("twolink")
+    reference = default_trajectory(robot)
+    runs = {}
+    for label, plant in (
+        ("Pinocchio", PlantOptions()),
+        ("MuJoCo + armature", PlantOptions(engine="mujoco", armature="arm")),
+        (
+            "MuJoCo, every effect",
+            PlantOptions(
+                engine="mujoco",
+                armature="arm",
+                joint_damping="arm",
+                frictionloss="arm",
+                saturate=True,
+                integrator="implicitfast",
+            ),
+        ),
+    ):
+        spec = RunSpec(law="computed-torque", plant=plant, simulation=SimulationConfig(duration=12.0))
+        runs[label] = simulate(*spec.build(robot), reference, spec.simulation)
+    return [
+        save_overlay_figure(
+            runs,
+            IMAGES / "mujoco_computed_torque.png",
+            "computed-torque on the twolink: Pinocchio, and MuJoCo with the arm's effects",
+        )
+    ]
+
+
 MAKERS: dict[str, Callable[[], list[Path]]] = {
     "report": report,
     "animation": animation,
@@ -369,6 +433,8 @@ MAKERS: dict[str, Callable[[], list[Path]]] = {
     "limits": limits,
     "within_limits": within_limits,
     "mpc": mpc,
+    "mujoco": mujoco,
+    "mujoco_overlay": mujoco_overlay,
 }
 
 

@@ -48,6 +48,9 @@ GROUPS: dict[str, str] = {
     "test_controllers.py": "controllers",  # two 8-s adaptive runs (Lyapunov checks)
     "test_simulation.py": "simulation",  # the cached 3-s DOP853 reference runs (conftest_sim.run)
     "test_tune_browser.py": "tune",  # Chromium on two live tune servers
+    "test_tune_page.py": "tune_page",  # one Chromium page on a live tuner, its tests in order
+    "test_tune_layout.py": "tune_layout",  # Chromium at 1366x768 on a live mpc tuner
+    "test_tune_page_periods.py": "tune_page_periods",  # one Chromium for its tuners
 }
 """Test file → its xdist group: files whose expensive per-process setup is shared by their tests."""
 
@@ -206,3 +209,15 @@ def _signals_left_as_found() -> Any:
     yield
     after = (signal.getsignal(signal.SIGINT), signal.pthread_sigmask(signal.SIG_BLOCK, []))
     assert after == before, f"SIGINT's handler or the signal mask changed: {before} -> {after}"
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _equations_cache_of_the_run(tmp_path_factory: pytest.TempPathFactory) -> Any:
+    """The symbolic equations' cache (twolink_pin/symbolic/cache.py) in a folder of this test
+    run, not the user's ~/.cache: the report, the tutorial and the CLI tests derive through it
+    (subprocesses inherit the variable). A test that needs its own sets it again."""
+    import os
+
+    if "TWOLINK_PIN_CACHE" not in os.environ:
+        os.environ["TWOLINK_PIN_CACHE"] = str(tmp_path_factory.mktemp("equations-cache"))
+    return os.environ["TWOLINK_PIN_CACHE"]

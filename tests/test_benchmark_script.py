@@ -87,3 +87,37 @@ def test_big_arms_rows_give_ratios_and_the_floor() -> None:
         assert row["seconds"] > 0 and row["ratio"] > 0, label
     for label in batches:
         assert 0 < rows[label]["floor"] < rows[label]["seconds"], label
+
+
+def test_the_mujoco_benchmark_prints_both_plants_and_the_equality() -> None:
+    """``benchmark.py --mujoco-only --quick``: a row per case with positive seconds and ratios, and
+    an equality line per arm and law under the goal."""
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), "--mujoco-only", "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=600,
+    )
+    results = json.loads(done.stdout.splitlines()[-1])["mujoco"]
+    assert set(results["speed"]) >= {"twolink pd single", "panda osc single"}
+    assert all(row["ratio"] > 0 and row["cpu_ratio"] > 0 for row in results["speed"].values())
+    assert len(results["equality"]) == 12 and max(results["equality"].values()) <= 1e-8
+
+
+def test_quick_equations_section_prints_its_goals() -> None:
+    """``--equations-only --quick``: the goals' lines and the scaling table's rows (no timing asserted)."""
+    done = subprocess.run(
+        [sys.executable, str(SCRIPT), "--equations-only", "--quick", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+        timeout=600,
+    )
+    lines = done.stdout.splitlines()
+    assert any(line.startswith("  twolink, M C g Y:") for line in lines)
+    assert any(line.startswith("  UR5's first 3 joints:") for line in lines)
+    assert len([line for line in lines if line.startswith("    n = ")]) == 3
+    results = json.loads(lines[-1])["equations"]
+    assert results["twolink_seconds"] > 0 and results["mass_matrix_seconds"]["crba"] > 0
+    assert [row["joints"] for row in results["scaling"]] == [1, 2, 3]

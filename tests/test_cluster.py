@@ -243,6 +243,24 @@ def test_a_law_and_a_urdf_from_files_reach_workers_that_do_not_have_them(
     assert sorted(p.name for p in (scheduler.folder / "workers-cwd").iterdir()) == []
 
 
+def test_a_sweep_on_the_mujoco_plant_runs_on_the_workers_as_in_process(
+    scheduler: DaskProcesses, tmp_path: Path
+) -> None:
+    """``--plant mujoco`` with the arm's armature and dry friction: each worker builds the MuJoCo
+    plant from the run's description (its own ``mujoco.batch``) and the table is the in-process one."""
+    from twolink_pin.plant import PlantOptions
+
+    run = RunSpec(
+        law="pd",
+        plant=PlantOptions(engine="mujoco", armature="arm", frictionloss="arm"),
+        simulation=SimulationConfig(duration=0.2),
+    )
+    study = SweepConfig(run, samples=12, seed=3, q0_spread=0.1, chunk=5)
+    run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "here", plot=False)
+    run_sweep(study, ROBOT, TRAJECTORY, tmp_path / "there", plot=False, scheduler=scheduler.address)
+    assert_identical(tmp_path / "here", tmp_path / "there")
+
+
 def test_a_robot_the_workers_would_rebuild_differently_is_refused(
     scheduler: DaskProcesses, tmp_path: Path
 ) -> None:

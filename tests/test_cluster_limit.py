@@ -211,3 +211,27 @@ def test_the_command_allocates_parquet_memory_without_jemalloc() -> None:
     env = {k: v for k, v in os.environ.items() if k != "ARROW_DEFAULT_MEMORY_POOL"}
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
     assert done.stdout.split() == ["system", "system"], done.stderr
+
+
+def test_the_command_starts_no_jemalloc_thread_when_pyarrow_is_imported() -> None:
+    """The fork case above still printed jemalloc's line after the pool was chosen: importing
+    pyarrow starts jemalloc's background thread (its compiled-in conf asks for one), whichever
+    pool allocates. Behind the command's entry, importing pyarrow starts one thread fewer than the
+    same import without it (pyarrow starts threads of its own besides: the count is compared, not
+    fixed)."""
+    code = (
+        "import os, sys;"
+        "sys.argv[1] == 'entry' and __import__('twolink_pin_entry');"
+        "a = len(os.listdir('/proc/self/task')); import pyarrow;"
+        "print(len(os.listdir('/proc/self/task')) - a)"
+    )
+    env = {
+        k: v for k, v in os.environ.items() if k not in ("JE_ARROW_MALLOC_CONF", "ARROW_DEFAULT_MEMORY_POOL")
+    }
+    added = {
+        how: subprocess.run(
+            [sys.executable, "-c", code, how], env=env, capture_output=True, text=True, timeout=300
+        ).stdout.strip()
+        for how in ("entry", "bare")
+    }
+    assert int(added["entry"]) == int(added["bare"]) - 1, added

@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 from corpus import runner
 from corpus.cases import CASES, LIBRARY
+from corpus.cases_equations import EQUATIONS
 from corpus.cases_joint_limits import JOINT_LIMITS
 from corpus.cases_limits import LIMITS, LIMITS_LIBRARY
 from corpus.cases_mpc import MPC
@@ -66,7 +67,7 @@ def _registry() -> Any:
             del sys.modules[name]
 
 
-ALL_CASES = [*CASES, *LIMITS, *JOINT_LIMITS, *GAINS, *OPTIMAL, *MPC, *TUNE_CASES]
+ALL_CASES = [*CASES, *LIMITS, *JOINT_LIMITS, *GAINS, *OPTIMAL, *MPC, *TUNE_CASES, *EQUATIONS]
 ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY, *GAINS_LIBRARY, *OPTIMAL_LIBRARY]
 
 

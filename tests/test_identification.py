@@ -663,6 +663,7 @@ def test_the_html_report_answers_figure_27(tmp_path: Path) -> None:
         workers=1,
         animation=False,
         limits_section=False,
+        sim_to_sim=False,
         controllers=("adaptive",),
     )
     results = build_report(tmp_path / "r", options)

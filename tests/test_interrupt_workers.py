@@ -131,6 +131,7 @@ def test_a_signal_some_library_swallowed_stops_the_report_at_its_next_step(tmp_p
         animation=False,
         identification=False,
         limits_section=False,
+        sim_to_sim=False,
         controllers=("pd", "computed-torque"),
     )
     seen: list[str] = []

@@ -44,7 +44,7 @@ def test_a_law_files_variant_is_keyed_by_the_laws_name() -> None:
 @pytest.mark.parametrize(
     ("text", "words"),
     [
-        ("pd@zeta=1", ("zeta", "a gain of 'pd' (kp, kd), model or p0")),
+        ("pd@zeta=1", ("zeta", "a gain of 'pd' (kp, kd), model, p0 or a plant key")),
         ("pd@kp=1@kp=2", ("kp is given twice: '1' and '2'",)),
         ("pd@kp=", ("kp = ''", "a value after 'kp='")),
         ("pd@", ("'@'", "nothing follows it")),
@@ -242,7 +242,7 @@ def test_compare_refuses_a_bad_variant_or_gain_naming_the_row(
     gains, and a bad --gain of one law named with that law (not a bare ``kp``)."""
     cases = [
         (["pd", "pd@kd=50@kp=1", "pd@kp=1@kd=50"], "each variant once"),
-        (["pd", "pd@zeta=1"], "a gain of 'pd' (kp, kd), model or p0"),
+        (["pd", "pd@zeta=1"], "a gain of 'pd' (kp, kd), model, p0 or a plant key"),
         (
             ["pd", "computed-torque", "--gain", "computed-torque.k=1,2,3"],
             "computed-torque: k = [1.0, 2.0, 3.0] is invalid",

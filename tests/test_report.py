@@ -15,7 +15,9 @@ from twolink_pin.report import MARKER, ReportOptions, build_report
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.twolink.reference import REPORT_CONTROLLERS
 
-SHORT = ReportOptions(run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False)
+SHORT = ReportOptions(
+    run=RunSpec(simulation=SimulationConfig(duration=4.0)), workers=1, limits_section=False, sim_to_sim=False
+)
 
 
 @pytest.fixture(scope="module")
@@ -60,6 +62,25 @@ def test_results_json_holds_every_controller_and_the_model(report_dir: Path) -> 
         re.MULTILINE,
     )
     assert row is not None and "lam = 5," in row["gains"] and "k = (90, 90)" in row["gains"]
+
+
+def test_the_derived_equations_beside_the_courses(report_dir: Path) -> None:
+    """Issue 47: the model section shows M, C, g derived from the URDF (as MathML) and, for the
+    twolink, the derived M and C written in the p they find beside the report's, all equal."""
+    results = json.loads((report_dir / "results.json").read_text())
+    equations = results["robot"]["equations"]
+    assert equations["shown"] and equations["skew_symmetric"] and len(equations["M"]) == 3
+    course = results["twolink"]["course_equations"]
+    assert course["found"] == {"p1": "beta1 + beta4", "p2": "beta4", "p3": "beta2*l2x"}
+    assert course["M"] and course["C"] and course["Y"] and course["p_expressions"]
+    html = (report_dir / "index.html").read_text()
+    for section in ("equations-beta", "equations-M", "equations-C", "equations-g", "equations-course"):
+        assert f'id="{section}"' in html
+    table = html[
+        html.index('id="equations-course"') : html.index("</table>", html.index('id="equations-course"'))
+    ]
+    assert table.count("<tr>") == 7 and table.count("<math") == 14
+    assert "$$" in (report_dir / "report.md").read_text()
 
 
 def test_numbers_on_the_page_have_a_stated_precision(report_dir: Path) -> None:
@@ -127,6 +148,7 @@ def test_a_sixth_law_gets_its_own_section_and_the_errata_use_the_runs_lambda(tmp
         run=RunSpec(simulation=SimulationConfig(duration=1.0), lam=3.0),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,  # its table is the test above's
         controllers=("pd", "adaptive", "examples/sliding_mode.py:SlidingMode"),
@@ -150,12 +172,15 @@ def test_another_robot_gets_the_pipeline_without_the_reports_sections(tmp_path: 
         run=RunSpec(simulation=SimulationConfig(duration=1.0)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         controllers=("pd",),
     )
     results = build_report(tmp_path / "r", options)
     assert results["twolink"] is None and results["errata"] == []
+    assert results["robot"]["equations"]["shown"]  # its own derived equations, no course beside them
     html = (tmp_path / "r" / "index.html").read_text()
+    assert 'id="equations-M"' in html and 'id="equations-course"' not in html
     assert "table1" not in html and "table2-report" not in html and "Errata" not in html
     # the sections it has are numbered 1, 2, 3 ... with no gap where the report's would be
     numbers = [int(n) for n in re.findall(r'<h2 id="[^"]+">(\d+)\. ', html)]
@@ -189,6 +214,7 @@ def test_what_the_report_shows_of_a_robot_is_its_profiles_declaration(
         run=RunSpec(simulation=SimulationConfig(duration=0.5), plant=PlantOptions(friction="on")),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
     )
     results = build_report(tmp_path / "r", options)
@@ -208,6 +234,7 @@ def test_the_identification_section_can_be_left_out(tmp_path: Path, report_dir: 
         "run": RunSpec(simulation=SimulationConfig(duration=1.0)),
         "workers": 1,
         "limits_section": False,
+        "sim_to_sim": False,
         "animation": False,
         "controllers": ("pd",),
     }
@@ -252,6 +279,7 @@ def test_failure_midway_leaves_the_previous_report_whole(
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,
         controllers=("pd",),
@@ -269,6 +297,7 @@ def test_a_diverging_run_in_a_worker_is_a_section_and_the_others_are_written(tmp
         run=RunSpec(simulation=SimulationConfig(duration=0.5), lam=1e6),
         workers=2,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         animation=False,
         identification=False,
     )
@@ -294,6 +323,7 @@ def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> No
         run=RunSpec(simulation=SimulationConfig(duration=0.5)),
         workers=1,
         limits_section=False,  # its own tests: test_report_within_limits.py
+        sim_to_sim=False,  # its own tests: test_report_sim_to_sim.py
         controllers=("pd",),
     )
     results = build_report(tmp_path / "r", options)

@@ -22,7 +22,7 @@ VARIANT = "pd@kp=200,150"
 def report(tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("report") / "r"
     argv = ["report", "--controller", "osc", "--controller", "pd", "--controller", VARIANT]
-    argv += ["--no-animation", "--no-identification", "--no-limits-section"]
+    argv += ["--no-animation", "--no-identification", "--no-limits-section", "--no-sim-to-sim"]
     assert main([*argv, *RUN, "--workers", "1", "--out", str(out)]) == 0
     return out
 

@@ -27,6 +27,7 @@ OPTIONS = {
     "animation": False,
     "identification": False,
     "controllers": LAWS,
+    "sim_to_sim": False,
 }
 FINE = 12001
 """Instants of the finer grid the tests recompute a reference on (the section's: 4001)."""

@@ -45,6 +45,15 @@ SAMPLES = {
     "--sensor-noise": ["--sensor-noise", "0.001"],
     "--noise-seed": ["--sensor-noise", "0.001", "--noise-seed", "5"],
     "--delay": ["--delay", "2"],
+    "--plant": ["--plant", "mujoco"],
+    "--armature": ["--armature", "0.1"],
+    "--joint-damping": ["--joint-damping", "0.5"],
+    "--frictionloss": ["--plant", "mujoco", "--frictionloss", "0.2"],
+    "--soft-limits": ["--plant", "mujoco", "--soft-limits", "off"],
+    "--solref": ["--plant", "mujoco", "--solref", "0.01,1"],
+    "--solimp": ["--plant", "mujoco", "--solimp", "0.8,0.9,0.01"],
+    "--mujoco-integrator": ["--plant", "mujoco", "--mujoco-integrator", "euler"],
+    "--believe-effects": ["--armature", "0.1", "--believe-effects"],
 }
 """A non-default value of each run option (a new option needs one here)."""
 NOT_FROM_OPTIONS = {"law", "law_gains", "shared", "parameters_use", "rtol", "atol", "v0_offset"}

@@ -4,7 +4,8 @@ only one feature needs is paid by all of them. ``scipy.interpolate`` (pose paths
 ``scipy.optimize``: ~0.8 s), ``scipy.integrate`` (the adaptive-step method, ~0.3 s),
 ``scipy.linalg`` (the pivoted QR of the base parameters of an arm without a closed-form map,
 ``expm`` of the adaptation's averaged modes: ~0.3 s of CPU, a third of a twolink command's),
-matplotlib (figures), Dask, TOPP-RA (~1.1 s: it loads matplotlib) and ProxQP are imported where they are used, not at start-up.
+matplotlib (figures), Dask, TOPP-RA (~1.1 s: it loads matplotlib), ProxQP and SymPy (the equations,
+~0.5 s) are imported where they are used, not at start-up.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ DEFERRED = (
     "rosbags",
     "toppra",
     "proxsuite",
+    "sympy",
 )
 """Modules that importing the package and its CLI must not import."""
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

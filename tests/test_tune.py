@@ -146,7 +146,9 @@ def test_controls_follow_the_gains_declaration() -> None:
         "kd joint 2 [N·m·s/rad]",
         "kd × (all)",
     ]
-    assert [(k.low, k.high, k.step) for k in knobs[:2]] == [(0.0, 1400.0, 1.0), (0.0, 1200.0, 1.0)]
+    # the range: 0 … 4 × the default; the first step: to the log grid's next value (350 → 400, 300 → 350)
+    assert [(k.low, k.high, k.step) for k in knobs[:2]] == [(0.0, 1400.0, 50.0), (0.0, 1200.0, 50.0)]
+    assert {k.rule.kind for k in knobs} == {"log"}
     assert gains_from(knobs, {}) == {"kp": (350.0, 300.0), "kd": (40.0, 50.0)}
     assert gains_from(knobs, {2: 0.5, 3: 41.0}) == {"kp": (175.0, 150.0), "kd": (41.0, 50.0)}
 
@@ -163,9 +165,9 @@ def test_a_scalar_gain_is_one_control_and_a_signed_one_ranges_both_ways() -> Non
         bias: Any = gain(-2.0, bound="any", unit="N·m")
 
     knobs = knobs_of(G, {"lam": 5.0, "bias": -2.0})
-    assert [(k.label, k.low, k.high, k.step) for k in knobs] == [
-        ("lam [1/s]", 0.0, 20.0, 0.01),
-        ("bias [N·m]", -8.0, 8.0, 0.01),
+    assert [(k.label, k.low, k.high, k.step, k.rule.kind) for k in knobs] == [
+        ("lam [1/s]", 0.0, 20.0, 0.5, "log"),  # 5 → 5.5: the grid's next value
+        ("bias [N·m]", -8.0, 8.0, 0.1, "linear"),  # a signed gain: a twentieth of its default
     ]
 
 

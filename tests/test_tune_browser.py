@@ -33,6 +33,9 @@ ROOT = Path(__file__).resolve().parents[1]
 WAIT = 600.0
 """Bound on every wait [s] (a busy machine): a failure, never a pass, when it runs out."""
 CLI = [sys.executable, "-m", "twolink_pin_entry"]
+VIEW = slice(40, 480)
+"""The columns [px] of a 1400-px window where the arm is drawn: left of the controls, which
+float over the 3-D view's right part (the results are docked at the window's right edge)."""
 SHORT = ("--duration", "4")
 """The tuner's runs here: 4 s simulated (its default, 30 s, made every run and every redraw
 of the page 7.5 times longer; nothing checked here depends on the length)."""
@@ -158,31 +161,32 @@ def test_the_page_draws_the_arm_and_a_gain_moved_by_keyboard_runs_again(pd: Tune
     driver.get(pd.url)
     thumb = slider(driver, "kp joint 1 [N·m/rad]")
 
-    def drawn(d: Any) -> bool:  # the arm (and its trail) in the middle of the 3-D view, left of the panel
-        view = screenshot(d)[150:850, 300:950, :3]
+    def drawn(d: Any) -> bool:  # the arm (and its trail) in the 3-D view left of the floating controls
+        view = screenshot(d)[150:850, VIEW, :3]
         return bool((view.min(axis=2) < 0.8).mean() > 0.01)
 
     WebDriverWait(driver, WAIT).until(drawn)
-    press(thumb, Keys.ARROW_RIGHT)
+    press(thumb, Keys.ARROW_RIGHT)  # one step of the log grid: 350 → 400
     line = pd.next(ran)
-    assert line["gains"]["kp"] == [351.0, 300.0]
-    assert "--gain=kp=351.0,300.0" in line["command"]
+    assert line["gains"]["kp"] == [400.0, 300.0]
+    assert "--gain=kp=400.0,300.0" in line["command"]
     assert line["metrics"] != first["metrics"]
 
 
 def test_after_a_burst_the_last_line_carries_the_final_value(pd: Tune, driver: Any) -> None:
-    """Five presses: the values reported never go back (a stale run never follows a newer
-    one) and the last is the control's final value; a later change of another gain runs
-    with it."""
+    """Five presses, five grid steps (400 → 450 → 500 → 550 → 600 → 700): the values
+    reported never go back (a stale run never follows a newer one) and the last is the
+    control's final value; a later change of another gain runs with it."""
     from selenium.webdriver.common.keys import Keys
 
     thumb = slider(driver, "kp joint 1 [N·m/rad]")
     start = float(thumb.get_attribute("aria-valuenow"))
+    assert start == 400.0
     press(thumb, *[Keys.ARROW_RIGHT] * 5)
-    final = start + 5
+    final = 700.0
     pd.next(lambda line: ran(line) and line["gains"]["kp"][0] == final)
-    press(slider(driver, "kd joint 2 [N·m·s/rad]"), Keys.ARROW_LEFT)  # 50 − one step (0.1)
-    last = pd.next(lambda line: ran(line) and line["gains"]["kd"][1] < 50.0)
+    press(slider(driver, "kd joint 2 [N·m·s/rad]"), Keys.ARROW_LEFT)  # 50 → 45: one step down
+    last = pd.next(lambda line: ran(line) and line["gains"]["kd"][1] == 45.0)
     assert last["gains"]["kp"][0] == final
     burst = [line["gains"]["kp"][0] for line in pd.seen if ran(line) and line["gains"]["kp"][0] > start]
     assert burst == sorted(burst) and burst[-1] == final
@@ -207,8 +211,8 @@ def test_a_refused_value_shows_the_laws_message_and_the_server_stays_up(pd: Tune
     refused = pd.next(lambda line: "error" in line)
     assert refused["error"].startswith("kp[0] = 0.0 is invalid: expected finite numbers > 0")
     WebDriverWait(driver, WAIT).until(lambda d: "refused: kp[0] = 0.0 is invalid" in page_text(d))
-    press(thumb, Keys.ARROW_RIGHT)
-    assert pd.next(ran)["gains"]["kp"][0] == 1.0
+    press(thumb, Keys.ARROW_RIGHT)  # up from 0: a hundredth of the slider's range, 14
+    assert pd.next(ran)["gains"]["kp"][0] == 14.0
 
 
 def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_controls(
@@ -232,8 +236,8 @@ def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_con
         driver.switch_to.window(first_tab)
         press(thumb, Keys.ARROW_RIGHT)
         line = pd.next(ran)
-        moved = before[0] + 1.0
-        assert line["gains"]["kp"] == [moved, before[1]]
+        moved = 16.0  # from 14, one step of the preferred grid (350 is a preferred value)
+        assert before[0] == 14.0 and line["gains"]["kp"] == [moved, before[1]]
         shown = f"run {line['run']}: "
 
         def latest(d: Any) -> bool:
@@ -250,7 +254,7 @@ def test_two_tabs_show_the_same_latest_run_and_a_reopened_tab_draws_with_its_con
         WebDriverWait(driver, WAIT).until(latest)
         assert {"kp joint 1 [N·m/rad]", "kd joint 2 [N·m·s/rad]"} <= set(labels(driver))
         WebDriverWait(driver, WAIT).until(
-            lambda d: bool((screenshot(d)[150:850, 300:950, :3].min(axis=2) < 0.8).mean() > 0.01)
+            lambda d: bool((screenshot(d)[150:850, VIEW, :3].min(axis=2) < 0.8).mean() > 0.01)
         )
     finally:
         for handle in driver.window_handles:

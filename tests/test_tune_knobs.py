@@ -82,12 +82,21 @@ def test_a_typed_value_that_is_no_gain_is_refused_naming_the_text(
     assert f"kp = {text!r} is invalid" in str(raised.value) and why in str(raised.value)
 
 
-def test_what_a_box_shows_reads_back_to_the_same_numbers() -> None:
+def test_what_a_box_shows_is_the_value_to_six_digits_and_short_values_exactly() -> None:
+    """A box shows each number to at most 7 significant digits: what it shows reads back to
+    the value within 5e-6 relative (6 digits rounded: half a unit of the 6th digit of a mantissa ≥ 1), and exactly when the value's shortest
+    text is that short (a typed value, a grid value, the course's gains)."""
     rng = np.random.default_rng(0)
     for value in (rng.normal(size=()) * 1e3, rng.normal(size=7) * 1e-5, rng.normal(size=(3, 3)), 1e308):
         text = format_typed(value)
         shape = np.shape(value)
         count = None if not shape else shape[0]
         back = parse_typed("g", text, count, matrix=len(shape) == 2)
-        np.testing.assert_array_equal(back, value)
+        np.testing.assert_allclose(back, value, rtol=5e-6, atol=0)
+        for token in text.replace(";", ",").split(","):
+            digits = token.strip().lower().partition("e")[0].replace("-", "").replace(".", "").strip("0")
+            assert len(digits) <= 7, text
+    for exact in (350.0, 0.025, 1e-300, 1e308, 123.4567, -2500.0):
+        assert parse_typed("g", format_typed(exact), None) == exact
     assert format_typed(FULL) == "150, 20, 0; 20, 150, 0; 0, 0, 80"
+    assert format_typed([1600.0, 159.99999999999997]) == "1600, 160"  # mpc's derived weight_q

@@ -1,9 +1,11 @@
-"""The tuner's page as a person uses it (issue 38), in a real Chromium from the keyboard:
-a typed gain runs on Enter only (nothing runs at each keystroke), reads exponent notation
-as typed, refuses NaN next to its box and moves a slider's end to reach a typed value; the
+"""The tuner's page as a person uses it (issues 38, 45, 48), in a real Chromium from the
+keyboard: a typed gain runs on Enter only (nothing runs at each keystroke), reads exponent
+notation as typed, refuses NaN next to its box and moves a slider's end to reach a typed
+value; the box beside a gain's slider and the run's and plant's number boxes take what is
+typed the same way, once, and a negative duration is refused where it was typed; the
 periods control makes a run of two periods whose "last period" differs from the whole;
-"keep this run" names a column as ``compare`` names the variant; a full matrix gain keeps
-its off-diagonal terms in the page, the runs and the command line."""
+"keep this run" names the kept run as ``compare`` names the variant; a full matrix gain
+keeps its off-diagonal terms in the page, the runs and the command line."""
 
 from __future__ import annotations
 
@@ -80,7 +82,7 @@ def test_a_typed_gain_runs_on_enter_not_at_each_keystroke(pd: Tune, driver: Any)
     WebDriverWait(driver, WAIT).until(lambda d: box(d, "kd =").get_attribute("value") == "120, 120")
     press(slider(driver, "kp joint 1 [N·m/rad]"), Keys.ARROW_RIGHT)  # a slider still runs at once
     moved = pd.next(ran)
-    assert moved["gains"] == {"kp": [351.0, 300.0], "kd": [120.0, 120.0]} and moved["run"] == typed["run"] + 1
+    assert moved["gains"] == {"kp": [400.0, 300.0], "kd": [120.0, 120.0]} and moved["run"] == typed["run"] + 1
 
 
 def test_exponent_notation_beyond_the_slider_and_nan_next_to_the_box(pd: Tune, driver: Any) -> None:
@@ -126,11 +128,12 @@ def test_keep_this_run_names_its_column_as_compare_names_the_variant(pd: Tune, d
         )
     )
     button.click()
-    header = WebDriverWait(driver, WAIT).until(
+    header = WebDriverWait(driver, WAIT).until(  # the column is headed "kept", its name under the table
         lambda d: d.execute_script(
             "var t = Array.from(document.querySelectorAll('table')).find(e => e.textContent.includes('RMS e [rad]'));"
-            "var h = t ? Array.from(t.querySelectorAll('th')).map(e => e.textContent) : [];"
-            "return h.length > 4 ? h[h.length - 1] : null"
+            "var h = t ? Array.from(t.querySelectorAll('thead th')).map(e => e.textContent) : [];"
+            "var c = document.querySelector('code.twolink-kept');"
+            "return h.length > 4 && h[h.length - 1] === 'kept' && c ? c.textContent : null"
         )
     )
     variant = parse_variant(header)
@@ -140,26 +143,73 @@ def test_keep_this_run_names_its_column_as_compare_names_the_variant(pd: Tune, d
     assert {name for name, _ in variant.gains} == {"kp", "kd"}  # both moved from their defaults
 
 
-def test_a_letter_in_a_run_settings_number_box_is_refused_next_to_it(pd: Tune, driver: Any) -> None:
-    """ "1e3" typed into ``payload [kg]``: the "e" is refused with the browser's bubble at the
-    box (Mantine's box would silently drop it: 13); "2" and Enter then run with 2 kg."""
+def number_box(driver: Any, label: str, index: int = 0) -> Any:
+    """The ``index``-th input of the row labelled ``label`` (a slider's box: its only one)."""
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    script = """
+    var l = Array.from(document.querySelectorAll('label')).find(function (e) { return e.textContent === arguments[0]; });
+    var n = l;
+    for (var i = 0; n && i < 12; i++) { n = n.parentElement; var all = n && n.querySelectorAll('input:not([type=hidden])'); if (all && all.length) return all[arguments[1]] || null; }
+    return null;
+    """.replace("arguments[0]", json.dumps(label)).replace("arguments[1]", str(index))
+    return WebDriverWait(driver, WAIT).until(lambda d: d.execute_script(script))
+
+
+def test_the_box_beside_a_gains_slider_runs_what_is_typed_once(pd: Tune, driver: Any) -> None:
+    """Issue 45: "1.2e2" typed key by key into the box beside "kd joint 1", then Enter: one
+    run with kd = 120 (exponent notation read as the ``kd =`` box reads it), the box shows
+    it; leaving the box afterwards runs nothing more; Enter on a box left as it was runs
+    nothing; "abc" is refused next to the gain and nothing runs."""
     from selenium.webdriver.common.keys import Keys
     from selenium.webdriver.support.ui import WebDriverWait
 
-    from twolink_pin.tuning.typed_js import NUMBER_ONLY
-
-    driver.find_element("xpath", "//*[text()='run']").click()  # open the run's folder
-    payload = WebDriverWait(driver, WAIT).until(
-        lambda d: d.execute_script(
-            "var l = Array.from(document.querySelectorAll('label')).find(e => e.textContent === 'payload [kg]');"
-            "return l ? document.getElementById(l.htmlFor) : null"
-        )
+    before = [x for x in pd.seen if ran(x)][-1]
+    box = number_box(driver, "kd joint 1 [N·m·s/rad]")
+    type_into(box, "1.2e2")
+    press(box, Keys.ENTER)
+    line = pd.next(ran)
+    assert line["gains"]["kd"] == [120.0, before["gains"]["kd"][1]] and line["run"] == before["run"] + 1
+    WebDriverWait(driver, WAIT).until(
+        lambda d: number_box(d, "kd joint 1 [N·m·s/rad]").get_attribute("value") == "120"
     )
-    type_into(payload, "1e")
-    assert payload.get_attribute("validationMessage") == NUMBER_ONLY
-    type_into(payload, "2")
+    press(box, Keys.TAB)  # the box loses focus: no second run
+    press(box, Keys.ENTER)  # focused again, nothing typed: nothing runs
+    type_into(box, "abc")
+    press(box, Keys.ENTER)
+    WebDriverWait(driver, WAIT).until(lambda d: "refused: kd joint 1 = 'abc' is invalid" in page_text(d))
+    type_into(box, "130")
+    press(box, Keys.TAB)  # leaving an edited box runs it
+    after = pd.next(ran)
+    assert after["gains"]["kd"][0] == 130.0 and after["run"] == line["run"] + 1  # nothing ran between
+
+
+def test_a_number_typed_into_the_plant_or_run_settings_runs_or_is_refused_visibly(
+    pd: Tune, driver: Any
+) -> None:
+    """ "1.5e0" into ``payload [kg]`` runs 1.5 kg (Mantine's box alone read it as 150); a
+    negative duration is refused next to it saying what is expected, and nothing runs; a
+    good one then runs."""
+    from selenium.webdriver.common.keys import Keys
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    driver.find_element("xpath", "//*[text()='plant']").click()  # open the plant's folder
+    payload = number_box(driver, "payload [kg]")
+    type_into(payload, "1.5e0")
     press(payload, Keys.ENTER)
-    assert pd.next(ran)["payload"] == 2.0
+    line = pd.next(ran)
+    assert line["payload"] == 1.5
+    duration = number_box(driver, "duration [s]")
+    type_into(duration, "-3")
+    press(duration, Keys.ENTER)
+    WebDriverWait(driver, WAIT).until(
+        lambda d: "refused: duration [s] = '-3' is invalid: expected a number from 0.001 to" in page_text(d)
+    )
+    type_into(duration, "6")
+    press(duration, Keys.ENTER)
+    after = pd.next(ran)
+    assert after["spec"]["simulation"]["duration"] == 6.0 and after["run"] == line["run"] + 1  # -3 never ran
+    WebDriverWait(driver, WAIT).until(lambda d: "refused: duration" not in page_text(d))
 
 
 FULL = [[150.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
@@ -189,10 +239,10 @@ def test_a_full_matrix_gain_keeps_its_off_diagonals_in_the_page_the_runs_and_the
     assert "--gain=kp=150.0,20.0,0.0,20.0,150.0,0.0,0.0,0.0,80.0" in first["command"]
     driver.get(panda.url)
     assert box(driver, "kp =").get_attribute("value") == "150, 20, 0; 20, 150, 0; 0, 0, 80"
-    press(slider(driver, "kp axis x [1/s²]"), Keys.ARROW_RIGHT)
+    press(slider(driver, "kp axis x [1/s²]"), Keys.ARROW_RIGHT)  # 150 · 10^(1/20) = 168 → 170
     moved = panda.next(ran)
-    assert moved["gains"]["kp"] == [[151.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
+    assert moved["gains"]["kp"] == [[170.0, 20.0, 0.0], [20.0, 150.0, 0.0], [0.0, 0.0, 80.0]]
     WebDriverWait(driver, WAIT).until(
-        lambda d: box(d, "kp =").get_attribute("value") == "151, 20, 0; 20, 150, 0; 0, 0, 80"
+        lambda d: box(d, "kp =").get_attribute("value") == "170, 20, 0; 20, 150, 0; 0, 0, 80"
     )
     assert simulate_json(moved["command"])["gains"] == moved["gains"]

@@ -53,6 +53,32 @@ def test_loopback_is_told_apart_from_every_interface() -> None:
     assert not check_listen("0.0.0.0").loopback
 
 
+@pytest.mark.parametrize(
+    ("host", "why"),
+    [
+        ("224.0.0.1", "224.0.0.1 is a multicast address"),
+        ("239.1.2.3", "239.1.2.3 is a multicast address"),
+        ("ff02::1", "ff02::1 is a multicast address"),
+        ("255.255.255.255", "255.255.255.255 is the broadcast address"),
+        # the loopback network's broadcast: Linux binds it and nothing connects (elsewhere: no bind)
+        ("127.255.255.255", "(nothing can connect to|cannot listen on) 127.255.255.255"),
+    ],
+)
+def test_a_multicast_or_broadcast_host_is_refused(host: str, why: str) -> None:
+    """Linux lets a TCP socket bind and listen on these (the page "served", and no browser
+    could reach it): refused, naming the address and why."""
+    with pytest.raises(InvalidParameterError, match=rf"--host = '{host}' is invalid: .*{why}"):
+        check_listen(host)
+
+
+def test_tune_on_a_broadcast_address_is_one_line_and_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
+    from twolink_pin.cli import main
+
+    assert main(["tune", "pd", "--host", "255.255.255.255", "--no-browser", "--duration", "0.1"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "broadcast address" in err and "Traceback" not in err
+
+
 # --- where the page writes ------------------------------------------------------------
 
 
@@ -256,14 +282,15 @@ def test_save_and_export_write_inside_the_folder_offer_downloads_and_refuse_othe
         lines.get(timeout=WAIT)
         assert tuner.session.idle(WAIT)
         shown = tuner._latest.result  # the run on screen
+        files = tuner.files  # the folder "as a command"
         for refused in (str(outside), "../outside.npz"):
-            tuner.save_path.value = refused
-            tuner._save(page)  # the button's handler
-            assert tuner.saved.content.startswith("**not saved**") and refused in tuner.saved.content
-        tuner.save_path.value = "runs/kept.npz"
-        tuner._save(page)
-        tuner.html_path.value = "arm.html"
-        tuner._export(page)
+            files.save_path.value = refused
+            files.save(page)  # the button's handler
+            assert files.saved.content.startswith("**not saved**") and refused in files.saved.content
+        files.save_path.value = "runs/kept.npz"
+        files.save(page)
+        files.html_path.value = "arm.html"
+        files.export(page)
     finally:
         tuner.close()
     assert not outside.exists() and sorted(p.name for p in folder.rglob("*")) == [
@@ -344,3 +371,59 @@ def test_the_default_run_holds_three_periods_as_help_says(capsys: pytest.Capture
         parser.parse_args(["tune", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "default: 3 periods of the reference" in text and "(default 30)" not in text
+
+
+# --- numbers typed into the page's boxes (what the script sends, without a page) --------
+
+
+def test_typed_numbers_reach_the_run_settings_the_plant_and_the_playback_or_are_refused_there() -> None:
+    """The script's messages, as a page sends them: "2" into ``periods`` runs two periods;
+    "-1" into ``delay [steps]`` and "0" into the playback's speed are refused beside them,
+    naming what is expected, and nothing runs; "2e0" into the speed plays twice as fast."""
+    import json
+
+    tuner, lines = _tuner("pd", 0.2)
+    try:
+        lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        channel = tuner.panel.channel
+
+        def typed(n: int, label: str, text: str) -> None:
+            channel.received(json.dumps({"page": "p", "items": [[n, label, 0, text]]}))
+
+        typed(1, "periods", "2")
+        line = lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        typed(2, "delay [steps]", "-1")
+        typed(3, "speed", "0")
+        refused_speed = tuner.scene.note.content
+        typed(4, "speed", "2e0")
+        plant_note, speed_note = tuner.panel.plant.error.content, tuner.scene.note.content
+        speed = float(tuner.scene.speed.value)
+        generation = tuner.session.generation
+    finally:
+        tuner.close()
+    assert line["spec"]["simulation"]["duration"] == 8.0  # two 4-s periods of the twolink's reference
+    assert plant_note.startswith(
+        "**refused**: delay [steps] = '-1' is invalid: expected a whole number from 0 to"
+    )
+    assert refused_speed == "**refused**: speed = '0' is invalid: expected a number > 0"
+    assert speed_note == "" and speed == 2.0  # then "2e0" taken
+    assert generation == 2  # the refused values ran nothing; the speed is the playback's
+
+
+def test_the_plant_folders_engine_runs_the_arm_on_mujoco_and_its_line_says_so() -> None:
+    """The engine menu (the plant's folder) set to mujoco: the run and its command line are
+    MuJoCo's (``--plant mujoco``), as ``simulate`` would run it."""
+    tuner, lines = _tuner("pd", 0.2)
+    try:
+        lines.get(timeout=WAIT)
+        assert tuner.session.idle(WAIT)
+        assert tuple(tuner.panel.plant.engine.options) == ("pinocchio", "mujoco")
+        tuner.panel.plant.engine.value = "mujoco"
+        tuner.changed()
+        line = lines.get(timeout=WAIT)
+    finally:
+        tuner.close()
+    assert "error" not in line, line
+    assert line["spec"]["plant"]["engine"] == "mujoco" and "--plant=mujoco" in line["command"]

@@ -18,6 +18,10 @@ OpenMP's wait policy is set here, before anything below imports Pinocchio (see
 """
 
 from twolink_pin import openmp as _openmp  # noqa: F401  # first: sets the wait policy before pinocchio loads
+
+# isort: split
+
+from twolink_pin import mujoco_plant as _mujoco_plant  # noqa: F401  # registers the engine 'mujoco' (--plant mujoco)
 from twolink_pin.controllers import (
     CONTROLLERS,
     Adaptive,

@@ -214,6 +214,24 @@ class OutputError(TwolinkPinError):
         super().__init__(f"{path}: {reason}")
 
 
+class EquationsError(TwolinkPinError):
+    """An arm whose equations of motion the symbolic derivation does not give: a joint it does
+    not handle (planar, floating, spherical), a closed chain, more joints than it derives in
+    the time it states, or a derivation stopped by ``--timeout`` (bad input: exit status 2).
+
+    Attributes:
+        robot: The robot (catalog name or URDF path).
+        reason: Which part of the arm, why, and what was expected.
+    """
+
+    _fields = ("robot", "reason")
+
+    def __init__(self, robot: str, reason: str) -> None:
+        self.robot = robot
+        self.reason = reason
+        super().__init__(f"{robot}: {reason}")
+
+
 def raised_at(exc: BaseException, law: object = None) -> str:
     """`` (raised at FILE:LINE in FUNCTION)`` for ``exc``: the innermost frame of the file that
     defines ``law``'s class (a user's law: the line to look at), else the innermost frame; ``""``

@@ -7,12 +7,17 @@ variant is a row of its own, named by its text (:attr:`Variant.key`).
 
 * ``LAW`` is what a command takes as a law: a registered name, ``path/to/file.py:Class`` or
   ``package.module:Class``.
-* ``KEY`` is a gain of the law (``kp``, ``lam``, …: its ``Gains`` fields), ``model`` or ``p0``.
+* ``KEY`` is a gain of the law (``kp``, ``lam``, …: its ``Gains`` fields), ``model``, ``p0``, or
+  a plant key (:data:`~twolink_pin.arm_effects.PLANT_KEYS`: ``plant``, ``armature``,
+  ``joint_damping``, ``frictionloss``, ``soft_limits``, ``solref``, ``solimp``, ``integrator``,
+  ``saturate``): ``pd@plant=mujoco`` runs ``pd`` on the MuJoCo plant beside ``pd`` on
+  Pinocchio's, ``pd@plant=mujoco@armature=arm`` with the arm's armature.
 * ``VALUE`` is written as the single-law options take it: a gain as ``--gain NAME=V`` does
   (one number, or comma-separated numbers: per joint, or a matrix row by row;
   :func:`gain_value`), ``model=FILE`` as ``--model FILE`` (identified parameters or a URDF
   whose inertias the law believes), ``p0=FILE`` as ``--p0 FILE`` (where the estimates of a
-  law that estimates start).
+  law that estimates start); a plant key as its option does (``plant=mujoco``,
+  ``armature=arm`` or ``armature=0.1,0.2``, ``soft_limits=off``, ``integrator=implicitfast``).
 
 **Where a setting starts.** An ``@`` starts a setting only when a key and ``=`` follow it
 (``@kp=``, ``@model=``): a law file's path or a parameter file's path may hold ``@`` and ``:``
@@ -39,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from twolink_pin.arm_effects import PLANT_KEYS, plant_value
 from twolink_pin.controllers import Controller
 from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
@@ -100,6 +106,8 @@ class Variant:
         gains: The gains it sets, ``((name, value), ...)`` in the order written.
         parameters: The parameter file of ``model=`` or ``p0=``, or None.
         parameters_use: ``"model"``, ``"p0"``, or ``""`` without a file.
+        plant: The plant options it sets, ``((PlantOptions field, value), ...)``
+            (:data:`~twolink_pin.arm_effects.PLANT_KEYS`).
     """
 
     text: str
@@ -108,6 +116,7 @@ class Variant:
     gains: tuple[tuple[str, GainValue], ...] = ()
     parameters: str | None = None
     parameters_use: str = ""
+    plant: tuple[tuple[str, Any], ...] = ()
 
     @property
     def key(self) -> str:
@@ -120,7 +129,7 @@ class Variant:
     def settings(self) -> tuple[tuple[str, Any], ...]:
         """Every setting, gains and the parameter file, as ``((key, value), ...)``."""
         extra = () if self.parameters is None else ((self.parameters_use, self.parameters),)
-        return (*self.gains, *extra)
+        return (*self.gains, *extra, *self.plant)
 
     def law_class(self) -> type[Controller]:
         """The law's class."""
@@ -179,17 +188,19 @@ def parse_variant(text: str) -> Variant:
     """
     law, pairs = split_variant(text)
     cls = law_class(law)
-    keys = (*cls.Gains.field_names(), *PARAMETER_KEYS)
+    keys = (*cls.Gains.field_names(), *PARAMETER_KEYS, *PLANT_KEYS)
     where = f"variant {_shown(text)}"
     gains: dict[str, GainValue] = {}
     files: dict[str, str] = {}
+    plant: dict[str, Any] = {}
     seen: dict[str, str] = {}
     for key, value in pairs:
         if key not in keys:
             raise InvalidParameterError(
                 f"{where}: key",
                 key,
-                f"a gain of '{cls.name}' ({', '.join(cls.Gains.field_names())}), model or p0",
+                f"a gain of '{cls.name}' ({', '.join(cls.Gains.field_names())}), model, p0 or a plant key "
+                f"({', '.join(PLANT_KEYS)})",
             )
         if key in seen:
             raise InvalidParameterError(
@@ -202,6 +213,12 @@ def parse_variant(text: str) -> Variant:
             )
         if key in PARAMETER_KEYS:
             files[key] = value
+            continue
+        if key in PLANT_KEYS and key not in cls.Gains.field_names():
+            try:
+                plant[PLANT_KEYS[key]] = plant_value(key, value)
+            except InvalidParameterError as exc:
+                raise InvalidParameterError(f"{where}: {key}", value, exc.expected) from None
             continue
         try:
             gains[key] = gain_value(key, value, spec_of(cls.Gains, key).choices)
@@ -219,11 +236,12 @@ def parse_variant(text: str) -> Variant:
             f"a law that estimates parameters ('{cls.name}' estimates none; model=FILE "
             "is the file its model believes)",
         )
-    return Variant(text, law, cls.name, tuple(gains.items()), path, use)
+    return Variant(text, law, cls.name, tuple(gains.items()), path, use, tuple(plant.items()))
 
 
 def _example(key: str) -> str:
-    return {"model": "model=identified.urdf", "p0": "p0=identified.json"}.get(key, f"{key}=200")
+    examples = {"model": "model=identified.urdf", "p0": "p0=identified.json", "plant": "plant=mujoco"}
+    return examples.get(key, f"{key}=200")
 
 
 def parse_variants(texts: Sequence[str]) -> tuple[Variant, ...]:

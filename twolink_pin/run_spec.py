@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.arm_effects import believe_effects, refuse_idle
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.law_variant import Variant
@@ -75,6 +76,9 @@ class RunSpec:
             ``p0`` seeds the laws that estimate, the others run as usual.
         simulation: Duration, step, integrator, initial offset, control period.
         shared: Whether this spec is the common part of several laws' runs.
+        believed_effects: The law's model includes the plant's armature (in its ``M(q)``) and
+            joint damping (in the viscous friction a friction-estimating law believes)
+            (``--believe-effects``; :mod:`twolink_pin.arm_effects`).
     """
 
     law: str | type[Controller] | None = None
@@ -86,6 +90,7 @@ class RunSpec:
     parameters_use: str = ""
     simulation: SimulationConfig = field(default_factory=SimulationConfig)
     shared: bool = False
+    believed_effects: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "gains", _frozen_gains(self.gains))
@@ -201,8 +206,11 @@ class RunSpec:
                     if smoothing
                     else belief.friction
                 )
+        law_robot = robot
+        if self.believed_effects:
+            law_robot, friction = believe_effects(robot, plant, friction)
         controller = make_controller(
-            cls, robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
+            cls, law_robot, lam=self.lam, gains=gains, friction=friction, model_parameters=parameters
         )
         return Scenario(controller, plant)
 
@@ -232,6 +240,13 @@ class RunSpec:
             )
         if plant.position_stops:
             self._check_stops(robot)
+        refuse_idle(plant, robot, sim.method)  # the arm's effects (twolink_pin.arm_effects)
+        if self.believed_effects and plant.armature is None and plant.joint_damping is None:
+            raise InvalidParameterError(
+                "--believe-effects",
+                True,
+                "a plant with armature or joint damping to believe (--armature, --joint-damping)",
+            )
         built = [
             plant.plant(robot, estimates_friction="friction" in cls.estimates, method=sim.method).friction
             for cls in classes
@@ -333,6 +348,7 @@ class RunSpec:
             "parameters_use": self.parameters_use,
             "simulation": {k: list(v) if isinstance(v, tuple) else v for k, v in sim.items()},
             "shared": self.shared,
+            "believed_effects": self.believed_effects,
         }
 
     @classmethod
@@ -351,6 +367,7 @@ class RunSpec:
             parameters_use=data.get("parameters_use", ""),
             simulation=SimulationConfig(**sim),
             shared=bool(data.get("shared", False)),
+            believed_effects=bool(data.get("believed_effects", False)),
         )
 
 
@@ -361,8 +378,14 @@ def law_spec(spec: RunSpec, variant: Variant) -> RunSpec:
     parameters, use = spec.parameters, spec.parameters_use
     if variant.parameters is not None:
         parameters, use = variant.parameters, variant.parameters_use
+    plant = spec.plant
+    if variant.plant:  # its plant keys over the command's plant options
+        try:
+            plant = dataclasses.replace(plant, **dict(variant.plant))
+        except InvalidParameterError as exc:
+            raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
     return dataclasses.replace(
-        spec, gains=tuple(gains.items()), lam=lam, parameters=parameters, parameters_use=use
+        spec, gains=tuple(gains.items()), lam=lam, parameters=parameters, parameters_use=use, plant=plant
     )
 
 
@@ -404,6 +427,8 @@ def build_rows(
         if spec.parameters is not None and spec.parameters not in files:
             files[spec.parameters] = read(spec) if read is not None else spec.read_parameters(robot)
         try:
+            if variant.plant:  # its own plant options: refused where they would do nothing
+                refuse_idle(spec.plant, robot, spec.simulation.method)
             scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
         except InvalidParameterError as exc:
             raise InvalidParameterError(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None

@@ -43,6 +43,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ),
     ("dynamics", "Dynamics", "Every term from Pinocchio: M, C, g, RNEA, ABA, the regressor.", ("dynamics",)),
     (
+        "symbolic",
+        "Equations in closed form",
+        "M, C, g and the regressor derived with SymPy from the URDF's tree: text, LaTeX, JSON, a numpy module.",
+        ("symbolic",),
+    ),
+    (
         "optimal",
         "Optimisation",
         "The one optimisation core: QP solves, B-splines, transcriptions on Pinocchio's derivatives, SQP.",
@@ -52,9 +58,19 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "simulation",
         "Plant and simulation",
-        "The simulated arm, what pushes back on it, a law with its plant, a law's variants, the run description, "
-        "and the engine.",
-        ("plant", "disturbances", "scenario", "law_variant", "run_spec", "simulation"),
+        "The simulated arm (Pinocchio's and MuJoCo's), the effects a real arm has, what pushes back on it, a law "
+        "with its plant, a law's variants, the run description, and the engine.",
+        (
+            "plant",
+            "arm_effects",
+            "mujoco_model",
+            "mujoco_plant",
+            "disturbances",
+            "scenario",
+            "law_variant",
+            "run_spec",
+            "simulation",
+        ),
     ),
     ("metrics", "Metrics", "RMS, L2 and max norms of a run or a batch.", ("metrics", "task_metrics")),
     ("studies", "Studies", "Batches, Monte Carlo sweeps, comparisons, clusters.", ("studies",)),

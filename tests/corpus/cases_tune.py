@@ -26,6 +26,9 @@ TUNE_CASES: list[Case] = [
     # a port in use: one line, no "(viser) Server stopped" beside it (stdout, or stderr under --json)
     C("traceback-tune-port-in-use", f"{TUNE} --port {{port}}", 2, err=("{port}", "in use"), not_err=("viser",), run="proc", timeout=30),
     C("traceback-tune-port-in-use-json", f"{TUNE} --json --port {{port}}", 2, err=("{port}", "in use"), not_err=("viser",), run="proc", timeout=30),
+    # a multicast or broadcast address: Linux binds and listens on it, no browser can connect (issue 48)
+    C("wrong-tune-host-multicast", f"{TUNE} --host 224.0.0.1", 2, err=("--host", "224.0.0.1", "multicast address"), timeout=30),
+    C("wrong-tune-host-broadcast", f"{TUNE} --host 255.255.255.255", 2, err=("--host", "255.255.255.255", "broadcast address"), timeout=30),
     # an option that would do nothing is refused
     C("wrong-tune-watch-registered-law", f"{TUNE} --watch", 2, err=("--watch", "'pd'", "path/to/law.py:Class")),
     # a host other than loopback serves, and says the page is reachable from the network

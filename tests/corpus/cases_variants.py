@@ -40,7 +40,7 @@ GAINS: list[Case] = [
     C("wrong-sweep-user-law-gain-draws", f"sweep examples/sliding_mode.py:SlidingMode --samples 2 {SIM} --gain k=0:1e-300 --no-plot --out s", 2, err=("--gain k=0:1e-300", "run 0", "sliding-mode"), cwd="repo", setup=REPO, absent=("repo/s",)),
     C("wrong-simulate-matrix-gain-below-range", f"simulate osc --robot ur5 {SIM} --gain kp=1e-301,0,0,0,1e-301,0,0,0,1e-301", 2, err=("kp", "smallest eigenvalue", "below 1e-12"), note="9 numbers passed the Cholesky check; a number s was refused below 1e-12 already"),
     # variants: LAW@KEY=VALUE in compare and report
-    C("unclear-compare-variant-unknown-key", f"compare pd pd@zeta=1 {SIM} --no-plot --out c", 2, err=("pd@zeta=1", "zeta", "a gain of 'pd' (kp, kd), model or p0"), absent=("c",)),
+    C("unclear-compare-variant-unknown-key", f"compare pd pd@zeta=1 {SIM} --no-plot --out c", 2, err=("pd@zeta=1", "zeta", "a gain of 'pd' (kp, kd), model, p0 or a plant key"), absent=("c",)),
     C("wrong-compare-variant-key-twice", f"compare pd pd@kp=1@kp=2 {SIM} --no-plot --out c", 2, err=("kp is given twice",), absent=("c",)),
     C("traceback-compare-variant-empty-value", f"compare pd pd@kp= {SIM} --no-plot --out c", 2, err=("a value after 'kp='",), absent=("c",)),
     C("traceback-compare-variant-at-nothing", f"compare pd pd@ {SIM} --no-plot --out c", 2, err=("pd@", "nothing follows it"), absent=("c",)),

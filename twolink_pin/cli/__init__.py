@@ -2,7 +2,9 @@
 
 =====================  ====================================================================================
 ``parser.py``          commands and options (``identify_parser.py``: those of ``identify`` and ``excite``;
-                       ``optimal_parser.py``: ``optimize`` and ``trajectory --time-optimal``)
+                       ``optimal_parser.py``: ``optimize`` and ``trajectory --time-optimal``;
+                       ``equations_parser.py``: ``equations``; ``sweep_options.py``: ``sweep``'s draws
+                       and engine)
 ``common_options.py``  the options every family shares: the robot, the payload, the trajectory
 ``arguments.py``       the argument types that check numbers against their bounds
 ``commands/``          one module per family of commands, each command a thin shell over the library

@@ -67,6 +67,10 @@ def whole(low: int, high: int) -> Callable[[str], int]:
     return parse
 
 
+MAX_DURATION = 1e6
+"""Largest simulated time accepted on the command line [s] (the step count is bounded too)."""
+MAX_OFFSET = 100.0
+"""Largest initial offset accepted on the command line [rad]."""
 MAX_GAIN = 1e12
 """Largest gain accepted on the command line (any unit)."""
 

@@ -46,7 +46,7 @@ def results_only_on_stdout(active: bool) -> Iterator[None]:
 __all__ = ["DEFAULT_TIMEOUT", "TUNE_TIMEOUT", "results_only_on_stdout"]
 
 
-OUTPUT_OPTIONS = ("save", "save_data", "out", "html", "write_urdf", "plot")
+OUTPUT_OPTIONS = ("save", "save_data", "out", "html", "write_urdf", "plot", "latex", "python")
 """Destinations of the options that name something the command writes."""
 
 

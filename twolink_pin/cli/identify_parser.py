@@ -87,6 +87,12 @@ def _identify_run_options(p: Any) -> None:
         help="add white Gaussian noise of this standard deviation to the logged τ [N·m]",
     )
     p.add_argument("--seed", type=whole(0, 2**63 - 1), default=0, help="seed of the noise (default 0)")
+    p.add_argument(
+        "--plant",
+        choices=("pinocchio", "mujoco"),
+        default="pinocchio",
+        help="the simulator of the simulated log: Pinocchio's ABA (default) or MuJoCo (docs/mujoco.md)",
+    )
 
 
 def _identify_fit_options(p: Any) -> None:

@@ -5,17 +5,30 @@ from __future__ import annotations
 import argparse
 from typing import Any, NoReturn
 
-from twolink_pin.cli.arguments import MAX_TEXT, NUMBER, bounded, finite, gain_range, port, whole
+from twolink_pin.cli.arguments import (
+    MAX_DURATION,
+    MAX_GAIN,
+    MAX_OFFSET,
+    MAX_TEXT,
+    NUMBER,
+    bounded,
+    finite,
+    port,
+    whole,
+)
 from twolink_pin.cli.common_options import (
     add_robot_options,
     add_trajectory_option,
     run_group,
     run_option_strings,
 )
-from twolink_pin.cli.disturbance_options import add_disturbance_options, scale_range
+from twolink_pin.cli.disturbance_options import add_disturbance_options
+from twolink_pin.cli.equations_parser import add_equations_command
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
+from twolink_pin.cli.plant_options import add_plant_options
+from twolink_pin.cli.sweep_options import add_sweep_draws, add_sweep_engine
 
 CONTROLLER_HELP = (
     "a control law: a registered name (twolink-pin controllers lists them), path/to/file.py:ClassName "
@@ -33,14 +46,6 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         self.exit(2, f"{self.prog}: error: {message[: 2 * MAX_TEXT]}\n")
-
-
-MAX_DURATION = 1e6
-"""Largest simulated time accepted on the command line [s] (the step count is bounded too)."""
-MAX_OFFSET = 100.0
-"""Largest initial offset accepted on the command line [rad]."""
-MAX_GAIN = 1e12
-"""Largest gain accepted on the command line (any unit)."""
 
 
 def add_sim_options(parser: argparse.ArgumentParser) -> None:
@@ -112,6 +117,7 @@ def add_sim_options(parser: argparse.ArgumentParser) -> None:
         help="the robot's friction in the plant: of the laws that estimate friction (law, default), of every "
         "law (on), of none (off)",
     )
+    add_plant_options(parser)
 
 
 def add_gain_option(p: argparse.ArgumentParser) -> None:
@@ -156,27 +162,6 @@ def add_identified_options(p: argparse.ArgumentParser, several: bool = False) ->
     )
 
 
-def chunk_size(high: int) -> Any:
-    """``sweep --chunk``: ``auto`` (None) or a whole number from 1 to ``high``."""
-    number = whole(1, high)
-
-    def parse(text: str) -> int | None:
-        return None if text.strip().lower() == "auto" else number(text)
-
-    return parse
-
-
-def scheduler_option(text: str) -> str:
-    """``sweep --scheduler``: a Dask scheduler's address, normalised (``tcp://HOST:PORT``)."""
-    from twolink_pin.errors import InvalidParameterError
-    from twolink_pin.studies.cluster import scheduler_address
-
-    try:
-        return scheduler_address(text)
-    except InvalidParameterError as exc:
-        raise argparse.ArgumentTypeError(f"expected {exc.expected}, got {text[:MAX_TEXT]!r}") from None
-
-
 def build_parser() -> argparse.ArgumentParser:
     """The ``twolink-pin`` argument parser: each family of commands added by its own function."""
     from twolink_pin.cli import commands as c
@@ -196,6 +181,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_run_commands(sub, c)
     _add_sweep_command(sub, c)
     add_identification_commands(sub, c)
+    add_equations_command(sub, c)
     return parser
 
 
@@ -404,6 +390,11 @@ def _add_report(sub: Any, c: Any) -> None:
     p.add_argument(
         "--no-limits-section", action="store_true", help="skip the section 'The reference within the limits'"
     )
+    p.add_argument(
+        "--no-sim-to-sim",
+        action="store_true",
+        help="skip the section 'Sim-to-sim': each law on Pinocchio and on MuJoCo with the arm's effects (docs/mujoco.md)",
+    )
     add_robot_options(p)
     add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)
@@ -415,10 +406,10 @@ def _add_sweep_command(sub: Any, c: Any) -> None:
         "sweep", help="Monte Carlo study of one law on the batch engine: table, summary, histograms"
     )
     p.add_argument("controller", metavar="CONTROLLER", help=CONTROLLER_HELP)
-    _add_sweep_draws(p)
+    add_sweep_draws(p)
     p.add_argument("--out", default="out/sweep", metavar="DIR", help="output directory (default out/sweep)")
     add_disturbance_options(p)
-    _add_sweep_engine(p)
+    add_sweep_engine(p)
     p.add_argument(
         "--keep-trajectories", action="store_true", help="also write every run's q, q̇, τ (large) as .npz"
     )
@@ -426,98 +417,3 @@ def _add_sweep_command(sub: Any, c: Any) -> None:
     add_sim_options(p)
     add_robot_options(p)
     p.set_defaults(func=c.cmd_sweep)
-
-
-def _add_sweep_draws(p: argparse.ArgumentParser) -> None:
-    """The study's runs and what each draws: count, seed, initial error, parameter error,
-    gain ranges, wrench scale."""
-    from twolink_pin.studies.sweep import MAX_SAMPLES
-
-    p.add_argument(
-        "--samples",
-        type=whole(1, MAX_SAMPLES),
-        required=True,
-        metavar="N",
-        help=f"number of runs (1 to {MAX_SAMPLES})",
-    )
-    p.add_argument(
-        "--seed",
-        type=whole(0, 2**63 - 1),
-        default=0,
-        help="random seed >= 0 (default 0): same seed, same files",
-    )
-    p.add_argument(
-        "--q0-spread",
-        type=bounded(0.0, MAX_OFFSET, unit="rad"),
-        default=0.0,
-        metavar="RAD",
-        help="initial error q0-offset ± U(RAD) per joint [rad] (default 0)",
-    )
-    p.add_argument(
-        "--param-error",
-        type=bounded(0.0, 0.999999, unit=""),
-        default=0.0,
-        metavar="FRAC",
-        help="the law believes p·(1 + U(±FRAC)) per parameter (0 to <1, default 0)",
-    )
-    p.add_argument(
-        "--gain",
-        type=gain_range,
-        action="append",
-        default=[],
-        metavar="NAME=LO:HI",
-        help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
-    )
-    p.add_argument(
-        "--wrench-scale",
-        type=scale_range,
-        default=None,
-        metavar="LO:HI",
-        help="draw each run's factor on --wrench uniformly in [LO, HI], e.g. 0:2",
-    )
-
-
-def _add_sweep_engine(p: argparse.ArgumentParser) -> None:
-    """Where and how the chunks run: threads, chunk size, a LocalCluster or a scheduler."""
-    from twolink_pin.studies.cluster import CONNECT_TIMEOUT, MAX_WORKERS
-    from twolink_pin.studies.sweep import MAX_CHUNK
-
-    p.add_argument(
-        "--threads",
-        type=whole(1, 256),
-        default=None,
-        help="threads of the batch engine per chunk (default the cores this process may use, or "
-        "TWOLINK_PIN_THREADS, in-process; 1 per Dask task)",
-    )
-    p.add_argument(
-        "--chunk",
-        type=chunk_size(MAX_CHUNK),
-        default=None,
-        metavar="N|auto",
-        help=f"runs per batch, one Dask task each (1 to {MAX_CHUNK}; default auto: equal chunks of at most 1000 "
-        "in-process; on a cluster about 4 per worker within 250..1000, never fewer chunks than workers)",
-    )
-    where = p.add_mutually_exclusive_group()
-    where.add_argument(
-        "--workers",
-        type=whole(1, MAX_WORKERS),
-        default=None,
-        metavar="N",
-        help=f"run on a Dask LocalCluster of N worker processes on this machine, bound to 127.0.0.1 "
-        f"(1 to {MAX_WORKERS}; needs twolink-pin[cluster])",
-    )
-    where.add_argument(
-        "--scheduler",
-        type=scheduler_option,
-        default=None,
-        metavar="ADDRESS",
-        help="run on the Dask scheduler at tcp://HOST:PORT or tls://HOST:PORT (see docs/cluster.md; "
-        "needs twolink-pin[cluster])",
-    )
-    p.add_argument(
-        "--connect-timeout",
-        type=bounded(0.0, 3600.0, low_open=True, unit="s"),
-        default=CONNECT_TIMEOUT,
-        metavar="S",
-        help=f"seconds for the scheduler to answer and have a worker (default {CONNECT_TIMEOUT:g})",
-    )

@@ -50,6 +50,31 @@ def _plant_tokens(spec: RunSpec) -> list[str]:
         tokens.append(f"--delay={plant.delay}")
     if plant.position_stops:
         tokens.append("--joint-stops")
+    return tokens + _effect_tokens(spec)
+
+
+def _effect_tokens(spec: RunSpec) -> list[str]:
+    """The plant's engine and the arm's effects (:mod:`twolink_pin.arm_effects`) as options."""
+    plant = spec.plant
+    tokens: list[str] = []
+    if plant.engine != "pinocchio":
+        tokens.append(f"--plant={plant.engine}")
+    for name in ("armature", "joint_damping", "frictionloss"):
+        value = getattr(plant, name)
+        if value is not None:
+            tokens.append(
+                f"--{name.replace('_', '-')}={value if isinstance(value, str) else _numbers(value)}"
+            )
+    if plant.soft_limits is not None:
+        tokens.append(f"--soft-limits={'on' if plant.soft_limits else 'off'}")
+    for name in ("solref", "solimp"):
+        value = getattr(plant, name)
+        if value is not None:
+            tokens.append(f"--{name}={_numbers(value)}")
+    if plant.integrator != "rk4":
+        tokens.append(f"--mujoco-integrator={plant.integrator}")
+    if spec.believed_effects:
+        tokens.append("--believe-effects")
     return tokens
 
 

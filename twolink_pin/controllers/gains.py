@@ -113,6 +113,8 @@ def gain(
         raise ValueError(
             f"a gain of choices {choices} is scalar and defaults to one of them, got {default!r}"
         )
+    if multiple_of and per != "scalar":
+        raise ValueError("a gain that is a multiple of another is a scalar gain")
     spec = GainSpec(per, unit, bound, doc, matrix, tuple(choices), multiple_of)
     return field(default=default, metadata={"gain": spec})
 

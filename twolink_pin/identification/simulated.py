@@ -72,6 +72,7 @@ def simulate_log(
     duration: float | None = None,
     dt: float = DEFAULT_DT,
     friction: Friction | None = None,
+    engine: str = "pinocchio",
 ) -> RunLog:
     """A logged closed-loop run of ``robot`` along ``trajectory`` (see the module docstring).
 
@@ -81,6 +82,8 @@ def simulate_log(
         duration: Simulated time [s]; default :data:`DEFAULT_PERIODS` periods.
         dt: RK4 step and log spacing [s].
         friction: The plant's friction (compensated by the law); default :func:`plant_friction`.
+        engine: The simulator of the run: ``pinocchio`` or ``mujoco`` (the same arm, MuJoCo's
+            forward dynamics at each RK4 stage: :mod:`twolink_pin.mujoco_plant`).
 
     Returns:
         The log, with ``true_parameters`` (base parameters, then V and C per joint).
@@ -90,7 +93,7 @@ def simulate_log(
             joints; SimulationDivergedError if the run diverges.
     """
     require_type(robot, RobotModel, "robot", "a RobotModel (twolink_pin.load_robot)")
-    from twolink_pin.plant import Plant
+    from twolink_pin.plant import ENGINES
     from twolink_pin.simulation import SimulationConfig, simulate
 
     if friction is None:
@@ -99,7 +102,9 @@ def simulate_log(
         raise InvalidParameterError("friction", friction, f"viscous and Coulomb values for {robot.nv} joints")
     length = DEFAULT_PERIODS * trajectory.period if duration is None else duration
     controller = FrictionCompensatedTracking(robot, friction=friction)
-    plant = Plant(robot, friction=friction)
+    if engine not in ENGINES:
+        raise InvalidParameterError("engine", engine, f"one of {', '.join(ENGINES)}")
+    plant = ENGINES[engine](robot, friction=friction)
     result = simulate(controller, plant, trajectory, SimulationConfig(duration=length, dt=dt, q0_offset=0.0))
     truth = ParameterSet.of(robot, friction=True).true_values(robot.model, friction)
     return RunLog(
@@ -107,7 +112,8 @@ def simulate_log(
         q=result.q,
         tau=result.tau,
         v=result.v,
-        source=f"simulated: {robot.name} tracking the excitation ({controller.name}), {length:g} s at dt = {dt:g} s",
+        source=f"simulated: {robot.name} tracking the excitation ({controller.name}), {length:g} s at dt = {dt:g} s"
+        + ("" if engine == "pinocchio" else f" on the {engine} plant"),
         true_parameters=np.asarray(truth),
         reference=trajectory,
     )

@@ -16,6 +16,11 @@ What each entry adds to the URDF, and why:
   arm, the fingers' masses carried by the hand;
 * ``ee_frame``: the tool frame Cartesian via points and the figures refer to;
 * ``q0_offset``: the initial tracking error of a run (:data:`Q0_OFFSET`);
+* ``effects``: the armature and joint damping the MuJoCo Menagerie's models of these arms set
+  (:class:`~twolink_pin.model.profile.ArmEffects`, ``--armature arm``): the Panda's
+  (``franka_emika_panda/panda.xml``: 0.1 kg·m² and 1 N·m·s/rad on every joint) and the UR5's
+  armature from the UR5e model (``universal_robots_ur5e/ur5e.xml``: 0.1 kg·m²; its damping of 200
+  and 15 N·m·s/rad stands in for the position servos that model drives, and is not taken);
 * ``acceleration_limits``: the Panda's joint acceleration limits from Franka's data sheet
   ("Robot and interface specifications": 15, 7.5, 10, 12.5, 15, 20, 20 rad/s²); the other
   makers publish none for these arms, and a URDF has no element for them.
@@ -31,7 +36,7 @@ from pathlib import Path
 
 from twolink_pin.model import catalog
 from twolink_pin.model.catalog import example_robot_urdf
-from twolink_pin.model.profile import RobotProfile
+from twolink_pin.model.profile import ArmEffects, RobotProfile
 
 _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
     "double_pendulum": (
@@ -48,6 +53,10 @@ _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
             "description": "Universal Robots UR5, 6 revolute joints",
             "ee_frame": "tool0",
             "home": (0.0, -1.5708, 1.5708, -1.5708, -1.5708, 0.0),
+            "effects": ArmEffects(
+                armature=(0.1,) * 6,
+                source="armature: the MuJoCo Menagerie's UR5e (universal_robots_ur5e/ur5e.xml)",
+            ),
         },
     ),
     "panda": (
@@ -62,6 +71,11 @@ _ROBOTS: dict[str, tuple[str, dict[str, object]]] = {
             "home": (0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4),
             # Franka's data sheet ("Robot and interface specifications", q̈max per joint)
             "acceleration_limits": (15.0, 7.5, 10.0, 12.5, 15.0, 20.0, 20.0),
+            "effects": ArmEffects(
+                armature=(0.1,) * 7,
+                damping=(1.0,) * 7,
+                source="armature and damping: the MuJoCo Menagerie's Panda (franka_emika_panda/panda.xml)",
+            ),
         },
     ),
     "kinova": (

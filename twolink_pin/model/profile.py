@@ -110,6 +110,24 @@ class ReportProfile:
 
 
 @dataclass(frozen=True)
+class ArmEffects:
+    """What a real arm adds to its rigid bodies, per joint, with where the values come from
+    (a plant models them on request: ``--armature arm``, :mod:`twolink_pin.arm_effects`).
+
+    Attributes:
+        armature: Rotor inertia reflected through the gearbox [kg·m²] per joint; None: none given.
+        damping: Joint damping [N·m·s/rad] per joint; None: none given.
+        frictionloss: Dry friction [N·m] per joint (MuJoCo's ``frictionloss``); None: none given.
+        source: Where each value comes from, cited (a data sheet, a published model).
+    """
+
+    armature: tuple[float, ...] | None = None
+    damping: tuple[float, ...] | None = None
+    frictionloss: tuple[float, ...] | None = None
+    source: str = ""
+
+
+@dataclass(frozen=True)
 class RobotProfile:
     """A robot's name and the defaults the toolkit uses with it.
 
@@ -139,6 +157,9 @@ class RobotProfile:
             model, from the maker's data sheet (a URDF has no acceleration limit); ``None``:
             none (:mod:`twolink_pin.limits`).
         report: What ``twolink-pin report`` shows of this robot (:class:`ReportProfile`).
+        effects: The arm's armature, joint damping and dry friction with their sources
+            (:class:`ArmEffects`); ``None``: none given (a URDF's ``<dynamics>`` may give
+            damping and friction).
     """
 
     name: str
@@ -156,6 +177,7 @@ class RobotProfile:
     home: tuple[float, ...] | None = None
     acceleration_limits: tuple[float, ...] | None = None
     report: ReportProfile = field(default_factory=ReportProfile)
+    effects: ArmEffects | None = None
 
 
 DEFAULT_Q0_OFFSET = 0.05

@@ -35,7 +35,7 @@ from twolink_pin.files import output_directory
 from twolink_pin.law_variant import Variant, file_stem, parse_variants
 from twolink_pin.metrics import Metrics
 from twolink_pin.model import load_robot
-from twolink_pin.report import facts
+from twolink_pin.report import facts, sim_to_sim
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
@@ -93,6 +93,7 @@ def build_report(
     options.run.check_effective(robot, laws)
     rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
     steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
+    steps += 1 if options.sim_to_sim else 0
     steps += sections.steps(options) if sections else 0
     done = 0
     heard = len(interrupts.received)
@@ -180,6 +181,7 @@ def _build(
         "errata": errata,
         "identification": ran.identification,
         "within_limits": ran.within_limits,
+        "sim_to_sim": ran.sim_to_sim,
         "versions": facts.versions(),
     }
 
@@ -210,6 +212,8 @@ class _Ran(NamedTuple):
     within_limits: dict[str, Any] | None
     """The section "The reference within the limits" (:mod:`~twolink_pin.report.within_limits`),
     None without it."""
+    sim_to_sim: dict[str, Any] | None
+    """The section "Sim-to-sim" (:mod:`~twolink_pin.report.sim_to_sim`), None without it."""
 
 
 def _run_all(
@@ -251,6 +255,11 @@ def _run_all(
         futures = {
             n: pool.submit(run_law, rows[n].variant, options, str(fig_dir), numbers.get(n)) for n in order
         }
+        sim_pending = (  # short runs: after the laws' own
+            sim_to_sim.submit(pool, [(n, rows[n].variant) for n in names], options)
+            if options.sim_to_sim
+            else None
+        )
         traj_future = pool.submit(trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
         model = facts.model_facts(robot)
         own_facts = sections.facts(robot, via) if sections else None
@@ -274,6 +283,10 @@ def _run_all(
         if limits_future is not None:
             within_limits = interrupts.result_of(limits_future, heard)
             tick("the reference within the limits")
+        sim_section = None
+        if sim_pending is not None:
+            sim_section = sim_to_sim.collect(sim_pending, robot, options, str(fig_dir), heard)
+            tick("sim-to-sim")
         identification = None
         if sections and pending is not None:
             done_runs = {n: r[0] for n, r in runs.items()}
@@ -281,7 +294,7 @@ def _run_all(
             tick("identification")
     return _Ran(
         runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays,
-        within_limits,
+        within_limits, sim_section,
     )  # fmt: skip
 
 

@@ -1,5 +1,6 @@
-"""The numbers every robot's report shows that are not simulations: the model, the torque
-check, the software versions (the twolink's closed-form check and Table 1 are its profile's
+"""The numbers every robot's report shows that are not simulations: the model and its
+equations of motion derived in closed form, the torque check, the software versions (the
+twolink's closed-form check, its equations beside the course's and Table 1 are its profile's
 sections: :mod:`twolink_pin.twolink.course_report`)."""
 
 from __future__ import annotations
@@ -45,6 +46,46 @@ def model_facts(robot: RobotModel) -> dict[str, Any]:
         "links": links,
         "parameters": dict(zip(robot.parameter_map.names, robot.p.tolist())),
         "parameter_units": dict(zip(robot.parameter_map.names, robot.parameter_map.units)),
+        "equations": equations_facts(robot),
+    }
+
+
+REPORT_EQUATIONS_JOINTS = 3
+"""The report shows the derived equations of an arm of at most this many joints (a 4-joint
+arm's C alone runs to pages; ``twolink-pin equations`` writes any arm's)."""
+
+
+def equations_facts(robot: RobotModel) -> dict[str, Any]:
+    """The arm's equations of motion derived in closed form (:mod:`twolink_pin.symbolic`), as
+    LaTeX: the base parameters, M (upper triangle), C and g; or why they are not shown."""
+    from twolink_pin.errors import EquationsError
+    from twolink_pin.symbolic import derive_equations
+    from twolink_pin.symbolic.formats import latex_entry
+
+    command = f"twolink-pin equations --robot {robot.urdf_path}"
+    if robot.nv > REPORT_EQUATIONS_JOINTS:
+        return {"shown": False, "reason": f"{robot.nv} joints: too long to show here ({command} writes them)"}
+    try:
+        eq = derive_equations(robot)
+    except EquationsError as exc:
+        return {"shown": False, "reason": str(exc)}
+    n = eq.n
+    M, C, g = eq.shown(eq.M), eq.shown(eq.C), eq.shown(eq.g)
+    return {
+        "shown": True,
+        "base_parameters": [
+            {"latex": rf"\beta_{{{k + 1}}} = {latex_entry(eq, d)}", "value": float(v), "unit": u}
+            for k, (d, v, u) in enumerate(zip(eq.beta_definitions, eq.beta_values, eq.beta_units))
+        ],
+        "zero": [f"β{k + 1}" for k in eq.zero_parameters],
+        "lengths_m": dict(eq.lengths),
+        "M": [rf"M_{{{r + 1}{c + 1}}} = {latex_entry(eq, M[r, c])}" for r in range(n) for c in range(r, n)],
+        "C": [rf"C_{{{r + 1}{c + 1}}} = {latex_entry(eq, C[r, c])}" for r in range(n) for c in range(n)],
+        "g": [rf"g_{{{r + 1}}} = {latex_entry(eq, g[r])}" for r in range(n)],
+        "skew_symmetric": eq.skew_symmetric,
+        "seconds": eq.seconds,
+        "from_cache": eq.from_cache,
+        "command": command,
     }
 
 

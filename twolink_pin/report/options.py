@@ -38,6 +38,9 @@ class ReportOptions:
             (:mod:`twolink_pin.report.within_limits`: the reference, its time-optimal
             retiming and the minimum-effort trajectory, the laws tracking each; about
             a tenth of the report's CPU time, docs/performance.md).
+        sim_to_sim: Whether the report has its section "Sim-to-sim" (:mod:`twolink_pin.report.sim_to_sim`:
+            each law on the Pinocchio plant and on MuJoCo with the arm's effects, one effect at a
+            time; short runs of 2 periods).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
@@ -53,6 +56,7 @@ class ReportOptions:
     identification: bool = True
     limits_section: bool = True
     trajectory: str | None = None
+    sim_to_sim: bool = True
 
     def __post_init__(self) -> None:
         if self.workers is None:

@@ -18,7 +18,7 @@ import markupsafe
 import numpy as np
 
 from twolink_pin.files import atomic_write, write_json
-from twolink_pin.mathml import docstring_html
+from twolink_pin.mathml import docstring_html, latex_to_mathml
 from twolink_pin.metrics import NORMS, SIGNALS
 from twolink_pin.studies.comparison import headers
 from twolink_pin.task_metrics import TASK_TITLES, TASK_UNITS
@@ -72,6 +72,8 @@ def _environment() -> jinja2.Environment:
     env.filters["fmt"] = fmt
     env.filters["evidence"] = evidence_text
     env.filters["docstring"] = lambda text: markupsafe.Markup(docstring_html(text))
+    env.filters["math"] = lambda tex: markupsafe.Markup(latex_to_mathml(tex, display=True))
+    env.filters["inline_math"] = lambda tex: markupsafe.Markup(latex_to_mathml(tex))
     return env
 
 
@@ -118,8 +120,43 @@ def html(r: dict[str, Any]) -> str:
             discussion=_discussion(r),
             nv=nv,
             limits=_limits_tables(r, nv),
+            s2s=sim_to_sim_table(r),
         )
     )
+
+
+def sim_to_sim_table(r: dict[str, Any]) -> dict[str, Any] | None:
+    """The section "Sim-to-sim" as one table (a row per law and plant) with its texts; None
+    without the section."""
+    section = r.get("sim_to_sim")
+    if not section:
+        return None
+    headers = [
+        "controller",
+        "plant",
+        "RMS ‖e‖ [rad]",
+        "max |e| [rad]",
+        "Δ RMS ‖e‖ [rad]",
+        "Δ max |e| [rad]",
+    ]
+    rows = []
+    for law in section["laws"]:
+        for row in law["rows"]:
+            if not row["finished"]:
+                rows.append([law["law"], row["row"], "—", "—", "—", f"did not finish: {row['failed']}"])
+                continue
+            deltas = [row.get("delta_rms_e"), row.get("delta_max_e")]
+            shown = ["" if row is law["rows"][0] else _signed(d) for d in deltas]
+            label = row["row"] + (" — cannot act here, not rerun" if row.get("derived") else "")
+            rows.append([law["law"], label, fmt(row["rms_e"]), fmt(row["max_e"]), *shown])
+    return section | {"headers": headers, "rows": rows}
+
+
+def _signed(x: float | None) -> str:
+    """A difference with its sign (``+1.2e-04``, ``−3.4e-05``); "—" for none."""
+    if x is None:
+        return "—"
+    return ("+" if x >= 0 else "−") + fmt(abs(x))
 
 
 RATIO_SYMBOLS = {"velocity": "q̇", "acceleration": "q̈", "effort": "τ"}
@@ -220,6 +257,7 @@ def markdown(r: dict[str, Any]) -> str:
             f"Closed-form check: max |ΔM| = {check['max_abs_dM']:.2e}, max |ΔC| = {check['max_abs_dC']:.2e}.",
             "",
         ]
+    lines += _equations_markdown(model.get("equations"), twolink)
     lines += [
         "## Torque check",
         "",
@@ -247,6 +285,7 @@ def markdown(r: dict[str, Any]) -> str:
             lines.append(f"| {row['title']} | " + " | ".join(fmt(x) for x in cells) + " |")
         lines.append("")
     lines += _limits_markdown(r)
+    lines += _sim_markdown(r)
     if r["errata"]:
         lines += ["## Errata", ""]
         for e in r["errata"]:
@@ -264,6 +303,26 @@ def markdown(r: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def _equations_markdown(equations: dict[str, Any] | None, twolink: dict[str, Any] | None) -> list[str]:
+    """The derived equations as LaTeX (``$$…$$``), and the twolink's beside the course's."""
+    if not equations:
+        return []
+    if not equations["shown"]:
+        return ["## Equations of motion", "", equations["reason"], ""]
+    lines = ["## Equations of motion, derived from the URDF", ""]
+    lines += [f"$${b['latex']}$$ ({fmt(b['value'], 6)} {b['unit']})" for b in equations["base_parameters"]]
+    lines += [f"$${entry}$$" for key in ("M", "C", "g") for entry in equations[key]]
+    course = (twolink or {}).get("course_equations")
+    if course and course["latex"]:
+        lines += [
+            "",
+            "Written in the p they find (" + ", ".join(f"${p}$" for p in course["latex"]["p"]) + "):",
+        ]
+        same = all(course[k] for k in ("M", "C", "Y", "p_expressions"))
+        lines.append("the report's M, C and Y, and its p in masses and lengths: " + ("yes" if same else "NO"))
+    return [*lines, ""]
+
+
 def _limits_markdown(r: dict[str, Any]) -> list[str]:
     """``report.md``'s lines of the section "The reference within the limits" (none without it)."""
     tables = _limits_tables(r, r["robot"]["nv"])
@@ -278,6 +337,21 @@ def _limits_markdown(r: dict[str, Any]) -> list[str]:
         lines += ["| " + " | ".join(escaped[0]) + " |", "|" + "---|" * len(heads)]
         lines += ["| " + " | ".join(row) + " |" for row in escaped[1:]] + [""]
     return lines + [f"- {note}" for note in r["within_limits"]["notes"]]
+
+
+def _sim_markdown(r: dict[str, Any]) -> list[str]:
+    """``report.md``'s lines of the section "Sim-to-sim" (none without it)."""
+    table = sim_to_sim_table(r)
+    if table is None:
+        return []
+    if not table["rows"]:
+        return ["## Sim-to-sim", "", table.get("note", ""), ""]
+    heads, rows = table["headers"], table["rows"]
+    lines = ["## Sim-to-sim", "", "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return (
+        [*lines, "", f"Sources of the effects: {table['sources']}", ""] if table["sources"] else [*lines, ""]
+    )
 
 
 def write_pages(stage: Path, r: dict[str, Any]) -> None:

@@ -23,7 +23,7 @@ from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_
 from twolink_pin.simulation.containment import check_output, contained
 from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.engine import Samples
-from twolink_pin.simulation.forward import SingleRunDynamics
+from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.task_reference import law_input
 from twolink_pin.simulation.terms import SingleRunTerms
 from twolink_pin.trajectory import Trajectory
@@ -92,7 +92,7 @@ def integrate_adaptive(
     t = np.arange(n + 1) * dt
     name = controller.name
     terms = SingleRunTerms(controller)
-    accel = SingleRunDynamics(plant)
+    accel = dynamics_for(plant, 1)
     budget = MAX_EVALUATIONS_PER_STEP * n + 10_000
     calls = 0
 

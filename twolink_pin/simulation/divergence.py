@@ -38,9 +38,11 @@ def late_divergence(
     name: str,
     stop_on_divergence: bool,
     why: Callable[[int], str | None] = lambda run: None,
+    plant_why: Callable[[int], str | None] | None = None,
 ) -> np.ndarray:
     """Flag the live runs whose state after a block (at ``t`` [s]) has diverged; returns them
-    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`)."""
+    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`; ``plant_why(run)``:
+    the plant's own cause, added to the state's, :func:`with_plant`)."""
     current = bad_rows(q[None])[0] | bad_rows(v[None])[0] | bad_rows(z[None])[0]
     late = alive & current
     if late.any():
@@ -49,12 +51,20 @@ def late_divergence(
             given = why(first)
             if given is not None:
                 raise ControllerError(name, t, given)
-            raise SimulationDivergedError(name, t, state_detail(q, v, z, late))
+            raise SimulationDivergedError(name, t, with_plant(state_detail(q, v, z, late), plant_why, first))
         for r in np.flatnonzero(late):
             diverged_at[r] = t
-            detail[r] = why(int(r)) or state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r])
+            detail[r] = why(int(r)) or with_plant(
+                state_detail(q, v, z, np.eye(len(alive), dtype=bool)[r]), plant_why, int(r)
+            )
         alive &= ~late
     return late
+
+
+def with_plant(detail: str, plant_why: Callable[[int], str | None] | None, run: int) -> str:
+    """``detail`` with the plant's own cause of run ``run``'s failure, when it gives one."""
+    cause = plant_why(run) if plant_why is not None else None
+    return f"{detail}; {cause}" if cause else detail
 
 
 def state_detail(q: np.ndarray, v: np.ndarray, z: np.ndarray, mask: np.ndarray) -> str:
@@ -81,9 +91,11 @@ def flag_block(
     name: str,
     raise_now: bool,
     why: Callable[[int], str | None] = lambda run: None,
+    plant_why: Callable[[int], str | None] | None = None,
 ) -> np.ndarray:
     """Flag the runs that diverged within buffer rows ``start:stop``; returns them
-    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`)."""
+    (``why(run)``: the law's reason for a run it gave up, :func:`law_reason`; ``plant_why``: the
+    plant's own cause of a state that diverged, :func:`with_plant`)."""
     rows = slice(start, stop)
     state_bad = bad_rows(Q[rows]) | bad_rows(V[rows]) | bad_rows(Z[rows])
     torque_bad = ~np.isfinite(T[rows]).all(axis=-1)
@@ -116,6 +128,7 @@ def flag_block(
                     f" one step after a sound state at t = {times[k - 1]:.6g} s: the controller's torque"
                     " or the plant produced NaN or inf within that step"
                 )
+            what = with_plant(what, plant_why, int(r))
             if raise_now:
                 raise SimulationDivergedError(name, t, what)
         diverged_at[r] = t

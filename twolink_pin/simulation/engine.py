@@ -259,7 +259,11 @@ class _Run:
             if self.update_every is None
             else law_call(controller, self.noise if noisy else None, "update")
         )
-        self.sampled = hold is not None or line is not None  # the law evaluated once per step or period
+        # the law evaluated once per step or period: sampled, delayed, or a plant whose own
+        # integrator steps it (MuJoCo's Euler and implicitfast evaluate their forces once per step)
+        self.sampled = hold is not None or line is not None or not plant.law_per_stage
+        # the plant's own cause of a failed run (MuJoCo's warnings), beside the state's
+        self.plant_why = events.failure if events is not None else getattr(self.accel, "failure", None)
         self.every = hold if hold is not None else 1
         self.total = total = n + 1
         self.out = _Outputs.empty(total if record else min(total, BLOCK), runs, nv, nz, record and noisy)
@@ -349,7 +353,7 @@ class _Run:
                 if k == n:
                     break
                 if sampled:  # zero-order hold (or delay): τ and ż fixed over the step
-                    q, v, z = _held_step(accel, q, v, z, tau_k, dz_k, steps, nz)
+                    q, v, z = getattr(accel, "held_step", _held_rk4(accel))(q, v, z, tau_k, dz_k, steps, nz)
                 else:
                     q, v, z = _stage_step(
                         compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
@@ -385,7 +389,7 @@ class _Run:
         return flag_block(
             o.Q, o.V, o.Z, o.T, start, stop, self.times, off,
             self.alive, self.diverged_at, self.detail, self.controller.name, raise_now,
-            law_reason(self.controller),
+            law_reason(self.controller), self.plant_why,
         )  # fmt: skip
 
     def check(self, k0: int, k1: int, rq: np.ndarray, rv: np.ndarray, stop_on_divergence: bool) -> None:
@@ -399,7 +403,7 @@ class _Run:
             name = self.controller.name
             newly |= late_divergence(
                 q, v, z, self.alive, k1 * self.dt, self.diverged_at, self.detail, name, stop_on_divergence,
-                law_reason(self.controller),
+                law_reason(self.controller), self.plant_why,
             )  # fmt: skip
             if newly.any():  # park them on the reference, keep the batch going
                 j = 2 * (k1 - k0)
@@ -502,6 +506,11 @@ def _stage_step(
     if nz:
         z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)
     return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z
+
+
+def _held_rk4(accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]) -> Callable[..., Any]:
+    """The engine's held step on ``accel`` (a plant that steps itself has its own ``held_step``)."""
+    return lambda *state: _held_step(accel, *state)
 
 
 def _held_step(

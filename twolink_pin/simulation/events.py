@@ -24,8 +24,8 @@ divergence checks are the engine's.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -39,12 +39,27 @@ Accel = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 
 
 def payload_plant(plant: Plant) -> Plant:
-    """``plant`` with its payload step's mass carried from the start (the model after the step)."""
-    step = plant.payload_step
-    assert step is not None
-    robot = plant.robot
-    model = step.model(robot.model, robot.ee_frame_id)
-    return dataclasses.replace(plant, model=model)
+    """``plant`` with its payload step's mass carried from the start (the plant after the step:
+    :meth:`~twolink_pin.plant.Plant.after_payload`, its engine's)."""
+    return plant.after_payload()
+
+
+class Pushed:
+    """``dynamics`` with the wrench's generalized force ``J(q)ᵀ F`` added to the torque: at every
+    RK4 stage, or at the start of a step that the plant's own integrator takes (``held_step``:
+    MuJoCo's Euler and implicitfast evaluate their forces once per step)."""
+
+    def __init__(self, dynamics: Accel, push: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> None:
+        self._dynamics = dynamics
+        self._push = push
+        if hasattr(dynamics, "held_step"):
+            self.held_step = self._held_step
+
+    def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        return self._dynamics(q, v, self._push(q, tau)).copy()
+
+    def _held_step(self, q: np.ndarray, v: np.ndarray, z: np.ndarray, tau: np.ndarray, *rest: Any) -> Any:
+        return self._dynamics.held_step(q, v, z, self._push(q, tau), *rest)  # type: ignore[attr-defined]
 
 
 class PlantEvents:
@@ -53,8 +68,9 @@ class PlantEvents:
     def __init__(self, plant: Plant, runs: int, threads: int | None, nv: int) -> None:
         self._plant = plant
         self._before = dynamics_for(plant, runs, threads)
+        self._after_plant = payload_plant(plant) if plant.payload_step is not None else None
         self._after = (
-            dynamics_for(payload_plant(plant), runs, threads) if plant.payload_step is not None else None
+            dynamics_for(self._after_plant, runs, threads) if self._after_plant is not None else None
         )
         self._payload_time = plant.payload_step.time if plant.payload_step is not None else np.inf
         self._wrench = plant.wrench
@@ -68,7 +84,7 @@ class PlantEvents:
         self._nv = nv
         self.stops = None
         if plant.position_stops:
-            after = payload_plant(plant).model if plant.payload_step is not None else plant.model
+            after = self._after_plant.model if self._after_plant is not None else plant.model
             self.stops = (JointStops(plant.joint_limits, plant.model), JointStops(plant.joint_limits, after))
 
     def stop(self, t: float, q: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -81,15 +97,26 @@ class PlantEvents:
         dynamics = self._after if self._after is not None and t >= self._payload_time else self._before
         wrench = self._wrench
         if wrench is None or not wrench.active(t):
+            if hasattr(dynamics, "held_step"):  # a plant that steps itself: returns fresh arrays
+                return dynamics
             return lambda q, v, tau: dynamics(q, v, tau).copy()
         kinematics, force, frame = self._kinematics, self._force, wrench.frame
         assert kinematics is not None and force is not None
 
-        def pushed(q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
-            J = kinematics.frame(q, np.zeros_like(v), frame).jacobian
-            return dynamics(q, v, tau + np.vecmat(np.broadcast_to(force, (J.shape[0], 6)), J)).copy()
+        def push(q: np.ndarray, tau: np.ndarray) -> np.ndarray:
+            J = kinematics.frame(q, np.zeros_like(q), frame).jacobian
+            return tau + np.vecmat(np.broadcast_to(force, (J.shape[0], 6)), J)
 
-        return pushed
+        return Pushed(dynamics, push)
+
+    def failure(self, run: int) -> str | None:
+        """The plant's own cause of run ``run``'s failure (its engine's), if it knows one."""
+        for dynamics in (self._after, self._before):
+            reason = getattr(dynamics, "failure", None)
+            text = reason(run) if reason is not None else None
+            if text:
+                return str(text)
+        return None
 
     def draw(self, k0: int, k1: int) -> None:
         """Draw the noise of steps ``k0 … k1 − 1`` (one block; every run its own generator)."""
@@ -132,4 +159,4 @@ class DelayLine:
         return (self._first if sample is None else outputs[sample][0]), dz
 
 
-__all__ = ["DelayLine", "PlantEvents", "payload_plant"]
+__all__ = ["DelayLine", "PlantEvents", "Pushed", "payload_plant"]

@@ -1,6 +1,9 @@
-"""The plant's accelerations for N runs: ``pin.aba`` for one, ``abaInParallel`` for many."""
+"""The plant's accelerations for N runs: ``pin.aba`` for one, ``abaInParallel`` for many, or the
+plant's own engine's (:meth:`~twolink_pin.plant.Plant.dynamics`: MuJoCo's)."""
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import pinocchio as pin
@@ -24,6 +27,7 @@ class SingleRunDynamics:
             None if friction is None else (np.array([friction.viscous]), np.array([friction.coulomb]))
         )
         self._smoothing = 0.0 if friction is None else friction.smoothing
+        self._damping = plant.joint_damping[None] if plant.joint_damping.any() else None
         # plant.applied_torque's clip as maximum then minimum against (1, nv) rows: the same
         # values (clip is min(max(τ, −limit), limit), NaN passed through) at a third of
         # np.clip's cost
@@ -36,6 +40,8 @@ class SingleRunDynamics:
         if self._friction is not None:
             viscous, coulomb = self._friction
             u = u - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
+        if self._damping is not None:
+            u = u - self._damping * v
         return pin.aba(self._model, self._data, q[0], v[0], u[0], ABA_CONVENTION)[None]
 
 
@@ -50,7 +56,7 @@ class BatchDynamics:
         # RK4 keeps the four stages' accelerations alive at once: four output buffers in turn.
         self._outs = [np.empty((runs, plant.model.nv)) for _ in range(4)]
         self._next = 0
-        self._plain = plant.friction is None and not plant.saturate
+        self._plain = plant.friction is None and not plant.saturate and not plant.joint_damping.any()
 
     def __call__(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """The result is valid until the fourth call after this one."""
@@ -68,6 +74,10 @@ class BatchDynamics:
         return out
 
 
-def dynamics_for(plant: Plant, runs: int, threads: int | None = None) -> SingleRunDynamics | BatchDynamics:
-    """The plant's acceleration function for ``runs`` runs advanced together."""
+def dynamics_for(plant: Plant, runs: int, threads: int | None = None) -> Any:
+    """The plant's acceleration function for ``runs`` runs advanced together: the plant's own
+    engine's (MuJoCo's), else Pinocchio's ABA."""
+    own = plant.dynamics(runs, threads_for(runs, threads) if runs > 1 else 1)
+    if own is not None:
+        return own
     return SingleRunDynamics(plant) if runs == 1 else BatchDynamics(plant, runs, threads)

@@ -1,6 +1,8 @@
 """The tuner: a Viser server whose page shows the arm, the controls, the plots and the
 metrics of the latest run, and re-simulates (latest wins) whenever a control moves or,
-with ``watch``, the law's file is saved."""
+with ``watch``, the law's file is saved. The page's parts live in their modules: the
+controls (:mod:`.panel`), the results beside them (:mod:`.results`, :mod:`.table`,
+:mod:`.plots`), the arm (:mod:`.scene`), the command and its files (:mod:`.command_folder`)."""
 
 from __future__ import annotations
 
@@ -9,20 +11,18 @@ import contextlib
 import io
 import os
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError, TwolinkPinError, raised_at
 from twolink_pin.tuning.address import check_listen
-from twolink_pin.tuning.knobs import knob_changes, knobs_of, matrices_of
+from twolink_pin.tuning.knobs import choices_of, knob_changes, knobs_of, matrices_of
 from twolink_pin.tuning.latest import STUCK_AFTER, LatestWins
-from twolink_pin.tuning.outputs import page_path
 from twolink_pin.tuning.periods import Cuts, heading
 from twolink_pin.tuning.runner import Finished, Partial, PeriodDone, Request, Runner
 from twolink_pin.tuning.scene import RESUME_AFTER
+from twolink_pin.tuning.table import metrics_table
 
 if TYPE_CHECKING:
     from twolink_pin.model import RobotModel
@@ -31,49 +31,6 @@ if TYPE_CHECKING:
 
 WATCH_PERIOD = 0.25
 """How often the law's file is looked at [s] (``watch``)."""
-
-
-WIDE = 3
-"""A run with more joints than this shows, per metric, its largest joint (the panel is narrow)."""
-
-
-def metrics_table(this: Finished, columns: Mapping[str, Finished | None]) -> str:
-    """The metrics of this run beside other runs (column name → run; None: "–"), as
-    Markdown. Up to :data:`WIDE` joints a cell lists every joint; beyond, the largest
-    joint's value and which joint (``0.012 (j4)``): 6 or 7 joints fit the panel."""
-    runs = {"this run": this, **columns}
-
-    def cell(done: Finished | None, pick: Callable[[Finished], Any]) -> str:
-        if done is None:
-            return "–"
-        value = np.asarray(pick(done), dtype=float)
-        if value.ndim == 0:
-            return f"{float(value):.3g}"
-        if value.size <= WIDE:
-            return ", ".join(f"{x:.3g}" for x in value)
-        j = int(np.nanargmax(np.abs(value)))
-        return f"{value[j]:.3g} (j{j + 1})"
-
-    def m(kind: str, name: str) -> Callable[[Finished], Any]:
-        return lambda d: getattr(getattr(d.metrics, kind), name)
-
-    rows = [
-        ("RMS e [rad]", m("rms", "e")),
-        ("max \\|e\\| [rad]", m("max", "e")),
-        ("last period max \\|e\\| [rad]", lambda d: d.metrics.final_period_max_abs_e),
-        ("RMS τ [N·m]", m("rms", "tau")),
-        ("max \\|τ\\| [N·m]", m("max", "tau")),
-    ]
-    if this.task is not None:
-        rows += [
-            ("task RMS \\|p − p_d\\| [mm]", lambda d: d.task.position_rms_mm if d.task else float("nan")),
-            ("task RMS angle [deg]", lambda d: d.task.orientation_rms_deg if d.task else float("nan")),
-        ]
-    lines = ["| | " + " | ".join(runs) + " |", "|---" * (len(runs) + 1) + "|"]
-    lines += [f"| {name} | " + " | ".join(cell(run, f) for run in runs.values()) + " |" for name, f in rows]
-    if this.result.q.shape[1] > WIDE:
-        lines.append("\n(largest joint shown: `tune --json` prints every joint)")
-    return "\n".join(lines)
 
 
 def run_line(done: Finished, command: str, generation: int) -> dict[str, Any]:
@@ -183,14 +140,17 @@ class Tuner:
         gui.add_markdown(
             f"**twolink-pin tune** · {controller.title} (`{controller.name}`) on {robot.name}", order=0.0
         )
-        self.status = gui.add_markdown("starting…", order=1.0)
         from twolink_pin.tuning.panel import Panel
+        from twolink_pin.tuning.results import Results
 
+        self.results = Results(self.server, self._keep_latest)
+        self.status, self.metrics, self.plots = self.results.status, self.results.metrics, self.results.plots
         _, reference = self._runner.arm(payload)
         period = float(getattr(reference, "period", 0.0) or 0.0)
         matrices = matrices_of(type(controller).Gains, used)  # a full matrix keeps its off-diagonal terms
-        self.panel = Panel(self.server, knobs, base, payload, self.changed, matrices, period, order=10.0)
-        self._add_results(robot)
+        choices = choices_of(type(controller).Gains, used)  # a gain that is a word: a dropdown
+        self.panel = Panel(self.server, knobs, base, payload, self.changed, matrices, period, 10.0, choices)
+        self._add_folders(robot)
         self._lock = threading.Lock()
         self._latest: Finished | None = None
         self._previous: Finished | None = None
@@ -215,32 +175,24 @@ class Tuner:
             self._watcher.start()
         self.changed()
 
-    def _add_results(self, robot: RobotModel) -> None:
-        """The page's folders below the controls: metrics (with "keep this run"), plots,
-        playback, and the run as a command with save and export."""
-        from twolink_pin.tuning.plots import Plots
+    def _add_folders(self, robot: RobotModel) -> None:
+        """The controls' folders below the run's: playback, and the run as a command with
+        save and export."""
+        from twolink_pin.tuning.command_folder import CommandFolder
         from twolink_pin.tuning.scene import ArmScene
 
         gui = self.server.gui
-        with gui.add_folder("metrics", order=20.0):
-            self.metrics = gui.add_markdown("")
-            self.keep = gui.add_button(
-                "keep this run",
-                hint="pin the run shown as a reference: a column here, grey curves in the plots",
-            )
-            self.keep.on_click(lambda _: self._keep_latest())
-        with gui.add_folder("plots", order=30.0) as folder:
-            self.plots = Plots(self.server, folder)
-        with gui.add_folder("playback", order=50.0):
-            self.scene = ArmScene(self.server, robot)
+        with gui.add_folder("playback", expand_by_default=False, order=50.0):
+            self.scene = ArmScene(self.server, robot, self.panel.channel)
+        self.panel.focus.on_update(lambda _: self.scene.focused(str(self.panel.focus.value)))
         with gui.add_folder("as a command", order=60.0):
-            self.command = gui.add_markdown("")
-            hint = f"a file name inside {self.folder} (also offered as a download)"
-            self.save_path = gui.add_text("run file (.npz)", "tune-run.npz", hint=hint)
-            gui.add_button("save run").on_click(lambda event: self._save(event.client))
-            self.html_path = gui.add_text("animation file (.html)", "tune-animation.html", hint=hint)
-            gui.add_button("export animation").on_click(lambda event: self._export(event.client))
-            self.saved = gui.add_markdown(f"files are written in `{self.folder}`")
+            self.files = CommandFolder(
+                self.server,
+                self.folder,
+                lambda: self._latest,
+                self._record_of,
+                lambda p: self._runner.arm(p)[1],
+            )
 
     def _start_server(self, host: str, port: int) -> Any:
         """The Viser server on ``host``:``port``, stopped quietly at exit."""
@@ -343,8 +295,8 @@ class Tuner:
             line = f"run {generation}: period {k} of {part.periods} shown ({seconds:g} s simulated in {done.seconds:.2f} s)"
             self.plots.show(done, columns)  # the others resampled on this run's times: 0 … k T
             with self.server.atomic():
-                self.metrics.content = heading(k, part.periods, seconds) + metrics_table(done, cut)
-                self.command.content = f"```\n{command}\n```"
+                self.metrics.content = metrics_table(done, cut, heading(k, part.periods, seconds))
+                self.files.show(command)
                 self.status.content = f"{line}; running…"
             self._period_shown = (generation, line)
 
@@ -393,7 +345,7 @@ class Tuner:
         self.plots.show(done, columns)  # first: the status line below says all is shown
         with self.server.atomic():
             self.metrics.content = metrics_table(done, columns)
-            self.command.content = f"```\n{command}\n```"
+            self.files.show(command)
             self.status.content = (
                 f"run {generation}: {result.duration:g} s simulated in {done.seconds:.2f} s{suffix}"
             )
@@ -437,53 +389,6 @@ class Tuner:
             "its command line use their values); restart tune for the new ones"
         )
 
-    def _offer(self, client: Any, path: Path) -> None:
-        """Offer the file just written as a download in the page of ``client`` (None: every page)."""
-        target = client if client is not None else self.server
-        target.send_file_download(path.name, path.read_bytes())
-
-    def _save(self, client: Any = None) -> None:
-        from twolink_pin.simulation.storage import save_result
-
-        done = self._latest
-        if done is None:
-            return
-        try:
-            path = page_path(self.folder, str(self.save_path.value), ".npz", "run file")
-            save_result(done.result, path, record=self._record_of(*done.request[:2]))
-            self._offer(client, path)
-            self.saved.content = f"saved `{path}` (and offered as a download)"
-        except (TwolinkPinError, OSError) as exc:
-            self.saved.content = f"**not saved**: {exc}"
-
-    def _export(self, client: Any = None) -> None:
-        from twolink_pin.kinematics import joint_positions
-        from twolink_pin.visualization import write_html
-        from twolink_pin.visualization.overlays import run_overlays
-
-        done = self._latest
-        if done is None:
-            return
-        result = done.result
-        _, reference = self._runner.arm(done.request.payload)
-        via_q = getattr(reference, "via_q", None)
-        points = None if via_q is None else joint_positions(done.robot, via_q)[:, -1, :]
-        try:
-            path = page_path(self.folder, str(self.html_path.value), ".html", "animation file")
-            write_html(
-                done.robot,
-                result.t,
-                result.q,
-                result.q_des,
-                path=path,
-                via_points=points,
-                **run_overlays(done.request.spec.plant.wrench, result.t),
-            )
-            self._offer(client, path)
-            self.saved.content = f"animation written to `{path}` (and offered as a download)"
-        except (TwolinkPinError, OSError) as exc:
-            self.saved.content = f"**not written**: {exc}"
-
     def _watch(self, path: Path) -> None:
         def stamp() -> tuple[int, int] | None:
             try:
@@ -502,4 +407,4 @@ class Tuner:
                 self.changed()
 
 
-__all__ = ["Tuner", "error_text", "metrics_table", "run_line"]
+__all__ = ["Tuner", "error_text", "run_line"]

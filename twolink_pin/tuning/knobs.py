@@ -1,9 +1,7 @@
 """The controls of a law's gains, read from its :class:`~twolink_pin.controllers.Gains`
 declaration: what each control sets, its label, range and step (no widget here).
 
-* a scalar gain: one control; one declared a whole multiple of another
-  (:attr:`~twolink_pin.controllers.gains.GainSpec.multiple_of`, ``mpc``'s horizon of whole
-  knots) steps by that gain's value, from one of it;
+* a scalar gain: one control;
 * a per-joint (per-axis, per-estimate) gain: one control per component and one that scales
   them all (the gain is component × scale);
 * a matrix gain: its diagonal, one control per entry, and an overall scale; its
@@ -12,12 +10,15 @@ declaration: what each control sets, its label, range and step (no widget here).
   set; a matrix given as a number ``s`` (``s I``): one control.
 
 Every gain has a box that takes its whole value typed (:func:`parse_typed`: a number,
-k numbers, or a matrix's k² numbers row by row) and shows the value that runs
-(:func:`format_typed`).
+k numbers, or a matrix's k² numbers row by row) and shows the value that runs to the digits
+that matter (:func:`format_typed`; the value itself runs with every digit).
 
 The range is about the default: ``[0, 4 v]`` for a positive or nonnegative gain (0 is
 refused by a positive gain: the law's own message is shown), ``[−4|v|, 4|v|]`` for a signed
-one; the scale runs over ``[0, 4]``.
+one, ``[0, 1]`` for a fraction; the scale runs over ``[0, 4]``. How a value steps (a key
+press, a drag) is the control's :class:`~twolink_pin.tuning.steps.Rule`: the logarithmic grid
+for a positive gain and a scale, a whole multiple of another gain for a gain declared so
+(``multiple_of``: mpc's horizon in knots), linear otherwise (:mod:`.steps`).
 """
 
 from __future__ import annotations
@@ -30,11 +31,14 @@ import numpy as np
 
 from twolink_pin.controllers.gains import GainSpec, spec_of
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.tuning.steps import FRACTION_STEP, SIGNED_SHARE, Rule, grid_nearest, shown, slider_step
 
-SCALE_RANGE = (0.0, 4.0, 0.01)
-"""Low, high and step of a scale control."""
+SCALE_RANGE = (0.0, 4.0)
+"""Low and high of a scale control (its default 1, stepping on the log grid)."""
 SPAN = 4.0
 """A gain's control runs up to SPAN × its default."""
+ZERO_STEP = 0.01
+"""The step up from 0 of a scale (a gain's step from 0 is a hundredth of its range)."""
 
 
 class Knob(NamedTuple):
@@ -56,23 +60,44 @@ class Knob(NamedTuple):
     """The default (the value the run starts from)."""
     hint: str
     """The gain's description."""
+    rule: Rule = Rule("linear", step=ZERO_STEP)
+    """How the value steps (:mod:`.steps`)."""
 
 
-def nice_step(value: float) -> float:
-    """A round step about 1/100 of ``|value|`` (a power of ten; 0.01 for 0)."""
-    if value == 0 or not math.isfinite(value):
-        return 0.01
-    return float(10.0 ** math.floor(math.log10(abs(value)) - 2))
+def rule_of(value: float, spec: GainSpec, scalars: Mapping[str, float] | None = None) -> Rule:
+    """How a control of a gain declared ``spec`` whose default is ``value`` steps: whole
+    multiples of the gain it names (``multiple_of``, when that gain is one of ``scalars``:
+    a one-value control), linear for a fraction or a signed gain, else the log grid."""
+    if spec.multiple_of and spec.multiple_of in (scalars or {}):
+        return Rule("multiple", anchor=value, of=spec.multiple_of)
+    if spec.bound == "fraction":
+        return Rule("linear", step=FRACTION_STEP)
+    if spec.bound == "any" or not math.isfinite(value):
+        return Rule("linear", step=abs(value) / SIGNED_SHARE if value else ZERO_STEP)
+    return Rule("log", anchor=value, step=ZERO_STEP)
 
 
-def _range(value: float, spec: GainSpec) -> tuple[float, float, float]:
+def _range(value: float, spec: GainSpec) -> tuple[float, float]:
     if spec.bound == "fraction":  # 0 < value <= 1: the whole range
-        return 0.0, 1.0, min(nice_step(value), 0.01)
-    step = nice_step(value)
+        return 0.0, 1.0
     top = SPAN * abs(value) if value else 1.0
-    top = math.ceil(top / step) * step
     low = -top if spec.bound == "any" else 0.0
-    return low, top, step
+    return low, top
+
+
+def _knob(
+    name: str, component: int | None, label: str, value: float, spec: GainSpec, scalars: Mapping[str, float]
+) -> Knob:
+    low, high = _range(value, spec)
+    rule = rule_of(value, spec, scalars)
+    if (
+        rule.kind == "log"
+    ):  # up from 0 (the grid has none): to the grid value nearest a hundredth of the range
+        rule = rule._replace(step=grid_nearest((high - low) / 100.0))
+    if rule.kind == "multiple":  # from one of the other gain's value (mpc's horizon: one knot)
+        low = min(scalars[rule.of], value)
+    step = slider_step(rule, value, scalars.get(rule.of))
+    return Knob(name, component, False, label, low, high, step, value, spec.doc, rule)
 
 
 def _components(value: Any, matrix: bool) -> list[float] | None:
@@ -90,28 +115,39 @@ def knobs_of(gains_type: Any, values: Mapping[str, Any]) -> list[Knob]:
     """The controls of every gain of ``gains_type`` whose resolved value is in ``values``
     (:func:`~twolink_pin.run_spec.gains_used` of the law built with its defaults)."""
     knobs: list[Knob] = []
-    for name, value in values.items():
-        if value is None or isinstance(value, (bool, str)):
-            continue
+    shown_values = {n: v for n, v in values.items() if v is not None and not isinstance(v, (bool, str))}
+    scalars = {  # the one-value gains: what a gain declared a multiple of another steps by
+        n: float(v) for n, v in shown_values.items() if _components(v, spec_of(gains_type, n).matrix) is None
+    }
+    for name, value in shown_values.items():
         spec = spec_of(gains_type, name)
         unit = f" [{spec.unit}]" if spec.unit else ""
         parts = _components(value, spec.matrix)
         if parts is None:
-            low, high, step = _range(float(value), spec)
-            unit_step = values.get(spec.multiple_of) if spec.multiple_of else None
-            if isinstance(unit_step, float) and unit_step > 0:  # whole multiples (mpc's horizon: whole knots)
-                low, step = unit_step, unit_step
-                high = max(high, unit_step) // unit_step * unit_step
-            knobs.append(Knob(name, None, False, f"{name}{unit}", low, high, step, float(value), spec.doc))
+            knobs.append(_knob(name, None, f"{name}{unit}", float(value), spec, scalars))
             continue
         what = {"joint": "joint", "axis": "axis", "estimate": "estimate"}.get(spec.per, "entry")
         for i, x in enumerate(parts):
-            low, high, step = _range(x, spec)
             label = f"{name} {what} {'xyz'[i] if spec.per == 'axis' and i < 3 else i + 1}{unit}"
-            knobs.append(Knob(name, i, False, label, low, high, step, x, spec.doc))
-        low, high, step = SCALE_RANGE
-        knobs.append(Knob(name, None, True, f"{name} × (all)", low, high, step, 1.0, f"scales every {name}"))
+            knobs.append(_knob(name, i, label, x, spec, scalars))
+        low, high = SCALE_RANGE
+        scale = Rule("log", anchor=1.0, step=grid_nearest((high - low) / 100.0))
+        step = slider_step(scale, 1.0)
+        knobs.append(
+            Knob(name, None, True, f"{name} × (all)", low, high, step, 1.0, f"scales every {name}", scale)
+        )
     return knobs
+
+
+def choices_of(gains_type: Any, values: Mapping[str, Any]) -> dict[str, tuple[tuple[str, ...], str]]:
+    """Each gain in ``values`` declared as one word of a few (its spec's ``choices``): its
+    words and the word it has."""
+    out: dict[str, tuple[tuple[str, ...], str]] = {}
+    for name, value in values.items():
+        options = tuple(getattr(spec_of(gains_type, name), "choices", ()) or ())
+        if options and isinstance(value, str):
+            out[name] = (options, value)
+    return out
 
 
 def matrices_of(gains_type: Any, values: Mapping[str, Any]) -> dict[str, np.ndarray]:
@@ -168,20 +204,16 @@ def gains_from(
     return gains
 
 
-def _text(x: float) -> str:
-    text = repr(float(x))
-    return text[:-2] if text.endswith(".0") else text
-
-
 def format_typed(value: Any) -> str:
     """A gain's value as its box shows it: ``350``, ``350, 300``, a ``(k, k)`` matrix as its
-    rows ``150, 20, 0; 20, 150, 0; 0, 0, 80`` (each number the shortest text that reads back)."""
+    rows ``150, 20, 0; 20, 150, 0; 0, 0, 80``; each number to the digits that matter
+    (:func:`~.steps.shown`: ``159.99999999999997`` as ``160``; the value runs exactly)."""
     array = np.asarray(value, dtype=float)
     if array.ndim == 0:
-        return _text(float(array))
+        return shown(float(array))
     if array.ndim == 2:
-        return "; ".join(", ".join(_text(x) for x in row) for row in array)
-    return ", ".join(_text(x) for x in array.reshape(-1))
+        return "; ".join(", ".join(shown(x) for x in row) for row in array)
+    return ", ".join(shown(x) for x in array.reshape(-1))
 
 
 def parse_typed(name: str, text: str, count: int | None, matrix: bool = False) -> float | np.ndarray:
@@ -243,11 +275,12 @@ __all__ = [
     "SCALE_RANGE",
     "SPAN",
     "Knob",
+    "choices_of",
     "format_typed",
     "gains_from",
     "knob_changes",
     "knobs_of",
     "matrices_of",
-    "nice_step",
     "parse_typed",
+    "rule_of",
 ]

@@ -132,9 +132,9 @@ class Cuts:
 
 def heading(k: int, periods: int, seconds: float) -> str:
     """The line above the metrics of a run shown up to the end of its period ``k`` of
-    ``periods``, at ``seconds`` [s] simulated."""
+    ``periods``, at ``seconds`` [s] simulated (plain text)."""
     span = "period 1" if k == 1 else f"periods 1–{k}"
-    return f"**over {span} of {periods}** (t ≤ {seconds:g} s: every column, and the plots)\n\n"
+    return f"over {span} of {periods} (t ≤ {seconds:g} s: every column, and the plots)"
 
 
 __all__ = [

@@ -12,6 +12,7 @@ what the page is sent per run stays small whatever the run's length."""
 from __future__ import annotations
 
 import contextlib
+import threading
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
@@ -157,12 +158,13 @@ def compose(
 
 
 class Plots:
-    """The panels in ``server``'s GUI, in ``folder`` (a Viser folder handle; None: the GUI's
-    top level)."""
+    """The panels in ``server``'s GUI, in ``folder`` (a Viser folder or tab handle; None: the
+    GUI's top level). Drawn from one thread at a time (a container is entered by one)."""
 
     def __init__(self, server: Any, folder: Any = None) -> None:
         self._server = server
         self._folder = folder
+        self._lock = threading.Lock()
         self._handles: dict[str, Any] = {}
         self._orders: dict[str, int] = {}
         self._cache: list[tuple[Finished, Panels]] = []
@@ -194,7 +196,7 @@ class Plots:
         self._draw({title: compose(curves) for title, curves in wanted.items()}, False)
 
     def _draw(self, wanted: dict[str, tuple[Any, Any]], hide_others: bool) -> None:
-        with self._server.atomic():
+        with self._lock, self._server.atomic():
             if hide_others:
                 for title, handle in self._handles.items():
                     handle.visible = title in wanted

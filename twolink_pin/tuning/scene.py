@@ -21,8 +21,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from twolink_pin.errors import TwolinkPinError
+from twolink_pin.errors import InvalidParameterError, TwolinkPinError
 from twolink_pin.kinematics import joint_positions
+from twolink_pin.tuning.typed import Channel, read_number
 from twolink_pin.visualization.scene import GHOST_RGB, ghost_visual_model, visual_model
 
 if TYPE_CHECKING:
@@ -75,9 +76,16 @@ def light_model(robot: RobotModel) -> Any:
     return collision
 
 
-def view_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where the camera looks (the motion's centre [m]) and where it is: along the normal of
-    a planar motion, obliquely otherwise, far enough to see it all."""
+SHIFT = 0.2
+"""How far right of the motion's centre the camera looks, as a share of its distance: the
+controls float over the right part of the 3-D view (:mod:`.results`), so the arm is drawn
+in the part left of them (about the middle of what they leave at 1366 to 1920 px)."""
+
+
+def view_of(points: np.ndarray, shift: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """Where the camera looks (the motion's centre [m], moved ``shift`` × the camera's
+    distance to the screen's right) and where it is: along the normal of a planar motion,
+    obliquely otherwise, far enough to see it all."""
     centre = 0.5 * (points.min(axis=0) + points.max(axis=0))
     spread = points - points.mean(axis=0)
     _, sigma, axes = np.linalg.svd(spread, full_matrices=False)
@@ -87,14 +95,20 @@ def view_of(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     else:
         direction = np.array([1.0, -1.2, 0.8])
     direction /= np.linalg.norm(direction)
-    return centre, centre + 2.2 * radius * direction
+    distance = 2.2 * radius
+    right = np.cross(-direction, np.array([0.0, 0.0, 1.0]))  # the screen's right, z up
+    if np.linalg.norm(right) > 1e-9:
+        centre = centre + shift * distance * right / np.linalg.norm(right)
+    return centre, centre + distance * direction
 
 
 class ArmScene:
     """The arm, its ghost and trail in ``server``'s scene, with the playback controls in its
-    GUI (created in the folder open when this is built)."""
+    GUI (created in the folder open when this is built); a number typed into the time's or
+    the speed's box arrives through ``channel`` (:class:`~twolink_pin.tuning.typed.Channel`).
+    :meth:`focused` is told whether a control has the focus (:mod:`.typed_js`)."""
 
-    def __init__(self, server: Any, robot: RobotModel) -> None:
+    def __init__(self, server: Any, robot: RobotModel, channel: Channel | None = None) -> None:
         import pinocchio as pin
         from pinocchio.visualize import ViserVisualizer
 
@@ -113,12 +127,10 @@ class ArmScene:
         self.time = server.gui.add_slider("time [s]", 0.0, 1.0, 0.01, 0.0, hint="the instant shown")
         self.speed = server.gui.add_slider("speed", 0.1, 4.0, 0.1, 1.0, hint="× real time")
         self.time.on_update(self._on_scrub)
-        from twolink_pin.tuning.typed_js import FOCUS_LABEL
-
-        self.focus = server.gui.add_text(
-            FOCUS_LABEL, "0", hint="set by the page: a gain's control has the focus"
-        )
-        self.focus.on_update(lambda _: self.hold(self.focus.value == "1", RESUME_AFTER, why="focus"))
+        self.note = server.gui.add_markdown("")
+        if channel is not None:
+            channel.register(self.time.label, lambda _i, text: self._typed(self.time, text))
+            channel.register(self.speed.label, lambda _i, text: self._typed(self.speed, text))
         self._lock = threading.Lock()
         self._t = np.zeros(1)
         self._q = np.array([robot.home])
@@ -144,7 +156,7 @@ class ArmScene:
         if not self._framed:  # the first run frames the view; later ones keep the user's
             self._framed = True
             joints = joint_positions(self._robot, q_des[:: max(1, len(q_des) // 50)]).reshape(-1, 3)
-            centre, eye = view_of(np.vstack([joints, ee, ee_des]))
+            centre, eye = view_of(np.vstack([joints, ee, ee_des]), SHIFT)
             self._server.initial_camera.look_at = centre
             self._server.initial_camera.position = eye
             self._server.initial_camera.up = (0.0, 0.0, 1.0)
@@ -169,9 +181,31 @@ class ArmScene:
             else:
                 self._held.clear()
 
+    def focused(self, value: str) -> None:
+        """The page's focus box says ``"1"`` (a control has the focus: hold still) or ``"0"``."""
+        self.hold(value == "1", RESUME_AFTER, why="focus")
+
     def close(self) -> None:
         """Stop the playback thread."""
         self._stop.set()
+
+    def _typed(self, slider: Any, text: str) -> None:
+        """A number typed into the time's box (an instant past the run's end is its end) or
+        the speed's (> 0: × real time; past the slider's end, the end moves)."""
+        try:
+            if slider is self.time:
+                value = min(max(read_number("time [s]", text, 0.0), 0.0), float(self.time.max))
+            else:
+                value = read_number("speed", text, 0.0, None, above_low=True)
+        except InvalidParameterError as exc:
+            self.note.content = f"**refused**: {exc}"
+            return
+        self.note.content = ""
+        if value > float(slider.max):
+            slider.max = value
+        slider.value = value
+        if slider is self.time:
+            self._seek(value)
 
     def _on_scrub(self, event: Any) -> None:
         if event.client is not None:  # the user moved it (the playback sets it too)

@@ -3,6 +3,8 @@
 ============================  ==============================================================
 ``lumped_map.py``             the report's parameters (p1, p2, p3) as a parameter map
 ``closed_form.py``            the report's closed-form model: an independent cross-check
+``course_equations.py``       the report's formulas in SymPy, and p1, p2, p3 found from the
+                              equations derived from the URDF (:mod:`twolink_pin.symbolic`)
 ``errata.py``                 where the report is wrong or silent, with the evidence
 ``excitation.py``             its stored excitations (identification, adaptation) and why the
                               report's adaptive estimates are still far from p at 30 s

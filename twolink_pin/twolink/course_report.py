@@ -2,7 +2,8 @@
 declares (:class:`~twolink_pin.model.profile.ReportSections`).
 
 The report asks the robot's profile for its sections instead of testing its name; for the
-twolink they are the closed-form check, Table 1 and Table 2 beside ours, the errata, and
+twolink they are the closed-form check, the equations derived from the URDF written in the
+course's p beside its formulas, Table 1 and Table 2 beside ours, the errata, and
 the identification section beside Fig. 27 (:mod:`twolink_pin.twolink.report_identification`).
 Imported with the profile when the package is imported: what it needs is imported when
 called.
@@ -39,8 +40,8 @@ class CourseReport:
         return reused, ident._submit_identification(pool, options, fig_dir, reused)
 
     def facts(self, robot: Any, via: Any) -> dict[str, Any]:
-        """The closed-form check, Table 1 (None for another trajectory) and the report's
-        printed p, coefficients and Table 2."""
+        """The closed-form check, the derived equations beside the report's, Table 1 (None for
+        another trajectory) and the report's printed p, coefficients and Table 2."""
         from twolink_pin.twolink.reference import (
             REPORT_COEFFICIENTS,
             REPORT_P,
@@ -50,6 +51,7 @@ class CourseReport:
 
         return {
             "closed_form_check": closed_form_check(robot),
+            "course_equations": course_equations_check(robot),
             "table1": None if via is None else table1(robot, via),
             "report_p": REPORT_P,
             "report_coefficients": [list(c) for c in REPORT_COEFFICIENTS],
@@ -135,6 +137,15 @@ def closed_form_check(robot: Any, samples: int = 1000) -> dict[str, Any]:
             dev_c, float(np.abs(coriolis_matrix(robot.model, data, q, v) - cf_coriolis(q, v, robot.p)).max())
         )
     return {"states": samples, "max_abs_dM": dev_m, "max_abs_dC": dev_c}
+
+
+def course_equations_check(robot: Any) -> dict[str, Any]:
+    """The equations derived from the URDF written in the p they find, beside the report's
+    (:func:`twolink_pin.twolink.course_equations.course_check`)."""
+    from twolink_pin.symbolic import derive_equations
+    from twolink_pin.twolink.course_equations import course_check
+
+    return course_check(derive_equations(robot))
 
 
 def table1(robot: Any, via: Any) -> list[dict[str, Any]]:

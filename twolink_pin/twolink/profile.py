@@ -11,7 +11,7 @@ from pathlib import Path
 from types import MappingProxyType
 
 from twolink_pin.model import catalog
-from twolink_pin.model.profile import ReportProfile, RobotProfile, TrajectorySpec
+from twolink_pin.model.profile import ArmEffects, ReportProfile, RobotProfile, TrajectorySpec
 from twolink_pin.twolink import reference
 from twolink_pin.twolink.course_report import ANIMATED_LAW, CourseReport
 from twolink_pin.twolink.lumped_map import TwoLinkLumpedMap
@@ -33,6 +33,13 @@ TWOLINK = RobotProfile(
         times=reference.REPORT_TIMES, cartesian_points=reference.REPORT_VIA_XY, branch=0
     ),
     ee_frame="ee_link",
+    effects=ArmEffects(
+        armature=reference.ARMATURE,
+        damping=reference.REPORT_FRICTION[0],
+        frictionloss=reference.REPORT_FRICTION[1],
+        source="armature: the MuJoCo Menagerie's Panda (franka_emika_panda/panda.xml), the report giving no "
+        "drive data; damping and dry friction: the report's viscous V and Coulomb C friction",
+    ),
     source="robots/twolink.urdf (this package)",
     report=ReportProfile(
         laws=reference.REPORT_CONTROLLERS,

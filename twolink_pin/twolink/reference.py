@@ -23,6 +23,13 @@ LAMBDA = 5.0
 REPORT_FRICTION = ((0.4, 0.2), (0.2, 0.1))
 """The report's joint friction: viscous V [N·m·s/rad], Coulomb C [N·m] per joint."""
 
+ARMATURE = (0.1, 0.1)
+"""Rotor inertia reflected through each joint's gearbox [kg·m²]: the report gives no drive data;
+ours is the value the MuJoCo Menagerie's Franka Panda model sets on every joint
+(``franka_emika_panda/panda.xml``, class ``panda``), an arm of the twolink's size (links of
+0.3–0.4 m, joint inertias of 0.4–3.4 kg·m² here). The sim-to-sim section's arm effects (with the
+report's friction as MuJoCo's joint damping and dry friction: :data:`REPORT_FRICTION`)."""
+
 REPORT_GAINS: dict[str, dict[str, tuple[float, ...]]] = {
     "pd": {"kp": (350.0, 300.0), "kd": (40.0, 50.0)},
     "computed-torque": {"k": (40.0, 50.0)},

@@ -8,6 +8,7 @@
 ``run.py``        ``simulate``, ``compare``, ``animate``, ``report``
 ``sweep.py``      ``sweep``
 ``tune.py``       ``tune``
+``equations.py``  ``equations``: the equations of motion in closed form
 ================  =====================================================================
 
 Every command prints a readable summary, or JSON with ``--json``. The library is imported
@@ -16,6 +17,7 @@ inside each command, so ``--help`` stays fast.
 
 from __future__ import annotations
 
+from twolink_pin.cli.commands.equations import cmd_equations
 from twolink_pin.cli.commands.identify import cmd_excite, cmd_identify
 from twolink_pin.cli.commands.model import (
     cmd_controllers,
@@ -34,6 +36,7 @@ __all__ = [
     "cmd_animate",
     "cmd_compare",
     "cmd_controllers",
+    "cmd_equations",
     "cmd_excite",
     "cmd_fk",
     "cmd_identify",

@@ -86,6 +86,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
     of several laws' runs, as ``compare`` and ``report`` give them; ``fixed_gains`` False: the
     command's ``--gain`` is not a fixed gain, as the sweep's ranges)."""
     from twolink_pin.cli.disturbance_options import plant_events
+    from twolink_pin.cli.plant_options import plant_effects
     from twolink_pin.run_spec import PlantOptions, RunSpec
 
     several = law is None
@@ -102,11 +103,13 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
             friction_smoothing=args.friction_smoothing,
             position_stops=args.joint_stops,
             **plant_events(args),
+            **plant_effects(args),
         ),
         parameters=getattr(args, mode) if mode else None,
         parameters_use=mode,
         simulation=_config(args),
         shared=several,
+        believed_effects=bool(getattr(args, "believe_effects", False)),
     )
 
 

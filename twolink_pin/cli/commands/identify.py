@@ -41,10 +41,17 @@ def _data_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog, str,
     refusals of options that only shape a simulated run."""
     from twolink_pin.identification import read_log
 
-    given = [name for name, value in (("--duration", args.duration), ("--dt", args.dt)) if value is not None]
+    plant = getattr(args, "plant", "pinocchio")
+    given = [
+        name
+        for name, value in (("--duration", args.duration), ("--dt", args.dt), ("--plant", plant))
+        if value not in (None, "pinocchio")
+    ]
     if given:
         raise InvalidParameterError(
-            given[0], getattr(args, given[0][2:]), "no value with --data (it shapes a simulated run only)"
+            given[0],
+            getattr(args, given[0][2:]),
+            "no value with --data (it shapes a simulated run only)",
         )
     from twolink_pin.identification.bags import DEFAULT_TOPIC, is_bag, read_bag
 
@@ -92,7 +99,11 @@ def _simulated_log(args: argparse.Namespace, robot: RobotModel) -> tuple[RunLog,
     else:
         trajectory, reference = _excitation(robot)
     log = simulate_log(
-        robot, trajectory, duration=args.duration, dt=DEFAULT_DT if args.dt is None else args.dt
+        robot,
+        trajectory,
+        duration=args.duration,
+        dt=DEFAULT_DT if args.dt is None else args.dt,
+        engine=getattr(args, "plant", "pinocchio"),
     )
     return log, reference
 

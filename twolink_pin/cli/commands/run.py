@@ -420,6 +420,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         animation=not args.no_animation,
         identification=not args.no_identification,
         limits_section=not args.no_limits_section,
+        sim_to_sim=not args.no_sim_to_sim,
         trajectory=args.trajectory,
     )
     command = "twolink-pin " + " ".join(shlex.quote(a) for a in (args.argv or []))

@@ -1,0 +1,57 @@
+"""The sim-to-sim figure: what each of the arm's effects on MuJoCo changes in each law's tracking.
+
+:func:`save_sim_to_sim_figure` draws, for each row of the report's section "Sim-to-sim"
+(:mod:`twolink_pin.report.sim_to_sim`) after the first, each law's differences ``Δ RMS ‖e‖``
+and ``Δ max |e|`` [mrad] from the law on the Pinocchio plant, as grouped
+horizontal bars on symmetric-log axes (an effect can lower the error as well as raise it;
+"no effect" sits at rounding level, inside the linear band around 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from twolink_pin.plotting._style import new_figure, save_figure
+
+LINEAR_BAND = 1e-3
+"""The symmetric-log axis is linear within ±this [mrad] (differences at rounding level)."""
+
+
+PANELS = (("delta_rms_e", "Δ RMS ‖e‖ [mrad]"), ("delta_max_e", "Δ max |e| [mrad]"))
+"""The two panels: the row field [rad] and the axis label."""
+
+
+def save_sim_to_sim_figure(laws: Sequence[Mapping[str, Any]], path: Path, title: str) -> Path:
+    """Write the figure (module docstring) of ``laws`` (each ``{"law", "rows": [{"short",
+    "finished", "delta_rms_e", "delta_max_e" [rad]}, ...]}``, the same rows for every law) to
+    ``path``: one panel per :data:`PANELS` entry, a group of bars (one per law) per row."""
+    labels = [row["short"] for row in laws[0]["rows"][1:]]
+    count = max(len(laws), 1)
+    height = 0.8 / count
+    fig = new_figure((11.0, 1.6 + 0.5 * len(labels) * max(count, 3) / 3))
+    y = np.arange(len(labels))[::-1].astype(float)
+    axes = [fig.add_subplot(1, len(PANELS), k + 1) for k in range(len(PANELS))]
+    for ax, (field, xlabel) in zip(axes, PANELS):
+        for i, law in enumerate(laws):
+            values = [
+                1e3 * row[field] if row.get("finished") and field in row else np.nan
+                for row in law["rows"][1:]
+            ]
+            ax.barh(y + (count - 1 - 2 * i) * height / 2, values, height=height, label=law["law"])
+        ax.set_xscale("symlog", linthresh=LINEAR_BAND)
+        ax.axvline(0.0, color="0.3", lw=0.8)
+        ax.set_xlabel(xlabel + ", symmetric log")
+        ax.grid(axis="x", alpha=0.3)
+    axes[0].set_yticks(y, labels)
+    axes[1].set_yticks(y, [""] * len(labels))
+    handles, names = axes[0].get_legend_handles_labels()
+    fig.legend(handles, names, loc="outside lower center", ncol=min(count, 5), fontsize="small")
+    fig.suptitle(title)
+    return save_figure(fig, path)
+
+
+__all__ = ["LINEAR_BAND", "PANELS", "save_sim_to_sim_figure"]
