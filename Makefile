@@ -1,5 +1,6 @@
 # twolink-pin: the two commands of the quick start.
-#   make demo   creates .venv, installs the package, runs the main job into out/
+#   make demo   creates .venv, installs the package, runs the main job into out/ (another folder:
+#               make demo TWOLINK_PIN_DEMO_OUT=DIR; a plain OUT in the environment is not ours to read)
 #   make check  the edit-test loop: ruff, the format check, mypy and every test that needs no
 #               browser, Dask cluster, docs/tutorial/report build and is not marked slow
 #   make test   installs the test extras (and headless Chromium), runs the same checks and the whole
@@ -8,7 +9,7 @@
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-OUT ?= out
+TWOLINK_PIN_DEMO_OUT ?= out
 TEST_WORKERS ?= 2
 CHECK_MARKERS ?= not browser and not slow and not cluster and not docs and not report
 
@@ -32,7 +33,7 @@ $(VENV)/.installed-docs: pyproject.toml $(VENV)/.installed
 	touch $@
 
 demo: $(VENV)/.installed
-	$(BIN)/twolink-pin report --out $(OUT)
+	$(BIN)/twolink-pin report --out $(TWOLINK_PIN_DEMO_OUT)
 
 # tests/test_docs.py runs the same strict build as `make docs` (into a temporary folder),
 # on the tutorial that tests/test_tutorial.py has just executed on a fresh kernel.
@@ -59,5 +60,7 @@ lint: static
 bench: $(VENV)/.installed
 	$(BIN)/python scripts/benchmark.py
 
+# the report folder only as far as its marker says the report wrote it (a file of yours stays)
 clean:
-	rm -rf $(VENV) $(OUT) site .pytest_cache .ruff_cache .hypothesis
+	$(PYTHON) scripts/clean_report.py $(TWOLINK_PIN_DEMO_OUT)
+	rm -rf $(VENV) site .pytest_cache .ruff_cache .hypothesis

@@ -36,7 +36,7 @@ Usage::
     .venv/bin/python scripts/benchmark.py --big-arms-only [--quick]  # issue 31: Panda osc/impedance, batches, floor
     .venv/bin/python scripts/benchmark.py --tune-only [--quick]    # tune: from a change to updated results
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
-    .venv/bin/python scripts/benchmark.py --optimal-only [--quick] # issue 36: retiming, minimum effort, UR5 via poses
+    .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
     .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a);
                                                                    # issue 45: against crocoddyl's MPC (mpc_anchor.py)
     .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
@@ -1433,99 +1433,6 @@ def ur5_commands_section(quick: bool) -> dict[str, Any]:
     return rows
 
 
-# -- trajectories within limits (issue 36) ------------------------------------------------------
-
-RETIME_GOAL = 0.020
-"""Issue 36: the time-optimal retiming of the report's via points within 20 ms [s]."""
-EFFORT_GOAL = 0.100
-"""Issue 36: the minimum-effort twolink through the report's via points within 100 ms, cold [s]."""
-POSES_GOAL = 2.0
-"""Issue 36: the UR5 through the four via poses of examples/ur5_square_pose.toml within 2 s [s]."""
-
-_COLD = """
-import json, time
-from twolink_pin import load_robot, default_trajectory
-from twolink_pin.trajectory import optimize
-robot = load_robot("twolink"); reference = default_trajectory(robot)
-start = time.perf_counter(); first = optimize(robot, reference, "effort"); cold = time.perf_counter() - start
-start = time.perf_counter(); optimize(robot, reference, "effort"); warm = time.perf_counter() - start
-print(json.dumps({"cold": cold, "warm": warm, "iterations": first.iterations}))
-"""
-"""A fresh process: the package and the robot loaded (not timed), then the first optimisation
-(its lazy imports of ProxQP and threadpoolctl included) and a second one."""
-
-
-def _best(run: Callable[[], Any], repeats: int) -> tuple[float, float, Any]:
-    """The fastest and the median wall time of ``repeats`` calls [s], and the last result."""
-    times, out = [], None
-    for _ in range(repeats):
-        start = time.perf_counter()
-        out = run()
-        times.append(time.perf_counter() - start)
-    return min(times), float(np.median(times)), out
-
-
-def _goal(seconds: float, goal: float) -> str:
-    return f"(goal <= {goal * 1e3:g} ms: {'met' if seconds <= goal else 'NOT met'})"
-
-
-def optimal_section(quick: bool) -> dict[str, Any]:
-    """Issue 36's three goals, each in this process after a first call that pays the imports
-    (the cold minimum-effort run in a fresh process): the retiming of the report's path (and
-    TOPP-RA's own solve inside it), the minimum-effort twolink, the UR5 through four via poses;
-    the minimum-time runs beside them, with no goal."""
-    from pathlib import Path
-
-    from twolink_pin.trajectory import optimize, read_trajectory_file, time_optimal
-
-    repeats = 1 if quick else 5
-    twolink, ur5 = load_robot("twolink"), load_robot("ur5")
-    reference = default_trajectory(twolink)
-    poses = read_trajectory_file(
-        Path(__file__).resolve().parents[1] / "examples" / "ur5_square_pose.toml", ur5
-    )
-    time_optimal(twolink, reference)  # imports toppra (about 1 s), once
-    retime, retime_median, retimed = _best(lambda: time_optimal(twolink, reference), repeats)
-    done = subprocess.run([sys.executable, "-c", _COLD], capture_output=True, text=True, check=True)
-    cold = json.loads(done.stdout.splitlines()[-1])
-    effort, effort_median, least = _best(lambda: optimize(twolink, reference, "effort"), repeats)
-    ur5_poses, ur5_median, square = _best(lambda: optimize(ur5, poses, "effort"), 1 if quick else 3)
-    fastest = optimize(twolink, reference, "time")
-    print("\ntrajectories within limits (issue 36): wall time of one call (best / median)")
-    print(
-        f"  time-optimal retiming, report's path: {retime * 1e3:.1f} / {retime_median * 1e3:.1f} ms "
-        f"{_goal(retime, RETIME_GOAL)}; {retimed.duration:.4f} s against the reference's {retimed.original_duration:g} s"
-    )
-    print(
-        f"  minimum effort, twolink: cold {cold['cold'] * 1e3:.0f} ms {_goal(cold['cold'], EFFORT_GOAL)}, "
-        f"then {effort * 1e3:.1f} / {effort_median * 1e3:.1f} ms; {least.iterations} SQP iterations; "
-        f"∫τᵀτ {least.effort:.4g} against the polynomial's {least.reference_effort:.4g} N²·m²·s"
-    )
-    print(
-        f"  minimum effort, UR5 through four via poses: {ur5_poses:.2f} / {ur5_median:.2f} s "
-        f"(goal <= {POSES_GOAL:g} s: {'met' if ur5_poses <= POSES_GOAL else 'NOT met'}); {square.iterations} iterations"
-    )
-    print(
-        f"  minimum time, twolink: {fastest.seconds:.2f} s; {fastest.duration:.4f} s against the retiming's "
-        f"{fastest.retimed_duration:.4f} s"
-    )
-    return {
-        "optimal": {
-            "retime_seconds": retime,
-            "retime_median_seconds": retime_median,
-            "retimed_duration": retimed.duration,
-            "effort_cold_seconds": cold["cold"],
-            "effort_warm_seconds": effort,
-            "effort_iterations": least.iterations,
-            "ur5_poses_seconds": ur5_poses,
-            "ur5_poses_iterations": square.iterations,
-            "time_seconds": fastest.seconds,
-            "time_duration": fastest.duration,
-            "goals": {"retime": RETIME_GOAL, "effort_cold": EFFORT_GOAL, "ur5_poses": POSES_GOAL},
-        }
-    }
-
-
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="short runs and few repeats (smoke test)")
@@ -1568,6 +1475,12 @@ def main(argv: list[str] | None = None) -> int:
         action="store_true",
         help="only mpc's goals: 30-s runs on the twolink and the UR5, demo (a), and against crocoddyl's MPC "
         "(CROCODDYL_PYTHON: a scratch venv's python with pin 4.0 and crocoddyl 3.2.1; skipped without)",
+    )
+    parser.add_argument(
+        "--croc",
+        metavar="PYTHON",
+        default=None,
+        help="with --optimal-only: a python with pin 4.0 and crocoddyl 3.2.1 (a scratch venv) to run the anchor beside",
     )
     parser.add_argument(
         "--mujoco-only",
@@ -1647,8 +1560,24 @@ def main(argv: list[str] | None = None) -> int:
         if args.json:
             print(json.dumps(results))
         return 0
-    if args.optimal_only:
-        results.update(optimal_section(quick))
+    if args.optimal_only:  # scripts/bench_optimal.py, beside the baseline of this run
+        from bench_optimal import optimal_section
+
+        robot0 = load_robot()
+        reference0 = default_trajectory(robot0)
+        gains0 = make_scenario("pd", robot0).controller.gains
+        start0 = reference0.sample(0.0)
+        steps = round(2.0 / DT)
+
+        def baseline_30s() -> float:
+            q0 = start0.q + np.array([0.1, -0.1])
+            return (
+                _timed(lambda: baseline_pd(reference0, robot0.p, gains0, q0, start0.v, DT, steps))
+                * FULL
+                / 2.0
+            )
+
+        results.update(optimal_section(quick, baseline_30s, args.croc))
         if args.json:
             print(json.dumps(results))
         return 0
@@ -1800,7 +1729,9 @@ def main(argv: list[str] | None = None) -> int:
     if not quick:  # the smoke test runs --big-arms-only --quick on its own
         results.update(big_arms_section(baseline, scale, quick, repeats))
     results.update(identification_section(quick))
-    results.update(optimal_section(quick))
+    from bench_optimal import optimal_section
+
+    results.update(optimal_section(quick, lambda: _timed(baseline) * scale))
 
     # -- batch scaling ------------------------------------------------------------------------------
     sizes = (1, 10, 100) if quick else (1, 10, 100, 1000, 10000)

@@ -302,7 +302,7 @@ def within_limits() -> list[Path]:
         )  # fmt: skip
         made += save_limit_figures(
             verify_motion(robot, least.trajectory, 20), least.limits, tmp, "least_effort_",
-            "twolink, minimum ∫τᵀτ dt with the report's via times", (), polynomial,
+            "twolink, least ∫τᵀτ dt near the path (the default)", (), polynomial,
         )  # fmt: skip
         for path in made:
             if path.name in wanted:

@@ -29,6 +29,7 @@ from corpus.cases_joint_limits import JOINT_LIMITS
 from corpus.cases_limits import LIMITS, LIMITS_LIBRARY
 from corpus.cases_mpc import MPC
 from corpus.cases_optimal import OPTIMAL, OPTIMAL_LIBRARY
+from corpus.cases_round5 import ROUND5
 from corpus.cases_tune import TUNE_CASES
 from corpus.cases_variants import GAINS, GAINS_LIBRARY
 from corpus.spec import URDF, Case, LibCase
@@ -67,7 +68,7 @@ def _registry() -> Any:
             del sys.modules[name]
 
 
-ALL_CASES = [*CASES, *LIMITS, *JOINT_LIMITS, *GAINS, *OPTIMAL, *MPC, *TUNE_CASES, *EQUATIONS]
+ALL_CASES = [*CASES, *LIMITS, *JOINT_LIMITS, *GAINS, *OPTIMAL, *MPC, *TUNE_CASES, *EQUATIONS, *ROUND5]
 ALL_LIBRARY = [*LIBRARY, *LIMITS_LIBRARY, *GAINS_LIBRARY, *OPTIMAL_LIBRARY]
 
 

@@ -15,13 +15,13 @@ Slow-ish: two 2.5-s Panda runs (one with its limits binding for 0.7 s) and one t
 
 from __future__ import annotations
 
-import re
 import shlex
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
+from docs_pages import blocks, commands, quoted_in
 
 from twolink_pin.cli import main
 from twolink_pin.documents import load_toml
@@ -30,25 +30,7 @@ from twolink_pin.model import load_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = (ROOT / "docs" / "control_within_limits.md").read_text()
-BLOCK = re.compile(r"```(\w*)\n(.*?)```", re.S)
-
-
-def _blocks() -> list[tuple[str, str]]:
-    return [(m.group(1), m.group(2)) for m in BLOCK.finditer(PAGE)]
-
-
-def _commands() -> list[tuple[str, list[str]]]:
-    """Each ``sh`` block's command with the ``text`` block right after it (the quoted output)."""
-    blocks = _blocks()
-    out = []
-    for (kind, text), (next_kind, quoted) in zip(blocks, [*blocks[1:], ("", "")], strict=True):
-        if kind == "sh":
-            assert next_kind == "text", f"no quoted output after {text!r}"
-            out.append((text.strip(), quoted.strip("\n").splitlines()))
-    return out
-
-
-COMMANDS = _commands()
+COMMANDS = commands(PAGE)
 
 
 def test_the_page_compares_osc_and_qp_osc_on_its_example_path() -> None:
@@ -56,7 +38,7 @@ def test_the_page_compares_osc_and_qp_osc_on_its_example_path() -> None:
     assert ["compare", "osc"] in verbs and ["simulate", "qp-osc"] in verbs
     panda = [c for c, _ in COMMANDS if "--robot panda" in c and "--wrench" not in c]  # not the push
     assert len(panda) == 3 and all("examples/panda_fold_pose.toml" in c for c in panda)
-    page = load_toml(next(text for kind, text in _blocks() if kind == "toml"), "page")
+    page = load_toml(next(text for kind, text in blocks(PAGE) if kind == "toml"), "page")
     assert page == load_toml((ROOT / "examples" / "panda_fold_pose.toml").read_text(), "file")
 
 
@@ -130,7 +112,7 @@ def test_every_command_prints_what_the_page_says(
     assert status == (1 if fails else 0), err
     printed = (err if fails else out).splitlines()
     for line in quoted:
-        assert any(line in p for p in printed) if fails else line in printed, (
+        assert quoted_in(line, printed, whole=not fails), (
             f"{line!r} is not in the output of {command!r}:\n" + "\n".join(printed)
         )
     if "qp-osc" in runs and "--wrench" in command:
@@ -201,3 +183,17 @@ def _check_demo(runs: dict[str, Any]) -> None:
     assert limits.excess(POSITION, osc.q)[:, 3].max() > 0.1  # the elbow past its range
     assert limits.excess(EFFORT, osc.tau_command)[:, 5].max() > 5.0  # joint 6 above its 12 N·m
     assert np.abs(osc.v).max(axis=0)[0] > 2 * limits.velocity[0]  # and the base twice its speed
+
+
+def test_the_quoted_numbers_are_compared_to_a_stated_tolerance_not_digit_by_digit() -> None:
+    """What an AMD EPYC printed for the page's mpc run (0.03248 for 0.03249, 134.557 for
+    134.556 N·m) matches the page; a difference the page's claims would notice (1 %), other
+    words, or another integer (a joint, a count of iterations) does not."""
+    quoted = "| mpc | 0.03249 | 0.03423 | 0.2991 | 0.6225 | 134.6 | 30.54 |"
+    saved = "  RMS  e (0.03249, 0.03423) rad   edot (0.29906, 0.62248) rad/s   tau (134.556, 30.540) N·m"
+    assert quoted_in(quoted, ["| mpc | 0.03248 | 0.03423 | 0.2991 | 0.6225 | 134.6 | 30.54 |"])
+    assert quoted_in(saved, [saved.replace("134.556", "134.557")])
+    assert not quoted_in(quoted, ["| mpc | 0.03281 | 0.03423 | 0.2991 | 0.6225 | 134.6 | 30.54 |"])
+    assert not quoted_in(quoted, ["| pd | 0.03249 | 0.03423 | 0.2991 | 0.6225 | 134.6 | 30.54 |"])
+    assert not quoted_in("failed after 15 iterations", ["x: failed after 16 iterations"], whole=False)
+    assert quoted_in("failed after 15 iterations", ["x: failed after 15 iterations: y"], whole=False)

@@ -8,13 +8,13 @@ what is checked here is what they print (the figures are tests/test_plotting.py'
 
 from __future__ import annotations
 
-import re
 import shlex
 from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
 import pytest
+from docs_pages import blocks, commands, quoted_in
 
 from twolink_pin.cli import main
 from twolink_pin.controllers import load_controller
@@ -23,25 +23,7 @@ from twolink_pin.model import load_robot
 
 ROOT = Path(__file__).resolve().parents[1]
 PAGE = (ROOT / "docs" / "task_space.md").read_text()
-BLOCK = re.compile(r"```(\w*)\n(.*?)```", re.S)
-
-
-def _blocks() -> list[tuple[str, str]]:
-    return [(m.group(1), m.group(2)) for m in BLOCK.finditer(PAGE)]
-
-
-def _commands() -> list[tuple[str, list[str]]]:
-    """Each ``sh`` block's command with the ``text`` block right after it (the quoted output)."""
-    blocks = _blocks()
-    out = []
-    for (kind, text), (next_kind, quoted) in zip(blocks, [*blocks[1:], ("", "")], strict=True):
-        if kind == "sh":
-            assert next_kind == "text", f"no quoted output after {text!r}"
-            out.append((text.strip(), quoted.strip("\n").splitlines()))
-    return out
-
-
-COMMANDS = _commands()
+COMMANDS = commands(PAGE)
 
 
 def test_the_page_runs_simulate_compare_and_sweep() -> None:
@@ -76,12 +58,14 @@ def test_every_command_prints_what_the_page_says(
     assert main(argv) == 0
     printed = capsys.readouterr().out.splitlines()
     for line in quoted:
-        assert line in printed, f"{line!r} is not in the output of {command!r}:\n" + "\n".join(printed)
+        assert quoted_in(line, printed), f"{line!r} is not in the output of {command!r}:\n" + "\n".join(
+            printed
+        )
 
 
 def test_the_pages_code_is_the_examples() -> None:
     source = (ROOT / "examples" / "jacobian_transpose.py").read_text()
-    python = [text for kind, text in _blocks() if kind == "python"]
+    python = [text for kind, text in blocks(PAGE) if kind == "python"]
     assert python
     for line in python[0].splitlines():
         if line.strip():
@@ -89,7 +73,7 @@ def test_the_pages_code_is_the_examples() -> None:
 
 
 def test_the_pages_square_is_the_example_file() -> None:
-    page = load_toml(next(text for kind, text in _blocks() if kind == "toml"), "page")
+    page = load_toml(next(text for kind, text in blocks(PAGE) if kind == "toml"), "page")
     file = load_toml((ROOT / "examples" / "ur5_square_pose.toml").read_text(), "file")
     assert page == file
 

@@ -514,6 +514,54 @@ def test_a_significant_parameter_outside_the_map_is_refused(twolink) -> None:
     assert "50.0 σ from 0" in str(err.value) and "(p1, p2, p3)" in str(err.value)
 
 
+def test_a_file_without_sigma_drops_a_part_outside_the_map_by_its_torques_alone(twolink) -> None:
+    """A URDF (or a null std) gives no σ: no division by it; mcy is dropped while its torques
+    are within 1 % of the model's (a noisy fit's 0.025 % passes) and refused beyond, naming
+    the file, the parameter and the share of the torques."""
+    from twolink_pin.identification.parameters_file import UNKNOWN_SIGMA_TOLERANCE
+
+    unknown = np.full(4, np.nan)
+    small = np.array([2.5, 0.7, -0.000893693, 0.35])
+    p = map_parameters(twolink, IdentifiedParameters("id.urdf", small, unknown, None))
+    np.testing.assert_allclose(p, [2.85, 0.35, 0.38 * 0.7], rtol=1e-12)  # mcy, noise, left out
+    large = np.array([2.5, 0.7, 0.05, 0.35])
+    with pytest.raises(InvalidParameterError) as err:
+        map_parameters(twolink, IdentifiedParameters("id.urdf", large, unknown, None))
+    assert err.value.name == "id.urdf: link2.mcy" and "σ from" not in str(err.value)
+    assert f"at most {100 * UNKNOWN_SIGMA_TOLERANCE:g} %" in str(err.value) and "no σ" in str(err.value)
+
+
+def test_a_urdf_written_from_a_noisy_fit_is_believed_as_its_json_is(tmp_path: Path) -> None:
+    """identify --noise-q 1e-4 --noise-tau 0.5 --write-urdf, then --model id.urdf: the law
+    believes the same p as from the fit's own JSON (to the URDF's printed digits), and the run
+    goes (it was refused: 'link2.mcy … 8.9e+299 σ from 0', a URDF's σ taken as 1e-300)."""
+    from twolink_pin.identification import urdf_parameters
+
+    urdf, saved = tmp_path / "id.urdf", tmp_path / "id.json"
+    noisy = ["--noise-q", "1e-4", "--noise-tau", "0.5", "--duration", "12"]
+    assert main(["identify", *noisy, "--write-urdf", str(urdf), "--save", str(saved)]) == 0
+    robot = load_robot()
+    from_urdf = map_parameters(robot, urdf_parameters(urdf, robot))
+    from_json = map_parameters(robot, read_parameter_file(saved, robot))
+    np.testing.assert_allclose(from_urdf, from_json, rtol=1e-8)
+    assert main(["simulate", "computed-torque", "--model", str(urdf), "--duration", "0.2"]) == 0
+    assert (
+        main(
+            [
+                "compare",
+                "computed-torque",
+                f"computed-torque@model={urdf}",
+                "--duration",
+                "0.2",
+                "--no-plot",
+                "--out",
+                str(tmp_path / "c"),
+            ]
+        )
+        == 0
+    )
+
+
 def test_identify_then_control_with_what_was_identified(tmp_path: Path, twolink, twolink_log: RunLog) -> None:
     """identify --save writes the file; --p0 starts the adaptive-friction law at the identified
     values exactly (p mapped, friction), --model gives them to computed torque, and --p0 on a law

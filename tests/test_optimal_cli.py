@@ -69,12 +69,12 @@ def test_optimize_json_against_the_library_and_its_file(capsys, tmp_path: Path) 
 
 
 def test_a_failed_optimisation_exits_1_and_replaces_nothing(capsys, tmp_path: Path) -> None:
-    """One SQP iteration does not converge: exit 1 naming the iterations and the violation; the
-    file already at --save is left as it was."""
+    """One SQP iteration does not converge: exit 1 saying what did not (the cost), by how much
+    and what to try; the file already at --save is left as it was."""
     saved = tmp_path / "mine.json"
     saved.write_text('{"mine": true}\n')
     code, out, err = run(capsys, "optimize", "--max-iterations", "1", "--save", str(saved))
-    assert code == 1 and "no convergence in 1 SQP iterations" in err and "violation" in err
+    assert code == 1 and "the cost did not settle in 1 SQP iterations" in err and "--max-iterations" in err
     assert saved.read_text() == '{"mine": true}\n' and out == ""
 
 

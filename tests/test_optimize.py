@@ -4,6 +4,7 @@ the via points (and poses, by forward kinematics) from the saved file read back.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -163,7 +164,21 @@ def test_bad_via_points_and_costs_are_refused_naming_what(twolink) -> None:
 
 
 def test_a_solver_that_does_not_converge_says_so(twolink) -> None:
-    """One SQP iteration cannot reach the minimum: OptimizationError (exit 1) with the
-    iterations and the remaining violation."""
-    with pytest.raises(OptimizationError, match=r"no convergence in 1 SQP iterations.*violation"):
+    """One SQP iteration cannot reach the minimum: OptimizationError (exit 1) that says what
+    did not converge — the cost, not the constraints, which hold — by how much (what the last
+    step gained, what the model sees left, against the tolerance), and what to try (issue 45:
+    "no convergence … violation 1.19e-09 (tolerance 1e-06)" read as a constraint failing)."""
+    with pytest.raises(OptimizationError) as caught:
         optimize(twolink, default_trajectory(twolink), max_iterations=1)
+    message = str(caught.value)
+    assert re.search(
+        r"the cost did not settle in 1 SQP iterations: the last accepted step lowered the cost by "
+        r"\S+ of its starting value and the model sees \S+ more \(tolerance 1e-05\)",
+        message,
+    ), message
+    assert (
+        "the constraints hold (largest violation" in message
+        and "try more iterations (--max-iterations" in message
+    )
+    left = float(re.search(r"the model sees (\S+) more", message).group(1))
+    assert left > 1e-5  # really not settled: more than the tolerance left

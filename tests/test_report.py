@@ -331,3 +331,31 @@ def test_a_missing_mesh_costs_the_animation_not_the_report(tmp_path: Path) -> No
     assert len(results["warnings"]) == 1 and "nothere.stl" in results["warnings"][0]
     html = (tmp_path / "r" / "index.html").read_text()
     assert "nothere.stl" in html and not (tmp_path / "r" / "animation.html").exists()
+
+
+def test_a_report_without_an_adaptive_law_has_no_section_about_one_and_captions_its_figures(
+    tmp_path: Path,
+) -> None:
+    """``--controller mpc --controller pd`` (here pd alone): the identification section answers
+    why an adaptive law's p̂ is still far from p — without one it is not there (it was); every
+    figure's caption says what it shows (the figure's title), its file name beside it."""
+    from twolink_pin.report.pages import figure_captions
+
+    options = ReportOptions(
+        run=RunSpec(simulation=SimulationConfig(duration=0.5)),
+        workers=1,
+        limits_section=False,
+        animation=False,
+        controllers=("pd",),
+    )  # identification asked for (the default)
+    results = build_report(tmp_path / "r", options)
+    html = (tmp_path / "r" / "index.html").read_text()
+    assert results["identification"] is None and "still far" not in html and 'id="identification"' not in html
+    captions = figure_captions(tmp_path / "r" / "figures")
+    assert "pd_theta1.png" in captions and "joint 1 position" in captions["pd_theta1.png"]
+    for name, caption in captions.items():
+        assert (
+            f'<figcaption>{caption.replace("&", "&amp;")} <span class="file">({name})</span>'
+            in html.replace("&#39;", "'")
+        )
+    assert "$" not in "".join(captions.values())  # mathtext made plain

@@ -413,7 +413,15 @@ def test_live_server_honours_host_and_closes_its_sockets() -> None:
         port, zmq_port = viewer.port, int(viewer.zmq_url.rsplit(":", 1)[1])
         assert _listening(port) == ["0200007F"]
         assert _listening(zmq_port) == ["0100007F"]
-    assert _listening(port) == [] and _listening(zmq_port) == []
+    assert _listening(port) == []
+    # libzmq closes a socket on its own I/O thread after close(linger=0) returns (the bridge's
+    # context is meshcat's class attribute, shared: it cannot be terminated to wait for it). The
+    # check failed once in a loaded make check: wait for that thread, bounded (a hang, not a pace).
+    for _ in range(1000):
+        if not _listening(zmq_port):
+            break
+        time.sleep(0.01)
+    assert _listening(zmq_port) == []
     assert not viewer.running
 
 

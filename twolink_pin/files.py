@@ -9,6 +9,12 @@
   or was written by the same command (its marker file), so a user's folder is never
   overwritten.
 * :func:`write_json` — JSON through :func:`atomic_write` (no NaN or inf: they are not JSON).
+* :func:`outputs_together` — one command's files, all or nothing: inside it
+  :func:`atomic_write` stages each file beside its target and :func:`commit_outputs` (the CLI
+  calls it before it prints its summary) moves them all into place, or none when the command
+  fails; a folder of figures (:func:`removed_on_failure`, ``--plot DIR``) is the command's only
+  for the names its marker (:data:`FIGURES_MARKER`) lists: a file of yours of the same name as a
+  figure is never replaced.
 
 Every OS failure (read-only folder, full disk, a file where a folder is expected) becomes
 an :class:`~twolink_pin.errors.OutputError` naming the path and the reason.
@@ -17,6 +23,7 @@ an :class:`~twolink_pin.errors.OutputError` naming the path and the reason.
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import errno
 import json
 import os
@@ -28,7 +35,11 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
-from twolink_pin.errors import InputFileError, OutputError
+from twolink_pin.errors import OutputError
+
+# the readers' checks, re-exported beside the writer
+from twolink_pin.input_files import check_input_file as check_input_file
+from twolink_pin.input_files import read_input_file as read_input_file
 from twolink_pin.readiness import ready
 from twolink_pin.user_code import restore_baseline
 
@@ -43,8 +54,155 @@ def _umask() -> int:
     return mask
 
 
+class OutputSet:
+    """The files one command writes, staged beside their targets and moved into place together
+    (:func:`outputs_together`)."""
+
+    def __init__(self) -> None:
+        self.staged: list[tuple[Path, Path]] = []
+        """``(temporary file, target)`` in the order written (a later write of a target wins)."""
+        self.created: list[Path] = []
+        """Folders made for the staged files, deepest first (removed again if the set is discarded)."""
+        self.claimed: set[Path] = set()
+        """Folders of figures (their real paths): a file there is replaced only if their
+        :data:`FIGURES_MARKER` lists it."""
+
+    def _check(self) -> None:
+        for _, target in self.staged:
+            check_replaceable(target)  # nothing else took the name meanwhile
+            folder = target.parent
+            if folder in self.claimed and target.exists() and target.name not in _listed(folder):
+                raise OutputError(
+                    str(target),
+                    f"is not a figure twolink-pin wrote (the folder's {FIGURES_MARKER} does not list it); refusing "
+                    "to replace it with one — move it, or give another folder",
+                )
+
+    def commit(self) -> None:
+        """Move every staged file into place (signals held for the renames); the figure
+        folders' markers list what they now hold of ours.
+
+        Raises:
+            OutputError: a target became a folder or a device, or is a file of the user's in a
+                folder of figures: nothing is moved then.
+        """
+        try:
+            self._check()
+            for folder in sorted(self.claimed):
+                names = {t.name for _, t in self.staged if t.parent == folder}
+                if names:
+                    _write_listing(folder, _listed(folder) | names)
+            with _signals_deferred():
+                for tmp, target in self.staged:
+                    os.replace(tmp, target)
+                    _STAGING.discard(str(tmp))
+        except OSError as exc:
+            self.discard()
+            raise OutputError(str(self.staged[0][1]), f"cannot write the file ({_reason(exc)})") from exc
+        except BaseException:
+            self.discard()
+            raise
+        self.staged.clear()
+        self.created.clear()
+
+    def discard(self) -> None:
+        """Remove every staged file and the folders made for them (when empty)."""
+        for tmp, _ in self.staged:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+            _STAGING.discard(str(tmp))
+        for folder in self.created:
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        self.staged.clear()
+        self.created.clear()
+
+
+_PENDING: contextvars.ContextVar[OutputSet | None] = contextvars.ContextVar(
+    "twolink_pin_outputs", default=None
+)
+
+_STAGING: set[str] = set()
+"""Temporary files and staging folders that exist now (what :func:`remove_staging` removes)."""
+
+
+def remove_staging() -> None:
+    """Remove every temporary file and staging folder this process has made and not yet moved
+    into place or removed: for an exit that runs no ``finally`` (the deadline's backstop,
+    :mod:`twolink_pin.simulation.deadline`)."""
+    for path in sorted(_STAGING, reverse=True):
+        if os.path.isdir(path) and not os.path.islink(path):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(path)
+    _STAGING.clear()
+
+
+FIGURES_MARKER = ".twolink-pin-figures"
+"""The file in a ``--plot`` folder that lists the figures twolink-pin wrote there (``entry:
+NAME`` lines): only those are replaced by the next command's figures."""
+
+
+@contextlib.contextmanager
+def outputs_together() -> Iterator[OutputSet]:
+    """The files written inside the block (through :func:`atomic_write`) are staged and moved
+    into place together when the block ends without an exception (or earlier, at
+    :func:`commit_outputs`); on an exception none is, and nothing staged stays behind. A
+    folder written as a whole (:func:`output_directory`) is its own unit: its files are not
+    staged twice."""
+    pending = OutputSet()
+    token = _PENDING.set(pending)
+    try:
+        yield pending
+        pending.commit()
+    except BaseException:
+        pending.discard()
+        raise
+    finally:
+        _PENDING.reset(token)
+
+
+def commit_outputs() -> None:
+    """Move the files staged so far (:func:`outputs_together`) into place; nothing outside it."""
+    pending = _PENDING.get()
+    if pending is not None:
+        pending.commit()
+
+
+def _listed(folder: Path) -> set[str]:
+    try:
+        text = (folder / FIGURES_MARKER).read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return set()
+    return {line[len(MANIFEST_PREFIX) :] for line in text.splitlines() if line.startswith(MANIFEST_PREFIX)}
+
+
+def _write_listing(folder: Path, names: set[str]) -> None:
+    token = _PENDING.set(None)  # written now: it must list a figure before the figure is there
+    try:
+        with atomic_write(folder / FIGURES_MARKER) as f:
+            f.write("figures written by twolink-pin (--plot); a file not listed here is never replaced\n")
+            f.write("".join(f"{MANIFEST_PREFIX}{name}\n" for name in sorted(names)))
+    finally:
+        _PENDING.reset(token)
+
+
+def _missing_folders(path: Path) -> list[Path]:
+    """The folders of ``path`` (itself included) that do not exist, deepest first."""
+    missing = []
+    probe = path
+    while not probe.exists() and probe != probe.parent:
+        missing.append(probe)
+        probe = probe.parent
+    return missing
+
+
 def _make_parent(target: Path) -> None:
     parent = target.parent
+    pending = _PENDING.get()
+    if pending is not None:
+        pending.created.extend(_missing_folders(parent))
     try:
         parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
@@ -94,6 +252,7 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
         fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     except OSError as exc:
         raise OutputError(str(target), f"cannot write in {target.parent} ({_reason(exc)})") from exc
+    _STAGING.add(tmp)
     try:
         try:
             with os.fdopen(fd, mode, encoding=None if "b" in mode else "utf-8") as f:
@@ -103,26 +262,33 @@ def atomic_write(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[A
                 os.fsync(f.fileno())
             os.chmod(tmp, 0o666 & ~_umask())
             check_replaceable(target)  # nothing else took the name meanwhile
-            os.replace(tmp, target)
+            pending = _PENDING.get()
+            if pending is not None:  # moved into place with the command's other outputs
+                pending.staged.append((Path(tmp), Path(os.path.realpath(target))))
+            else:
+                os.replace(tmp, target)
+                _STAGING.discard(tmp)
         except OSError as exc:
             raise OutputError(str(target), f"cannot write the file ({_reason(exc)})") from exc
     except BaseException:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        _STAGING.discard(tmp)
         raise
 
 
 @contextlib.contextmanager
 def removed_on_failure(folder: str | os.PathLike[str]) -> Iterator[Path]:
-    """A block that may create ``folder`` (and its missing parents): if the block fails, the
-    folders it created are removed again when they are still empty (a full disk or a
-    read-only file then leaves nothing behind)."""
+    """A block that may create ``folder`` (and its missing parents) for files whose names the
+    command chooses (``--plot DIR``'s figures): if the block fails, the folders it created are
+    removed again when they are still empty (a full disk or a read-only file then leaves
+    nothing behind). Inside :func:`outputs_together` the folder is claimed: a file of the same
+    name as one written there is replaced only if the folder's :data:`FIGURES_MARKER` lists it."""
     path = Path(folder)
-    missing = []
-    probe = path
-    while not probe.exists() and probe != probe.parent:
-        missing.append(probe)
-        probe = probe.parent
+    missing = _missing_folders(path)
+    pending = _PENDING.get()
+    if pending is not None:
+        pending.claimed.add(Path(os.path.realpath(path)))
     try:
         yield path
     except BaseException:
@@ -253,10 +419,21 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
     restore_baseline()  # a law that changed the working directory cannot move the output
     out = check_output_directory(path, marker)
     _make_parent(out)
+    token = _PENDING.set(None)  # the folder is the unit: its files are written in its stage now
+    try:
+        with _output_stage(out, marker, note) as stage:
+            yield stage
+    finally:
+        _PENDING.reset(token)
+
+
+@contextlib.contextmanager
+def _output_stage(out: Path, marker: str, note: str) -> Iterator[Path]:
     try:
         stage = Path(tempfile.mkdtemp(prefix=f".{out.name}.partial-", dir=out.parent))
     except OSError as exc:
         raise OutputError(str(out.parent), f"cannot create a folder there ({_reason(exc)})") from exc
+    _STAGING.add(str(stage))
     try:
         os.chmod(stage, 0o777 & ~_umask())
         ready("writing")
@@ -273,60 +450,17 @@ def output_directory(path: str | os.PathLike[str], marker: str, note: str = "") 
                 old = out.parent / f".{out.name}.old-{os.getpid()}"
                 os.replace(out, old)
             os.replace(stage, out)
+            _STAGING.discard(str(stage))
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
     except OSError as exc:
         shutil.rmtree(stage, ignore_errors=True)
+        _STAGING.discard(str(stage))
         code = errno.errorcode.get(exc.errno or 0, "")
         raise OutputError(
             str(out), f"cannot write the outputs ({_reason(exc)}{', ' + code if code else ''})"
         ) from exc
     except BaseException:
         shutil.rmtree(stage, ignore_errors=True)
+        _STAGING.discard(str(stage))
         raise
-
-
-def check_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> Path:
-    """``path`` if it is a regular file of at most ``max_bytes`` that this process can read.
-
-    Reading a FIFO, a device (``/dev/zero``) or a directory would block, never end, or fail
-    obscurely: they are refused before any read.
-
-    Raises:
-        InputFileError: missing, not a regular file, unreadable, or larger than ``max_bytes``
-            (the message names the bound).
-    """
-    file = Path(path)
-    try:
-        info = os.stat(file)
-    except FileNotFoundError:
-        raise InputFileError(str(file), f"file not found (expected {what})") from None
-    except OSError as exc:
-        raise InputFileError(str(file), f"cannot be examined ({_reason(exc)})") from exc
-    if stat.S_ISDIR(info.st_mode):
-        raise InputFileError(str(file), f"is a directory (expected {what})")
-    if not stat.S_ISREG(info.st_mode):
-        raise InputFileError(str(file), f"is not a regular file (a device, pipe or socket; expected {what})")
-    if info.st_size > max_bytes:
-        raise InputFileError(
-            str(file), f"is {info.st_size} bytes, more than the {max_bytes} bytes accepted for {what}"
-        )
-    if not os.access(file, os.R_OK):
-        raise InputFileError(str(file), "cannot be read (permission denied)")
-    return file
-
-
-def read_input_file(path: str | os.PathLike[str], max_bytes: int, what: str) -> bytes:
-    """The bytes of ``path`` after :func:`check_input_file`, read without following a swap to
-    a device between the check and the read (the size is checked again on the open file)."""
-    file = check_input_file(path, max_bytes, what)
-    try:
-        with open(file, "rb") as f:
-            if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
-                raise InputFileError(str(file), f"is not a regular file (expected {what})")
-            data = f.read(max_bytes + 1)
-    except OSError as exc:
-        raise InputFileError(str(file), f"cannot be read ({_reason(exc)})") from exc
-    if len(data) > max_bytes:
-        raise InputFileError(str(file), f"is more than the {max_bytes} bytes accepted for {what}")
-    return data

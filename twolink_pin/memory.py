@@ -1,7 +1,7 @@
 """The memory a command may use: what the machine has available, read before a large input is.
 
-A reader that needs memory in proportion to its input (a ROS bag) compares its need with
-:func:`available_memory` first and refuses an input too large for it by its size on disk,
+A reader that needs memory in proportion to its input (a ROS bag), or a solver in proportion
+to its problem (``mpc``'s horizon), compares its need with :func:`available_memory` first and refuses an input too large for it by its size on disk,
 instead of being killed half-way by the kernel's out-of-memory killer.
 """
 
@@ -16,10 +16,24 @@ MEMORY_ENV = "TWOLINK_PIN_MEMORY"
 reports (a test, or a share of a machine that runs other work)."""
 
 
+def address_space_used() -> int | None:
+    """Bytes of address space this process holds now (``VmSize`` in ``/proc/self/status``),
+    None where it cannot be read."""
+    try:
+        with open("/proc/self/status", encoding="ascii", errors="replace") as f:
+            for line in f:
+                if line.startswith("VmSize:"):
+                    return int(line.split()[1]) * 1024  # reported in kB
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
 def available_memory() -> int | None:
     """Bytes this process may still allocate: :data:`MEMORY_ENV` if set, else the smaller of
-    ``MemAvailable`` in ``/proc/meminfo`` and the address-space limit (``ulimit -v``); None
-    where neither is known.
+    ``MemAvailable`` in ``/proc/meminfo`` and what is left under the address-space limit
+    (``ulimit -v``: the limit less the address space the process already holds, which is
+    250 MB or more once Pinocchio and NumPy are imported); None where neither is known.
 
     Raises:
         InvalidParameterError: :data:`MEMORY_ENV` is set but not a positive whole number of bytes.
@@ -49,5 +63,5 @@ def available_memory() -> int | None:
     if resource is not None:
         soft, _ = resource.getrlimit(resource.RLIMIT_AS)
         if soft != resource.RLIM_INFINITY:
-            bounds.append(int(soft))
+            bounds.append(max(0, int(soft) - (address_space_used() or 0)))
     return min(bounds) if bounds else None

@@ -41,9 +41,47 @@ _BASELINE: contextvars.ContextVar[tuple[Any, ...] | None] = contextvars.ContextV
 
 
 class _TimedOut(Exception):
-    def __init__(self, seconds: float) -> None:
-        super().__init__(seconds)
-        self.seconds = seconds
+    """The bound's error (``bound(_TimedOut)``), made from its timeout: the seconds and whether
+    the code made no progress for that long (the stall) rather than ran past ``--timeout``."""
+
+    def __init__(self, timeout: Any) -> None:
+        super().__init__(timeout)
+        self.seconds = float(getattr(timeout, "seconds", timeout))
+        self.stalled = bool(getattr(timeout, "stalled", False))
+
+
+class HardExit(SystemExit):
+    """``os._exit(code)`` called by user code while a command runs (:func:`exits_contained`):
+    raised where it was called, so that the law is named and the command cleans up (staging
+    files, workers) instead of the process ending at once with the law's status."""
+
+    def __init__(self, code: object) -> None:
+        super().__init__(code)
+
+
+@contextlib.contextmanager
+def exits_contained() -> Iterator[None]:
+    """Inside the block, ``os._exit`` (and ``posix._exit``) called in this process's main thread
+    raises :class:`HardExit` instead of ending the process: a law's ``os._exit(0)`` is an error
+    naming the law (exit status 1), not a silent success with its staging folders left behind.
+    A child process (``fork``: a ``multiprocessing`` worker ends with ``os._exit``), another
+    thread and the code after the block get the real one."""
+    import posix
+    import threading
+
+    real = os._exit
+    pid = os.getpid()
+
+    def contained_exit(code: int) -> None:
+        if os.getpid() != pid or threading.current_thread() is not threading.main_thread():
+            real(code)
+        raise HardExit(code)
+
+    os._exit = posix._exit = contained_exit  # type: ignore[assignment]
+    try:
+        yield
+    finally:
+        os._exit = posix._exit = real
 
 
 def _state() -> tuple[Any, ...]:
@@ -120,6 +158,8 @@ def location_of(exc: BaseException) -> str:
 def _raised(exc: BaseException) -> str:
     if isinstance(exc, SyntaxError):  # its place is the file's line, not a frame (location_of)
         return f"raised {type(exc).__name__}: {exc.msg}"
+    if isinstance(exc, HardExit):
+        return f"called os._exit({exc.code!r})"
     if isinstance(exc, SystemExit):
         return f"called sys.exit({exc.code!r})"
     if isinstance(exc, MemoryError):
@@ -148,7 +188,11 @@ def guarded(reference: str, what: str, *, timed: bool = True) -> Iterator[None]:
             raise ControllerError(
                 reference,
                 float("nan"),
-                f"{what} did not finish within --timeout {exc.seconds:g} s"
+                (
+                    f"{what} did not return within {exc.seconds:g} s (no progress; --timeout 0 waits forever)"
+                    if exc.stalled
+                    else f"{what} did not finish within --timeout {exc.seconds:g} s"
+                )
                 + (f" (it was at {where})" if where else ""),
             ) from None
         except (KeyboardInterrupt, TwolinkPinError):
@@ -162,4 +206,13 @@ def guarded(reference: str, what: str, *, timed: bool = True) -> Iterator[None]:
             ) from exc
 
 
-__all__ = ["baseline", "guarded", "location", "location_of", "process_state", "restore_baseline"]
+__all__ = [
+    "HardExit",
+    "baseline",
+    "exits_contained",
+    "guarded",
+    "location",
+    "location_of",
+    "process_state",
+    "restore_baseline",
+]

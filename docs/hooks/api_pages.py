@@ -99,11 +99,12 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     (
         "files",
         "Files, errors, arrays, math, threads, version",
-        "The one writer, bounded input documents, the stages a command reports, the signals it "
+        "The one writer and the input files' checks, bounded input documents, the stages a command reports, the signals it "
         "received, user code outside compute, the memory available, the exceptions, read-only "
         "arrays, LaTeX → MathML, OpenMP and BLAS threads, the version.",
         (
             "files",
+            "input_files",
             "documents",
             "readiness",
             "interrupts",

@@ -25,7 +25,7 @@ MPC: list[Case] = [
     C("nonfinite-simulate-mpc-horizon-nan", f"simulate mpc {SIM} --gain horizon=nan", 2, err=("horizon", "nan", "finite")),
     C("nonfinite-simulate-mpc-horizon-inf", f"simulate mpc {SIM} --gain horizon=inf", 2, err=("horizon", "inf")),
     C("unclear-simulate-mpc-horizon-below-knot-interval", f"simulate mpc {SIM} --gain horizon=0.01", 2, err=("horizon", "0.01", "at least one knot interval (0.025 s)")),
-    C("hang-simulate-mpc-horizon-too-long-for-memory", f"simulate mpc {SIM} --gain horizon=1000 --gain knot_interval=0.001", 2, err=("horizon", "1000 s (1000000 knots", "fit in memory", "MB available"), note="refused before anything of its size is made: 8 B × (2 (n + m)² + N (n² + m n)) against the memory available"),
+    C("hang-simulate-mpc-horizon-too-long-for-memory", f"simulate mpc {SIM} --gain horizon=1000 --gain knot_interval=0.001", 2, err=("horizon", "1000 s (1000000 knots", "fit in memory", "MB available"), note="refused before anything of its size is made: 8 B × (10 (n + m)² + 9 n² + 2 m n + N (5 n² + m n)) against the memory available"),
     C("unclear-simulate-mpc-replan-shorter-than-step", f"simulate mpc {SIM} --gain replan_period=0.0005", 2, err=("mpc: update period", "0.0005", "multiple of the simulation step dt = 0.001 s")),
     C("unclear-simulate-mpc-replan-not-a-multiple", f"simulate mpc {SIM} --gain replan_period=0.0015", 2, err=("mpc: update period", "0.0015", "multiple of the simulation step")),
     C("unclear-simulate-mpc-replan-zero", f"simulate mpc {SIM} --gain replan_period=0", 2, err=("replan_period", "0", "> 0")),

@@ -52,12 +52,23 @@ caught it), the outcome is the interrupt; long loops check it (:func:`interrupts
 def _run(args: argparse.Namespace) -> int:
     """The command under its guards; an exception after a signal is the interrupt, whatever
     it turned into on its way (an ``ImportError`` from an interrupted import)."""
+    from functools import partial
+
     from twolink_pin import user_code
-    from twolink_pin.simulation.deadline import bounded, per_run_limit
+    from twolink_pin.files import outputs_together
+    from twolink_pin.simulation.deadline import bounded, per_run_limit, start_backstop
+
+    start_backstop()  # its thread's memory held before any memory check counts what is left
 
     try:  # --timeout bounds each simulation (a law that never returns), not the whole command,
-        # and each import and construction of a law (user_code.guarded)
-        with per_run_limit(getattr(args, "timeout", None)), user_code.baseline(bounded):
+        # and each import and construction of a law (user_code.guarded); the command's files are
+        # written all or none (files.outputs_together: committed before its summary is printed)
+        with (
+            per_run_limit(getattr(args, "timeout", None)),
+            user_code.baseline(partial(bounded, stall=True)),
+            user_code.exits_contained(),  # a law's os._exit: an error naming it, and the cleanup
+            outputs_together(),
+        ):
             with guard.results_only_on_stdout(bool(getattr(args, "json", False))):
                 code = int(args.func(args))
     except BaseException:

@@ -36,7 +36,14 @@ def add_within_limits_options(p: argparse.ArgumentParser, retime: bool) -> None:
 
 def add_optimize_command(sub: Any, c: Any) -> None:
     """``optimize``: an optimal trajectory through the reference's via points."""
-    from twolink_pin.trajectory.optimal import COSTS, MAX_ITERATIONS
+    from twolink_pin.trajectory.optimal import (
+        COSTS,
+        DEFAULT_REGULARISER,
+        ENDS,
+        MAX_ITERATIONS,
+        REGULARISER_WEIGHT,
+        REGULARISERS,
+    )
 
     p = sub.add_parser(
         "optimize",
@@ -48,6 +55,30 @@ def add_optimize_command(sub: Any, c: Any) -> None:
         choices=COSTS,
         default="effort",
         help="∫τᵀτ dt with the via times (effort, default) or the duration (time)",
+    )
+    p.add_argument(
+        "--ends",
+        choices=tuple(ENDS),
+        default="smooth",
+        help="effort: at rest with zero acceleration and jerk at both ends (smooth, default: the course "
+        "polynomial's) or at rest only (rest: crocoddyl's; the torque may step at the start)",
+    )
+    p.add_argument(
+        "--regulariser",
+        choices=REGULARISERS,
+        default=DEFAULT_REGULARISER,
+        help="effort: add w ∫‖q − q_ref(t)‖² dt (path, default: near the reference's path, for via poses its "
+        "straight SE(3) path), w ∫‖q̇‖² dt (velocity: the least motion) or minimise the effort alone (none: "
+        "joints that cost little torque may swing far and fast)",
+    )
+    p.add_argument(
+        "--regulariser-weight",
+        type=bounded(0.0, 1e6, unit=""),
+        default=REGULARISER_WEIGHT,
+        metavar="K",
+        help="the regulariser's weight as a fraction of the reference's ∫τᵀτ dt: path, one joint 0.1 rad off the "
+        "path for the whole motion costs K times it; velocity, the reference's own motion costs K times it "
+        f"(default {REGULARISER_WEIGHT:g})",
     )
     add_trajectory_option(p)
     add_within_limits_options(p, retime=False)

@@ -35,11 +35,16 @@ else written to ``sys.stdout`` to stderr: :mod:`twolink_pin.cli.guard`)."""
 
 
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
-    """Print ``payload`` as one JSON line with ``--json``, else ``text``.
+    """Print ``payload`` as one JSON line with ``--json``, else ``text`` — after the command's
+    files are in place (:func:`~twolink_pin.files.commit_outputs`: a summary never names a file
+    that is not written).
 
     Raises:
-        OutputError: stdout is closed (nothing can be printed).
+        OutputError: stdout is closed (nothing can be printed), or the files cannot be put in place.
     """
+    from twolink_pin.files import commit_outputs
+
+    commit_outputs()
     stream = RESULT_STREAM if RESULT_STREAM is not None else sys.stdout
     if stream is None:
         from twolink_pin.errors import OutputError
@@ -89,12 +94,16 @@ def progress_bar(total: int, unit: str, desc: str, disable: bool = False) -> Any
 
 
 def limits_payload(check: Any) -> dict[str, Any]:
-    """``trajectory --json``'s limit fields of a :class:`~twolink_pin.feasibility.TorqueCheck`:
-    ``limits_check`` (:meth:`~twolink_pin.limits.LimitsCheck.summary`) and its grid."""
-    t = check.limits_check.motion.t
+    """``trajectory --json``'s limit fields of a :class:`~twolink_pin.feasibility.TorqueCheck`
+    (or a :class:`~twolink_pin.limits.LimitsCheck`): ``limits_check``
+    (:meth:`~twolink_pin.limits.LimitsCheck.summary`) and its grid: ``instants`` and ``step``,
+    the largest time between two [s] (a sampled reference's grid is even on each interval
+    between its samples, :func:`~twolink_pin.limits.reference_motion`)."""
+    limits_check = getattr(check, "limits_check", check)
+    t = limits_check.motion.t
     return {
-        "limits_check": check.limits_check.summary(),
-        "limits_check_grid": {"instants": len(t), "step": float(t[1] - t[0])},
+        "limits_check": limits_check.summary(),
+        "limits_check_grid": {"instants": len(t), "step": float(np.diff(t).max()) if len(t) > 1 else 0.0},
     }
 
 
@@ -103,11 +112,16 @@ def limits_check_lines(check: Any) -> list[str]:
     time, the limit and the margin (``none``: the robot gives no such limit), then the
     verdict; the first line says how fine the grid was."""
     t = check.motion.t
-    step = float(t[1] - t[0]) if len(t) > 1 else 0.0
+    step = float(np.diff(t).max()) if len(t) > 1 else 0.0
     names = check.limits.joint_names
     width = max(5, *(len(n) for n in names))
+    spacing = (
+        f"{1e3 * step:.3g} ms apart"
+        if np.ptp(np.diff(t)) <= 1e-9 * step
+        else f"at most {1e3 * step:.3g} ms apart"
+    )
     lines = [
-        f"limits over one period, checked at {len(t)} instants {1e3 * step:.3g} ms apart (torque by RNEA):",
+        f"limits over one period, checked at {len(t)} instants {spacing} (torque by RNEA):",
         f"  {'limit':22s} {'joint':{width}s} {'peak':>11s} {'at t [s]':>9s} {'limit':>11s} {'margin':>11s}",
     ]
     failed = []

@@ -24,6 +24,7 @@ from twolink_pin.cli.common_options import (
 )
 from twolink_pin.cli.disturbance_options import add_disturbance_options
 from twolink_pin.cli.equations_parser import add_equations_command
+from twolink_pin.cli.examples_command import add_examples_command
 from twolink_pin.cli.guard import DEFAULT_TIMEOUT, TUNE_TIMEOUT
 from twolink_pin.cli.identify_parser import add_identification_commands
 from twolink_pin.cli.optimal_parser import add_optimize_command, add_within_limits_options
@@ -182,6 +183,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_sweep_command(sub, c)
     add_identification_commands(sub, c)
     add_equations_command(sub, c)
+    add_examples_command(sub)
     return parser
 
 

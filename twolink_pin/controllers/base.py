@@ -71,7 +71,9 @@ class StateVariable(NamedTuple):
 def check_state_declaration(controller: Any) -> None:
     """Refuse a law whose state declaration is wrong, when it is built: a name empty or given
     twice in :meth:`Controller.state_variables`, or an :meth:`Controller.initial_state` whose
-    size is not the number of entries declared.
+    size is not the number of entries declared. Its :meth:`Controller.update_period` is asked
+    here too, so that a hook that raises does so while the law is built (user code contained:
+    the law, its file and line named), not inside the engine.
 
     Raises:
         InvalidParameterError: naming the law, the entry and what was expected.
@@ -99,6 +101,7 @@ def check_state_declaration(controller: Any) -> None:
             f"(nz,) or (N, nz) with nz = {len(variables)}, the entries state_variables() declares "
             f"({', '.join(map(str, names)) or 'none'})",
         )
+    controller.update_period()  # its value is checked against the step by the engine
 
 
 class LawInput(NamedTuple):

@@ -398,6 +398,7 @@ def _fit_rows(
     rows = np.flatnonzero(fitting)[::stride]
     needed = math.ceil((pset.size + 1) / robot.nv)
     if rows.size < max(needed, 2):
+        _refuse_still_joints(filtered, robot, opts.zero_phase.min_speed, t < split, where)
         raise InputFileError(
             where,
             f"leaves {rows.size} samples to fit after dropping {np.count_nonzero(~filtered.valid)} of {t.size} "
@@ -406,6 +407,28 @@ def _fit_rows(
             f"from {robot.nv} joints needs at least {max(needed, 2)}: log a longer run",
         )
     return rows, stride
+
+
+def _refuse_still_joints(
+    filtered: FilteredLog, robot: RobotModel, min_speed: float, fitted: np.ndarray, where: str
+) -> None:
+    """Name the joints that never move in the fitted part of the log (``fitted``: its samples),
+    when there are: their ``|q̇|`` stays below ``min_speed`` [rad/s] at every sample, so every
+    sample is dropped as sticking — a longer log would not help."""
+    speed = np.abs(filtered.v[fitted])
+    peak = np.nanmax(np.where(np.isfinite(speed), speed, 0.0), axis=0) if speed.size else np.zeros(robot.nv)
+    still = [j for j in range(robot.nv) if peak[j] < min_speed]
+    if not still:
+        return
+    names = tuple(robot.model.names)[1:]
+    joints = ", ".join(f"joint {j + 1}" + (f" ({names[j]})" if len(names) == robot.nv else "") for j in still)
+    fastest = ", ".join(f"{peak[j]:.3g}" for j in still)
+    raise InputFileError(
+        where,
+        f"{joints} never move{'s' if len(still) == 1 else ''}: the largest |q̇| is {fastest} rad/s, below the "
+        f"{min_speed:g} rad/s under which a sample is dropped as sticking, so no sample is left to fit; "
+        "identification needs every joint to move (a trajectory that moves each joint, e.g. twolink-pin excite)",
+    )
 
 
 def _checked_condition(W: np.ndarray, pset: ParameterSet, where: str) -> float:

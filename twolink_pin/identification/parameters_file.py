@@ -13,7 +13,10 @@ the base parameters (same names). The twolink's laws use the report's lumped
 reproduces the base parameters' torques at random states (least squares, exact when the
 map can express ``β``: for the twolink ``p1 = β1 + β4``, ``p2 = β4``, ``p3 = l1 β2``). A part of
 ``β`` the map cannot express (the twolink's ``link2.mcy``) is dropped when it is noise (within
-3σ of 0, or negligible torque), and refused, naming the parameter, when it is significant.
+3σ of 0, or negligible torque), and refused, naming the parameter, when it is significant. A
+file without σ (a URDF, a parameter file whose ``std`` is null) cannot tell noise from an
+offset: such a part is dropped while its torques stay within :data:`UNKNOWN_SIGMA_TOLERANCE`
+of the model's.
 
 :func:`believed` gives what a law takes from them (:meth:`~twolink_pin.run_spec.RunSpec.build`
 builds the law once with it): ``mode="model"`` (``--model``)
@@ -48,6 +51,16 @@ EXPRESSED_TOLERANCE = 1e-6
 """A part of β the map cannot express is ignored below this fraction of the torques it acts on."""
 SIGNIFICANCE = 3.0
 """... or within this many standard deviations of zero."""
+UNKNOWN_SIGMA_TOLERANCE = 0.01
+"""Without a σ (a URDF), a part of β the map cannot express is dropped below this fraction of
+the torques it acts on: 1 %, ten times what the noisy fits of ``identify --noise-tau 0.5``
+leave there (the twolink's ``link2.mcy``: 0.025 %), and far below the model errors the laws
+are shown to tolerate (the docs' demos believe links 20 % light)."""
+MAX_ESTIMATE = 1e9
+"""Largest magnitude of an estimate or its σ in a parameter file [kg, kg·m, kg·m²; N·m·s/rad,
+N·m]: ten times the largest principal inertia a URDF may give (1e8 kg·m²,
+:mod:`twolink_pin.model.urdf_elements`), far beyond any arm's; the physical-consistency check's
+solver declared 1e12 'infeasible' and 1e300 'unbounded' without naming the file."""
 MODES = ("model", "p0")
 """How identified parameters seed a law (module docstring)."""
 
@@ -60,7 +73,7 @@ class IdentifiedParameters(NamedTuple):
     base: np.ndarray
     """Base parameters ``β̂`` in the robot's base-map order."""
     base_std: np.ndarray
-    """Their standard deviations (0 where the file gives none)."""
+    """Their standard deviations (NaN where the file gives none: a URDF, a null ``std``)."""
     friction: Friction | None
     """Identified friction (negative estimates clipped to 0), or None if the file has none."""
     notes: tuple[str, ...] = ()
@@ -106,8 +119,12 @@ def identification_document(identification: Any, robot: RobotModel) -> dict[str,
 
 
 def _number(path: str, where: str, value: Any, what: str) -> float:
+    """``value`` as a float: a finite number of magnitude at most :data:`MAX_ESTIMATE`, else an
+    error naming the file, the entry and the value."""
     if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value)):
         raise InputFileError(path, f"{where}: {value!r} is not {what}")
+    if abs(value) > MAX_ESTIMATE:
+        raise InputFileError(path, f"{where}: {value:.6g} is beyond ±{MAX_ESTIMATE:g}, no arm's value")
     return float(value)
 
 
@@ -133,8 +150,11 @@ def urdf_parameters(path: str | os.PathLike[str], robot: RobotModel) -> Identifi
         )
     base = ParameterSet.of(robot, friction=False).base.values(believed_robot.model)
     urdf = believed_robot.urdf_friction
-    return IdentifiedParameters(
-        file, np.asarray(base, dtype=float), np.zeros(len(base)), None if urdf is None else Friction(*urdf)
+    return IdentifiedParameters(  # a URDF carries no σ
+        file,
+        np.asarray(base, dtype=float),
+        np.full(len(base), np.nan),
+        None if urdf is None else Friction(*urdf),
     )
 
 
@@ -177,9 +197,10 @@ def read_parameter_file(path: str | os.PathLike[str], robot: RobotModel) -> Iden
             raise InputFileError(
                 file, f"parameters[{k}] repeats the name {name!r}; expected each parameter once"
             )
-        estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), "a finite number")
+        bounded = f"a finite number within ±{MAX_ESTIMATE:g}"
+        estimate = _number(file, f"parameters[{k}] ({name}).estimate", row.get("estimate"), bounded)
         std = row.get("std")
-        sigma = 0.0 if std is None else _number(file, f"parameters[{k}] ({name}).std", std, "a finite number")
+        sigma = math.nan if std is None else _number(file, f"parameters[{k}] ({name}).std", std, bounded)
         values[name] = (estimate, abs(sigma))
     pset = ParameterSet.of(robot, friction=True)
     base_names = pset.base.names
@@ -217,7 +238,12 @@ def _refuse_unphysical(file: str, robot: RobotModel, pset: ParameterSet, base: n
     pseudo-inertia ⪰ 0 reproduce them: :func:`~twolink_pin.identification.physical.consistency`)."""
     from twolink_pin.identification.physical import consistency
 
-    check = consistency(robot, pset.base, base)
+    try:
+        check = consistency(robot, pset.base, base)
+    except InvalidParameterError as exc:  # the solver gave up: say which file it was checking
+        raise InputFileError(
+            file, f"its base parameters could not be checked for physical consistency ({exc})"
+        ) from None
     if not check.feasible:
         link, least = next(
             (n, s) for n, s in zip(check.links, check.least_eigenvalue) if s < -check.tolerance
@@ -271,20 +297,52 @@ def map_parameters(robot: RobotModel, identified: IdentifiedParameters) -> np.nd
     scale = float(np.linalg.norm(torques)) or 1.0
     for d in directions:
         value = float(d @ identified.base)
-        sigma = float(np.sqrt(np.sum((d * identified.base_std) ** 2)))
         effect = float(np.linalg.norm(unexplained @ (d * value))) / scale
-        if effect > EXPRESSED_TOLERANCE and abs(value) > SIGNIFICANCE * sigma:
-            main = int(np.argmax(np.abs(d)))
-            name = pset.base.names[main]
-            raise InvalidParameterError(
-                f"{identified.source}: {name}",
-                f"{identified.base[main]:.6g} ± {identified.base_std[main]:.2g} {pset.base.units[main]}",
-                f"a value {robot.name}'s parameter map ({', '.join(robot.parameter_map.names)}) can express: it has "
-                f"no such parameter, and this one is {abs(value) / max(sigma, 1e-300):.1f} σ from 0 "
-                f"(its torques are {100 * effect:.2g} % of the model's)",
-            )
+        _refuse_if_significant(robot, identified, pset, d, value, effect)
     expressible = identified.base - directions.T @ (directions @ identified.base)  # the rest is noise
     return L @ expressible
+
+
+def _refuse_if_significant(
+    robot: RobotModel,
+    identified: IdentifiedParameters,
+    pset: ParameterSet,
+    d: np.ndarray,
+    value: float,
+    effect: float,
+) -> None:
+    """Refuse the part ``value`` of ``β̂`` along ``d`` (which the map cannot express, its torques
+    ``effect`` of the model's) when it is significant: beyond :data:`SIGNIFICANCE` σ and
+    :data:`EXPRESSED_TOLERANCE` of the torques; without σ, beyond :data:`UNKNOWN_SIGMA_TOLERANCE`."""
+    support = np.abs(d) > 1e-12
+    known = bool(np.isfinite(identified.base_std[support]).all())
+    main = int(np.argmax(np.abs(d)))
+    name, unit = pset.base.names[main], pset.base.units[main]
+    expected = f"a value {robot.name}'s parameter map ({', '.join(robot.parameter_map.names)}) can express: it has no such parameter"
+    if known:
+        sigma = float(np.sqrt(np.sum((d[support] * identified.base_std[support]) ** 2)))
+        if effect > EXPRESSED_TOLERANCE and abs(value) > SIGNIFICANCE * sigma:
+            raise InvalidParameterError(
+                f"{identified.source}: {name}",
+                f"{identified.base[main]:.6g} ± {identified.base_std[main]:.2g} {unit}",
+                f"{expected}, and this one {_sigmas(abs(value), sigma)} "
+                f"(its torques are {100 * effect:.2g} % of the model's)",
+            )
+    elif effect > UNKNOWN_SIGMA_TOLERANCE:
+        raise InvalidParameterError(
+            f"{identified.source}: {name}",
+            f"{identified.base[main]:.6g} {unit}",
+            f"{expected}, and its torques are {100 * effect:.2g} % of the model's (the file gives no σ to tell "
+            f"noise from an offset: at most {100 * UNKNOWN_SIGMA_TOLERANCE:g} % is left out)",
+        )
+
+
+def _sigmas(value: float, sigma: float) -> str:
+    """How far ``value`` is from 0 in standard deviations ``sigma``, for a message."""
+    if sigma <= 0:
+        return "is given with σ = 0, so it is no noise"
+    ratio = value / sigma
+    return f"is {ratio:.1f} σ from 0" if ratio < 1e6 else f"is {ratio:.3g} σ from 0"
 
 
 class Belief(NamedTuple):

@@ -112,7 +112,7 @@ def simulate_log(
         q=result.q,
         tau=result.tau,
         v=result.v,
-        source=f"simulated: {robot.name} tracking the excitation ({controller.name}), {length:g} s at dt = {dt:g} s"
+        source=f"simulated: {robot.name} tracking its reference ({controller.name}), {length:g} s at dt = {dt:g} s"
         + ("" if engine == "pinocchio" else f" on the {engine} plant"),
         true_parameters=np.asarray(truth),
         reference=trajectory,

@@ -11,7 +11,15 @@ the checks of a reference, the crossings of a run, retiming, optimisation and co
 """
 
 from twolink_pin.limits.active import ActiveLimit, active_limits
-from twolink_pin.limits.check import KindCheck, LimitsCheck, check_limits, check_motion, reference_motion
+from twolink_pin.limits.check import (
+    KindCheck,
+    LimitsCheck,
+    Shortfall,
+    check_limits,
+    check_motion,
+    reference_motion,
+    shortfall,
+)
 from twolink_pin.limits.crossings import (
     CROSSED_KINDS,
     Crossings,
@@ -47,6 +55,7 @@ __all__ = [
     "LimitsCheck",
     "Motion",
     "RunningCrossings",
+    "Shortfall",
     "active_limits",
     "check_limits",
     "check_motion",
@@ -54,4 +63,5 @@ __all__ = [
     "kind_named",
     "motion_crossings",
     "reference_motion",
+    "shortfall",
 ]

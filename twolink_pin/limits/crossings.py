@@ -84,6 +84,12 @@ class Crossings(NamedTuple):
         """One run's crossings, JSON-ready, by kind (:meth:`KindCrossings.summary`)."""
         return {k.kind.name: k.summary() for k in self}
 
+    @property
+    def within_limits(self) -> bool:
+        """One run's answer for every kind: no joint crossed its position range, velocity or
+        effort limit (the ``within_limits`` of a run's JSON)."""
+        return not any(bool(k.crossed.any()) for k in self)
+
     def events(
         self, kinds: tuple[str, ...] = ("position", "velocity")
     ) -> list[tuple[str, int, float, float]]:

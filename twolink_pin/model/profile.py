@@ -53,8 +53,9 @@ class ReportSections(Protocol):
     the report).
     """
 
-    def steps(self, options: Any) -> int:
-        """Progress steps :meth:`collect` adds for the report's ``options``."""
+    def steps(self, options: Any, laws: Sequence[str]) -> int:
+        """Progress steps :meth:`collect` adds for the report's ``options`` and ``laws`` (the
+        laws or variants it runs)."""
         ...
 
     def submit(self, pool: Any, options: Any, fig_dir: str, laws: Sequence[str]) -> Any:

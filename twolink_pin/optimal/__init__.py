@@ -10,8 +10,12 @@ and ``limits/``.
 ``spline.py``               :class:`BSplineBasis`: values and derivatives of a B-spline as matrices
 ``layout.py``               :class:`SplineLayout`: a trajectory in spline segments, its variables
                             and Jacobians; :class:`Points` where it is evaluated
-``transcription.py``        :class:`TrajectoryProblem`: costs (:class:`Cost`), equalities
-                            (:class:`Pin`), limits, linearised on the dynamics' derivatives
+``cost.py``                 :class:`Cost`: the weights of a problem's cost terms
+``transcription.py``        :class:`TrajectoryProblem`: costs, equalities (:class:`Pin`), limits,
+                            linearised on the dynamics' derivatives
+``row_labels.py``           what each limit row of a problem is, in words (messages)
+``active_set.py``           :func:`solve_qp_active_set`: an SQP step's QP by DAQP's dual active-set
+                            method, warm-started from the last active set
 ``sqp.py``                  :func:`solve_sqp` (to convergence), :func:`sqp_step` (one real-time iteration)
 ``refinement.py``           :func:`solve_within_limits`: the limits between the check points too
 ``horizon.py``              :class:`~twolink_pin.optimal.horizon.Horizon`: the model-predictive law's
@@ -27,12 +31,14 @@ batched): Pinocchio's offline (:class:`~twolink_pin.dynamics.RneaDerivatives`), 
 through its ``Terms.inverse_dynamics_derivatives``.
 """
 
+from twolink_pin.optimal.active_set import solve_qp_active_set
+from twolink_pin.optimal.cost import Cost
 from twolink_pin.optimal.layout import Points, SplineLayout
 from twolink_pin.optimal.qp import QP, QPSolution, kkt_residual, solve_qp, unconstrained_minimiser
 from twolink_pin.optimal.refinement import WithinLimits, solve_within_limits
 from twolink_pin.optimal.spline import BSplineBasis
 from twolink_pin.optimal.sqp import SQPOptions, SQPResult, StepResult, solve_sqp, sqp_step
-from twolink_pin.optimal.transcription import Cost, Evaluation, Pin, TrajectoryProblem
+from twolink_pin.optimal.transcription import Evaluation, Pin, TrajectoryProblem
 
 __all__ = [
     "QP",
@@ -50,6 +56,7 @@ __all__ = [
     "WithinLimits",
     "kkt_residual",
     "solve_qp",
+    "solve_qp_active_set",
     "solve_sqp",
     "solve_within_limits",
     "sqp_step",

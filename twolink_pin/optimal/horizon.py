@@ -417,26 +417,52 @@ def whole_knots(horizon: float, interval: float) -> bool:
     return abs(ratio - round(ratio)) <= WHOLE * max(1.0, ratio)
 
 
+SOLVER_FACTOR = 10
+"""ProxQP's dense solver holds up to ``10 (n + m)²`` numbers while it solves a QP of ``n``
+variables and ``m`` rows (its KKT factor, the factorisation's workspace, the scaled copies;
+measured from the process's peak address space: 4.5 to 9.2 for the twolink's and the Panda's
+rows, ``m`` = 3 n to 4 n; ``tests/test_memory.py``)."""
+
+
+def horizon_bytes(knots: int, limits: JointLimits, runs: int) -> int:
+    """Bytes the QPs of a horizon of ``knots`` take at most (:func:`check_memory`): ``n = K nv``
+    variables, ``m`` rows (:func:`row_count`), ``N`` runs::
+
+        8 B × (10 (n + m)² + 9 n² + 2 m n + N (5 n² + m n))
+
+    the solver's (:data:`SOLVER_FACTOR`; one QP at a time), the law's fixed matrices (the
+    integration maps, 9 n² and 2 m n) and each run's Hessian, torque Jacobian and rows with
+    their temporaries (5 n² + m n)."""
+    n = knots * limits.nv
+    m = row_count(knots, limits)
+    return 8 * (SOLVER_FACTOR * (n + m) ** 2 + 9 * n * n + 2 * m * n + runs * (5 * n * n + m * n))
+
+
+def row_count(knots: int, limits: JointLimits) -> int:
+    """The horizon QP's rows: one per knot and effort limit, :data:`ROWS_PER_INTERVAL` per knot
+    interval and other limit the robot has (position, velocity, acceleration)."""
+    per_time = {kind: int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS}
+    state = sum(per_time.values()) - per_time[EFFORT]
+    return knots * (per_time[EFFORT] + ROWS_PER_INTERVAL * state)
+
+
 def check_memory(knots: int, interval: float, limits: JointLimits, runs: int, what: str = "horizon") -> None:
     """Refuse a horizon whose QPs would not fit in the memory available
-    (:func:`~twolink_pin.memory.available_memory`), before anything of its size is made: ``n = K nv``
-    variables and ``m`` rows (one per knot and effort limit, :data:`ROWS_PER_INTERVAL` per knot
-    interval and other limit the robot has) take
-    ``8 (2 (n + m)² + N (n² + m n))`` bytes (the solver's KKT matrix and its factor, and each
-    run's ``H`` and ``C``).
+    (:func:`~twolink_pin.memory.available_memory`: what is left under ``ulimit -v`` too), before
+    anything of its size is made (:func:`horizon_bytes`): a solver that runs out of memory
+    aborts the process (C++'s ``std::terminate``), it cannot be caught.
 
     Raises:
         InvalidParameterError: naming the horizon's knots, the bytes needed and available.
     """
     n = knots * limits.nv
-    per_time = {kind: int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS}
-    state = sum(per_time.values()) - per_time[EFFORT]
-    m = knots * (per_time[EFFORT] + ROWS_PER_INTERVAL * state)
-    need, have = 8 * (2 * (n + m) ** 2 + runs * (n * n + m * n)), available_memory()
+    m = row_count(knots, limits)
+    need, have = horizon_bytes(knots, limits, runs), available_memory()
     if have is not None and need > have:
         raise InvalidParameterError(
             what,
             f"{knots * interval:g} s ({knots} knots of {interval:g} s)",
             f"a horizon whose QPs fit in memory: {need / 1e6:.4g} MB needed for {runs} run(s) "
-            f"(8 B × (2 (n + m)² + N (n² + m n)), n = {n} variables, m = {m} rows), {have / 1e6:.4g} MB available",
+            f"(8 B × (10 (n + m)² + 9 n² + 2 m n + N (5 n² + m n)), n = {n} variables, m = {m} rows), "
+            f"{have / 1e6:.4g} MB available",
         )

@@ -403,3 +403,9 @@ def _infeasible_reason(qp: QP, eps: float, max_iter: int, flagged: bool = False)
         f"the constraints cannot all hold: the closest point misses {row} by {excess[i]:.3g} "
         f"(bounds [{qp.l[i]:.6g}, {qp.u[i]:.6g}], value {cx[i]:.6g})"
     )
+
+
+infeasible_reason = _infeasible_reason
+"""Which constraint a QP's closest feasible point violates most, in words (or None): what a
+failed solve says; public for the trajectory optimiser's active-set steps
+(:mod:`twolink_pin.optimal.active_set`)."""

@@ -1,8 +1,10 @@
 """Sequential quadratic programming on a :class:`~twolink_pin.optimal.transcription.TrajectoryProblem`.
 
 Each iteration linearises the problem at ``x`` (Gauss–Newton model of the cost, linearised
-constraints) and solves the step ``d`` with :func:`~twolink_pin.optimal.qp.solve_qp`
-(ProxQP, warm-started from the previous step's solution)::
+constraints) and solves the step ``d`` with
+:func:`~twolink_pin.optimal.active_set.solve_qp_active_set` (DAQP's dual active-set method,
+its active set started from the previous step's: a handful of iterations once the active
+limits settle; ProxQP when DAQP stops without an answer)::
 
     min_d  s (∇fᵀd + dᵀJᵀJ d) + ½ μ dᵀ D d
     s.t.   c_E(x) + A_E d = 0,   l <= c_I(x) + A_I d <= u
@@ -32,6 +34,7 @@ import numpy as np
 
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError, OptimizationError
+from twolink_pin.optimal.active_set import solve_qp_active_set
 from twolink_pin.optimal.qp import QP, QPSolution, solve_qp
 from twolink_pin.optimal.transcription import Evaluation, TrajectoryProblem
 
@@ -103,6 +106,12 @@ class SQPResult(NamedTuple):
     """The last QP's solution (a warm start for a problem of the same sizes)."""
     seconds: float
     """Wall time [s]."""
+    multipliers: np.ndarray | None = None
+    """The last step's multiplier of every inequality row of ``problem`` in its own scale (0:
+    a row left out of the QP; positive: the upper bound active): where another solve of a
+    problem with these rows first may start its active set."""
+    damping: float | None = None
+    """The last Levenberg–Marquardt ``μ``."""
 
 
 class StepResult(NamedTuple):
@@ -265,7 +274,12 @@ class _Loop:
     """The state of :func:`solve_sqp`'s iterations."""
 
     def __init__(
-        self, problem: TrajectoryProblem, x0: np.ndarray, options: SQPOptions, warm: QPSolution | None
+        self,
+        problem: TrajectoryProblem,
+        x0: np.ndarray,
+        options: SQPOptions,
+        warm: QPSolution | None,
+        multipliers: np.ndarray | None = None,
     ):
         self.problem, self.options = problem, options
         self.x = np.array(x0, dtype=float)
@@ -273,9 +287,12 @@ class _Loop:
         self.scale = 1.0 / max(abs(self.ev.cost), 1e-12)
         self.mu, self.rho = options.damping, 1.0
         self.solves, self.last_step = 0, np.inf
+        self.gained, self.left = np.inf, np.inf  # the last accepted step's cost decrease, the model's next
         self.z = np.zeros(self.ev.inequality.size)  # the multipliers of every row (0: not in the QP)
+        if multipliers is not None and multipliers.shape == self.z.shape:
+            self.z = np.array(multipliers, dtype=float)
         self.warm = warm
-        self.watched = _excess(self.ev) > -options.screen
+        self.watched = (_excess(self.ev) > -options.screen) | (self.z != 0)
         self.radius = TRUST_RADIUS if problem.layout.free_durations else None
 
     def step(self, what: str) -> bool:
@@ -285,11 +302,19 @@ class _Loop:
         scaled = _qp(self.problem, self.x, ev, self.scale, self.mu, rows, self.radius)
         z = np.append(self.z[rows] * scaled.objective * scaled.inequality_rows, np.zeros(scaled.trust))
         warm = None if self.warm is None else self.warm._replace(z=z)
-        solution = solve_qp(
-            scaled.qp, _warm(warm, scaled.qp), eps=options.qp_tolerance, max_iter=options.qp_iterations, what=what,
-            accept=1e3 * options.qp_tolerance, explain=options.explain, rho=PROXIMAL_RHO,
-            infeasibility_eps=INFEASIBILITY_EPS,
-        )  # fmt: skip
+        if warm is None and z.any():  # the active set a previous solve of these rows ended with
+            equalities = 0 if scaled.qp.A is None else scaled.qp.A.shape[0]
+            warm = QPSolution(np.zeros(scaled.qp.g.size), np.zeros(equalities), z, 0, 0.0, 0.0)
+        fallback = {
+            "eps": options.qp_tolerance, "max_iter": options.qp_iterations, "accept": 1e3 * options.qp_tolerance,
+            "rho": PROXIMAL_RHO, "infeasibility_eps": INFEASIBILITY_EPS,
+        }  # fmt: skip
+        try:
+            solution = solve_qp_active_set(
+                scaled.qp, _warm(warm, scaled.qp), what=what, explain=options.explain, fallback=fallback
+            )
+        except OptimizationError as exc:  # counted in SQP iterations, not the QP solver's
+            raise OptimizationError(exc.problem, exc.reason, self.solves + 1) from None
         self.solves += 1
         d = solution.x
         multipliers = scaled.multipliers(solution)
@@ -302,6 +327,7 @@ class _Loop:
         ):  # feasibility bought with cost: worth it (N&W 18.36)
             self.rho = max(self.rho, 2.0 * model / ev.l1_violation)
         predicted = self.rho * ev.l1_violation - model
+        self.left = -model
         if ev.violation <= options.feasibility and -model <= options.cost_tolerance:
             return True  # feasible, and the model sees no cost left to gain
         merit = self.scale * ev.cost + self.rho * ev.l1_violation
@@ -317,6 +343,7 @@ class _Loop:
             self.radius = None if self.radius is None else self.radius / 4.0
             return False
         self.x, self.ev, self.last_step = self.x + d, trial, float(np.abs(d).max())
+        self.gained = self.scale * (ev.cost - trial.cost)
         self.warm = solution
         self.z = np.zeros(trial.inequality.size)
         self.z[rows] = solution.z[: rows.size] / scaled.objective / scaled.inequality_rows
@@ -341,8 +368,11 @@ def solve_sqp(
     *,
     warm: QPSolution | None = None,
     what: str = "the trajectory optimisation",
+    multipliers: np.ndarray | None = None,
 ) -> SQPResult:
-    """Minimise ``problem`` from ``x0`` (module docstring).
+    """Minimise ``problem`` from ``x0`` (module docstring); ``warm``: a previous step's QP
+    solution (same rows), ``multipliers``: each inequality row's multiplier from a previous
+    solve of the same rows (:attr:`SQPResult.multipliers`), where the active set starts.
 
     Raises:
         OptimizationError: a QP without solution, or no convergence within the iterations
@@ -350,16 +380,33 @@ def solve_sqp(
     """
     options = options or SQPOptions()
     start = time.perf_counter()
-    loop = _Loop(problem, x0, options, warm)
+    loop = _Loop(problem, x0, options, warm, multipliers)
     while loop.solves < options.max_iterations:
         interrupts.check()
         if loop.step(what):
-            return SQPResult(loop.x, loop.ev, loop.solves, loop.warm, time.perf_counter() - start)
-    raise OptimizationError(
-        what,
-        f"no convergence in {loop.solves} SQP iterations: the largest constraint violation is still "
-        f"{loop.ev.violation:.3g} (tolerance {options.feasibility:g}), the last step {loop.last_step:.3g}",
-        loop.solves,
+            return SQPResult(
+                loop.x, loop.ev, loop.solves, loop.warm, time.perf_counter() - start, loop.z, loop.mu
+            )
+    raise OptimizationError(what, _unconverged(loop), loop.solves)
+
+
+def _unconverged(loop: _Loop) -> str:
+    """What did not converge in ``loop``'s iterations, by how much: the constraints (their
+    largest violation), or, with them holding, the cost (what the last step gained and the
+    model sees left, fractions of the starting cost)."""
+    options, violation = loop.options, loop.ev.violation
+    cost = (
+        f"the last accepted step lowered the cost by {loop.gained:.3g} of its starting value and the model sees "
+        f"{loop.left:.3g} more (tolerance {options.cost_tolerance:g})"
+    )
+    if violation <= options.feasibility:
+        return (
+            f"the cost did not settle in {loop.solves} SQP iterations: {cost}; the constraints hold (largest "
+            f"violation {violation:.3g}, tolerance {options.feasibility:g})"
+        )
+    return (
+        f"the constraints do not hold after {loop.solves} SQP iterations: the largest violation is still "
+        f"{violation:.3g} (tolerance {options.feasibility:g}), the last step {loop.last_step:.3g}; {cost}"
     )
 
 

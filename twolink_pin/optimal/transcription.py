@@ -1,8 +1,8 @@
 """A trajectory problem on a :class:`~twolink_pin.optimal.layout.SplineLayout`: its costs, its
 constraints, and their linearisation at an iterate (what each SQP step solves).
 
-**Costs** (:class:`Cost`), integrals by Gauss–Legendre quadrature on every knot interval
-(``cost_points``), in seconds of physical time::
+**Costs** (:class:`~twolink_pin.optimal.cost.Cost`), integrals by Gauss–Legendre quadrature on
+every knot interval (``cost_points``), in seconds of physical time::
 
     f(x) = w_τ ∫ τᵀτ dt + w_q ∫ ‖q − q_ref‖² dt + w_v ∫ ‖q̇ − q̇_ref‖² dt + w_j ∫ ‖q⃛‖² dt + w_T Σ h_k
 
@@ -11,8 +11,8 @@ quadratic terms are sums of squares of residuals ``r(x)``, linearised (Gauss–N
 Hessian ``2 JᵀJ``, no second derivatives of the dynamics); the time term is linear.
 
 **Equalities** (:class:`Pin`: ``q^{(r)}(segment, σ) = target``): via points, rest at the
-ends, an initial state; and the continuity of ``q, q̇ .. q^{(4)}`` where two segments meet
-(linear for fixed durations). A row of order ``r`` is multiplied by ``time_scale^r`` and
+ends, an initial state; and the continuity of ``q, q̇ .. q^{(r)}`` where two segments meet
+(``r = continuity_order``, 4 by default; linear for fixed durations). A row of order ``r`` is multiplied by ``time_scale^r`` and
 divided by its largest basis entry, so that its value is about the change of a coefficient
 [rad] that would make it hold (a via point's row: its error in radians).
 
@@ -21,6 +21,7 @@ and effort limits where the robot has them (:class:`~twolink_pin.limits.JointLim
 row divided by its limit (so a violation is a fraction of it) and tightened by ``margin``
 (a fraction of the limit, so that what the linearisation and the solver's tolerance leave
 stays inside); effort linearised at the iterate. Free durations stay above ``min_duration``.
+What each row is in words: :mod:`~twolink_pin.optimal.row_labels`.
 """
 
 from __future__ import annotations
@@ -34,41 +35,12 @@ import numpy as np
 from twolink_pin.dynamics.derivatives import InverseDynamics, InverseDynamicsDerivatives
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import EFFORT, KINDS, POSITION, JointLimits, LimitKind
+from twolink_pin.optimal.cost import Cost
 from twolink_pin.optimal.layout import Points, SplineLayout
+from twolink_pin.optimal.row_labels import RowLabels
 
 CONTINUITY_ORDER = 4
 """Derivatives of ``q`` kept continuous where segments meet (a quintic spline is ``C⁴``)."""
-
-
-@dataclass(frozen=True)
-class Cost:
-    """The weights of the cost (module docstring); zero: the term is absent.
-
-    Attributes:
-        effort: ``w_τ`` [1/(N²·m²·s)].
-        position: ``w_q`` [1/(rad²·s)], with ``reference``.
-        velocity: ``w_v`` [s/rad²], with ``reference``.
-        jerk: ``w_j`` [s⁵/rad²].
-        time: ``w_T`` [1/s] on the total duration (free durations only).
-        reference: ``(q_ref, q̇_ref)`` at the problem's cost points, each (K, nv) [rad, rad/s].
-    """
-
-    effort: float = 0.0
-    position: float = 0.0
-    velocity: float = 0.0
-    jerk: float = 0.0
-    time: float = 0.0
-    reference: tuple[np.ndarray, np.ndarray] | None = None
-
-    def __post_init__(self) -> None:
-        for name in ("effort", "position", "velocity", "jerk", "time"):
-            value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and np.isfinite(value) and value >= 0):
-                raise InvalidParameterError(f"cost weight {name}", value, "a finite weight >= 0")
-        if (self.position > 0 or self.velocity > 0) and self.reference is None:
-            raise InvalidParameterError(
-                "cost reference", None, "(q_ref, v_ref) at the cost points for tracking"
-            )
 
 
 class Pin(NamedTuple):
@@ -151,7 +123,10 @@ class TrajectoryProblem:
             feasibility tolerance, so what it leaves stays inside the limit).
         time_scale: A typical segment duration [s] (scales the equality rows).
         min_duration: Shortest segment when durations are free [s].
-        continuity: Whether segments join ``C⁴`` (equality rows).
+        continuity: Whether segments join (equality rows).
+        continuity_order: The highest derivative of ``q`` continuous where segments join
+            (default :data:`CONTINUITY_ORDER`: ``C⁴``, a quintic spline's smoothness; ``2`` lets
+            the jerk jump there, as the least-effort motion's does at a via point).
     """
 
     layout: SplineLayout
@@ -167,11 +142,18 @@ class TrajectoryProblem:
     time_scale: float = 1.0
     min_duration: float = 1e-3
     continuity: bool = True
-    _scales: dict[str, np.ndarray] = field(default_factory=dict, repr=False, compare=False)
+    continuity_order: int = CONTINUITY_ORDER
+    _joins: dict[tuple[int, int], tuple[object, Points, Points]] = field(
+        default_factory=dict, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         if self.limits.nv != self.layout.nv:
             raise InvalidParameterError("limits", self.limits.nv, f"limits of {self.layout.nv} joints")
+        if not (isinstance(self.continuity_order, int) and 0 <= self.continuity_order <= CONTINUITY_ORDER):
+            raise InvalidParameterError(
+                "continuity_order", self.continuity_order, f"an integer from 0 to {CONTINUITY_ORDER}"
+            )
         if not (0 <= self.margin < 0.5):
             raise InvalidParameterError("margin", self.margin, "a fraction 0 <= m < 0.5 of each limit")
 
@@ -324,10 +306,8 @@ class TrajectoryProblem:
                 J = layout.jacobian(x, pin.points, pin.order, value) * row[:, :, None]
                 jacs.append(J.reshape(-1, layout.size))
         if self.continuity and layout.segments > 1:
-            S = layout.segments
-            ends = layout.points(np.arange(S - 1), np.ones(S - 1))
-            starts = layout.points(np.arange(1, S), np.zeros(S - 1))
-            for order in range(0, min(CONTINUITY_ORDER, layout.basis.degree - 1) + 1):
+            ends, starts = self._join_points()
+            for order in range(0, min(self.continuity_order, layout.basis.degree - 1) + 1):
                 left = layout.derivative(x, ends, order)
                 right = layout.derivative(x, starts, order)
                 row = _row_scale(ends, order, scale)
@@ -339,6 +319,18 @@ class TrajectoryProblem:
         if not jacobians:
             return value, None
         return value, (np.concatenate(jacs) if jacs else np.zeros((0, layout.size)))
+
+    def _join_points(self) -> tuple[Points, Points]:
+        """Where two segments meet: the ends of the earlier ones, the starts of the later ones
+        (made once per basis and segment count: problems made by :meth:`with_check_points`
+        share them; the basis is kept with them, so that its ``id`` is not reused)."""
+        basis, S = self.layout.basis, self.layout.segments
+        key = (id(basis), S)
+        if key not in self._joins:
+            ends = self.layout.points(np.arange(S - 1), np.ones(S - 1))
+            self._joins[key] = (basis, ends, self.layout.points(np.arange(1, S), np.zeros(S - 1)))
+        _, ends, starts = self._joins[key]
+        return ends, starts
 
     def _inequalities(
         self,
@@ -444,7 +436,7 @@ class TrajectoryProblem:
     def labels(self, x: np.ndarray) -> Sequence[str]:
         """What each inequality row is (``effort of joint 2 (joint2) at t = 0.310 s``), in
         the order of :meth:`evaluate`'s rows."""
-        return _RowLabels(self, self.layout.times(x, self.check_points))
+        return RowLabels(self, self.layout.times(x, self.check_points))
 
 
 def _row_scale(points: Points, order: int, time_scale: float) -> np.ndarray:
@@ -453,51 +445,6 @@ def _row_scale(points: Points, order: int, time_scale: float) -> np.ndarray:
     [rad] that would make it hold."""
     largest = np.abs(points.rows[order]).max(axis=1)
     return (time_scale**order / np.where(largest > 0, largest, 1.0))[:, None]
-
-
-class _RowLabels(Sequence[str]):
-    """The labels of a problem's inequality rows, made when one is read (a failed solve
-    reads one; thousands of rows are built every iteration)."""
-
-    def __init__(self, problem: TrajectoryProblem, times: np.ndarray) -> None:
-        self.times = times
-        self.names = problem.limits.joint_names
-        self.blocks: list[tuple[str, np.ndarray]] = []
-        for kind in problem.kinds:
-            given = problem.limits.given(kind)
-            if given.any():
-                self.blocks.append((kind.name, np.flatnonzero(given)))
-        self.hull: list[tuple[str, np.ndarray, int]] = []
-        layout = problem.layout
-        for kind in problem.hull:
-            given = problem.limits.given(kind)
-            if given.any():
-                m = layout.basis.size - (kind.order or 0)
-                self.hull.append((kind.name, np.flatnonzero(given), layout.segments * m))
-        self.coefficients = layout.basis.size
-        self.durations = problem.layout.segments if problem.layout.free_durations else 0
-        self.min_duration = problem.min_duration
-
-    def __len__(self) -> int:
-        grid = sum(len(self.times) * joints.size for _, joints in self.blocks)
-        return grid + sum(n * joints.size for _, joints, n in self.hull) + self.durations
-
-    def __getitem__(self, i: int) -> str:  # type: ignore[override]
-        for name, joints in self.blocks:
-            n = len(self.times) * joints.size
-            if i < n:
-                k, j = divmod(i, joints.size)
-                joint = int(joints[j])
-                return f"the {name} limit of joint {joint + 1} ({self.names[joint]}) at t = {self.times[k]:.4g} s"
-            i -= n
-        for name, joints, count in self.hull:
-            n = count * joints.size
-            if i < n:
-                k, j = divmod(i, joints.size)
-                joint = int(joints[j])
-                return f"the {name} limit of joint {joint + 1} ({self.names[joint]}) on its spline's coefficient {k}"
-            i -= n
-        return f"the duration of segment {i} >= {self.min_duration:g} s"
 
 
 __all__ = ["CONTINUITY_ORDER", "Cost", "Evaluation", "Pin", "TrajectoryProblem"]

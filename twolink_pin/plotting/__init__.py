@@ -32,6 +32,7 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
                      one joint's effort limit
 ``velocity_limits``  :func:`save_velocity_limits_figure`: several runs against one joint's
                      velocity and effort limits
+``titles.py``        a figure's title as plain text, carried in its file (the report's captions)
 ===================  =====================================================================
 
 Each module's private builder (``_trajectory_figures``, ``_simulation_figures``,

@@ -30,6 +30,7 @@ from matplotlib.transforms import Bbox
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.files import atomic_write
+from twolink_pin.plotting.titles import shown_title
 
 
 @dataclass(frozen=True)
@@ -227,7 +228,8 @@ def save_figure(fig: Figure, path: Path) -> Path:
     The figure is drawn once on its Agg canvas; a figure with fixed :class:`Margins` whose
     labels do not fit (:func:`_labels_fit`) is then laid out by constrained layout and drawn
     again. A PNG's pixels are written as drawn (zlib level :data:`PNG_COMPRESS_LEVEL`); other
-    formats go through ``savefig``."""
+    formats go through ``savefig``. The file carries the figure's title
+    (:func:`~twolink_pin.plotting.titles.shown_title`) as its ``Title``."""
     fmt = path.suffix[1:].lower() or "png"
     _lay_out_once(fig)
     canvas = fig.canvas
@@ -237,9 +239,10 @@ def save_figure(fig: Figure, path: Path) -> Path:
         fig.set_layout_engine("constrained")
         _lay_out_once(fig)
         canvas.draw()
+    title = shown_title(fig)
     if fmt != "png":
         with atomic_write(path, "wb") as f:
-            fig.savefig(f, format=fmt, dpi=DPI)
+            fig.savefig(f, format=fmt, dpi=DPI, metadata={"Title": title} if fmt in ("pdf", "svg") else None)
         return path
     with atomic_write(path, "wb") as f:
         matplotlib.image.imsave(
@@ -248,6 +251,7 @@ def save_figure(fig: Figure, path: Path) -> Path:
             format="png",
             origin="upper",
             dpi=fig.dpi,
+            metadata={"Title": title},
             pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL},
         )
     return path

@@ -377,7 +377,7 @@ def _desired_torque_figure(check: TorqueCheck, figure_numbers: Mapping[str, int]
     if not np.isfinite(check.limits).any():
         verdict = "the URDF gives no motor limits"
     else:
-        verdict = ("within" if check.within_limits else "EXCEEDS") + " the motor limits"
+        verdict = ("within" if check.within_effort_limits else "EXCEEDS") + " the motor limits"
     what = f"desired torques M q̈ + C q̇ + g along one period: {verdict}"
     fig.suptitle(figure_title(what, "desired_torque", figure_numbers))
     fix_margins(fig, TORQUE_MARGINS)

@@ -94,7 +94,7 @@ def build_report(
     rows = build_rows(options.run, variants, robot)  # every row's law built once, before any run
     steps = 4 + len(rows) + (1 if options.animation else 0) + (1 if options.limits_section else 0)
     steps += 1 if options.sim_to_sim else 0
-    steps += sections.steps(options) if sections else 0
+    steps += sections.steps(options, laws) if sections else 0
     done = 0
     heard = len(interrupts.received)
 

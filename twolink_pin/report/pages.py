@@ -99,8 +99,26 @@ def _discussion(r: dict[str, Any]) -> dict[str, Any] | None:
     return {"ours": sorted(names, key=lambda n: ours[n]), "report": sorted(names, key=lambda n: rep[n])}
 
 
-def html(r: dict[str, Any]) -> str:
-    """``index.html`` of results ``r``."""
+def figure_captions(folder: Path) -> dict[str, str]:
+    """File name → caption of the PNG figures in ``folder``: the title each carries (what the
+    figure says it shows, written by :func:`twolink_pin.plotting._style.save_figure`)."""
+    from PIL import Image  # matplotlib's own dependency
+
+    captions = {}
+    for path in sorted(folder.glob("*.png")) if folder.is_dir() else ():
+        try:
+            with Image.open(path) as image:
+                title = getattr(image, "text", {}).get("Title")
+        except (OSError, ValueError):
+            continue
+        if isinstance(title, str) and title.strip():
+            captions[path.name] = title
+    return captions
+
+
+def html(r: dict[str, Any], captions: dict[str, str] | None = None) -> str:
+    """``index.html`` of results ``r``; ``captions`` (figure file → caption, the file's name
+    where none)."""
     nv = r["robot"]["nv"]
     tables = {
         kind: {
@@ -120,6 +138,7 @@ def html(r: dict[str, Any]) -> str:
             discussion=_discussion(r),
             nv=nv,
             limits=_limits_tables(r, nv),
+            captions=captions or {},
             s2s=sim_to_sim_table(r),
         )
     )
@@ -202,15 +221,18 @@ def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
     ]
     track_headers = ["controller", "reference", "run [s]"]
     track_headers += [f"RMS e{j + 1} [rad]" for j in range(nv)] + [f"max |e{j + 1}| [rad]" for j in range(nv)]
+    track_headers += [f"last period max |e{j + 1}| [rad]" for j in range(nv)]
     track_headers += [f"max |τ{j + 1}| [N·m]" for j in range(nv)] + ["limits crossed"]
     track_rows = []
     for row in section["tracking"]:
         head = [row["law"], refs[row["reference"]]["short"], fmt(row["duration_s"])]
         if not row["finished"]:
-            track_rows.append(head + ["—"] * (3 * nv) + [f"did not finish: {row['failed']}"])
+            track_rows.append(head + ["—"] * (4 * nv) + [f"did not finish: {row['failed']}"])
             continue
         m = row["metrics"]
-        cells = [fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["max"]["tau"]]
+        cells = [
+            fmt(x) for x in m["rms"]["e"] + m["max"]["e"] + m["final_period_max_abs_e"] + m["max"]["tau"]
+        ]
         track_rows.append(head + cells + [_crossed(row["crossings"]) or "none"])
     return {
         "reference_headers": ref_headers,
@@ -365,4 +387,4 @@ def write_pages(stage: Path, r: dict[str, Any]) -> None:
         {k: v for k, v in r.items() if k not in ("comparison_markdown", "comparison_csv")},
     )
     with atomic_write(stage / "index.html") as f:
-        f.write(html(r))
+        f.write(html(r, figure_captions(stage / "figures")))

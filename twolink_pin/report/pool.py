@@ -45,15 +45,25 @@ def _worker_start() -> None:
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
 
 
+def _contained(fn: Callable[..., Any], *args: Any) -> Any:
+    """``fn(*args)`` in a worker with ``os._exit`` contained (:func:`~twolink_pin.user_code.exits_contained`):
+    a law that calls it fails its run, named, instead of killing the worker and breaking the pool."""
+    from twolink_pin.user_code import exits_contained
+
+    with exits_contained():
+        return fn(*args)
+
+
 class _Workers:
-    """The process pool, with each ``submit`` (which may fork workers) run deferred."""
+    """The process pool, with each ``submit`` (which may fork workers) run deferred, and each
+    task's user code unable to end its worker (:func:`_contained`)."""
 
     def __init__(self, pool: ProcessPoolExecutor) -> None:
         self._pool = pool
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         with interrupts.deferred():
-            return self._pool.submit(fn, *args)
+            return self._pool.submit(_contained, fn, *args)
 
 
 @contextmanager

@@ -19,11 +19,18 @@ check grid, torque by RNEA); ``∫ τᵀτ dt`` [N²·m²·s] is
 ``references/<key>.json``, a trajectory file every ``--trajectory`` reads (``simulate``,
 ``compare``, ``animate``; the report's own ``--trajectory`` wants via points).
 
-**The tracking rows**: every row of the report (law or variant) on every reference, with the
-report's simulation settings (step, initial offset, plant) over **one period** of that
-reference (short runs: the section costs what 3 periods of each law cost), its metrics
-(:func:`~twolink_pin.metrics.compute_metrics`: RMS and max of ``e``, ``ė``, ``τ``, the
-crossings of the position, velocity and effort limits). A run that diverges is a row saying so.
+**The tracking rows**: every row of the report (law or variant), and ``mpc`` (the law that plans
+within the limits, :data:`PLANNER`) when the report does not run it, on every reference, with
+the report's simulation settings (step, initial offset, plant) for :data:`SETTLE` (at most one
+period) and then one period of that reference, its metrics (:func:`~twolink_pin.metrics.compute_metrics`: RMS and max of
+``e``, ``ė``, ``τ``, the max ``|e|`` over the last period of the run — its max ``|e|`` over the
+whole run is the initial offset's transient: 0.1 rad for every law — and the crossings of the position,
+velocity and effort limits). A run that diverges or cannot plan is a row saying so.
+
+**The numbers are the one check grid's** (:func:`~twolink_pin.limits.check_limits`: a sampled
+reference on each interval between its samples, where its acceleration jumps and its peaks
+are), the grid ``trajectory --time-optimal`` and ``trajectory --trajectory FILE`` of the saved
+file print theirs on: the same digits everywhere.
 
 :func:`limits_section` is one worker task (picklable arguments only): the design, the files,
 the figures and the runs; it returns the section as ``results.json`` holds it under
@@ -67,8 +74,14 @@ FIGURE_PREFIX = "limits_references_"
 """The section's figures: ``figures/limits_references_<velocity|acceleration|torque>.png``."""
 CROSSED_KINDS = ("position", "velocity", "effort")
 """The limits whose crossings a tracking row lists."""
+SETTLE = 1.0
+"""A tracking row runs one period of its reference after ``min(SETTLE, period)`` seconds [s]
+for the initial offset to settle: its last period's error is the tracking's (the report's
+laws settle the 0.1-rad offset in well under a second on the twolink)."""
+PLANNER = "mpc"
+"""The law that plans within the limits, tracked on every reference beside the report's."""
 
-__all__ = ["FIGURE_PREFIX", "REFERENCES", "limits_section", "reference_row"]
+__all__ = ["FIGURE_PREFIX", "PLANNER", "REFERENCES", "SETTLE", "limits_section", "reference_row"]
 
 
 def _design(robot: Any, reference: Any) -> tuple[dict[str, Any], list[str]]:
@@ -124,15 +137,16 @@ def reference_row(robot: Any, trajectory: Trajectory) -> tuple[dict[str, Any], L
 
 
 def _track(robot: Any, variant: Variant, options: ReportOptions, trajectory: Trajectory) -> dict[str, Any]:
-    """One law on one reference for one period (module docstring): its metrics and crossings,
-    or what stopped it."""
+    """One law on one reference, :data:`SETTLE` and a period (module docstring): its metrics
+    and crossings, or what stopped it."""
     cfg = options.run.simulation
-    duration = max(float(trajectory.period), cfg.control_period or 0.0, cfg.dt)
+    period = float(trajectory.period)
+    duration = max(period + min(SETTLE, period), cfg.control_period or 0.0, cfg.dt)
     start = time.perf_counter()
-    controller, plant = options.run.for_law(variant).build(robot)
     try:
+        controller, plant = options.run.for_law(variant).build(robot)
         result = simulate(controller, plant, trajectory, replace(cfg, duration=duration))
-    except (SimulationDivergedError, ControllerError) as exc:
+    except (SimulationDivergedError, ControllerError, OptimizationError, InvalidParameterError) as exc:
         return {"finished": False, "failed": str(exc), "duration_s": duration}
     metrics = compute_metrics(result)
     return {
@@ -171,10 +185,15 @@ def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stag
     figures = save_references_figures(
         motions, joint_limits(robot), Path(stage) / "figures", FIGURE_PREFIX, f"{robot.name}: the references"
     )
+    laws = list(rows)
+    if PLANNER not in {name for name, _ in rows}:
+        from twolink_pin.law_variant import parse_variants
+
+        laws.append((PLANNER, parse_variants((PLANNER,))[0]))
     tracking = [
         {"law": name, "reference": key} | _track(robot, variant, options, trajectory)
         for key, trajectory in designed.items()
-        for name, variant in rows
+        for name, variant in laws
     ]
     return {
         "references": references,

@@ -72,6 +72,14 @@ def check_progress(
         )
 
 
+def _law_error(exc: Exception, controller: Controller, time: float) -> ControllerError:
+    """The error naming the law for what its call at ``time`` [s] raised: a refusal of the
+    package (:class:`TwolinkPinError`) by its message, anything else by its type, message and line."""
+    if isinstance(exc, TwolinkPinError):
+        return ControllerError(controller.name, time, str(exc))
+    return ControllerError(controller.name, time, f"{type(exc).__name__}: {exc}{raised_at(exc, controller)}")
+
+
 def integrate_adaptive(
     controller: Controller,
     plant: Plant,
@@ -109,12 +117,8 @@ def integrate_adaptive(
             )
         except ControllerError:
             raise
-        except TwolinkPinError as exc:
-            raise ControllerError(name, time, str(exc)) from exc
         except Exception as exc:
-            raise ControllerError(
-                name, time, f"{type(exc).__name__}: {exc}{raised_at(exc, controller)}"
-            ) from exc
+            raise _law_error(exc, controller, time) from exc
         if calls <= 1:
             check_output(controller, out, 1, nv, nz, time)
         return out.tau, (out.dz if out.dz is not None else np.zeros((1, 0)))
@@ -134,7 +138,10 @@ def integrate_adaptive(
     from scipy.integrate import solve_ivp  # with scipy.optimize 0.3 s to import: only for this method
 
     # bounded in wall-clock time (--timeout, simulation.deadline): past it, an error naming the law
-    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, last[0], seconds)):
+    with (
+        np.errstate(all="ignore"),
+        bounded(lambda timeout: timed_out(controller, last[0], timeout), stall=True),
+    ):
         sol = solve_ivp(
             rhs,
             (t[0], t[-1]),

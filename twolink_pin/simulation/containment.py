@@ -21,8 +21,9 @@ What comes out of the door is checked too (:func:`check_output`, at a law's firs
 evaluation): a :class:`~twolink_pin.controllers.LawOutput` of the right shapes and of real
 numbers.
 
-What cannot be contained in-process: ``os._exit()``, a crash in C code, a law that blocks
-signals. The CLI bounds a law that never returns with ``--timeout`` (``cli``), and
+``os._exit()`` is contained while the CLI runs a command (:func:`~twolink_pin.user_code.exits_contained`:
+it raises there, and is named like ``sys.exit``). What cannot be contained in-process: a crash
+in C code, ``os._exit`` in a law's own thread or child, a law that blocks signals. The CLI bounds a law that never returns with ``--timeout`` (``cli``), and
 ``docs/reliability.md`` says what it does about ``os._exit``.
 """
 
@@ -35,7 +36,8 @@ import numpy as np
 
 from twolink_pin.controllers import Controller, LawInput, LawOutput
 from twolink_pin.errors import ControllerError, InvalidParameterError
-from twolink_pin.user_code import restore_baseline
+from twolink_pin.simulation.deadline import PROGRESS
+from twolink_pin.user_code import HardExit, restore_baseline
 
 READ_ONLY_HINT = (
     "wrote into an array it was given, which is read-only: its inputs (the engine's state and the "
@@ -60,6 +62,7 @@ def contained(controller: Controller, method: str = "compute") -> Callable[[LawI
     ``-> z``)."""
     restore_baseline()  # each run starts from the command's working directory and NumPy state
     compute = getattr(controller, method)
+    progress = PROGRESS
     name = controller.name
 
     def call(x: LawInput, terms: Any) -> LawOutput:
@@ -73,10 +76,13 @@ def contained(controller: Controller, method: str = "compute") -> Callable[[LawI
         x[2].setflags(False)  # type: ignore[call-arg]
         x[3].setflags(False)  # type: ignore[call-arg]
         try:
-            return compute(x, terms)
-        except SystemExit as exc:
+            out = compute(x, terms)
+            progress[0] += 1  # a call that returned: the run is slow, not stalled (deadline.STALL)
+            return out
+        except SystemExit as exc:  # sys.exit, or os._exit while the CLI contains it (user_code.HardExit)
+            how = "os._exit" if isinstance(exc, HardExit) else "sys.exit"
             raise ControllerError(
-                name, float(t), f"{method} called sys.exit({exc.code!r}); a law must return or raise"
+                name, float(t), f"{method} called {how}({exc.code!r}); a law must return or raise"
             ) from None
         except MemoryError as exc:
             raise ControllerError(
@@ -160,7 +166,10 @@ def update_steps(controller: Controller, dt: float) -> int | None:
     period = controller.update_period()
     if period is None:
         return None
-    value = float(period)
+    try:
+        value = float(period)
+    except (TypeError, ValueError):  # a law's period that is no number: refused below, naming it
+        value = float("nan")
     steps = round(value / dt) if np.isfinite(value) and value > 0 else 0
     if steps < 1 or abs(steps * dt - value) > 1e-9 * value:
         raise InvalidParameterError(

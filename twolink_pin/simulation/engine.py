@@ -158,7 +158,10 @@ def integrate(
     watcher = run_watcher()
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
     # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
-    with np.errstate(all="ignore"), bounded(lambda seconds: timed_out(controller, clock.now, seconds)):
+    with (
+        np.errstate(all="ignore"),
+        bounded(lambda timeout: timed_out(controller, clock.now, timeout), stall=True),
+    ):
         for k0 in range(0, run.total, BLOCK):
             k1 = min(k0 + BLOCK, run.total)
             rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt, ahead, run.update_every)

@@ -33,8 +33,15 @@ from urllib.parse import urlsplit
 
 from twolink_pin import interrupts
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout
-from twolink_pin.studies.cluster_startup import handshake, kill_workers, probe, quiet_worker_exit, start_local
+from twolink_pin.studies.cluster_errors import ClusterError, TaskTimeout, WorkerKilled
+from twolink_pin.studies.cluster_startup import (
+    handshake,
+    kill_workers,
+    probe,
+    quiet_worker_deaths,
+    quiet_worker_exit,
+    start_local,
+)
 
 INSTALL_HINT = "pip install 'twolink-pin[cluster]'"
 """How to install Dask for ``--workers`` / ``--scheduler``."""
@@ -300,11 +307,7 @@ class DaskEngine:
         if isinstance(exc, KilledWorker):
             deaths = int(getattr(exc, "allowed_failures", ALLOWED_FAILURES)) + 1
             last = getattr(getattr(exc, "last_worker", None), "address", "?")
-            error = ClusterError(
-                self.address,
-                f"{name} {index} killed {deaths} worker{'s' if deaths != 1 else ''} in a row (out of "
-                f"memory? a crash in the law?); the last was {last}: see its log",
-            )
+            error: ClusterError = WorkerKilled(self.address, name, index, deaths, str(last))
         elif isinstance(exc, ImportError):
             error = ClusterError(
                 self.address,
@@ -392,6 +395,8 @@ def open_cluster(
         assert workers is not None
         engine = _local_engine(address, workers, preload)
     client = engine.client
+    # an owned LocalCluster's worker killed by a task is the command's error, not Dask's log lines
+    quiet = quiet_worker_deaths() if engine.cluster is not None else contextlib.nullcontext()
     try:
         try:
             client.wait_for_workers(1, timeout=timeout)
@@ -400,7 +405,8 @@ def open_cluster(
                 engine.address,
                 f"has no worker after {timeout:g} s; start some with `dask worker {engine.address}`",
             ) from None
-        yield engine
+        with quiet:
+            yield engine
     except BaseException:
         engine.close(kill=True)
         raise

@@ -49,4 +49,26 @@ class TaskTimeout(ClusterError):
         )
 
 
-__all__ = ["ClusterError", "TaskTimeout"]
+class WorkerKilled(ClusterError):
+    """A task whose workers died while running it, more times in a row than Dask allows
+    (``KilledWorker``): what it runs ended their processes (``os._exit``, a crash in C code,
+    out of memory). The sweep names the law and the runs (:mod:`twolink_pin.studies.sweep`).
+
+    Attributes:
+        index: The task's index among the items.
+        deaths: How many workers died running it.
+        last: The address of the last one (its log says why).
+    """
+
+    _fields = ("address", "name", "index", "deaths", "last")
+
+    def __init__(self, address: str, name: str, index: int, deaths: int, last: str) -> None:
+        self.name, self.index, self.deaths, self.last = name, index, deaths, last
+        super().__init__(
+            address,
+            f"{name} {index} killed {deaths} worker{'s' if deaths != 1 else ''} in a row (out of memory? a crash "
+            f"in the law?); the last was {last}: see its log",
+        )
+
+
+__all__ = ["ClusterError", "TaskTimeout", "WorkerKilled"]

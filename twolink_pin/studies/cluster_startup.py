@@ -139,6 +139,30 @@ class _SlowExit(logging.Filter):
         return not record.getMessage().startswith("Worker process still alive after")
 
 
+class _Deaths(logging.Filter):
+    """Drops a nanny's "Restarting worker" and the scheduler's "… marked as failed because N
+    workers died …": the command's one line names the law and the runs that killed them."""
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        text = record.getMessage()
+        return not (text.startswith("Restarting worker") or "workers died while trying to run" in text)
+
+
+@contextlib.contextmanager
+def quiet_worker_deaths() -> Iterator[None]:
+    """While an owned LocalCluster runs the work: a worker killed by what it runs is the
+    command's error (:class:`~twolink_pin.studies.cluster_errors.WorkerKilled`), not log lines."""
+    quiet = _Deaths()
+    loggers = [logging.getLogger(name) for name in ("distributed.nanny", "distributed.scheduler")]
+    for logger in loggers:
+        logger.addFilter(quiet)
+    try:
+        yield
+    finally:
+        for logger in loggers:
+            logger.removeFilter(quiet)
+
+
 @contextlib.contextmanager
 def quiet_worker_exit() -> Iterator[None]:
     """While a LocalCluster closes after its work: a worker process that is slow to exit (a

@@ -105,6 +105,7 @@ class ComparisonTable:
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
             "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
             "relaxed": {name: r.summary() for name, r in self.relaxed.items()},
+            "within_limits": {name: m.crossings.within_limits for name, m in self.metrics.items()},
         }
 
     def crossing_rows(self) -> list[tuple[str, str, int, float, float, str]]:

@@ -1,7 +1,7 @@
 """A sweep's rows as a Parquet dataset: ``runs/part-<first run>.parquet``, one file per chunk.
 
 * :func:`table_schema` — the columns typed (``run`` int64, the flags :data:`FLAGS` bool,
-  every other column float64 and nullable), each with its SI unit in its field metadata
+  :data:`TEXTS` strings, every other column float64 and nullable), each with its SI unit in its field metadata
   (``b"unit"``), and the sweep's configuration as JSON in the schema metadata under
   :data:`METADATA_KEY`;
 * :func:`chunk_table` and :func:`write_part` — one chunk's rows, NaN as null (a diverged
@@ -33,6 +33,11 @@ FLAGS = ("limit_exceeded", "diverged", "position_crossed", "velocity_crossed")
 """The boolean columns."""
 RUN = "run"
 """The int64 column: the run's index."""
+REASON = "diverged_reason"
+"""The text column: why a run ended early (its law's reason, e.g. an ``mpc`` replan that could
+not hold its limits, or the state that became non-finite); null for a run that went to its end."""
+TEXTS = (REASON,)
+"""The string columns (nullable): given beside a chunk's numbers (:func:`chunk_table`)."""
 
 
 def part_name(start: int) -> str:
@@ -49,12 +54,12 @@ def table_schema(columns: Sequence[str], units: Mapping[str, str], metadata: Map
     """The ``pyarrow.Schema`` of a sweep's rows (see the module docstring)."""
     import pyarrow as pa
 
-    types = {RUN: pa.int64(), **{name: pa.bool_() for name in FLAGS}}
+    types = {RUN: pa.int64(), **{name: pa.bool_() for name in FLAGS}, **{name: pa.string() for name in TEXTS}}
     fields = [
         pa.field(
             name,
             types.get(name, pa.float64()),
-            nullable=name not in types,
+            nullable=name not in types or name in TEXTS,
             metadata={b"unit": units[name].encode()} if units.get(name) else None,
         )
         for name in columns
@@ -62,14 +67,25 @@ def table_schema(columns: Sequence[str], units: Mapping[str, str], metadata: Map
     return pa.schema(fields, metadata={METADATA_KEY: json.dumps(dict(metadata), allow_nan=False).encode()})
 
 
-def chunk_table(values: np.ndarray, schema: Any) -> Any:
+def chunk_table(
+    values: np.ndarray, schema: Any, texts: Mapping[str, Sequence[str | None]] | None = None
+) -> Any:
     """The ``pyarrow.Table`` of one chunk from its rows as floats, shape (n, columns) in the
-    schema's order (the run index and the flags as numbers too); NaN becomes null."""
+    schema's order without the :data:`TEXTS` columns (the run index and the flags as numbers
+    too; NaN becomes null), and the text columns' values (None: null; absent: all null)."""
     import pyarrow as pa
 
     arrays = []
-    for j, column in enumerate(schema):
+    j = 0
+    for column in schema:
+        if column.name in TEXTS:
+            given = (texts or {}).get(column.name)
+            arrays.append(
+                pa.array(list(given) if given is not None else [None] * values.shape[0], type=pa.string())
+            )
+            continue
         x = np.ascontiguousarray(values[:, j])
+        j += 1
         if column.name == RUN:
             arrays.append(pa.array(x.astype(np.int64)))
         elif column.name in FLAGS:
@@ -151,8 +167,10 @@ def read_columns(folder: str | Path, names: Sequence[str], every: int = 1) -> di
 __all__ = [
     "FLAGS",
     "METADATA_KEY",
+    "REASON",
     "RUN",
     "RUNS_FOLDER",
+    "TEXTS",
     "chunk_table",
     "part_name",
     "part_starts",

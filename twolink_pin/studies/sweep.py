@@ -72,6 +72,7 @@ from twolink_pin.studies.cluster import CONNECT_TIMEOUT, ClusterError, TaskTimeo
 from twolink_pin.studies.cluster import (
     dask_setup as dask_setup,  # the workers' preload hook (--preload this module)
 )
+from twolink_pin.studies.cluster_errors import WorkerKilled
 from twolink_pin.studies.parquet import (
     RUNS_FOLDER,
     table_schema,
@@ -139,10 +140,21 @@ class SweepOutput:
 
 @contextlib.contextmanager
 def _named_timeout(cls: type[Controller], ranges: list[tuple[int, int]]) -> Iterator[None]:
-    """A chunk past ``--timeout`` on a Dask worker as the failed run it is: an error naming
-    the law and the bound (as in-process, :func:`~twolink_pin.simulation.deadline.timed_out`)."""
+    """A chunk past ``--timeout`` on a Dask worker, or one that killed its workers, as the
+    failed run it is: an error naming the law and the bound (as in-process,
+    :func:`~twolink_pin.simulation.deadline.timed_out`) or the workers' deaths (exit status 1;
+    it was a cluster error without the law, exit 2)."""
     try:
         yield
+    except WorkerKilled as exc:
+        start, stop = ranges[exc.index]
+        raise ControllerError(
+            cls.name,
+            math.nan,
+            f"runs {start}–{stop - 1} killed {exc.deaths} Dask worker process{'es' if exc.deaths != 1 else ''} "
+            f"in a row: the law {cls.__qualname__} ended them (os._exit, a crash in C code, out of memory?); "
+            f"the last was {exc.last}: see its log",
+        ) from None
     except TaskTimeout as exc:
         start, stop = ranges[exc.index]
         raise ControllerError(

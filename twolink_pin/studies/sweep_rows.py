@@ -17,6 +17,7 @@ from twolink_pin.metrics import metric_array, metric_units
 from twolink_pin.model import RobotModel
 from twolink_pin.scenario import Scenario
 from twolink_pin.studies.batch import BatchResult, simulate_batch
+from twolink_pin.studies.parquet import REASON
 from twolink_pin.studies.sweep_cases import Cases, SweepConfig, check_draws, chunk_law, gain_target
 from twolink_pin.task_metrics import TASK_UNITS
 from twolink_pin.trajectory import Trajectory
@@ -200,6 +201,10 @@ class ChunkRows:
     """:func:`environment` where the chunk ran."""
     trajectories: dict[str, np.ndarray] | None = None
     """``t``, ``q``, ``v``, ``tau_command`` when trajectories are kept."""
+    reasons: tuple[str | None, ...] = ()
+    """Why each run ended early (:attr:`~twolink_pin.studies.batch.BatchResult.divergence`: its
+    law's reason or the state's), None for a run that went to its end; the column
+    :data:`~twolink_pin.studies.parquet.REASON`."""
 
     @property
     def stop(self) -> int:
@@ -245,7 +250,10 @@ class PreparedSweep:
         self.task = bool(cls.task_space)  # the law's class declares it: its figure shows them first
         self.metric_columns = metric_columns(nv, estimated)
         self.outcome_columns = outcome_columns(nv)
-        self.header = [*self.input_columns, *self.outcome_columns, *self.metric_columns]
+        # the reason a run ended early (text) right after when it did
+        after = self.outcome_columns.index("diverged_at") + 1
+        outcomes = [*self.outcome_columns[:after], REASON, *self.outcome_columns[after:]]
+        self.header = [*self.input_columns, *outcomes, *self.metric_columns]
         units = {"run": "", **{c: "rad" for c in joint_columns("q0_offset", nv)}}
         units.update({f"param_factor_{n}": "" for n in self.parameter_names})
         for g in config.gains:
@@ -256,6 +264,7 @@ class PreparedSweep:
         units.update(
             limit_exceeded="", diverged="", diverged_at="s", position_crossed="", velocity_crossed=""
         )
+        units[REASON] = ""
         for stem, unit in CROSSING_UNITS.items():
             units.update({c: unit for c in joint_columns(stem, nv)})
         for stem, unit in METRIC_UNITS.items():
@@ -306,4 +315,8 @@ class PreparedSweep:
         if self.record:
             assert result.q is not None and result.v is not None and result.tau_command is not None
             kept = {"t": result.t, "q": result.q, "v": result.v, "tau_command": result.tau_command}
-        return ChunkRows(start, inputs, flags, metrics, environment(), kept)
+        reasons = tuple(
+            (why or "diverged") if dead else None
+            for why, dead in zip(result.divergence, result.diverged.tolist(), strict=True)
+        )
+        return ChunkRows(start, inputs, flags, metrics, environment(), kept, reasons)

@@ -19,7 +19,9 @@ from twolink_pin.model import RobotModel
 from twolink_pin.simulation.config import joint_offsets
 from twolink_pin.studies.parquet import (
     FLAGS,
+    REASON,
     RUNS_FOLDER,
+    TEXTS,
     chunk_table,
     read_columns,
     read_part,
@@ -67,7 +69,8 @@ class RowSink:
         self.kept: list[Path] = []
 
     def add(self, rows: ChunkRows) -> None:
-        table = chunk_table(np.hstack([rows.inputs, rows.flags, rows.metrics]), self.schema)
+        reasons = {REASON: rows.reasons} if rows.reasons else None
+        table = chunk_table(np.hstack([rows.inputs, rows.flags, rows.metrics]), self.schema, reasons)
         write_part(table, self.folder, rows.start)
         if rows.trajectories is not None:
             path = self.stage / f"trajectories-{rows.start:07d}.npz"
@@ -94,6 +97,11 @@ class RowSink:
             if name in FLAGS:
                 csv_columns.append(["1" if v else "0" for v in values.tolist()])
                 json_columns.append(["true" if v else "false" for v in values.tolist()])
+                continue
+            if name in TEXTS:  # a reason: the text (empty in CSV, null in JSON where there is none)
+                texts = table.column(name).to_pylist()
+                csv_columns.append(["" if v is None else v for v in texts])
+                json_columns.append(["null" if v is None else json.dumps(v) for v in texts])
                 continue
             if name == "run":
                 text = list(map(str, values.tolist()))

@@ -12,7 +12,12 @@
 ``retiming.py``             :func:`time_optimal`: a path retimed to its shortest duration within the limits (TOPP-RA)
 ``retiming_path.py``        the path a retiming times: pieces from rest to rest, their resting ends stretched
 ``retiming_samples.py``     a TOPP-RA timing as samples (quintic Hermite between them), its via times
+``retiming_toppra.py``      toppra imported without the pyplot it loads, its path and limit classes
 ``optimal.py``              :func:`optimize`: the least effort or the shortest duration through via points (the core in ``optimal/``)
+``optimal_spline.py``       the spline an optimal reference is: via points and their checks, layout, start, samples
+``optimal_effort.py``       the minimum-effort reference: cost, regulariser (path, velocity, none), end conditions
+``optimal_time.py``         the minimum-time reference: the search from the retiming, its stated tolerance
+``optimal_measures.py``     ``∫τᵀτ dt``, pose errors, the end effector's excursion from the via points' hull
 ``file.py``                 trajectory files (TOML / JSON) for ``--trajectory FILE``
 ``file_values.py``          a file's numbers checked (finite, bounded, within the joint limits)
 ``samples_file.py``         a file's ``samples`` table (what the retiming and the optimiser save)

@@ -73,6 +73,7 @@ from twolink_pin.trajectory.file_values import (
     check_trajectory_limits,
     check_within_limits,
     parse_numbers,
+    shown,
 )
 from twolink_pin.trajectory.fourier import MAX_HARMONICS, MAX_PERIOD, MIN_PERIOD, FourierTrajectory
 from twolink_pin.trajectory.polynomial import JointTrajectory
@@ -140,7 +141,7 @@ def read_trajectory_file(
     unknown = sorted(set(document) - KEYS)
     if unknown:
         raise InvalidParameterError(
-            f"{file}: {unknown[0]}", document[unknown[0]], f"only the keys {sorted(KEYS)}"
+            f"{file}: {unknown[0]}", shown(document[unknown[0]]), f"only the keys {sorted(KEYS)}"
         )
     times = _via_times(file, document)
     period = document.get("period")
@@ -149,7 +150,9 @@ def read_trajectory_file(
     ):
         raise InvalidParameterError(f"{file}: period", period, "a finite period [s]")
     if "rpy" in document and "positions" not in document:
-        raise InvalidParameterError(f"{file}: rpy", document["rpy"], "orientations beside 'positions' (m)")
+        raise InvalidParameterError(
+            f"{file}: rpy", shown(document["rpy"]), "orientations beside 'positions' (m)"
+        )
     given = [key for key in ("joints", "positions") if key in document]
     if len(given) != 1:
         raise InvalidParameterError(
@@ -199,7 +202,7 @@ def _via_times(file: Path, document: dict[str, Any]) -> np.ndarray:
     times = parse_numbers(file, "times", document["times"], "a list of times [s]")
     if times.ndim != 1 or not 2 <= times.size <= MAX_VIA_POINTS:
         raise InvalidParameterError(
-            f"{file}: times", document["times"], f"a list of 2 to {MAX_VIA_POINTS} times [s]"
+            f"{file}: times", shown(document["times"]), f"a list of 2 to {MAX_VIA_POINTS} times [s]"
         )
     if np.any(np.abs(times) > MAX_TIME):
         k = int(np.flatnonzero(np.abs(times) > MAX_TIME)[0])
@@ -261,7 +264,7 @@ def _position_rows(
         )
         if seed.shape != (robot.nv,):
             raise InvalidParameterError(
-                f"{file}: seed", document["seed"], f"{robot.nv} joint positions [rad]"
+                f"{file}: seed", shown(document["seed"]), f"{robot.nv} joint positions [rad]"
             )
         check_within_limits(robot, seed[None, :], f"{file}: seed")
     return points, seed
@@ -289,7 +292,9 @@ def _pose_file(
     rpy = parse_numbers(file, "rpy", rows, "rows of (roll, pitch, yaw) [rad]", MAX_ANGLE, "rad")
     if points.shape[1] != 3:
         raise InvalidParameterError(
-            f"{file}: positions", document["positions"], "3 coordinates (x, y, z) [m] per row beside 'rpy'"
+            f"{file}: positions",
+            shown(document["positions"]),
+            "3 coordinates (x, y, z) [m] per row beside 'rpy'",
         )
     if robot.nv < 6:
         raise InvalidParameterError(
@@ -315,7 +320,7 @@ def _fourier_trajectory(file: Path, document: dict[str, Any], robot: RobotModel)
     others = sorted(set(document) - {"fourier"})
     if others:
         raise InvalidParameterError(
-            f"{file}: {others[0]}", document[others[0]], "no other key beside a 'fourier' table"
+            f"{file}: {others[0]}", shown(document[others[0]]), "no other key beside a 'fourier' table"
         )
     table = document["fourier"]
     if not isinstance(table, dict):

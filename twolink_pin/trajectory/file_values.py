@@ -22,6 +22,24 @@ MAX_ANGLE = 100.0
 of a command-line offset: beyond, a number is a typo or garbage (sin(1e300) is not an angle)."""
 
 
+SHOWN = 6
+"""A list longer than this is shown in a message by its length and its ends (:func:`shown`)."""
+
+
+def shown(value: Any) -> Any:
+    """``value`` as a message about it shows it: itself, or for a list longer than
+    :data:`SHOWN`, its length and first and last items (a file with 40 000 via times printed
+    them all in its one line)."""
+    if not isinstance(value, (list, tuple)) or len(value) <= SHOWN:
+        return value
+
+    def item(v: Any) -> str:
+        text = repr(v)
+        return text if len(text) <= 40 else text[:37] + "…"
+
+    return f"a list of {len(value)} items: {', '.join(item(v) for v in value[:3])}, …, {item(value[-1])}"
+
+
 def _only_numbers(value: Any) -> bool:
     """Whether ``value`` is a number or nested lists of numbers (``true`` and ``"0.5"`` are not)."""
     if isinstance(value, list):
@@ -35,11 +53,13 @@ def parse_numbers(
     """``value`` as a float array; a number that is not finite or beyond ``±bound`` [unit] is
     refused naming its row and column (``rpy[2][0]``)."""
     if not _only_numbers(value):
-        raise InvalidParameterError(f"{path}: {key}", value, f"numbers (not booleans or strings): {shape}")
+        raise InvalidParameterError(
+            f"{path}: {key}", shown(value), f"numbers (not booleans or strings): {shape}"
+        )
     try:
         array = np.array(value, dtype=float)
     except (TypeError, ValueError):
-        raise InvalidParameterError(f"{path}: {key}", value, shape) from None
+        raise InvalidParameterError(f"{path}: {key}", shown(value), shape) from None
     bad = ~np.isfinite(array) | (np.abs(array) > (math.inf if bound is None else bound))
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
@@ -85,4 +105,12 @@ def check_trajectory_limits(robot: RobotModel, trajectory: Trajectory, what: str
         )
 
 
-__all__ = ["MAX_ANGLE", "MAX_TIME", "check_trajectory_limits", "check_within_limits", "parse_numbers"]
+__all__ = [
+    "MAX_ANGLE",
+    "MAX_TIME",
+    "SHOWN",
+    "check_trajectory_limits",
+    "check_within_limits",
+    "parse_numbers",
+    "shown",
+]

@@ -40,18 +40,19 @@ raised if it binds where the tangent does not vanish.
 at the grid points (times ``t_i = Σ 2 Δs / (ṡ_i + ṡ_{i+1})``; the acceleration jumps there,
 so each interior point is sampled twice: before and after), quintic Hermite between them
 (``s(t)`` is quadratic on an interval); it repeats from rest to rest with period = duration.
-It is checked against every limit on a grid :data:`VERIFY` times finer than TOPP-RA's (torque by
-RNEA); where it exceeds a limit between grid points, the limits are tightened by that excess
-and the path retimed again, so that the result is within its limits on that grid.
+It is checked against every limit on the one check grid of every command
+(:func:`~twolink_pin.limits.reference_motion`: each interval between two samples at evenly
+spaced instants, both ends included, at most 1 ms apart; torque by RNEA); where it exceeds a
+limit, the limits are tightened by that excess and the path retimed again, so that the result
+is within its limits on that grid — the grid ``trajectory --time-optimal``, the report and a
+``trajectory --trajectory`` of the saved file state their peaks on.
 """
 
 from __future__ import annotations
 
-import functools
-import logging
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -65,12 +66,16 @@ from twolink_pin.limits import (
     JointLimits,
     LimitsCheck,
     Motion,
+    check_limits,
     check_motion,
     joint_limits,
+    reference_motion,
+    shortfall,
 )
 from twolink_pin.limits.active import ActiveLimit, active_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.trajectory.base import Trajectory
+from twolink_pin.trajectory.file_values import MAX_TIME
 from twolink_pin.trajectory.retiming_path import PathPiece, path_lengths, path_pieces
 from twolink_pin.trajectory.retiming_samples import (
     Timing,
@@ -79,6 +84,7 @@ from twolink_pin.trajectory.retiming_samples import (
     retimed_via_times,
     timing_of,
 )
+from twolink_pin.trajectory.retiming_toppra import toppra_classes as _toppra
 from twolink_pin.trajectory.sampled import SampledTrajectory
 
 if TYPE_CHECKING:
@@ -96,8 +102,6 @@ SPEED_CAP = 10.0
 module docstring)."""
 CLUSTER = 0.95
 """How much denser the grid is at a path's ends: spacing ``1 − CLUSTER`` times the mean there."""
-VERIFY = 10
-"""The check grid is this many times finer than TOPP-RA's."""
 FRICTION_PASSES = 3
 """Passes of the viscous-friction tangent bound (module docstring)."""
 TIGHTENING_ROUNDS = 4
@@ -105,8 +109,8 @@ TIGHTENING_ROUNDS = 4
 MARGIN = 3e-3
 """The timing keeps this fraction of each limit free: for what happens between TOPP-RA's
 grid points (it keeps the limits at :data:`SUBPOINTS` + 1 points of each interval) and for
-the samples' interpolation, so that the check (:data:`VERIFY` points per sample interval)
-passes at the first try (the twolink's path went 0.18 % beyond near its end with 0.1 % free:
+the samples' interpolation, so that the check (the check grid, at most 1 ms apart on each
+sample interval) passes at the first try (the twolink's path went 0.18 % beyond near its end with 0.1 % free:
 a second retiming, tightened by twice that, cost more time and more duration); where it does
 not, the limits are tightened by twice what it found."""
 REPRESENTATION = 1e-5
@@ -127,52 +131,13 @@ class TimeOptimal(NamedTuple):
     limits: JointLimits
     """The limits it was retimed within (scaled)."""
     check: LimitsCheck
-    """Every limit on the grid :data:`VERIFY` times finer than TOPP-RA's."""
+    """Every limit on the check grid (:func:`~twolink_pin.limits.reference_motion`)."""
     active: tuple[ActiveLimit, ...]
     """Where each limit is active (within 1 %)."""
     gridpoints: int
     """TOPP-RA's grid intervals."""
     seconds: float
     """Wall time of the retiming [s]."""
-
-
-@functools.cache
-def _toppra() -> Any:
-    """toppra (1.1 s to import: only here), its logger quiet, and the two classes on it."""
-    import toppra
-    import toppra.algorithm
-    from toppra.constraint import DiscretizationType, LinearConstraint
-    from toppra.interpolator import AbstractGeometricPath
-
-    logging.getLogger("toppra").setLevel(logging.ERROR)
-
-    class Path(AbstractGeometricPath):
-        def __init__(self, piece: PathPiece, nv: int) -> None:
-            self.piece, self._nv = piece, nv
-
-        def __call__(self, s: Any, order: int = 0) -> np.ndarray:
-            out = self.piece.path(np.atleast_1d(np.asarray(s, dtype=float)), order)
-            return out[0] if np.ndim(s) == 0 else out
-
-        @property
-        def dof(self) -> int:
-            return self._nv
-
-        @property
-        def path_interval(self) -> np.ndarray:
-            return np.array([self.piece.start, self.piece.end])
-
-    class Limits(LinearConstraint):
-        def __init__(self, params: Callable[[np.ndarray], tuple[np.ndarray, ...]], nv: int) -> None:
-            super().__init__()
-            self.params, self.dof, self.identical = params, nv, True
-            self.set_discretization_type(DiscretizationType.Collocation)  # the rows: :func:`_params`
-
-        def compute_constraint_params(self, path: Any, gridpoints: np.ndarray) -> Any:
-            a, b, c, F, g, xbound = self.params(gridpoints)
-            return a, b, c, F, g, None, xbound
-
-    return type("_TOPPRA", (), {"toppra": toppra, "Path": Path, "Limits": Limits})
 
 
 class _Stage(NamedTuple):
@@ -300,19 +265,40 @@ def _params(
 
 
 def _check_rest(robot: RobotModel, stage: _Stage, limits: JointLimits, where: str) -> None:
-    """Raise (bad input) where the path's rest points need more than an effort limit: the
-    torque at rest there is gravity (and nothing can lower it)."""
-    for index, label in ((0, "start"), (-1, "end")):
+    """Raise (bad input) where the path needs more than an effort limit to hold still: at its
+    rest points (the torque there is gravity, and nothing can lower it), then anywhere along it
+    (``c(s)``: gravity, which the timing cannot lower either)."""
+    points = [(0, f"at rest at the start of {where}"), (-1, f"at rest at the end of {where}")]
+    points += [(int(i), f"to hold still on {where}") for i in np.argsort(-np.abs(stage.c).max(axis=1))[:1]]
+    for index, label in points:
         excess = np.abs(stage.c[index]) - limits.effort
         j = int(np.argmax(excess))
         if excess[j] > 0:
             raise InvalidParameterError(
                 f"effort limit of joint {j + 1} ({limits.joint_names[j]})",
                 f"{limits.effort[j]:g} N·m",
-                f"at least the {abs(stage.c[index][j]):.4g} N·m that gravity needs at rest at the {label} of {where} "
+                f"at least the {abs(stage.c[index][j]):.4g} N·m that gravity needs {label} "
                 f"(q = {np.round(stage.q[index], 4).tolist()} rad): the path needs more torque than the limits allow "
                 "even at rest",
             )
+
+
+def _check_needs(robot: RobotModel, trajectory: Trajectory, limits: JointLimits, span: float) -> None:
+    """Raise (bad input) for a velocity, acceleration or effort limit so far below what the
+    reference needs at its own timing (over ``span`` [s]) that no retiming shorter than
+    :data:`~twolink_pin.trajectory.file_values.MAX_TIME` keeps it: slowed ``k`` times, a path
+    needs ``1/k`` of its velocity and ``1/k²`` of its acceleration and dynamic torque (the
+    gravity, which it does not lower, is :func:`_check_rest`'s). A limit scale of 1e-300 gave
+    numpy's warnings and "TOPP-RA found no admissible timing"."""
+    factor = MAX_TIME / max(span, 1e-300)
+    short = shortfall(
+        check_limits(robot, trajectory, limits=limits), lambda kind: factor if kind is VELOCITY else factor**2
+    )
+    if short is not None:
+        what, value, need = short.describe(limits.joint_names)
+        raise InvalidParameterError(
+            what, value, f"a limit a retiming shorter than {MAX_TIME:g} s can keep: it is {need}"
+        )
 
 
 def _solve(
@@ -368,18 +354,18 @@ def verify_motion(
     return Motion(t, sample.q, sample.v, sample.a, _torque(robot, sample.q, sample.v, sample.a, friction))
 
 
-def _over(motion: Motion, limits: JointLimits, per_interval: int) -> np.ndarray:
-    """The largest excess of a velocity, acceleration or effort limit (a fraction of it) in
-    each interval of a motion sampled ``per_interval + 1`` times per interval."""
-    worst = np.full(motion.t.size, -np.inf)
+def _over(motion: Motion, limits: JointLimits) -> float:
+    """The largest excess of a velocity, acceleration or effort limit along ``motion`` (a
+    fraction of it; negative: within every one)."""
+    worst = -np.inf
     for kind in (VELOCITY, ACCELERATION, EFFORT):
         values = kind.of(motion)
         given = limits.given(kind)
         if values is None or not given.any():
             continue
         _, upper = limits.bounds(kind)
-        worst = np.maximum(worst, np.max(limits.excess(kind, values)[:, given] / upper[given], axis=1))
-    return worst.reshape(-1, per_interval + 1).max(axis=1)
+        worst = max(worst, float(np.max(limits.excess(kind, values)[:, given] / upper[given])))
+    return worst
 
 
 def _timed(
@@ -446,6 +432,7 @@ def time_optimal(
     _toppra()  # imported once (about 1 s), before the clock starts
     start = time.perf_counter()
     wanted = base.scaled(limit_scale)
+    _check_needs(robot, trajectory, wanted, float(getattr(trajectory, "span", trajectory.period)))
     pieces = path_pieces(trajectory)
     lengths = path_lengths(pieces)
     if not np.all(lengths > 0):
@@ -464,8 +451,8 @@ def time_optimal(
     working, excess = wanted.scaled(1.0 - MARGIN), np.inf
     for _ in range(TIGHTENING_ROUNDS):
         result, _ = _timed(robot, trajectory, pieces, stages, working, friction)
-        motion = verify_motion(robot, result, VERIFY, friction)
-        excess = float(_over(motion, wanted, VERIFY).max())
+        motion = reference_motion(robot, result, friction=friction)  # the one check grid
+        excess = _over(motion, wanted)
         if excess <= 0:
             original = float(getattr(trajectory, "span", trajectory.period))
             return TimeOptimal(
@@ -481,4 +468,4 @@ def time_optimal(
     )
 
 
-__all__ = ["GRIDPOINTS", "VERIFY", "TimeOptimal", "path_pieces", "time_optimal", "verify_motion"]
+__all__ = ["GRIDPOINTS", "TimeOptimal", "path_pieces", "time_optimal", "verify_motion"]

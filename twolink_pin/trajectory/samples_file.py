@@ -51,20 +51,21 @@ def read_samples(file: Path, document: dict[str, Any], robot: RobotModel) -> Sam
         check_trajectory_limits,
         check_within_limits,
         parse_numbers,
+        shown,
     )
 
     others = sorted(set(document) - {"samples"})
     if others:
         raise InvalidParameterError(
-            f"{file}: {others[0]}", document[others[0]], "no other key beside a 'samples' table"
+            f"{file}: {others[0]}", shown(document[others[0]]), "no other key beside a 'samples' table"
         )
     table = document["samples"]
     if not isinstance(table, dict):
-        raise InvalidParameterError(f"{file}: samples", table, "a table with times, q, v and a")
+        raise InvalidParameterError(f"{file}: samples", shown(table), "a table with times, q, v and a")
     unknown = sorted(set(table) - SAMPLE_KEYS)
     if unknown:
         raise InvalidParameterError(
-            f"{file}: samples.{unknown[0]}", table[unknown[0]], f"only the keys {sorted(SAMPLE_KEYS)}"
+            f"{file}: samples.{unknown[0]}", shown(table[unknown[0]]), f"only the keys {sorted(SAMPLE_KEYS)}"
         )
     for key in ("times", "q", "v", "a"):
         if key not in table:
@@ -106,7 +107,7 @@ def read_samples(file: Path, document: dict[str, Any], robot: RobotModel) -> Sam
         )
         if via_times.ndim != 1:
             raise InvalidParameterError(
-                f"{file}: samples.via_times", table["via_times"], "a list of times [s]"
+                f"{file}: samples.via_times", shown(table["via_times"]), "a list of times [s]"
             )
     try:
         trajectory = SampledTrajectory(times, rows["q"], rows["v"], rows["a"], rows.get("tau"), via_times)

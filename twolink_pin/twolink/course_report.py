@@ -25,14 +25,14 @@ REUSED_LAW = "adaptive"
 class CourseReport:
     """The twolink's report sections (stateless: the profile holds one instance)."""
 
-    def steps(self, options: Any) -> int:
-        """One progress step: the identification section, when asked for."""
-        return 1 if options.identification else 0
+    def steps(self, options: Any, laws: Sequence[str]) -> int:
+        """One progress step: the identification section, when it is shown (:func:`shows_identification`)."""
+        return 1 if shows_identification(options, laws) else 0
 
     def submit(self, pool: Any, options: Any, fig_dir: str, laws: Sequence[str]) -> Any:
         """The identification section's tasks (the longest: 3 adaptive runs and a logged
         run), submitted first so that the laws' runs fill the other workers meanwhile."""
-        if not options.identification:
+        if not shows_identification(options, laws):
             return None
         from twolink_pin.twolink import report_identification as ident
 
@@ -118,6 +118,19 @@ class CourseReport:
             controller = make_scenario(cls, robot, lam=options.run.lam).controller
             items.append(errata.parameter_convergence(runs["adaptive"], controller, trajectory))  # type: ignore[arg-type]
         return [e._asdict() for e in items]
+
+
+def shows_identification(options: Any, laws: Sequence[str]) -> bool:
+    """Whether the report has the identification section: asked for (``options.identification``)
+    and one of its ``laws`` (laws or variants) estimates the inertial parameters — the section
+    answers a question about such a law (why its p̂ is still far from p at the end of the run),
+    which a report of ``mpc`` and ``pd`` does not raise."""
+    from twolink_pin.law_variant import parse_variant
+    from twolink_pin.scenario import law_class
+
+    if not options.identification:
+        return False
+    return any("inertial" in law_class(parse_variant(text).law).estimates for text in laws)
 
 
 def closed_form_check(robot: Any, samples: int = 1000) -> dict[str, Any]:

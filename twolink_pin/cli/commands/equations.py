@@ -12,10 +12,10 @@ from twolink_pin.cli.output import emit
 def _timed_out(robot: str, joints: int) -> Any:
     from twolink_pin.errors import EquationsError
 
-    def error(seconds: float) -> EquationsError:
+    def error(timeout: Any) -> EquationsError:  # a deadline.RunTimeout
         return EquationsError(
             robot,
-            f"the derivation of its {joints} joints did not finish within --timeout {seconds:g} s of wall-clock "
+            f"the derivation of its {joints} joints did not finish within --timeout {timeout.seconds:g} s of wall-clock "
             "time; give a larger --timeout, or fewer joints with --joints N (docs/equations.md: time per "
             "number of joints)",
         )

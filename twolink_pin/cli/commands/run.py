@@ -47,6 +47,7 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "limits": result.joint_limits.as_dict(),
         "crossings": metrics.crossings.summary(),
         "relaxed": None if result.relaxed is None else result.relaxed.summary(),
+        "within_limits": metrics.crossings.within_limits,  # every kind; limit_exceeded: the effort alone
         "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
         "p_true": None if result.p_true is None else result.p_true.tolist(),
