@@ -37,7 +37,8 @@ Usage::
     .venv/bin/python scripts/benchmark.py --tune-only [--quick]    # tune: from a change to updated results
     .venv/bin/python scripts/benchmark.py --qp-osc-only [--quick]  # issue 37: qp-osc against osc on the Panda
     .venv/bin/python scripts/benchmark.py --optimal-only [--quick] [--croc PYTHON] # issues 36, 45: retiming, optimize, the anchor
-    .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a)
+    .venv/bin/python scripts/benchmark.py --mpc-only [--quick]     # issue 37: mpc's 30-s runs, batch, demo (a);
+                                                                   # issue 45: against crocoddyl's MPC (mpc_anchor.py)
     .venv/bin/python scripts/benchmark.py --contact-only [--quick] # issue 46: the contact lab, contact's cost
     .venv/bin/python scripts/benchmark.py --arms-only [--quick]    # issue 50: every arm × law at the defaults
     .venv/bin/python scripts/benchmark.py --mujoco-only [--quick]  # issue 44: the MuJoCo plant beside Pinocchio's
@@ -1580,7 +1581,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--mpc-only",
         action="store_true",
-        help="only mpc's goals: 30-s runs on the twolink and the UR5, demo (a)",
+        help="only mpc's goals: 30-s runs on the twolink and the UR5, demo (a), and against crocoddyl's MPC "
+        "(CROCODDYL_PYTHON: a scratch venv's python with pin 4.0 and crocoddyl 3.2.1; skipped without)",
     )
     parser.add_argument(
         "--croc",
@@ -1659,6 +1661,9 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if args.mpc_only:
         results.update(mpc_section(quick, args.repeats or (1 if quick else 3)))
+        from mpc_anchor import anchor_section  # scripts/mpc_anchor.py, beside this file
+
+        results.update(anchor_section(quick))
         if args.json:
             print(json.dumps(results))
         return 0

@@ -122,3 +122,24 @@ def test_the_unconstrained_minimiser_needs_a_positive_definite_hessian() -> None
     outside = QP(np.eye(2), np.array([-2.0, 0.0]), C=np.eye(2), l=np.zeros(2), u=np.ones(2))
     assert unconstrained_minimiser(outside) is None
     np.testing.assert_allclose(solve_qp(outside, unconstrained_first=True).x, [1.0, 0.0], atol=1e-8)
+
+
+def test_bounds_beyond_the_cap_are_none_on_their_loose_side_and_the_cap_on_the_other() -> None:
+    """A damper of horizon 1e-12 s asks for bounds of 1e24 (issue 48): on the equilibrated problem a
+    bound past BOUND_CAP on its loose side is no bound (−inf / +inf), one past it on the tight side
+    is the cap (the problem stays infeasible, with sane numbers), and the minimiser of a problem
+    whose bounds are loose is the unconstrained one. ProxQP's inner iterations are capped, so a QP
+    that cannot hold is told so within max_iter outer iterations of at most max_inner each."""
+    from twolink_pin.optimal.qp import BOUND_CAP, equilibrate
+
+    H, g = np.diag([2.0, 8.0]), np.array([-2.0, 8.0])
+    C = np.eye(2)
+    loose = QP(H, g, None, None, C, np.array([-1e24, -1e30]), np.array([1e24, 1e30]))
+    scaled, _ = equilibrate(loose)
+    assert np.all(np.isneginf(scaled.l)) and np.all(np.isposinf(scaled.u))
+    np.testing.assert_allclose(solve_qp(loose, scale=True, max_inner=20).x, [1.0, -1.0], atol=1e-9)
+    tight = QP(H, g, None, None, C, np.array([1e24, -1.0]), np.array([1.0, 1.0]))  # x₀ ≥ 1e24 and ≤ 1
+    scaled, _ = equilibrate(tight)
+    assert scaled.l[0] == BOUND_CAP and np.isfinite(scaled.u[0])
+    with pytest.raises(OptimizationError, match="cannot all hold"):
+        solve_qp(tight, scale=True, max_iter=200, max_inner=20, infeasibility_eps=1e-9)

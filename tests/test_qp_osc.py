@@ -16,6 +16,7 @@ joint limits.
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 from typing import Any
 
@@ -34,7 +35,7 @@ from twolink_pin import (
     simulate_batch,
 )
 from twolink_pin.controllers import QPOperationalSpace, load_controller
-from twolink_pin.errors import InvalidParameterError, OptimizationError
+from twolink_pin.errors import ControllerError, InvalidParameterError
 from twolink_pin.limits import EFFORT, POSITION, joint_limits
 from twolink_pin.optimal import kkt_residual, solve_qp, unconstrained_minimiser
 from twolink_pin.simulation import law_input, terms_for
@@ -63,7 +64,8 @@ class Arm:
         qd, vd, ad = (np.asarray(a, dtype=float).reshape(1, -1) for a in (s[0], s[1], s[2]))
         q = qd + rng.uniform(-spread, spread, qd.shape)
         v = vd + rng.uniform(-4 * spread, 4 * spread, qd.shape)
-        return law_input(self.osc, t, q, v, np.zeros((1, 0)), qd, vd, ad), np.concatenate((q, v))
+        z = np.zeros((1, self.qp.state_size))  # qp-osc's observer, at rest (osc reads no state)
+        return law_input(self.osc, t, q, v, z, qd, vd, ad), np.concatenate((q, v))
 
     def acceleration(self, q: np.ndarray, v: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """q̈ [rad/s²] of the arm under ``tau`` [N·m] (Pinocchio's ABA: the plant's dynamics)."""
@@ -122,7 +124,8 @@ def _near_joint_4s_range() -> tuple[Arm, QPOperationalSpace, Any]:
     tight = QPOperationalSpace(a.robot, a.qp.Gains(limit_scale=0.4))
     q = np.array([[0.0, 0.6, 0.0, a.limits.position_upper[3] - 0.1, 0.0, 1.2, 0.785]])
     v = np.array([[0.0, -0.3, 0.0, 0.6, 0.0, 0.3, 0.0]])
-    return a, tight, law_input(a.osc, 0.0, q, v, np.zeros((1, 0)), q, v, np.zeros_like(q))
+    z = np.zeros((1, tight.state_size))
+    return a, tight, law_input(a.osc, 0.0, q, v, z, q, v, np.zeros_like(q))
 
 
 def test_an_active_limit_holds_to_the_solvers_tolerance() -> None:
@@ -163,7 +166,7 @@ def test_a_batch_equals_its_single_runs() -> None:
     rng = np.random.default_rng(0)
     q = np.concatenate((x.q, x.q + rng.uniform(-0.3, 0.3, x.q.shape), near.q, near.q))
     v = np.concatenate((x.v, x.v, near.v, -near.v))
-    batch = x._replace(q=q, v=v, z=np.zeros((4, 0)))
+    batch = x._replace(q=q, v=v, z=np.zeros((4, a.qp.state_size)))
     active = [unconstrained_minimiser(p) is None for p in a.qp.problems(batch, terms_for(a.qp, 4))]
     assert active[2] and not active[0]  # ProxQP for one run, the closed form for another
     together = a.qp.compute(batch, terms_for(a.qp, 4)).tau
@@ -215,40 +218,115 @@ def test_controllers_and_tune_list_its_gains_with_units(capsys: pytest.CaptureFi
     )
 
 
-def test_limits_that_cannot_hold_raise_naming_the_constraint() -> None:
+def test_limits_that_cannot_hold_fail_the_run_naming_the_constraint() -> None:
     """Effort limits at 1 % cannot hold the Panda up within its acceleration limits (at 1 %):
-    the QP has no solution, and the error names a row by its label and the time."""
+    the QP has no solution. With ``on_infeasible = "fail"`` the run's torque is NaN and its
+    reason names a row by its label and the time (the engine ends that run with it); with the
+    default ``relax`` the torque is finite and within the 1 % effort box, and the law records
+    the acceleration rows it let go (the only rows in conflict with the effort box here)."""
     a = arm("panda")
-    weak = QPOperationalSpace(a.robot, a.qp.Gains(limit_scale=0.01))
     x, _ = a.state(3)
-    with pytest.raises(
-        OptimizationError, match=r"the QP at t = .* s failed .* cannot all hold: .* of joint \d"
-    ):
-        weak.compute(x, terms_for(weak))
+    weak = QPOperationalSpace(a.robot, a.qp.Gains(limit_scale=0.01, on_infeasible="fail"))
+    weak.initial_state()
+    assert np.isnan(weak.compute(x, terms_for(weak)).tau).all()
+    reason = weak.run_failure(0)
+    assert reason is not None and re.search(
+        r"the QP at t = .* s failed .* cannot all hold: .* of joint \d", reason
+    )
+    relaxing = QPOperationalSpace(a.robot, a.qp.Gains(limit_scale=0.01))
+    relaxing.initial_state()
+    tau = relaxing.compute(x, terms_for(relaxing)).tau[0]
+    assert np.abs(tau).max() > 0 and (np.abs(tau) <= 0.01 * a.limits.effort * (1 + 1e-9)).all()
+    relaxed = relaxing.run_relaxations(0)
+    assert relaxed is not None and relaxed.instants == 1
+    assert np.nanmax(relaxed.largest[2]) > 0  # acceleration
+
+
+def test_an_infeasible_first_qp_fails_within_the_iteration_cap() -> None:
+    """The UR5 at ``limit_scale = 1e-12`` (a hostile run): its first QP cannot hold. With
+    ``fail`` the run fails at t = 0 within 200 of ProxQP's outer iterations (about a thousand of
+    its inner ones; uncapped it took 11 million and 131 s); with ``relax`` it runs, every
+    commanded torque within 1e-12 of each limit, and says where it relaxed."""
+    robot = load_robot("ur5")
+    reference = default_trajectory(robot)
+    config = SimulationConfig(duration=0.01)
+    law = QPOperationalSpace(robot, QPOperationalSpace.Gains(limit_scale=1e-12, on_infeasible="fail"))
+    plant = make_scenario("qp-osc", robot)[1]
+    with pytest.raises(ControllerError) as failed:
+        simulate(law, plant, reference, config)
+    message = str(failed.value)
+    assert "'qp-osc' failed at t = 0 s" in message
+    iterations = int(message.split("failed after ")[1].split(" iterations")[0])
+    assert iterations <= 2000  # 200 of ProxQP's outer iterations (it counts its inner ones)
+    law = QPOperationalSpace(robot, QPOperationalSpace.Gains(limit_scale=1e-12))
+    run = simulate(law, plant, reference, config)
+    assert (np.abs(run.tau_command) <= 1e-12 * joint_limits(robot).effort * (1 + 1e-6)).all()
+    assert run.relaxed is not None and run.relaxed.first_time[~np.isnan(run.relaxed.first_time)].min() == 0.0
+
+
+def test_a_damper_of_horizon_1e_12_s_near_a_range_is_solved_within_the_caps() -> None:
+    """``position_horizon = 1e-12`` s with the Panda's elbow started 1 mrad inside its range (a
+    hostile run: it ran for more than 300 s). The damper then asks for bounds of order 1e21 rad/s²:
+    read as none on their loose side and as 1e12 on the other, and ProxQP's inner iterations capped,
+    each QP ends within its caps — the run finishes, its commanded torque within the effort limits,
+    the elbow inside its range to RK4's rounding."""
+    robot = load_robot("panda")
+    limits = joint_limits(robot)
+    reference = default_trajectory(robot)
+    offset = np.zeros(7)
+    offset[3] = limits.position_lower[3] + 1e-3 - reference.sample(0.0).q[3]
+    law = QPOperationalSpace(robot, QPOperationalSpace.Gains(position_horizon=1e-12))
+    plant = make_scenario("qp-osc", robot)[1]
+    run = simulate(law, plant, reference, SimulationConfig(duration=0.02, q0_offset=offset))
+    assert np.isfinite(run.q).all() and run.t[-1] == pytest.approx(0.02)
+    assert (np.abs(run.tau_command) <= limits.effort * (1 + 1e-9)).all()
+    assert run.q[:, 3].min() >= limits.position_lower[3] - 1e-6
+
+
+def test_a_run_whose_qp_cannot_hold_ends_alone_in_a_batch() -> None:
+    """Three Panda runs with ``fail`` and per-run headroom (1, 0.01, 1): the middle one cannot
+    hold and ends at t = 0 with the law's reason; the others equal their single runs (it used to
+    end the whole batch, and a sweep with it)."""
+    robot = load_robot("panda")
+    gains = QPOperationalSpace.Gains(limit_scale=[1.0, 0.01, 1.0], on_infeasible="fail")
+    law = QPOperationalSpace(robot, gains)
+    plant = make_scenario("qp-osc", robot)[1]
+    config = SimulationConfig(duration=0.01)
+    batch = simulate_batch(
+        law, plant, default_trajectory(robot), config, q0_offsets=np.zeros((3, 7)), record=True
+    )
+    assert np.isnan(batch.diverged_at[[0, 2]]).all() and batch.diverged_at[1] == 0.0
+    assert batch.divergence[1] is not None and "cannot all hold" in batch.divergence[1]
+    single = simulate(
+        QPOperationalSpace(robot), plant, default_trajectory(robot), replace(config, q0_offset=0.0)
+    )
+    np.testing.assert_allclose(batch.q[0], single.q, rtol=0, atol=1e-9)
 
 
 def test_a_solver_that_stops_mid_run_fails_the_run_at_that_time(
     monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """ProxQP allowed no iteration (and no closed form) once the run is past 0.05 s: the QP it
-    cannot finish fails the run there — exit status 1, one line on stderr naming the law, the
-    time and what stopped — not a traceback and not a torque held from the step before."""
+    """ProxQP allowed no iteration (and no closed form) once the run is past 0.05 s, and
+    ``on_infeasible = "fail"``: the QP it cannot finish fails the run there — exit status 1, one
+    line on stderr naming the law, the time and what stopped — not a traceback and not a torque
+    held from the step before."""
     import twolink_pin.controllers.qp_osc as law_module
     import twolink_pin.optimal.qp as qp_module
     from twolink_pin.cli import main
 
     real = law_module.solve_qp
 
-    def starved(qp: Any, *, what: str, unconstrained_first: bool) -> Any:
-        if float(what.split("t = ")[1].split(" s")[0]) <= 0.05:
-            return real(qp, what=what, unconstrained_first=unconstrained_first)
-        return real(qp, what=what, max_iter=0)
+    def starved(qp: Any, **kwargs: Any) -> Any:
+        if float(kwargs["what"].split("t = ")[1].split(" s")[0]) <= 0.05:
+            return real(qp, **kwargs)
+        return real(qp, **{**kwargs, "max_iter": 0, "unconstrained_first": False})
 
     monkeypatch.setattr(law_module, "solve_qp", starved)
     monkeypatch.setattr(
         qp_module, "_infeasible_reason", lambda *args: None
     )  # a slow solve, not infeasibility
-    assert main(["simulate", "qp-osc", "--robot", "panda", "--duration", "0.2"]) == 1
+    argv = ["simulate", "qp-osc", "--robot", "panda", "--duration", "0.2", "--gain", "on_infeasible=fail"]
+    assert main(argv) == 1
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "Traceback" not in err[0], err
     assert "controller 'qp-osc' failed at t = 0.05" in err[0] and "ProxQP stopped with status" in err[0], err[
@@ -263,7 +341,9 @@ def test_per_run_gains_give_each_run_its_own_qp() -> None:
     a, _, near = _near_joint_4s_range()
     both = QPOperationalSpace(a.robot, a.qp.Gains(posture_weight=[0.01, 1.0], limit_scale=[1.0, 0.4]))
     assert both.runs == 2
-    x = near._replace(q=np.repeat(near.q, 2, axis=0), v=np.repeat(near.v, 2, axis=0), z=np.zeros((2, 0)))
+    x = near._replace(
+        q=np.repeat(near.q, 2, axis=0), v=np.repeat(near.v, 2, axis=0), z=np.zeros((2, both.state_size))
+    )
     together = both.compute(x, terms_for(both, 2)).tau
     for i, (w, f) in enumerate([(0.01, 1.0), (1.0, 0.4)]):
         single = QPOperationalSpace(a.robot, a.qp.Gains(posture_weight=w, limit_scale=f))

@@ -16,14 +16,15 @@ pytest.importorskip("pyarrow")
 
 
 def test_runs_mpc_could_not_plan_say_why_in_csv_json_and_parquet(tmp_path: Path) -> None:
-    """Started 3.5 ± 1 rad off (beyond joint 1's range for some draws): those runs end at
-    t = 0 with the replan's reason; the others have none (empty in CSV, null in JSON and
+    """Started 3.5 ± 1 rad off (beyond joint 1's range for some draws), ``on_infeasible=fail``
+    fixed for every run (a word, not a range): those runs end at t = 0 with the replan's reason; the others have none (empty in CSV, null in JSON and
     Parquet)."""
     import pyarrow.parquet as pq
 
     out = tmp_path / "s"
     argv = ["sweep", "mpc", "--samples", "4", "--chunk", "2", "--duration", "0.05"]
     argv += ["--q0-offset", "3.5", "0", "--q0-spread", "1", "--no-plot", "--out", str(out)]
+    argv += ["--gain", "on_infeasible=fail"]  # the default relaxes the range and goes on
     assert main(argv) == 0
     with open(out / "runs.csv", newline="") as f:
         rows = list(csv.DictReader(f))

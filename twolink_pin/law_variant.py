@@ -46,6 +46,7 @@ import numpy as np
 
 from twolink_pin.arm_effects import PLANT_KEYS, plant_value
 from twolink_pin.controllers import Controller
+from twolink_pin.controllers.gains import spec_of
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.scenario import law_class
 
@@ -54,18 +55,30 @@ PARAMETER_KEYS = ("model", "p0")
 ``--model``) or its estimates start at (``p0``, as ``--p0``)."""
 SETTING = re.compile(r"@(?=[A-Za-z_][A-Za-z0-9_]*=)")
 """An ``@`` that starts a setting: a key (a name) and ``=`` follow it."""
-GainValue = float | tuple[float, ...]
-"""A gain as the command line gives it: one number or several (per joint, a matrix row by row)."""
+GainValue = float | tuple[float, ...] | str
+"""A gain as the command line gives it: one number or several (per joint, a matrix row by row),
+or a word (a gain of choices, ``on_infeasible=fail``)."""
+WORD = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")
+"""A gain's value that is a word, not a number (``relax``): the gain's own check decides."""
 
 
-def gain_value(name: str, text: str) -> GainValue:
+def gain_value(name: str, text: str, choices: tuple[str, ...] | None = None) -> GainValue:
     """``text`` read as ``--gain NAME=TEXT`` reads it: one finite number (``200``, ``1e-3``)
-    or comma-separated finite numbers (``30,40``; a matrix row by row), as floats.
+    or comma-separated finite numbers (``30,40``; a matrix row by row), as floats; or one word
+    (``fail``: a gain of choices), as text. ``choices``: the gain's words when the law is known
+    (``()`` for a gain of numbers: a word is then refused here); None: a word is kept for the
+    gain's own check (:class:`~twolink_pin.controllers.Gains`) to judge.
 
     Raises:
         InvalidParameterError: an empty entry, text that is no number, or a non-finite one
             (named ``--gain NAME``, with the text received).
     """
+    word = text.strip()
+    if WORD.fullmatch(word) and word.lower() not in ("nan", "inf", "infinity"):
+        if choices is None or word in choices:
+            return word
+        if choices:
+            raise InvalidParameterError(f"--gain {name}", text, f"one of {', '.join(map(repr, choices))}")
     numbers = []
     for entry in text.split(","):
         try:
@@ -208,7 +221,7 @@ def parse_variant(text: str) -> Variant:
                 raise InvalidParameterError(f"{where}: {key}", value, exc.expected) from None
             continue
         try:
-            gains[key] = gain_value(key, value)
+            gains[key] = gain_value(key, value, spec_of(cls.Gains, key).choices)
         except InvalidParameterError as exc:
             raise InvalidParameterError(f"{where}: {key}", value, exc.expected) from None
     if len(files) > 1:
@@ -261,7 +274,10 @@ def _number(x: float) -> str:
 
 
 def _value_text(name: str, value: Any) -> str:
-    """A gain value as ``--gain NAME=`` takes it: numbers comma-separated (a matrix row by row)."""
+    """A gain value as ``--gain NAME=`` takes it: numbers comma-separated (a matrix row by row),
+    or the word of a gain of choices."""
+    if isinstance(value, str) and WORD.fullmatch(value):
+        return value
     if isinstance(value, (bool, str)) or value is None:
         raise InvalidParameterError(name, value, "a number, numbers per joint, or a matrix")
     array = np.asarray(value, dtype=float)
@@ -318,13 +334,20 @@ def format_variant(
             raise InvalidParameterError("gain", name, "a gain's field name (not model or p0)")
         if value is None:  # left to the robot: its default
             continue
-        if defaults is not None and defaults.get(name) is not None and _same_numbers(value, defaults[name]):
+        if defaults is not None and defaults.get(name) is not None and _same_value(value, defaults[name]):
             continue
         parts.append(f"{name}={_value_text(name, value)}")
     for key, path in (("model", model), ("p0", p0)):
         if path is not None:
             parts.append(f"{key}={_checked_text(key, path)}")
     return "@".join(parts)
+
+
+def _same_value(a: Any, b: Any) -> bool:
+    """Whether two gain values are the same: the same word, or :func:`_same_numbers`."""
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    return _same_numbers(a, b)
 
 
 def _same_numbers(a: Any, b: Any) -> bool:

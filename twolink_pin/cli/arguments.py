@@ -77,10 +77,16 @@ MAX_GAIN = 1e12
 
 def gain_range(text: str) -> Any:
     """``NAME=LO:HI`` as a :class:`~twolink_pin.studies.sweep.GainRange`, both bounds within
-    ±:data:`MAX_GAIN`."""
+    ±:data:`MAX_GAIN`; ``NAME=WORD`` (a word, no number: a gain of choices such as ``mpc``'s
+    ``on_infeasible=fail``) as the text itself, a gain fixed for every run."""
     from twolink_pin.errors import InvalidParameterError
     from twolink_pin.studies.sweep import GainRange
 
+    name, _, value = text.partition("=")
+    if (
+        name.strip() and value.strip().isidentifier()
+    ):  # a word: fixed (the law checks it is one of its choices)
+        return text
     try:
         parsed = GainRange.parse(text)
     except InvalidParameterError as exc:

@@ -72,7 +72,8 @@ def add_sweep_draws(p: argparse.ArgumentParser) -> None:
         action="append",
         default=[],
         metavar="NAME=LO:HI",
-        help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1 (repeatable)",
+        help="draw a gain uniformly, e.g. kp=100:400, kd2=20:80, lam=1:10, model_scale=0.2:1; or fix a gain "
+        "that is a word for every run, e.g. on_infeasible=fail (repeatable)",
     )
     p.add_argument(
         "--wrench-scale",

@@ -5,6 +5,8 @@
                        the ``Terms`` protocol, the registry :data:`CONTROLLERS`
 ``contact_input.py``   ``ContactInput``: the force sensor's wrench and the force reference
 ``gains.py``           :class:`Gains` and :func:`gain`: validated gains with units
+``preview.py``         :class:`ReferencePreview`: the reference ahead of now a law asks for
+``relaxation.py``      :class:`Relaxations`: the limits a law relaxed when they could not all hold
 ``loading.py``         :func:`load_controller`: a name, ``file.py:Class``, ``module:Class``
 ``pd.py``              ``pd`` — :class:`PDFeedforward` (report eq. 8)
 ``computed_torque.py`` ``computed-torque`` — :class:`ComputedTorque` (Slotine–Li)
@@ -39,6 +41,8 @@ from twolink_pin.controllers.base import (
 )
 from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.preview import ReferencePreview
+from twolink_pin.controllers.relaxation import Relaxations
 from twolink_pin.controllers.pd import PDFeedforward, PDGains
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, ComputedTorque, SlotineLiGains
 from twolink_pin.controllers.wrong_model import WrongModel, WrongModelGains
@@ -86,6 +90,8 @@ __all__ = [
     "PIDGains",
     "QPOSCGains",
     "QPOperationalSpace",
+    "ReferencePreview",
+    "Relaxations",
     "SlotineLiGains",
     "StateVariable",
     "Terms",

@@ -16,6 +16,8 @@ A law subclasses :class:`Controller`, states its law in the class docstring, dec
 
 and implements **one** method, :meth:`Controller.compute`, that maps a :class:`LawInput`
 (time, state, reference) to a :class:`LawOutput` (torque τ and, for a law with state, ż).
+A law that looks ahead declares :meth:`Controller.preview_times` (offsets from now [s]): the
+engine then samples the reference there and hands it in :attr:`LawInput.preview`.
 A law that plans (the model-predictive law) also declares :meth:`Controller.update_period`
 and :meth:`Controller.update`: a discrete update of its state (the new plan) that the engine
 makes at those instants.
@@ -44,6 +46,8 @@ import numpy as np
 from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.controllers.gains import Gains as GainsBase
 from twolink_pin.controllers.gains import as_matrix, check_width, gain_spec, runs_of
+from twolink_pin.controllers.preview import ReferencePreview
+from twolink_pin.controllers.relaxation import RunRelaxation
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.model import RobotModel
 
@@ -133,6 +137,11 @@ class LawInput(NamedTuple):
     """The force sensor's wrench, the force reference and its surface's normal
     (:class:`~twolink_pin.controllers.contact_input.ContactInput`) when the plant's scene has
     surfaces (``--scene``, ``--wall``), else None."""
+    preview: ReferencePreview | None = None
+    """The reference ahead of now at the offsets the law declares
+    (:meth:`Controller.preview_times`): times (P,) and ``q``, ``q̇``, ``q̈`` of shape (1, P, nv)
+    (:class:`~twolink_pin.controllers.preview.ReferencePreview`); None for a law that
+    declares none."""
 
 
 class LawOutput(NamedTuple):
@@ -453,6 +462,13 @@ class Controller(abc.ABC, Generic[G]):
         updates ``z`` moves only by the ``dz`` :meth:`compute` returns (zeros for a plan)."""
         raise NotImplementedError(f"{type(self).__name__} declares an update period but no update()")
 
+    def preview_times(self) -> np.ndarray | None:
+        """Offsets ``s_j ≥ 0`` [s] from now at which the law wants the reference at every
+        evaluation (a planning law: its knots), shape (P,), fixed for the run; ``None`` (the
+        default): none. The engine samples the trajectory at ``t + s_j`` for every run of a
+        batch at once and hands the samples in :attr:`LawInput.preview`."""
+        return None
+
     def run_failure(self, run: int) -> str | None:
         """Why the law gave up run ``run`` of the batch it computes, or ``None`` (the default).
 
@@ -461,6 +477,12 @@ class Controller(abc.ABC, Generic[G]):
         :meth:`update` (or :meth:`compute`) and says why here: the engine ends that run at that
         time with this text, as it ends a diverged one, and the other runs go on. A single run
         ends with an error naming the law, the time and this text."""
+        return None
+
+    def run_relaxations(self, run: int) -> RunRelaxation | None:
+        """Where and by how much the law relaxed limits it could not all keep in run ``run``
+        (:class:`~twolink_pin.controllers.relaxation.RunRelaxation`), or ``None`` (the
+        default: it relaxed none, or never relaxes). Read after the run, into its result."""
         return None
 
     def scaled_gains(self) -> dict[str, Any]:

@@ -64,9 +64,12 @@ class GainSpec(NamedTuple):
     """One-line description."""
     matrix: bool = False
     """A matrix gain (see the module docstring)."""
+    choices: tuple[str, ...] = ()
+    """A gain that is one word of these (``("relax", "fail")``), not a number: one value for
+    every run, given by name (``--gain on_infeasible=fail``); empty for a number."""
     multiple_of: str = ""
-    """The scalar gain this one is a whole multiple of (mpc's horizon: of its knot interval);
-    ``tune`` steps it by that gain's value."""
+    """The name of another gain of the law whose whole multiples this one takes (``mpc``'s
+    ``horizon``: whole knot intervals); a tuning control steps by that gain's value."""
 
 
 def gain(
@@ -77,6 +80,7 @@ def gain(
     bound: str = "positive",
     doc: str = "",
     matrix: bool = False,
+    choices: tuple[str, ...] = (),
     multiple_of: str = "",
 ) -> Any:
     """A gains field with its default, shape, unit and sign constraint.
@@ -91,8 +95,11 @@ def gain(
         doc: One-line description (shown by the CLI and the report).
         matrix: A symmetric positive-definite matrix gain of size k given by ``per``
             (``"joint"``, ``"estimate"`` or ``"axis"``); ``bound`` is then "positive".
-        multiple_of: The name of the scalar gain this scalar gain is a whole multiple of
-            (a horizon in knots of a knot interval): ``tune`` steps it by that gain's value.
+        choices: The words the gain may be (its default one of them): a gain that names a
+            behaviour (``on_infeasible = "relax"`` or ``"fail"``) rather than a number; scalar,
+            one value for every run.
+        multiple_of: Another gain whose whole multiples this one takes (see
+            :attr:`GainSpec.multiple_of`; the law enforces it).
     """
     if per not in SHAPES:
         raise ValueError(f"per must be one of {SHAPES}, got {per!r}")
@@ -102,9 +109,14 @@ def gain(
         raise ValueError("a scalar gain needs a default value")
     if matrix and (per == "scalar" or bound != "positive"):
         raise ValueError("a matrix gain is per joint, estimate or axis, and positive definite")
+    if choices and (per != "scalar" or matrix or default not in choices):
+        raise ValueError(
+            f"a gain of choices {choices} is scalar and defaults to one of them, got {default!r}"
+        )
     if multiple_of and per != "scalar":
         raise ValueError("a gain that is a multiple of another is a scalar gain")
-    return field(default=default, metadata={"gain": GainSpec(per, unit, bound, doc, matrix, multiple_of)})
+    spec = GainSpec(per, unit, bound, doc, matrix, tuple(choices), multiple_of)
+    return field(default=default, metadata={"gain": spec})
 
 
 def spec_of(gains_type: type[Gains] | Gains, name: str) -> GainSpec:
@@ -300,9 +312,20 @@ def apply_gain(gain: np.ndarray, x: np.ndarray) -> np.ndarray:
     return gain * x if gain.ndim == 2 else np.matvec(gain, x)
 
 
+def _validate_choice(name: str, value: Any, spec: GainSpec) -> str:
+    if isinstance(value, str) and value.strip() in spec.choices:
+        return value.strip()
+    words = ", ".join(repr(c) for c in spec.choices)
+    raise InvalidParameterError(name, value, f"one of {words} (one value for every run)")
+
+
 def _validate(name: str, value: Any, spec: GainSpec) -> Any:
+    if spec.choices:
+        return _validate_choice(name, value, spec)
     if value is not None and spec.matrix:
         return _validate_matrix(name, value, spec)
+    if isinstance(value, str):  # a word where a number is expected (--gain kp=abc)
+        raise InvalidParameterError(name, value, f"a number, got {value!r}: {_expected(spec)}")
     if value is None:
         if spec.per == "scalar":
             raise InvalidParameterError(name, value, _expected(spec))
@@ -416,6 +439,8 @@ def format_gain(value: Any, digits: int = 4) -> str:
     as its rows ``[[1500, 20, 0], [20, 1500, 0], [0, 0, 800]]``; per-run values (N of them)
     shortened."""
     shown = gain_as_json(value)
+    if isinstance(shown, str):  # a gain of choices
+        return shown
     if isinstance(shown, float):
         return f"{shown:.{digits}g}"
     array = np.asarray(shown, dtype=float)

@@ -7,13 +7,17 @@ from typing import Any, cast
 
 import numpy as np
 
-from twolink_pin.controllers.base import LawInput, LawOutput, Terms
+from twolink_pin.controllers.base import LawInput, LawOutput, StateVariable, Terms
+from twolink_pin.controllers.disturbance import DisturbanceObserver
 from twolink_pin.controllers.gains import gain
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
+from twolink_pin.controllers.relaxation import Relaxations, RunRelaxation
 from twolink_pin.controllers.task_space import posture_acceleration, row_index, task_acceleration
+from twolink_pin.errors import OptimizationError
 from twolink_pin.limits import ACCELERATION, EFFORT, POSITION, VELOCITY, JointLimits, LimitKind, joint_limits
 from twolink_pin.model import RobotModel
 from twolink_pin.optimal import QP, solve_qp
+from twolink_pin.optimal.relaxed import solve_relaxed
 
 POSTURE_WEIGHT = 0.01
 """Default ``w``: the posture's weight against the task's (both in the arm's inertia metric)."""
@@ -24,6 +28,33 @@ HORIZON_FLOOR = 0.1
 VELOCITY_HORIZON = 0.02
 """Default velocity-damper horizon ``h_v`` [s]: short, so that it brakes only near the limit, and 20
 steps of the default 1-ms step, so that RK4 follows it smoothly."""
+MAX_ITER = 200
+"""Most ProxQP iterations of one step's QP (a few variables and tens of rows: solved in tens); a
+QP that cannot hold is told apart at once (uncapped, the UR5's first step at ``limit_scale =
+1e-12`` took 11 million iterations and 131 s to fail, and a run ignored SIGTERM for 5 s)."""
+RELAXED_MAX_ITER = 1000
+"""Most ProxQP iterations of a step's QP with its rows relaxed."""
+RELAXED_ROUNDING = 1e-7
+"""A row's excess (relative to its value, at least 1) below this after a relaxed solve is the
+solver's rounding, not a relaxation."""
+RELAX_AFTER = 30
+"""With ``on_infeasible = "relax"``, the ProxQP iterations a step's QP gets with its rows hard
+before it is solved relaxed (whose answer is the hard one's whenever that exists: the penalty
+is exact); a QP that cannot hold costs 30, not 200, iterations before its answer."""
+MAX_INNER = 20
+"""Most of ProxQP's inner iterations per outer one (its default 1500): a QP that cannot hold,
+its bounds at 1e12 (a damper of horizon 1e-12 s), spent 1300 per outer iteration and a second a
+solve; a feasible one takes a few."""
+INFEASIBILITY_EPS = 1e-9
+"""ProxQP's infeasibility tolerances (its default, 1e-4, calls feasible steps infeasible)."""
+ACCEPT = 1e-6
+"""A QP stopped at :data:`MAX_ITER` whose equilibrated residuals are both below this is accepted."""
+PRIORITY = {EFFORT: -1, POSITION: 0, VELOCITY: 1, ACCELERATION: 2}
+"""The order rows give way in when they cannot all hold (−1: never)."""
+OBSERVER_RATE = 150.0
+"""Default ω_o [rad/s] of the disturbance observer (``mpc``'s): without it a push the model
+does not know makes every row a belief — the QP holds the acceleration it thinks the arm has
+while the arm, pushed, has another, and it never asks for the torque that would resist."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -41,6 +72,10 @@ class QPOSCGains(OSCGains):
         velocity_horizon: $h_v$ per joint [s] of the velocity damper; default 0.02 s.
         limit_scale: $f$, the fraction of the velocity, acceleration and effort limits the
             law may use, $0 < f \le 1$ (headroom; the position range is kept); default 1.
+        on_infeasible: ``"relax"`` (the position, velocity and acceleration rows give way, in
+            that order, the effort rows held; the run goes on) or ``"fail"`` (the run ends,
+            naming the row); default ``"relax"``.
+        observer_rate: $\omega_o$ [rad/s] of the disturbance observer (0: none); default 150.
     """
 
     posture_weight: Any = gain(POSTURE_WEIGHT, bound="fraction", doc="posture weight w against the task")
@@ -50,6 +85,14 @@ class QPOSCGains(OSCGains):
     )
     limit_scale: Any = gain(
         1.0, bound="fraction", doc="fraction f of the velocity, acceleration and effort limits used"
+    )
+    on_infeasible: Any = gain(
+        "relax",
+        choices=("relax", "fail"),
+        doc="when the limits cannot all hold: relax them in order, or fail",
+    )
+    observer_rate: Any = gain(
+        OBSERVER_RATE, unit="rad/s", bound="nonnegative", doc="rate ω_o of the disturbance observer (0: none)"
     )
 
 
@@ -139,6 +182,41 @@ class QPOperationalSpace(OperationalSpace):
         lower, upper, a_q, a_v = self._row_coefficients(given)
         self._rows = (lower, upper, a_q[:, self._n_effort :], a_v[:, self._n_effort :])
         self._weight = np.asarray(cast(QPOSCGains, self.gains).posture_weight, dtype=float).reshape(-1, 1, 1)
+        effort_limit = np.where(
+            np.isfinite(self.limits.effort),
+            np.asarray(scale, dtype=float).reshape(-1, 1) * self.limits.effort,
+            np.inf,
+        )
+        self._highest, self._lowest = effort_limit, -effort_limit  # f τ_max [N·m], (1 or N, nv)
+        self._priority = np.array([PRIORITY[kind] for kind, _ in given], dtype=int)
+        self._row_joint = np.array([j for _, j in given], dtype=int)
+        self._amount = self._row_units(given)
+        self._relax = cast(QPOSCGains, self.gains).on_infeasible == "relax"
+        self.observer = DisturbanceObserver(
+            robot, self.believed_parameters(), cast(QPOSCGains, self.gains).observer_rate, 0
+        )
+        """The estimate of the torque the model misses (a push, a wrong mass): the QP's dynamics
+        are ``M̂ q̈ + b̂ − d̂ = τ`` (``d̂``, ``ê``: the law's state ``z``)."""
+        self._failures: dict[int, str] = {}  # run → why its step's QP failed (:meth:`run_failure`)
+        self.relaxations = Relaxations(robot.nv)
+        """Where and by how much each run's QPs relaxed rows (:meth:`run_relaxations`)."""
+
+    def _row_units(self, given: list[tuple[LimitKind, int]]) -> np.ndarray:
+        """Per run and row, (1 or N, n_in), the factor from a row's slack [rad/s²] to how far
+        its limit was moved, in the limit's unit: ``h²`` for a position damper [rad], ``h_v``
+        for a velocity damper [rad/s], 1 for an acceleration row (0 for the effort rows)."""
+        g = cast(QPOSCGains, self.gains)
+        h, hv = np.atleast_2d(g.position_horizon), np.atleast_2d(g.velocity_horizon)
+        runs = max(h.shape[0], hv.shape[0])
+        shape = (runs, self.robot.nv)
+        per_kind = {
+            EFFORT: np.zeros(shape),
+            ACCELERATION: np.ones(shape),
+            VELOCITY: np.broadcast_to(hv, shape),
+            POSITION: np.broadcast_to(h * h, shape),
+        }
+        columns = [per_kind[kind][:, j] for kind, j in given]
+        return np.stack(columns, axis=-1) if columns else np.zeros((runs, 0))
 
     def _row_coefficients(self, given: list[tuple[LimitKind, int]]) -> tuple[np.ndarray, ...]:
         """Per inequality row, ``(lower, upper, a_q, a_v)`` with the row's bounds
@@ -165,14 +243,87 @@ class QPOperationalSpace(OperationalSpace):
     def scaled_gains(self) -> dict[str, Any]:
         return {"position_horizon": default_horizon(joint_limits(self.robot))}
 
+    def state_variables(self) -> tuple[StateVariable, ...]:
+        return (*super().state_variables(), *DisturbanceObserver.state_variables(self.robot.nv))
+
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
+        # a run ended already (its torque NaN at an earlier stage): no QP, a NaN torque again
+        ended = ~(np.isfinite(x.q).all(1) & np.isfinite(x.v).all(1) & np.isfinite(x.z).all(1))
+        if ended.any():
+            keep = ~ended[:, None]
+            x = x._replace(
+                q=np.where(keep, x.q, self.robot.home), v=np.where(keep, x.v, 0.0), z=np.where(keep, x.z, 0.0)
+            )
         problems, M, b = self._problems(x, terms)
         accel = np.empty_like(b)  # q̈ per run; then τ = M̂ q̈ + b̂
         at = f"the QP at t = {x.t:.6g} s"
         for i, qp in enumerate(problems):
             what = at if len(problems) == 1 else f"{at} (run {i})"
-            accel[i] = solve_qp(qp, what=what, unconstrained_first=True).x
-        return LawOutput(np.matvec(M, accel) + b)
+            accel[i] = np.nan if ended[i] else self._solve(qp, i, x.t, what, (M[i], b[i]))
+        tau = np.matvec(M, accel) + b
+        if self._n_effort:  # the effort rows hold to the solver's 1e-9: the box itself, exactly
+            np.clip(tau, self._lowest, self._highest, out=tau)
+        dz = np.zeros(x.z.shape)
+        if self.observer.on:  # M̂⁻¹(τ − b̂ + d̂) is the QP's q̈ (the clip moved it by rounding only)
+            gap = self.observer.gap(x.z, x.v - x.v_des)
+            dz[:, self.observer.columns[0]], dz[:, self.observer.columns[1]] = self.observer.derivative(
+                gap, accel - x.a_des
+            )
+        return LawOutput(tau, dz)
+
+    def _solve(
+        self, qp: QP, i: int, t: float, what: str, dynamics: tuple[np.ndarray, np.ndarray]
+    ) -> np.ndarray:
+        """Run ``i``'s ``q̈``: the QP's minimiser; with its rows relaxed in order when they cannot
+        all hold (``on_infeasible = "relax"``, recorded), else NaN: the run ends here
+        (:meth:`run_failure` says why). ``dynamics``: the run's ``(M̂, b̂ − d̂)``."""
+        try:
+            return solve_qp(
+                qp, what=what, unconstrained_first=True, max_iter=RELAX_AFTER if self._relax else MAX_ITER,
+                scale=True, accept=ACCEPT, infeasibility_eps=INFEASIBILITY_EPS, explain=not self._relax, max_inner=MAX_INNER,
+            ).x  # fmt: skip
+        except OptimizationError as exc:
+            if not self._relax:
+                self._failures.setdefault(i, str(exc))
+                return np.full(qp.g.shape, np.nan)
+        try:
+            accel = solve_relaxed(
+                qp, self._priority, what=what, max_iter=RELAXED_MAX_ITER, accept=ACCEPT, max_inner=MAX_INNER
+            ).solution.x
+        except OptimizationError:
+            accel = self._saturated(qp, i, dynamics)
+        assert qp.C is not None and qp.l is not None and qp.u is not None
+        cx = qp.C @ accel
+        excess = np.maximum(np.maximum(qp.l - cx, cx - qp.u), 0.0)
+        moved = np.where(excess > RELAXED_ROUNDING * np.maximum(1.0, np.abs(cx)), excess, 0.0)
+        moved = moved * self._amount[min(i, self._amount.shape[0] - 1)]
+        if moved.max(initial=0.0) > 0:
+            amounts = np.zeros((3, self.robot.nv))
+            soft = self._priority >= 0
+            np.maximum.at(amounts, (self._priority[soft], self._row_joint[soft]), moved[soft])
+            self.relaxations.add(i, t, amounts)
+        return accel
+
+    def _saturated(self, qp: QP, i: int, dynamics: tuple[np.ndarray, np.ndarray]) -> np.ndarray:
+        """The last resort when even the relaxed QP fails (an effort box narrower than the
+        solver's tolerance, ``limit_scale = 1e-12``): the cost's minimiser's torque clipped to
+        the effort box, and the acceleration it gives (every other row relaxed as it falls)."""
+        M, b = dynamics
+        tau = M @ np.linalg.solve(qp.H, -qp.g) + b
+        row = min(i, self._highest.shape[0] - 1)
+        tau = np.clip(tau, self._lowest[row], self._highest[row])
+        return np.linalg.solve(M, tau - b)
+
+    def run_failure(self, run: int) -> str | None:
+        return self._failures.get(run)
+
+    def run_relaxations(self, run: int) -> RunRelaxation | None:
+        return self.relaxations.of(run)
+
+    def initial_state(self) -> np.ndarray:
+        self._failures.clear()  # a new simulation: no run given up, nothing relaxed yet
+        self.relaxations.clear()
+        return super().initial_state()
 
     def problems(self, x: LawInput, terms: Terms) -> list[QP]:
         """The QP of each run at this evaluation (what :meth:`compute` solves; e.g. to inspect
@@ -191,6 +342,8 @@ class QPOperationalSpace(OperationalSpace):
         JtLam = np.matmul(Jt, Lam)
         task_hessian = np.matmul(JtLam, J)  # Jᵀ Λ J
         M, b = terms.mass(x.q), terms.bias(x.q, x.v)
+        if self.observer.on:
+            b = b - self.observer.estimate(x.z)  # the torque the model misses, as estimated
         posture = self._weight * (M - task_hessian)  # w Nᵀ M N: the null space (and any damped direction)
         H = task_hessian + posture
         gradient = -np.matvec(JtLam, task.desired - task.drift) - np.matvec(

@@ -6,7 +6,7 @@ and ``limits/``.
 
 ==========================  ================================================================
 ``qp.py``                   :func:`solve_qp`: the one QP solve (ProxQP; the unconstrained
-                            minimiser first on request), :func:`kkt_residual`
+                            minimiser first, equilibrated on request), :func:`kkt_residual`
 ``spline.py``               :class:`BSplineBasis`: values and derivatives of a B-spline as matrices
 ``layout.py``               :class:`SplineLayout`: a trajectory in spline segments, its variables
                             and Jacobians; :class:`Points` where it is evaluated
@@ -19,7 +19,10 @@ and ``limits/``.
 ``sqp.py``                  :func:`solve_sqp` (to convergence), :func:`sqp_step` (one real-time iteration)
 ``refinement.py``           :func:`solve_within_limits`: the limits between the check points too
 ``horizon.py``              :class:`~twolink_pin.optimal.horizon.Horizon`: the model-predictive law's
-                            horizon QP (knot accelerations, RNEA linearised, limits as rows)
+                            horizon QP (the reference plus knot accelerations, RNEA linearised,
+                            limits as rows)
+``relaxed.py``              :func:`~twolink_pin.optimal.relaxed.solve_relaxed`: a QP whose rows
+                            cannot all hold, the softer ones relaxed as little as they must, in order
 ==========================  ================================================================
 
 The robot's dynamics reach the core through one callable,

@@ -1,19 +1,22 @@
 """The finite-horizon QP of a model-predictive law: the plan's knot accelerations, the believed
 dynamics linearised on Pinocchio's RNEA derivatives, the joint limits as hard rows.
 
-**Decision.** The plan over the horizon ``[t, t + K h]`` is piecewise-constant acceleration:
-``a_k`` [rad/s²] on ``[t + k h, t + (k + 1) h)``, ``k = 0 … K − 1``, from the measured state
-``(q_0, q̇_0)``. Its states at the knots are linear in ``u = (a_0, …, a_{K−1})`` (knot-major,
-``K nv`` values)::
+**Decision.** The plan over the horizon ``[t, t + K h]`` is the reference plus a deviation of
+piecewise-constant acceleration: ``q̈_p(s) = q̈_r(s) + δ_k`` [rad/s²] on ``[t + k h, t + (k + 1) h)``,
+``k = 0 … K − 1``, from the measured state (``δq_0 = q_0 − q_r(t)``, ``δq̇_0 = q̇_0 − q̇_r(t)``).
+Its states at the knots are the reference's there (the law's preview of it) plus a deviation
+linear in ``u = (δ_0, …, δ_{K−1})`` (knot-major, ``K nv`` values)::
 
-    q̇_k = q̇_0 + h Σ_{j<k} a_j,      q_k = q_0 + k h q̇_0 + h² Σ_{j<k} (k − j − ½) a_j
+    q̇_k = q̇_r,k + δq̇_0 + h Σ_{j<k} δ_j,      q_k = q_r,k + δq_0 + k h δq̇_0 + h² Σ_{j<k} (k − j − ½) δ_j
 
-(exact for that acceleration: the velocity is linear between knots, so a velocity bound at the
-knots holds between them too).
+— exact for any reference: the reference's own motion between knots is not approximated, only
+the correction is piecewise constant (a reference extrapolated at constant acceleration from
+``t``, ``q_r(t + s) = q_d + q̇_d s + ½ q̈_d s²``, makes this the plan of pieces of constant
+acceleration ``q̈_d + δ_k``).
 
-**Dynamics.** ``τ_k = RNEA(q_k, q̇_k, a_k)`` on the believed model, linearised at a plan
-``ū`` (real-time iteration: the previous plan, shifted; its states rolled out from the measured
-state the same way)::
+**Dynamics.** ``τ_k = RNEA(q_k, q̇_k, a_k)`` with ``a_k = q̈_r,k + δ_k`` on the believed
+model, linearised at a plan ``ū`` (real-time iteration: the previous plan, shifted; its
+states rolled out from the measured state the same way)::
 
     τ_k ≈ τ̄_k + ∂τ/∂q (q_k − q̄_k) + ∂τ/∂q̇ (q̇_k − q̄̇_k) + M̂ (a_k − ā_k) = τ̄_k + T_k (u − ū)
 
@@ -30,10 +33,19 @@ and ``τ_k − τ_ref,k ≈ ∂τ/∂q (q_k − q_ref,k) + ∂τ/∂q̇ (q̇_k �
 the same linearisation (the reference's torque needs no further RNEA). With ``w_τ > 0`` the
 Hessian is positive definite.
 
-**Rows** (hard; ``f``: ``limit_scale``): ``|τ_k| ≤ f τ_max`` at knots 0 … K−1, ``|a_k| ≤ f
-q̈_max`` (where the arm has one), ``|q̇_k| ≤ f q̇_max`` and ``q_min ≤ q_k ≤ q_max`` at knots
-1 … K — the state bounds from the first knot on, not at the measured state (which the plan
-cannot change). A joint without a kind of limit has no row for it. Each row is labelled.
+**Rows** (``f``: ``limit_scale``): ``|τ_k − d̂| ≤ f τ_max`` at knots 0 … K−1 (``d̂``: the
+torque the law estimates its model misses, 0 without); ``|q̈| ≤ f q̈_max`` (where the arm has
+one), ``|q̇| ≤ f q̇_max`` and ``q_min ≤ q ≤ q_max`` at the **row times** ``i h / S``
+(:data:`ROWS_PER_INTERVAL` = S per knot interval; the state bounds from the first row time on,
+not at the measured state, which the plan cannot change). Between knots the plan is the
+reference plus a deviation: a reference whose velocity has a corner between two row times would
+carry the plan past a bound between them, so the velocity and acceleration rows bound the
+deviation at a row time plus the reference's extreme over the row times either side (its
+envelope: the deviation is linear, constant, between them — the bound then holds over the whole
+interval). A joint without a kind of limit has no row for it. Each row is labelled, and has a
+priority (:attr:`Horizon.priority`): the effort rows are hard, the position, velocity and
+acceleration rows give way in that order when they cannot all hold, by one amount per kind and
+joint over the horizon (:attr:`Horizon.group`; :mod:`twolink_pin.optimal.relaxed`).
 """
 
 from __future__ import annotations
@@ -51,6 +63,8 @@ from twolink_pin.optimal.qp import QP
 
 KINDS_IN_ROWS = (EFFORT, ACCELERATION, VELOCITY, POSITION)
 """The limits the QP's inequality rows bound, in the rows' order."""
+ROWS_PER_INTERVAL = 5
+"""``S``: the state rows' times per knot interval (every 5 ms at the default 25-ms knots)."""
 
 
 class CostWeights(NamedTuple):
@@ -100,88 +114,110 @@ class Horizon:
     """The horizon's fixed structure: ``K`` knots ``h`` [s] apart for a robot of ``nv`` joints
     and its limits, the integration matrices and the rows' labels (built once per law).
 
+    The state rows are checked ``S`` times per knot interval (:data:`ROWS_PER_INTERVAL`, the
+    **row times** ``t + i h / S``), not only at the knots: between knots the plan is the
+    reference plus a deviation, and a reference whose velocity peaks between two knots would
+    carry the plan past a limit there.
+
     Args:
         knots: ``K ≥ 1``, the number of knot intervals.
         interval: ``h`` [s] > 0.
         limits: The robot's joint limits (unscaled).
         limit_scale: ``f``, the fraction of the velocity, acceleration and effort limits used
             (one value for every run; the position range is kept).
+        per_interval: ``S``, the row times per knot interval.
     """
 
-    def __init__(self, knots: int, interval: float, limits: JointLimits, limit_scale: float) -> None:
+    def __init__(
+        self,
+        knots: int,
+        interval: float,
+        limits: JointLimits,
+        limit_scale: float,
+        per_interval: int = ROWS_PER_INTERVAL,
+    ) -> None:
         self.knots, self.interval, self.limits, self.nv = int(knots), float(interval), limits, limits.nv
+        self.per_interval = S = int(per_interval)
         K, h, nv = self.knots, self.interval, self.nv
-        k = np.arange(K + 1)[:, None]
-        j = np.arange(K)[None, :]
-        self.sq = np.where(j < k, h * h * (k - j - 0.5), 0.0)
-        """``q_k − q_0 − k h q̇_0 = Σ_j sq[k, j] a_j``, shape (K + 1, K) [s²]."""
-        self.sv = np.where(j < k, h, 0.0)
-        """``q̇_k − q̇_0 = Σ_j sv[k, j] a_j``, shape (K + 1, K) [s]."""
+        self.times = h / S * np.arange(K * S + 1)
+        """The row times [s] from now, ``i h / S`` for ``i = 0 … K S`` (the knots every ``S``th):
+        where the law wants the reference (its preview)."""
+        self.sq, self.sv = _integration(K, h, S)
+        """``q(t_i) − q_0 − t_i q̇_0 = Σ_j sq[i, j] a_j`` [s²] and ``q̇(t_i) − q̇_0 = Σ_j sv[i, j] a_j``
+        [s] at the row times, shape (K S + 1, K) (the knots: rows ``0, S, …, K S``)."""
+        self.sq_knots, self.sv_knots = self.sq[::S], self.sv[::S]
         eye = np.eye(nv)
-        self._kh = (h * np.arange(K + 1))[:, None]
-        self.Q = np.kron(self.sq, eye)  # ((K+1) nv, K nv)
-        self.V = np.kron(self.sv, eye)
-        self._Qk = self.Q.reshape(K + 1, nv, K * nv)
-        self._Vk = self.V.reshape(K + 1, nv, K * nv)
-        f = float(limit_scale)
-        rows: list[tuple[str, int, int, float, float]] = []  # kind, knot, joint, lower, upper
-        for kind in KINDS_IN_ROWS:
-            given = np.flatnonzero(limits.given(kind))
-            first = 0 if kind in (EFFORT, ACCELERATION) else 1
-            last = K - 1 if kind in (EFFORT, ACCELERATION) else K
-            for kn in range(first, last + 1):
-                for jj in given:
-                    if kind is POSITION:
-                        lo, hi = limits.position_lower[jj], limits.position_upper[jj]
-                    else:
-                        hi = f * float(getattr(limits, kind.name)[jj])
-                        lo = -hi
-                    rows.append((kind.name, kn, int(jj), float(lo), float(hi)))
+        self._t = self.times[:, None]
+        self.Q = np.kron(self.sq_knots, eye)  # ((K+1) nv, K nv): the knots' positions
+        self.V = np.kron(self.sv_knots, eye)
+        self._QVs = np.concatenate((self.Q[nv:], self.V[nv:]), axis=0)  # (2 K nv, K nv)
+        rows = _rows(K, S, limits, float(limit_scale))
         self.rows = rows
-        """Per inequality row: the kind's name, the knot, the joint (0-based), its bounds."""
+        """Per inequality row: the kind's name, the row time's index (the knot's for the effort
+        rows), the joint (0-based), its bounds."""
         self.labels: Sequence[str] = tuple(self._label(r) for r in rows)
         """What each row bounds, in words (a message's bounds and value are the row's: the
         quantity less its value on the plan the QP steps from)."""
+        self._layout(rows)
+
+    def _layout(self, rows: list[tuple[str, int, int, float, float]]) -> None:
+        """The rows' coefficients and where their values at a plan are read from."""
+        K, S, nv = self.knots, self.per_interval, self.nv
         kind_of = np.array([r[0] for r in rows], dtype=object)
-        knot = np.array([r[1] for r in rows], dtype=int)
+        at_time = np.array([r[1] for r in rows], dtype=int)
         joint = np.array([r[2] for r in rows], dtype=int)
         self._lower = np.array([r[3] for r in rows])
         self._upper = np.array([r[4] for r in rows])
         effort = np.flatnonzero(kind_of == EFFORT.name)
         state = np.flatnonzero(kind_of != EFFORT.name)
+        fine = K * S + 1
         C = np.zeros((len(rows), K * nv))
+        # each state row's value at a plan: an entry of [q (K S + 1, nv), q̇ (K S + 1, nv), q̈ (K S, nv)]
+        at = np.zeros(len(rows), dtype=int)
         for i in state:
-            kn, jj = knot[i], joint[i]
+            ti, jj = at_time[i], joint[i]
             if kind_of[i] == ACCELERATION.name:
-                C[i, kn * nv + jj] = 1.0
+                C[i, (ti // S) * nv + jj] = 1.0
+                at[i] = 2 * fine * nv + ti * nv + jj
             elif kind_of[i] == VELOCITY.name:
-                C[i] = self._Vk[kn, jj]
+                C[i, jj::nv] = self.sv[ti]
+                at[i] = fine * nv + ti * nv + jj
             else:
-                C[i] = self._Qk[kn, jj]
+                C[i, jj::nv] = self.sq[ti]
+                at[i] = ti * nv + jj
         self._C_state = C[state]
-        # the state rows' value at the measured state: q0_j + k h q̇0_j (position), q̇0_j (velocity)
-        B = np.zeros((state.size, 2 * nv))
-        for r, i in enumerate(state):
-            if kind_of[i] == POSITION.name:
-                B[r, joint[i]], B[r, nv + joint[i]] = 1.0, float(knot[i]) * h
-            elif kind_of[i] == VELOCITY.name:
-                B[r, nv + joint[i]] = 1.0
-        self._state_map = np.concatenate((self._C_state, B), axis=1).T.copy()  # (K nv + 2 nv, rows)
+        self._state_at = at[state]
+        self.joint = joint
+        """The joint (0-based) of each row."""
+        order = {POSITION.name: 0, VELOCITY.name: 1, ACCELERATION.name: 2}
+        self.priority = np.array([order.get(r[0], -1) for r in rows], dtype=int)
+        """Per row: −1 hard (effort), else the order it gives way in when the rows cannot all
+        hold — 0 position, 1 velocity, 2 acceleration (:mod:`twolink_pin.optimal.relaxed`; the
+        index into :data:`~twolink_pin.controllers.relaxation.RELAXED_KINDS`)."""
+        self.group = np.where(self.priority >= 0, self.priority * self.nv + joint, -1)
+        """Per row, the slack it shares when relaxed: one per kind and joint over the horizon
+        (a limit given way by one amount, whatever the row time); −1 for the hard rows."""
         # the rows of each kind and the variables of the effort rows' torques: slices where contiguous
         self._effort = _contiguous(effort)
-        self._effort_index = _contiguous(knot[effort] * nv + joint[effort])
+        self._effort_index = _contiguous(at_time[effort] * nv + joint[effort])
+        self._effort_joint = joint[effort]
         self._state = _contiguous(state)
         select = np.zeros((K, nv, K * nv))
         for block in range(K):
-            select[block, :, block * nv : (block + 1) * nv] = eye
-        self._QVE = np.concatenate((self._Qk[:K], self._Vk[:K], select), axis=1)  # (K, 3 nv, K nv)
-        self._QVs = np.concatenate((self.Q[nv:], self.V[nv:]), axis=0)  # (2 K nv, K nv)
+            select[block, :, block * nv : (block + 1) * nv] = np.eye(nv)
+        Qk = self.Q.reshape(K + 1, nv, K * nv)
+        Vk = self.V.reshape(K + 1, nv, K * nv)
+        self._QVE = np.concatenate((Qk[:K], Vk[:K], select), axis=1)  # (K, 3 nv, K nv)
+        self._piece = np.arange(K * S) // S  # the piece each row time (but the last) lies in
 
     def _label(self, row: tuple[str, int, int, float, float]) -> str:
-        name, kn, jj, lo, hi = row
+        name, ti, jj, lo, hi = row
         joint = f"joint {jj + 1} ({self.limits.joint_names[jj]})"
-        when = f"at knot {kn} (t + {kn * self.interval:.6g} s)"
         kind = {k.name: k for k in KINDS_IN_ROWS}[name]
+        if kind is EFFORT:
+            when = f"at knot {ti} (t + {ti * self.interval:.6g} s)"
+        else:
+            when = f"at t + {self.times[ti]:.6g} s"
         held = f"(row: {kind.symbol} less its value on the shifted plan [{kind.unit}])"
         if kind is POSITION:
             return f"the position range [{lo:.6g}, {hi:.6g}] rad of {joint} {when} {held}"
@@ -192,12 +228,35 @@ class Horizon:
         """``K nv``: the QP's variables."""
         return self.knots * self.nv
 
+    def relaxed_amounts(self, slack: np.ndarray) -> np.ndarray:
+        """A relaxed solve's slack per row [the row's unit] as the largest per kind that gives
+        way and joint, (3, nv) (position, velocity, acceleration; 0 where none)."""
+        amounts = np.zeros((3, self.nv))
+        soft = self.priority >= 0
+        np.maximum.at(amounts, (self.priority[soft], self.joint[soft]), slack[soft])
+        return amounts
+
     def rollout(self, q0: np.ndarray, v0: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The knot states ``q_k``, ``q̇_k`` [rad, rad/s], each (N, K + 1, nv), of the plan ``u``
-        (N, K, nv) [rad/s²] from ``(q0, v0)`` (N, nv)."""
-        q = q0[:, None] + self._kh * v0[:, None] + np.matmul(self.sq, u)
+        """``q``, ``q̇`` [rad, rad/s] at the row times, each (N, K S + 1, nv), of pieces of
+        constant acceleration ``u`` (N, K, nv) [rad/s²] from ``(q0, v0)`` (N, nv) — the plan's
+        deviation from the reference, from the measured state's deviation."""
+        q = q0[:, None] + self._t * v0[:, None] + np.matmul(self.sq, u)
         v = v0[:, None] + np.matmul(self.sv, u)
         return q, v
+
+    def plan(
+        self,
+        reference: tuple[np.ndarray, np.ndarray, np.ndarray],
+        dq0: np.ndarray,
+        dv0: np.ndarray,
+        u: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The plan at the row times: the reference ``(q_r, q̇_r, q̈_r)`` (1 or N, K S + 1, nv)
+        plus the deviation ``u`` (N, K, nv) from ``(dq0, dv0)`` (N, nv): ``q``, ``q̇`` (N, K S + 1, nv)
+        and ``q̈`` (N, K S, nv) [rad, rad/s, rad/s²]."""
+        qr, vr, ar = reference
+        dq, dv = self.rollout(dq0, dv0, u)
+        return qr + dq, vr + dv, ar[:, :-1] + u[:, self._piece]
 
     def weights(self, weight_q: np.ndarray, weight_v: np.ndarray, weight_tau: np.ndarray) -> CostWeights:
         """The cost's weights laid out over the knots, and its tracking Hessian (made once per law).
@@ -217,31 +276,30 @@ class Horizon:
 
     def problems(
         self,
-        q0: np.ndarray,
-        v0: np.ndarray,
-        u_bar: np.ndarray,
-        states: tuple[np.ndarray, np.ndarray],
+        states: tuple[np.ndarray, np.ndarray, np.ndarray],
         d: InverseDynamicsDerivatives,
         reference: tuple[np.ndarray, np.ndarray, np.ndarray],
         weights: CostWeights,
+        disturbance: np.ndarray | None = None,
     ) -> HorizonQPs:
         """The QPs of the N runs, over ``x = u − ū`` (the step from the linearisation plan:
-        the plan is ``ū + x``).
+        the plan's deviation is ``ū + x``).
 
         Args:
-            q0, v0: The measured state [rad, rad/s], (N, nv).
-            u_bar: The plan linearised at [rad/s²], (N, K, nv).
-            states: ``ū``'s knot states from ``(q0, v0)`` (:meth:`rollout`).
-            d: τ and its derivatives at ``ū``'s states, knots 0 … K−1, (N, K, nv[, nv]).
-            reference: ``q_ref``, ``q̇_ref``, ``q̈_ref`` at knots 0 … K, each (1 or N, K + 1, nv)
-                or broadcastable to it (a constant acceleration: (1, 1, nv)).
+            states: The plan ``ū`` at the row times (:meth:`plan`): ``q``, ``q̇`` (N, K S + 1, nv),
+                ``q̈`` (N, K S, nv).
+            d: τ and its derivatives at the plan's knots 0 … K−1, (N, K, nv[, nv]).
+            reference: ``q_r``, ``q̇_r``, ``q̈_r`` at the row times, each (1 or N, K S + 1, nv).
             weights: :meth:`weights`.
+            disturbance: ``d̂`` [N·m], (N, nv): the torque the model misses, which the motor's
+                torque ``τ_k − d̂`` must keep within its limit (None: 0).
         """
-        N, K, nv = q0.shape[0], self.knots, self.nv
+        qf, vf, af = states
+        S = self.per_interval
+        qb, vb, ab = qf[:, ::S], vf[:, ::S], af[:, ::S]
+        qr, vr, ar = (x[:, ::S] for x in reference)
+        N, K, nv = qb.shape[0], self.knots, self.nv
         n = K * nv
-        qb, vb = states
-        qr, vr, ar = reference
-        # T: the torque's Jacobian over u, (N, K, nv, K nv); block lower-triangular, M̂ on the diagonal
         # T: the torque's Jacobian over u, (N, K nv, K nv): [∂τ/∂q, ∂τ/∂q̇, M̂] at knot k times
         # [∂q_k/∂u; ∂q̇_k/∂u; ∂a_k/∂u] — block lower-triangular, M̂ on its diagonal
         D = np.concatenate((d.dtau_dq, d.dtau_dv, d.mass), axis=-1)  # (N, K, nv, 3 nv)
@@ -250,9 +308,9 @@ class Horizon:
         dq, dv = qb - qr, vb - vr
         eq = dq[:, 1:].reshape(N, n)  # q_k − q_ref,k, knots 1..K
         ev = dv[:, 1:].reshape(N, n)
-        et = np.matmul(
-            D, np.concatenate((dq[:, :K], dv[:, :K], u_bar - ar[:, :K]), axis=-1)[..., None]
-        ).reshape(N, n)
+        et = np.matmul(D, np.concatenate((dq[:, :K], dv[:, :K], ab - ar[:, :K]), axis=-1)[..., None]).reshape(
+            N, n
+        )
         Tt = T.transpose(0, 2, 1)
         H = weights.tracking + weights.tau * np.matmul(Tt, T)
         g = np.matmul(np.concatenate((weights.q2 * eq, weights.v2 * ev), axis=1), self._QVs) + weights.tau[
@@ -265,14 +323,69 @@ class Horizon:
         C = np.empty((N, len(self.rows), n))
         C[:, self._effort] = T[:, self._effort_index]
         C[:, self._state] = self._C_state
-        # each row's value at x = 0: the effort rows' τ̄, the state rows' (u, q0, q̇0) at ū
-        at_bar = np.empty((N, len(self.rows)))
-        at_bar[:, self._effort] = d.tau.reshape(N, n)[:, self._effort_index]
-        at_bar[:, self._state] = np.matmul(
-            np.concatenate((u_bar.reshape(N, n), q0, v0), axis=1), self._state_map
-        )
-        lower, upper = self._lower - at_bar, self._upper - at_bar
-        return HorizonQPs(H, g, C, lower, upper, self.labels)
+        # each row's value at x = 0: the effort rows' τ̄ (less d̂), the state rows' plan at ū —
+        # the velocity and acceleration rows with the reference's envelope over the neighbouring
+        # row times: the deviation is linear (constant) between them, the reference may have a
+        # corner there, so the bound holds over the whole interval, not only at its ends
+        vr, ar_full = reference[1], reference[2]
+        lo_bar, hi_bar = np.empty((N, len(self.rows))), np.empty((N, len(self.rows)))
+        tau_bar = d.tau.reshape(N, n)[:, self._effort_index]
+        if disturbance is not None:
+            tau_bar = tau_bar - disturbance[:, self._effort_joint]
+        lo_bar[:, self._effort] = hi_bar[:, self._effort] = tau_bar
+        for out, envelope in ((lo_bar, np.minimum), (hi_bar, np.maximum)):
+            v = vf + (_envelope(vr, envelope) - vr)
+            a = af + (_envelope(ar_full, envelope)[:, :-1] - ar_full[:, :-1])
+            plan = np.concatenate((qf.reshape(N, -1), v.reshape(N, -1), a.reshape(N, -1)), axis=1)
+            out[:, self._state] = plan[:, self._state_at]
+        return HorizonQPs(H, g, C, self._lower - lo_bar, self._upper - hi_bar, self.labels)
+
+
+def _envelope(x: np.ndarray, pick: np.ufunc) -> np.ndarray:
+    """Per row time (axis 1 of ``x``, (·, T, nv)), ``pick`` (``np.maximum`` or ``np.minimum``)
+    of ``x`` there and at the row times either side: the reference's extreme over the two
+    intervals a row time bounds."""
+    y = np.array(np.broadcast_to(x, x.shape))
+    pick(y[:, 1:], x[:, :-1], out=y[:, 1:])
+    pick(y[:, :-1], x[:, 1:], out=y[:, :-1])
+    return y
+
+
+def _integration(K: int, h: float, S: int) -> tuple[np.ndarray, np.ndarray]:
+    """``sq``, ``sv`` (K S + 1, K) of :class:`Horizon`: at row time ``t_i = i h / S``, piece ``j``
+    (``[j h, (j + 1) h)``) has run for ``f = clip(t_i / h − j, 0, 1)`` of its length, so it moved
+    the velocity by ``f h a_j`` and the position by ``h² f²/2 a_j`` while under way, by
+    ``h² (t_i / h − j − ½) a_j`` once over."""
+    r = (np.arange(K * S + 1) / S)[:, None] - np.arange(K)[None, :]  # t_i / h − j
+    f = np.clip(r, 0.0, 1.0)
+    sv = h * f
+    sq = h * h * np.where(r >= 1.0, r - 0.5, 0.5 * f * f)
+    return sq, sv
+
+
+def _rows(K: int, S: int, limits: JointLimits, f: float) -> list[tuple[str, int, int, float, float]]:
+    """The QP's inequality rows ``(kind, time index, joint, lower, upper)``, kind by kind
+    (:data:`KINDS_IN_ROWS`): effort at the knots 0 … K−1 (the index is the knot's), acceleration
+    at the row times 0 … K S − 1, velocity and position at 1 … K S (from the first row time on:
+    the measured state is what it is); a joint without a kind of limit has none."""
+    rows: list[tuple[str, int, int, float, float]] = []
+    for kind in KINDS_IN_ROWS:
+        given = np.flatnonzero(limits.given(kind))
+        if kind is EFFORT:
+            times = range(K)
+        elif kind is ACCELERATION:
+            times = range(K * S)
+        else:
+            times = range(1, K * S + 1)
+        for ti in times:
+            for jj in given:
+                if kind is POSITION:
+                    lo, hi = float(limits.position_lower[jj]), float(limits.position_upper[jj])
+                else:
+                    hi = f * float(getattr(limits, kind.name)[jj])
+                    lo = -hi
+                rows.append((kind.name, ti, int(jj), lo, hi))
+    return rows
 
 
 def _contiguous(index: np.ndarray) -> slice | np.ndarray:
@@ -282,14 +395,26 @@ def _contiguous(index: np.ndarray) -> slice | np.ndarray:
     return index
 
 
+WHOLE = 1e-9
+"""How far ``horizon / knot_interval`` may lie from a whole number (relative) and still be one."""
+
+
 def knots_of(horizon: float, interval: float) -> int:
     """``K = round(horizon / interval)`` knot intervals, at least 1: the horizon [s] in
-    intervals of ``interval`` [s] (a horizon shorter than one interval is refused)."""
+    intervals of ``interval`` [s] (a horizon shorter than one interval is refused; one that is
+    not a whole number of intervals is rounded: :func:`whole_knots` says whether it was)."""
     if not horizon >= interval:
         raise InvalidParameterError(
             "horizon", horizon, f"a horizon [s] of at least one knot interval ({interval:g} s)"
         )
     return max(1, round(horizon / interval))
+
+
+def whole_knots(horizon: float, interval: float) -> bool:
+    """Whether ``horizon`` [s] is a whole number of knot intervals ``interval`` [s] (to
+    :data:`WHOLE`, relative)."""
+    ratio = horizon / interval
+    return abs(ratio - round(ratio)) <= WHOLE * max(1.0, ratio)
 
 
 SOLVER_FACTOR = 10
@@ -301,7 +426,7 @@ rows, ``m`` = 3 n to 4 n; ``tests/test_memory.py``)."""
 
 def horizon_bytes(knots: int, limits: JointLimits, runs: int) -> int:
     """Bytes the QPs of a horizon of ``knots`` take at most (:func:`check_memory`): ``n = K nv``
-    variables, ``m`` rows (one per knot and limit the robot has), ``N`` runs::
+    variables, ``m`` rows (:func:`row_count`), ``N`` runs::
 
         8 B × (10 (n + m)² + 9 n² + 2 m n + N (5 n² + m n))
 
@@ -309,8 +434,16 @@ def horizon_bytes(knots: int, limits: JointLimits, runs: int) -> int:
     integration maps, 9 n² and 2 m n) and each run's Hessian, torque Jacobian and rows with
     their temporaries (5 n² + m n)."""
     n = knots * limits.nv
-    m = knots * sum(int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS)
+    m = row_count(knots, limits)
     return 8 * (SOLVER_FACTOR * (n + m) ** 2 + 9 * n * n + 2 * m * n + runs * (5 * n * n + m * n))
+
+
+def row_count(knots: int, limits: JointLimits) -> int:
+    """The horizon QP's rows: one per knot and effort limit, :data:`ROWS_PER_INTERVAL` per knot
+    interval and other limit the robot has (position, velocity, acceleration)."""
+    per_time = {kind: int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS}
+    state = sum(per_time.values()) - per_time[EFFORT]
+    return knots * (per_time[EFFORT] + ROWS_PER_INTERVAL * state)
 
 
 def check_memory(knots: int, interval: float, limits: JointLimits, runs: int, what: str = "horizon") -> None:
@@ -323,7 +456,7 @@ def check_memory(knots: int, interval: float, limits: JointLimits, runs: int, wh
         InvalidParameterError: naming the horizon's knots, the bytes needed and available.
     """
     n = knots * limits.nv
-    m = knots * sum(int(limits.given(kind).sum()) for kind in KINDS_IN_ROWS)
+    m = row_count(knots, limits)
     need, have = horizon_bytes(knots, limits, runs), available_memory()
     if have is not None and need > have:
         raise InvalidParameterError(

@@ -34,6 +34,10 @@ STRICT_INFEASIBILITY_EPS = 1e-9
 its closest point), a feasible one is solved."""
 DEFAULT_MAX_ITER = 10_000
 """Most ProxQP iterations of one solve."""
+BOUND_CAP = 1e12
+"""An equilibrated problem's bound beyond ±this (rows of unit largest coefficient, variables of
+unit curvature) is read as none on its side (±inf) or as this on the other (a bound no point
+of the problem's scale reaches: the problem stays infeasible, with sane numbers)."""
 
 
 class QP(NamedTuple):
@@ -78,8 +82,9 @@ class QPSolution(NamedTuple):
 def kkt_residual(qp: QP, solution: QPSolution) -> float:
     """The largest violation of the KKT conditions at ``solution``, computed here, not by the
     solver: stationarity ``‖H x + g + Aᵀ y + Cᵀ z‖∞``, primal feasibility, the sign of each
-    multiplier against the side of its bound, and complementarity ``|z_i| · dist(C_i x,
-    its bound)`` (all in the problem's own units)."""
+    multiplier against the side of its bound (a multiplier against a side without a bound,
+    ±inf, is its own violation), and complementarity ``|z_i| · dist(C_i x, its bound)`` (all in
+    the problem's own units)."""
     x, y, z = solution.x, solution.y, solution.z
     stationarity = qp.H @ x + qp.g
     residuals = []
@@ -91,11 +96,13 @@ def kkt_residual(qp: QP, solution: QPSolution) -> float:
         stationarity = stationarity + qp.C.T @ z
         cx = qp.C @ x
         residuals.append(np.maximum(np.maximum(qp.l - cx, cx - qp.u), 0.0).max())
-        upper = np.where(np.isfinite(qp.u), np.abs(qp.u - cx), np.inf)
-        lower = np.where(np.isfinite(qp.l), np.abs(cx - qp.l), np.inf)
-        # z > 0 pushes against the upper bound, z < 0 against the lower one
-        residuals.append((np.maximum(z, 0.0) * np.minimum(upper, 1e300)).max())
-        residuals.append((np.maximum(-z, 0.0) * np.minimum(lower, 1e300)).max())
+        # z > 0 pushes against the upper bound, z < 0 against the lower one; against a side
+        # that has no bound (±inf) a multiplier is itself the violation (its sign is wrong)
+        finite_u, finite_l = np.isfinite(qp.u), np.isfinite(qp.l)
+        upper = np.where(finite_u, np.abs(np.where(finite_u, qp.u, 0.0) - cx), 1.0)
+        lower = np.where(finite_l, np.abs(cx - np.where(finite_l, qp.l, 0.0)), 1.0)
+        residuals.append((np.maximum(z, 0.0) * upper).max())
+        residuals.append((np.maximum(-z, 0.0) * lower).max())
     residuals.append(np.abs(stationarity).max())
     return float(max(residuals))
 
@@ -112,6 +119,9 @@ def solve_qp(
     explain: bool = True,
     rho: float | None = None,
     infeasibility_eps: float | None = None,
+    scale: bool = False,
+    gap_rel: float = 0.0,
+    max_inner: int | None = None,
 ) -> QPSolution:
     """Solve ``qp`` with ProxQP (dense), warm-started from ``warm`` when given.
 
@@ -133,6 +143,16 @@ def solve_qp(
         infeasibility_eps: ProxQP's primal and dual infeasibility tolerances (None: its
             default, 1e-4, which declared the trajectory optimiser's feasible steps
             infeasible; it takes 1e-9, a problem that cannot hold still told apart below).
+        scale: Solve the problem equilibrated (:func:`equilibrate`: every variable of unit
+            curvature, every row of unit largest coefficient) and map the solution back, so
+            that ``eps`` and ``accept`` mean the same on an arm whose joint inertias span
+            four decades as on one whose do not; the residuals returned are the scaled ones.
+        gap_rel: ProxQP's relative duality-gap tolerance (the absolute one is ``eps``): a
+            problem whose costs are large (a relaxed QP's penalties, 10⁶) cannot close its gap to
+            1e-9 absolutely; it takes ``eps`` relative.
+        max_inner: Most of ProxQP's inner (Newton) iterations per outer one (None: its 1500):
+            ``max_iter`` bounds the outer ones only, and a problem that cannot hold took 1300
+            inner iterations per outer one, a second a solve, where a law asks for thousands.
 
     Raises:
         OptimizationError: ProxQP did not solve it: the constraints cannot all hold (the
@@ -143,35 +163,19 @@ def solve_qp(
         inside = unconstrained_minimiser(qp)
         if inside is not None:
             return inside
-    import proxsuite
-
-    proxqp = proxsuite.proxqp
     n = qp.g.shape[0]
-    if rho is not None or infeasibility_eps is not None:
-        result = _solve_set(qp, warm, eps, max_iter, rho, infeasibility_eps)
+    problem, back = equilibrate(qp) if scale else (qp, None)
+    start = warm if back is None or warm is None else back.scaled(warm)
+    if rho is not None or infeasibility_eps is not None or max_inner is not None:
+        result = _solve_set(problem, start, eps, max_iter, rho, infeasibility_eps, gap_rel, max_inner)
     else:
-        result = _solve_default_checked(qp, warm, eps, max_iter)
-    info = result.info
-    status = info.status
-    near = (
-        accept is not None
-        and status == proxqp.PROXQP_MAX_ITER_REACHED
-        and max(info.pri_res, info.dua_res) <= accept
-    )
-    if status != proxqp.PROXQP_SOLVED and not near:
-        # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
-        # the closest feasible point tells a problem that cannot hold from a slow one
-        flagged = status == proxqp.PROXQP_PRIMAL_INFEASIBLE
-        infeasible = _infeasible_reason(qp, eps, max_iter, flagged) if explain else None
-        reason = infeasible or (
-            f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
-            f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
-        )
-        raise OptimizationError(what, reason, int(info.iter))
+        result = _solve_default_checked(problem, start, eps, max_iter, gap_rel)
+    _check_status(qp, result.info, accept, explain, eps, max_iter, what)
     m = 0 if qp.A is None else qp.A.shape[0]
     k = 0 if qp.C is None else qp.C.shape[0]
+    info = result.info
     x = np.array(result.x[:n], dtype=float)
-    return QPSolution(
+    solution = QPSolution(
         x,
         np.array(result.y[:m], dtype=float),
         np.array(result.z[:k], dtype=float),
@@ -179,21 +183,104 @@ def solve_qp(
         float(info.pri_res),
         float(info.dua_res),
     )
+    return solution if back is None else back.unscaled(solution)
 
 
-def _solve_default_checked(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -> Any:
+def _check_status(
+    qp: QP, info: Any, accept: float | None, explain: bool, eps: float, max_iter: int, what: str
+) -> None:
+    """Raise :class:`OptimizationError` unless ProxQP solved ``qp`` (or stopped at its
+    iteration cap within ``accept``), naming the row that cannot hold (``explain``) or the status."""
+    import proxsuite
+
+    proxqp = proxsuite.proxqp
+    status = info.status
+    near = (
+        accept is not None
+        and status == proxqp.PROXQP_MAX_ITER_REACHED
+        and info.iter > 0  # with no iteration run ProxQP reports residuals of 0
+        and max(info.pri_res, info.dua_res) <= accept
+    )
+    if status == proxqp.PROXQP_SOLVED or near:
+        return
+    # ProxQP flags infeasibility only sometimes (an unbounded side keeps it iterating):
+    # the closest feasible point tells a problem that cannot hold from a slow one
+    flagged = status == proxqp.PROXQP_PRIMAL_INFEASIBLE
+    infeasible = _infeasible_reason(qp, eps, max_iter, flagged) if explain else None
+    reason = infeasible or (
+        f"ProxQP stopped with status {str(status).rsplit('.', 1)[-1]} after {info.iter} iterations "
+        f"(primal residual {info.pri_res:.3g}, dual residual {info.dua_res:.3g})"
+    )
+    raise OptimizationError(what, reason, int(info.iter))
+
+
+class Equilibration(NamedTuple):
+    """How :func:`equilibrate` scaled a QP: ``x = D x'``, ``C' = R C D``, ``A' = S A D``
+    (multipliers ``z = R z'``, ``y = S y'``)."""
+
+    D: np.ndarray
+    """Variable scales, (n,)."""
+    R: np.ndarray
+    """Inequality row scales, (n_in,)."""
+    S: np.ndarray
+    """Equality row scales, (n_eq,)."""
+
+    def scaled(self, solution: QPSolution) -> QPSolution:
+        """A solution of the original problem in the scaled variables (a warm start)."""
+        return solution._replace(x=solution.x / self.D, y=solution.y / self.S, z=solution.z / self.R)
+
+    def unscaled(self, solution: QPSolution) -> QPSolution:
+        """A solution of the scaled problem in the original variables."""
+        return solution._replace(x=solution.x * self.D, y=solution.y * self.S, z=solution.z * self.R)
+
+
+def equilibrate(qp: QP) -> tuple[QP, Equilibration]:
+    """``qp`` scaled so that every variable has unit curvature and every constraint row a
+    largest coefficient of 1 (Jacobi on the Hessian's diagonal, then each row by its
+    ∞-norm): ``x = D x'`` with ``D = diag(H)^(−1/2)`` (1 where the curvature is 0), ``H' = D H D``,
+    ``g' = D g``, ``C' = R C D`` with ``l, u`` times ``R`` (beyond :data:`BOUND_CAP`: none, or the
+    cap). The minimiser and the active set are the same; the solver's absolute tolerances then
+    weigh every joint alike (an arm whose
+    wrist inertia is 10⁻⁴ of its shoulder's has a Hessian whose diagonal spans eight decades,
+    on which an absolute dual tolerance of 1e-9 is met for the shoulder long before the wrist)."""
+    diagonal = np.diag(qp.H)
+    D = np.where(diagonal > 0, 1.0 / np.sqrt(np.where(diagonal > 0, diagonal, 1.0)), 1.0)
+    H = qp.H * D[:, None] * D[None, :]
+    g = qp.g * D
+
+    def rows(M: np.ndarray | None) -> tuple[np.ndarray | None, np.ndarray]:
+        if M is None or not M.size:
+            return M, np.ones(0 if M is None else M.shape[0])
+        scaled = M * D[None, :]
+        largest = np.abs(scaled).max(axis=1)
+        r = np.where(largest > 0, 1.0 / np.where(largest > 0, largest, 1.0), 1.0)
+        return scaled * r[:, None], r
+
+    A, S = rows(qp.A)
+    C, R = rows(qp.C)
+    b = None if qp.b is None else qp.b * S
+    # a bound beyond BOUND_CAP (a damper of horizon 1e-12 s asks for 1e24 rad/s²) is as good as
+    # none on one side and as impossible on the other: ProxQP took a second a solve on such numbers
+    lower = None if qp.l is None else np.clip(qp.l * R, -np.inf, BOUND_CAP)
+    lower = None if lower is None else np.where(lower < -BOUND_CAP, -np.inf, lower)
+    upper = None if qp.u is None else np.clip(qp.u * R, -BOUND_CAP, np.inf)
+    upper = None if upper is None else np.where(upper > BOUND_CAP, np.inf, upper)
+    return QP(H, g, A, b, C, lower, upper, qp.labels), Equilibration(D, R, S)
+
+
+def _solve_default_checked(qp: QP, warm: QPSolution | None, eps: float, max_iter: int, gap_rel: float) -> Any:
     """:func:`_solve_default`, and once more with :data:`STRICT_INFEASIBILITY_EPS` when it says
     the QP cannot hold: ProxQP's default infeasibility tolerance (1e-4) flags some feasible QPs
     (a box QP that x = 0 satisfies was flagged after 13 iterations: tests/test_qp.py, seed 8425)."""
     import proxsuite
 
-    result = _solve_default(qp, warm, eps, max_iter)
+    result = _solve_default(qp, warm, eps, max_iter, gap_rel)
     if result.info.status == proxsuite.proxqp.PROXQP_PRIMAL_INFEASIBLE:
-        result = _solve_set(qp, warm, eps, max_iter, None, STRICT_INFEASIBILITY_EPS)
+        result = _solve_set(qp, warm, eps, max_iter, None, STRICT_INFEASIBILITY_EPS, gap_rel)
     return result
 
 
-def _solve_default(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -> Any:
+def _solve_default(qp: QP, warm: QPSolution | None, eps: float, max_iter: int, gap_rel: float = 0.0) -> Any:
     """ProxQP's functional dense solve with its default settings, the duality gap checked
     (without it ProxQP may stop with an active bound 1e-5 away); its results."""
     import proxsuite
@@ -204,12 +291,19 @@ def _solve_default(qp: QP, warm: QPSolution | None, eps: float, max_iter: int) -
         kwargs = {"x": warm.x, "y": warm.y, "z": warm.z, "initial_guess": proxqp.InitialGuess.WARM_START}
     return proxqp.dense.solve(
         qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u, eps_abs=eps, eps_rel=0.0, max_iter=max_iter,
-        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=0.0, **kwargs,
+        check_duality_gap=True, eps_duality_gap_abs=eps, eps_duality_gap_rel=gap_rel, **kwargs,
     )  # fmt: skip
 
 
 def _solve_set(
-    qp: QP, warm: QPSolution | None, eps: float, max_iter: int, rho: float | None, infeasibility: float | None
+    qp: QP,
+    warm: QPSolution | None,
+    eps: float,
+    max_iter: int,
+    rho: float | None,
+    infeasibility: float | None,
+    gap_rel: float = 0.0,
+    max_inner: int | None = None,
 ) -> Any:
     """ProxQP's dense solver object with ``rho`` and the infeasibility tolerances set (the
     functional ``dense.solve`` takes neither), the duality gap checked; its results."""
@@ -222,11 +316,13 @@ def _solve_set(
     settings = solver.settings
     settings.eps_abs, settings.eps_rel, settings.max_iter = eps, 0.0, max_iter
     settings.check_duality_gap = True
-    settings.eps_duality_gap_abs, settings.eps_duality_gap_rel = eps, 0.0
+    settings.eps_duality_gap_abs, settings.eps_duality_gap_rel = eps, gap_rel
     if infeasibility is not None:
         settings.eps_primal_inf = settings.eps_dual_inf = infeasibility
     if rho is not None:
         settings.default_rho = rho
+    if max_inner is not None:
+        settings.max_iter_in = max_inner
     solver.init(qp.H, qp.g, qp.A, qp.b, qp.C, qp.l, qp.u)
     if warm is not None:
         settings.initial_guess = proxqp.InitialGuess.WARM_START

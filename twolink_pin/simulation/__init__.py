@@ -11,6 +11,7 @@
 ``events.py``          what a plant that pushes back does to a step: wrench, payload step, noise, delay, contact
 ``sensing.py``         the law's force sensor and force reference (``LawInput.contact``) on a plant with a scene
 ``task_reference.py``  the desired pose, twist and acceleration a task-space law sees (``law_input``)
+``preview.py``         the reference ahead of now a law asks for (its ``preview_times``), sampled per block
 ``adaptive_step.py``   DOP853 with error control, one run
 ``containment.py``     a law's one door: read-only inputs, sys.exit / MemoryError named, its output checked
 ``deadline.py``        the wall-clock bound per simulation (``--timeout``): SIGALRM, an error naming the law

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from twolink_pin.controllers import Controller, LawInput
+from twolink_pin.controllers import Controller
 from twolink_pin.errors import ControllerError, SimulationDivergedError, TwolinkPinError, raised_at
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.config import DIVERGENCE_LIMIT, MAX_EVALUATIONS_PER_STEP, SimulationConfig
@@ -24,7 +24,7 @@ from twolink_pin.simulation.containment import check_output, contained
 from twolink_pin.simulation.deadline import bounded, timed_out
 from twolink_pin.simulation.engine import Samples
 from twolink_pin.simulation.forward import dynamics_for
-from twolink_pin.simulation.task_reference import task_reference
+from twolink_pin.simulation.task_reference import law_input
 from twolink_pin.simulation.terms import SingleRunTerms
 from twolink_pin.trajectory import Trajectory
 
@@ -111,10 +111,9 @@ def integrate_adaptive(
     def law(time: float, q: np.ndarray, v: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         last[0] = time
         ref = trajectory.sample(time)
-        task = task_reference(controller, trajectory, np.array([time]), ref)
-        try:
+        try:  # the reference rows the engine would give (task fields, preview)
             out = compute(
-                LawInput(time, q, v, z, ref.q[None], ref.v[None], ref.a[None], *(x[0] for x in task)), terms
+                law_input(controller, time, q, v, z, ref.q[None], ref.v[None], ref.a[None], trajectory), terms
             )
         except ControllerError:
             raise

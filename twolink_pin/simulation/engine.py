@@ -62,6 +62,7 @@ from twolink_pin.simulation.deadline import bounded, run_watcher, timed_out
 from twolink_pin.simulation.divergence import flag_block, late_divergence, law_reason
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
+from twolink_pin.simulation.preview import preview_offsets
 from twolink_pin.simulation.samples import Observer, Outputs, Samples
 from twolink_pin.simulation.sensing import ForceSensor
 from twolink_pin.simulation.task_reference import reference_rows
@@ -121,6 +122,7 @@ def integrate(
     """
     run = _Run(controller, plant, config, q0, v0, z0, record, threads, trajectory.force_reference)
     n, dt, clock, events = run.n, run.dt, run.clock, run.events
+    ahead = preview_offsets(controller)  # the reference the law asks for ahead of now, or None
     watcher = run_watcher()
     # A diverging run overflows before its block is checked. The run is bounded in wall-clock
     # time (--timeout, simulation.deadline): past it, an error naming the law at t = now.
@@ -130,7 +132,9 @@ def integrate(
     ):
         for k0 in range(0, run.total, BLOCK):
             k1 = min(k0 + BLOCK, run.total)
-            rq, rv, ra, ref = _block_reference(controller, trajectory, k0, k1, n, dt, run.sensor)
+            rq, rv, ra, ref = _block_reference(
+                controller, trajectory, k0, k1, n, dt, run.sensor, ahead, run.update_every
+            )
             if events is not None:
                 events.draw(k0, k1)
             run.advance(k0, k1, ref)
@@ -377,19 +381,24 @@ def _block_reference(
     n: int,
     dt: float,
     sensor: ForceSensor | None = None,
+    ahead: np.ndarray | None = None,
+    update_every: int | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Any]:
     """The reference of steps ``k0 … k1 − 1`` on the half-step grid: ``q_des``, ``q̇_des``,
-    ``q̈_des`` as read-only (H, 1, nv) rows and the law's input rows (task fields included, and
-    the force reference's with a ``sensor``)."""
+    ``q̈_des`` as read-only (H, 1, nv) rows and the law's input rows (task fields included, the
+    force reference's with a ``sensor``, and the preview at the offsets ``ahead`` [s]: at every
+    half step, or for a law that plans every ``update_every`` steps at its update instants only)."""
     last_half = min(2 * k1, 2 * n)  # the last stage of step k1 - 1 is at half-step 2 k1
-    half_t = np.arange(2 * k0, last_half + 1) * (dt / 2)
+    halves = np.arange(2 * k0, last_half + 1)
+    half_t = halves * (dt / 2)
+    at = None if update_every is None else (halves % (2 * update_every) == 0)
     half = trajectory.sample(half_t)
     # Shared with later steps: the law can't write. C-contiguous rows: a trajectory may
     # sample column-major, and a strided (1, nv) row takes numpy's slow broadcasting
     # path in every operation of the law and the Terms that touches it.
     rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
     contact = None if sensor is None else sensor.rows(half_t)
-    return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra, contact)
+    return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra, contact, ahead, at)
 
 
 class _Clock:

@@ -7,6 +7,7 @@ from functools import cached_property
 
 import numpy as np
 
+from twolink_pin.controllers.relaxation import RunRelaxation
 from twolink_pin.limits import Crossings, JointLimits, Motion, motion_crossings
 
 
@@ -101,6 +102,16 @@ class SimulationResult:
             return None
         return -(np.asarray(self.wrench)[:, :3] @ np.asarray(self.contact_normal))
 
+    relaxed_first_time: np.ndarray | None = field(repr=False, default=None)
+    """Where the law relaxed limits it could not all keep (``qp-osc``, ``mpc``): per kind
+    (position, velocity, acceleration) and joint the first time [s] (NaN: never), shape (3, nv);
+    None when it relaxed none (:attr:`relaxed`)."""
+    relaxed_largest: np.ndarray | None = field(repr=False, default=None)
+    """By how much at most [the kind's unit], shape (3, nv); None when none."""
+    relaxed_span: np.ndarray | None = field(repr=False, default=None)
+    """``(instants, last time [s])``: the evaluation instants at which any row was relaxed and
+    the last of them, shape (2,); None when none."""
+
     @property
     def duration(self) -> float:
         """Simulated time [s]."""
@@ -136,6 +147,19 @@ class SimulationResult:
         names = self.joint_names if len(self.joint_names) == nv else tuple(f"joint{j + 1}" for j in range(nv))
         velocity = none if self.velocity_limits is None else self.velocity_limits
         return JointLimits(names, lower, upper, velocity, none, self.torque_limits)
+
+    @property
+    def relaxed(self) -> RunRelaxation | None:
+        """The law's relaxations (:class:`~twolink_pin.controllers.relaxation.RunRelaxation`),
+        or None when it relaxed no limit."""
+        if self.relaxed_first_time is None or self.relaxed_largest is None or self.relaxed_span is None:
+            return None
+        return RunRelaxation(
+            self.relaxed_first_time,
+            self.relaxed_largest,
+            int(self.relaxed_span[0]),
+            float(self.relaxed_span[1]),
+        )
 
     @cached_property
     def crossings(self) -> Crossings:

@@ -193,6 +193,7 @@ def run_result(
     p_hat = None if columns is None else (z if len(columns) == z.shape[1] else z[:, columns])
     limits = plant.joint_limits
     measured = [rows.get(name) for name in ("q_measured", "v_measured")]
+    relaxed = controller.run_relaxations(0) if hasattr(controller, "run_relaxations") else None
     return SimulationResult(
         controller=controller.name,
         method=config.method,
@@ -228,4 +229,7 @@ def run_result(
         position_stops=plant.position_stops,
         **{name: readonly_or_none(rows.get(name)) for name in ("wrench", "penetration", "wrench_measured")},
         **contact_rows(plant, trajectory, np.asarray(rows["t"])),
+        relaxed_first_time=None if relaxed is None else readonly(relaxed.first_time),
+        relaxed_largest=None if relaxed is None else readonly(relaxed.largest),
+        relaxed_span=None if relaxed is None else readonly(np.array([relaxed.instants, relaxed.last_time])),
     )

@@ -78,11 +78,12 @@ class ForceSensor:
         (the engine's input carries the reference's part there)."""
         new, contact = tuple.__new__, self.contact
         measure = self.measure if self._noise is not None else (lambda q, v: contact(q, v).wrench)
+        i = LawInput._fields.index("contact")  # the fields after it (the preview) kept
 
         def sensed(x: LawInput, terms: Any) -> Any:
-            part: Any = x[-1]  # the reference's part: (None, normal, force_des)
+            part: Any = x[i]  # the reference's part: (None, normal, force_des)
             reading = new(ContactInput, (measure(x[1], x[2]), part[1], part[2]))
-            return law(new(LawInput, (*x[:-1], reading)), terms)
+            return law(new(LawInput, (*x[:i], reading, *x[i + 1 :])), terms)
 
         return sensed
 

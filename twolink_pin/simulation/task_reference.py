@@ -29,6 +29,7 @@ import pinocchio as pin
 from twolink_pin.controllers import Controller, LawInput
 from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.simulation.containment import read_only
+from twolink_pin.simulation.preview import preview_offsets, previews
 from twolink_pin.trajectory import Trajectory, TrajectorySample
 from twolink_pin.trajectory.se3 import PoseSample, PoseTrajectory
 
@@ -104,11 +105,13 @@ def law_input(
     (to evaluate a law by itself, e.g. in a test): the reference ``q_des``, ``v_des``,
     ``a_des`` of shape (1, nv) and, for a task-space law, the desired frame from
     ``trajectory``'s SE(3) reference if it has one, else from their forward kinematics;
-    ``contact``: what the force sensor reads (None: no scene)."""
+    ``contact``: what the force sensor reads (None: no scene); for a law that declares preview
+    times, ``trajectory`` sampled there (None without a trajectory)."""
     joint = TrajectorySample(q_des, v_des, a_des, np.zeros_like(a_des))
     task = task_reference(controller, trajectory, np.array([t]), joint)
-    x_des, R_des, twist_des, accel_des = (x[0] for x in task)
-    return LawInput(t, q, v, z, q_des, v_des, a_des, x_des, R_des, twist_des, accel_des, contact)
+    ahead = previews(preview_offsets(controller), trajectory, np.array([t]))[0]
+    px, pr, pw, pa = (x[0] for x in task)
+    return LawInput(t, q, v, z, q_des, v_des, a_des, px, pr, pw, pa, contact, ahead)
 
 
 def reference_rows(
@@ -120,16 +123,24 @@ def reference_rows(
     rv: np.ndarray,
     ra: np.ndarray,
     contact: Sequence[ContactInput] | None = None,
+    ahead: np.ndarray | None = None,
+    at: np.ndarray | None = None,
 ) -> list[tuple[Any, ...]]:
-    """Per sample time ``t`` [s], the eight fields of a :class:`~twolink_pin.controllers.LawInput`
-    after ``(t, q, v, z)``: ``q_des``, ``v_des``, ``a_des`` (the rows of the read-only ``rq``,
-    ``rv``, ``ra``, each (K, 1, nv)), the four task fields of :func:`task_reference` (None for a
-    law that is not task-space) and the contact's reference part (``contact``, one per time:
-    :meth:`~twolink_pin.simulation.sensing.ForceSensor.rows`, whose wrench the sensor fills in;
-    None without a scene)."""
+    """Per sample time ``t`` [s], the nine reference fields of a
+    :class:`~twolink_pin.controllers.LawInput` after ``(t, q, v, z)``: ``q_des``, ``v_des``,
+    ``a_des`` (the rows of the read-only ``rq``, ``rv``, ``ra``, each (K, 1, nv)), the four task
+    fields of :func:`task_reference` (None for a law that is not task-space), the contact's
+    reference part (``contact``, one per time: :meth:`~twolink_pin.simulation.sensing.ForceSensor.rows`,
+    whose wrench the sensor fills in; None without a scene) and the preview at the offsets
+    ``ahead`` [s] (:mod:`twolink_pin.simulation.preview`; None without, and at the times ``at``
+    (K,) bool leaves out)."""
     px, pr, pw, pa = task_reference(controller, trajectory, t, joint)
     touch = contact if contact is not None else [None] * len(t)
+    preview = previews(ahead, trajectory, t, at)
     # Rows by iteration (the same read-only views as rq[i]; no Python __getitem__ of NONES per row)
     if px is NONES:
-        return [(q, v, a, None, None, None, None, c) for q, v, a, c in zip(rq, rv, ra, touch, strict=True)]
-    return list(zip(rq, rv, ra, px, pr, pw, pa, touch, strict=True))
+        return [
+            (q, v, a, None, None, None, None, c, p)
+            for q, v, a, c, p in zip(rq, rv, ra, touch, preview, strict=True)
+        ]
+    return list(zip(rq, rv, ra, px, pr, pw, pa, touch, preview, strict=True))

@@ -195,13 +195,10 @@ def simulate_batch(
     nv = plant.robot.nv
     n = batch_size(controller, q0_offsets, v0_offsets, runs=runs)
     q0_off, v0_off = _offsets(plant, trajectory, config, n, q0_offsets, v0_offsets)
-    ref0 = trajectory.sample(0.0)
-    z0 = np.asarray(controller.initial_state(), dtype=float)
-    z0 = np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
+    ref0, z0 = trajectory.sample(0.0), _initial_law_states(controller, n)
     if record:
         check_recorded_size(config.steps, nv, controller.state_size, n)
-    # one gain set: its step checked as a single run's (per-run gains are not: a run beyond its bound
-    # diverges and is flagged, the others go on)
+    # one gain set: its step checked as a single run's (per-run gains: a run beyond its bound diverges, flagged)
     if controller.runs is None:
         require_stable_step(controller, plant, trajectory, config)
     used = threads_for(n, threads) if n > 1 else 1
@@ -229,9 +226,13 @@ def simulate_batch(
     result = _batch_result(
         controller, plant, trajectory, config, run, q0_off, v0_off, metrics, task_metrics, used
     )
-    if contact is None:
-        return result
-    return dataclasses.replace(result, contact_metrics=contact.result(dead))
+    return result if contact is None else dataclasses.replace(result, contact_metrics=contact.result(dead))
+
+
+def _initial_law_states(controller: Controller, n: int) -> np.ndarray:
+    """The law's ``z(0)`` for ``n`` runs, shape (n, nz): its own rows, or one row for every run."""
+    z0 = np.asarray(controller.initial_state(), dtype=float)
+    return np.broadcast_to(z0 if z0.ndim == 2 else z0[None], (n, controller.state_size)).copy()
 
 
 def _offsets(

@@ -19,6 +19,7 @@ from typing import Any
 
 from twolink_pin.contact_metrics import CONTACT_TITLES, CONTACT_UNITS, SETTLE, ContactMetrics
 from twolink_pin.controllers.gains import format_gain
+from twolink_pin.controllers.relaxation import RunRelaxation
 from twolink_pin.errors import ControllerError, SimulationDivergedError
 from twolink_pin.files import atomic_write, write_json
 from twolink_pin.metrics import NORMS, SIGNALS, Metrics, compute_metrics
@@ -43,6 +44,8 @@ def gains_text(gains: dict[str, Any]) -> str:
     def shown(value: Any) -> str:
         if value is None:
             return "from the robot"
+        if isinstance(value, str):  # a gain of choices
+            return value
         array = np.asarray(value, dtype=float)
         return format_gain(array[None] if array.ndim == 2 and array.shape[0] == array.shape[1] else array)
 
@@ -86,6 +89,9 @@ class ComparisonTable:
     """Task-space metrics (mm, deg) of the task-space laws, by law name."""
     contact: dict[str, ContactMetrics] = field(default_factory=dict)
     """Contact metrics (force errors, impact, penetration, …) of runs against a scene, by law name."""
+    relaxed: dict[str, RunRelaxation] = field(default_factory=dict)
+    """Where and by how much each law that relaxed limits it could not all keep did so, by law
+    name (:class:`~twolink_pin.controllers.relaxation.RunRelaxation`)."""
 
     @property
     def nv(self) -> int:
@@ -106,6 +112,7 @@ class ComparisonTable:
             "task_metrics": {name: m.as_dict() for name, m in self.task.items()},
             "contact_metrics": {name: m.as_dict() for name, m in self.contact.items()},
             "crossings": {name: m.crossings.summary() for name, m in self.metrics.items()},
+            "relaxed": {name: r.summary() for name, r in self.relaxed.items()},
             "within_limits": {name: m.crossings.within_limits for name, m in self.metrics.items()},
         }
 
@@ -187,12 +194,26 @@ class ComparisonTable:
             out.append("|---|---|---:|---:|---:|")
             for name, kind, j, first, excess, unit in crossings:
                 out.append(f"| {name} | {kind} | {j} | {first:.4g} | {excess:.3g} {unit} |")
+        relaxed = [(name, r) for name, r in self.relaxed.items() if r.relaxed]
+        if relaxed:
+            out.append(
+                "\n### limits the law relaxed when they could not all hold (its rows, not the motion)\n"
+            )
+            out.append("| controller | limit | joint | first at [s] | largest relaxation | instants |")
+            out.append("|---|---|---:|---:|---:|---:|")
+            for name, r in relaxed:
+                for kind, j, first, largest, unit in r.events():
+                    out.append(
+                        f"| {name} | {kind} | {j + 1} | {first:.4g} | {largest:.3g} {unit} | {r.instants} |"
+                    )
         if self.plants or self.failed or self.gains:
             out.append("\n### the runs\n")
             out.append("| controller | gains | plant | outcome |")
             out.append("|---|---|---|---|")
             for name in [*self.metrics, *(n for n in self.failed if n not in self.metrics)]:
                 outcome = f"FAILED: {self.failed[name]}" if name in self.failed else "finished"
+                if name in self.relaxed and self.relaxed[name].relaxed:
+                    outcome += f", limits relaxed at {self.relaxed[name].instants} instants"
                 gains = gains_text(self.gains[name]) if name in self.gains else ""
                 out.append(f"| {name} | {gains} | {self.plants.get(name, '')} | {outcome} |")
         return "\n".join(out) + "\n"

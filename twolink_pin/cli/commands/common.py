@@ -59,7 +59,7 @@ def _config(args: argparse.Namespace) -> SimulationConfig:
     )
 
 
-def _gain_values(texts: list[str], law: str = "") -> dict[str, Any]:
+def gain_values(texts: list[str], law: str = "") -> dict[str, Any]:
     """``["kp=200", "kd=30,40"]`` → ``{"kp": 200.0, "kd": (30.0, 40.0)}`` (each value read by
     :func:`~twolink_pin.law_variant.gain_value`); a gain given twice is refused, naming it
     (as ``LAW.NAME`` with the ``law`` of ``--gain LAW.NAME=VALUE``)."""
@@ -93,7 +93,7 @@ def _law_gains(texts: list[str]) -> tuple[tuple[str, tuple[tuple[str, Any], ...]
         if not (sep and dot and law and gain):
             raise InvalidParameterError("--gain", text, "LAW.NAME=VALUE with several laws, e.g. pd.kp=200")
         per_law.setdefault(law, []).append(f"{gain}={value}")
-    return tuple((law, tuple(_gain_values(own, f"{law}.").items())) for law, own in per_law.items())
+    return tuple((law, tuple(gain_values(own, f"{law}.").items())) for law, own in per_law.items())
 
 
 def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool = True) -> RunSpec:
@@ -109,7 +109,7 @@ def run_spec(args: argparse.Namespace, law: str | None = None, fixed_gains: bool
     mode = "p0" if getattr(args, "p0", None) else "model" if getattr(args, "model", None) else ""
     return RunSpec(
         law=law,
-        gains=() if several else tuple(_gain_values(texts).items()),
+        gains=() if several else tuple(gain_values(texts).items()),
         law_gains=_law_gains(texts) if several else (),
         lam=args.lam,
         plant=PlantOptions(

@@ -225,6 +225,7 @@ def cmd_controllers(args: argparse.Namespace) -> int:
                 "unit": gain_spec(f).unit,
                 "default": default_as_json(cls.Gains, f.name),
                 "doc": gain_spec(f).doc,
+                **({"choices": list(gain_spec(f).choices)} if gain_spec(f).choices else {}),
             }
             for f in fields(cls.Gains)
         ]
@@ -243,6 +244,7 @@ def cmd_controllers(args: argparse.Namespace) -> int:
             f"{g['name']}"
             + (f" [{g['unit']}]" if g["unit"] else "")
             + (f" ({MATRIX_SIZE[g['per']]} matrix)" if g["matrix"] else "")
+            + (f" ({' | '.join(g['choices'])})" if g.get("choices") else "")
             for g in row["gains"]
         )
         lines.append(f"{row['name']:18s} {row['title']}\n{'':18s} gains: {listed}")

@@ -47,6 +47,7 @@ def _result_payload(result: SimulationResult, metrics: Metrics) -> dict[str, Any
         "limit_exceeded_at": result.first_exceeded_at,
         "limits": result.joint_limits.as_dict(),
         "crossings": metrics.crossings.summary(),
+        "relaxed": None if result.relaxed is None else result.relaxed.summary(),
         "within_limits": metrics.crossings.within_limits,  # every kind; limit_exceeded: the effort alone
         "joint_stops": result.position_stops,
         "parameter_names": list(result.parameter_names),
@@ -139,6 +140,9 @@ def _limit_and_estimate_lines(result: Any, metrics: Metrics) -> list[str]:
     """The summary's lines on the limits (position range and velocity crossed; torque exceeded,
     clipped, absent) and, for an adaptive law, its estimates at the end against the truth."""
     out: list[str] = [f"  {s}" for s in metrics.crossings.sentences(result.joint_limits)]
+    relaxed = result.relaxed
+    if relaxed is not None and relaxed.relaxed:
+        out += [f"  {line}" for line in relaxed.text(result.joint_names or None).splitlines()]
     if result.position_stops:
         out.append("  joint stops: each position range a hard stop (--joint-stops)")
     for j, (over, at) in enumerate(zip(result.limit_exceeded, result.first_exceeded_at)):
@@ -214,9 +218,13 @@ def cmd_compare(args: argparse.Namespace) -> int:
             contacts.add(key, result)
             return result
 
+        relaxed: dict[str, Any] = {}
+
         def on_result(key: str, result: SimulationResult) -> None:
             warnings.extend(position_warnings(key, result))
             figures.add(key, result)
+            if result.relaxed is not None:
+                relaxed[key] = result.relaxed
 
         def progress(name: str, result: SimulationResult | None) -> None:
             if result is not None:
@@ -238,6 +246,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
             gains={k: gains_used(r.scenario.controller) for k, r in rows.items()},
             task=tasks,
             contact=contacts.metrics,
+            relaxed=relaxed,
         )
         files = [Path(args.out) / p.name for p in table.write(stage)]
     if table.failed:  # a failed run: one line on stderr, nothing on stdout; the folder holds the rest

@@ -4,9 +4,16 @@ from __future__ import annotations
 
 import argparse
 import sys
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
-from twolink_pin.cli.commands.common import gains_echo, robot_from_args, run_spec, trajectory_from_args
+from twolink_pin.cli.commands.common import (
+    gain_values,
+    gains_echo,
+    robot_from_args,
+    run_spec,
+    trajectory_from_args,
+)
 from twolink_pin.cli.output import emit, progress_bar
 
 if TYPE_CHECKING:
@@ -26,13 +33,17 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         return 1
     robot = robot_from_args(args)
     trajectory = trajectory_from_args(args, robot)
+    fixed = [g for g in args.gain if isinstance(g, str)]  # NAME=WORD: one value for every run
+    run = run_spec(args, args.controller, fixed_gains=False)
+    if fixed:
+        run = replace(run, gains=tuple(gain_values(fixed).items()))
     config = SweepConfig(
-        run=run_spec(args, args.controller, fixed_gains=False),
+        run=run,
         samples=args.samples,
         seed=args.seed,
         q0_spread=args.q0_spread,
         param_error=args.param_error,
-        gains=tuple(args.gain),
+        gains=tuple(g for g in args.gain if not isinstance(g, str)),
         wrench_scale=args.wrench_scale,
         chunk=args.chunk,
         threads=args.threads,
