@@ -104,10 +104,11 @@ def test_random_arms_have_their_home_modes_at_the_stated_rates(seed: int, joints
     # PD + feedforward at rest on the exact model: (s + ω)² on every mode, i.e. (A + ω I)² = 0
     # (its eigenvalues, a double root, would spread by √ of the differences' error); the central
     # differences of g(q) (up to 1e3 N·m here) are good to ~1e-7 N·m/rad, which M⁻¹ of a 10-g
-    # link (1e-4 kg·m²) makes ~1e-3 1/s²
+    # link (1e-4 kg·m²) makes ~1e-3 1/s² in A, and (A + ωI)² multiplies it by entries up to ~ω²:
+    # 1e-3 ω² (seed 859780, 6 joints, reached 1.6e-4 ω²); a design off by one mode leaves ~ω²
     A = _closed_loop_at_home(robot)
     shifted = A + W * np.eye(len(A))
-    assert np.abs(shifted @ shifted).max() <= 1e-4 * W**2
+    assert np.abs(shifted @ shifted).max() <= 1e-3 * W**2
     np.testing.assert_allclose(np.linalg.eigvals(A).real, -W, rtol=0, atol=0.05 * W)
 
 
