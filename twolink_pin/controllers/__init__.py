@@ -1,10 +1,13 @@
 """Tracking controllers: one law per file, registered by name when its class is defined.
 
 =====================  ============================================================
-``base.py``            :class:`Controller` (the contract), ``LawInput``/``LawOutput``,
-                       the ``Terms`` protocol, the registry :data:`CONTROLLERS`
+``base.py``            :class:`Controller` (the contract), its state's declaration, the
+                       registry :data:`CONTROLLERS`
+``law_io.py``          what flows through ``compute``: ``LawInput``/``LawOutput``, the ``Terms``
+                       protocol
 ``contact_input.py``   ``ContactInput``: the force sensor's wrench and the force reference
 ``gains.py``           :class:`Gains` and :func:`gain`: validated gains with units
+``matrix_gains.py``    matrix gains (``K = κ M(q₀)``): read, checked, applied
 ``preview.py``         :class:`ReferencePreview`: the reference ahead of now a law asks for
 ``relaxation.py``      :class:`Relaxations`: the limits a law relaxed when they could not all hold
 ``loading.py``         :func:`load_controller`: a name, ``file.py:Class``, ``module:Class``
@@ -30,15 +33,8 @@
 
 from __future__ import annotations
 
-from twolink_pin.controllers.base import (
-    CONTROLLERS,
-    Controller,
-    FrameTerms,
-    LawInput,
-    LawOutput,
-    StateVariable,
-    Terms,
-)
+from twolink_pin.controllers.base import CONTROLLERS, Controller, StateVariable
+from twolink_pin.controllers.law_io import FrameTerms, LawInput, LawOutput, Terms
 from twolink_pin.controllers.contact_input import ContactInput
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.preview import ReferencePreview

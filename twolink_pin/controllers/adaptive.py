@@ -7,9 +7,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
-from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
+from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
 from twolink_pin.dynamics import Friction, regressor, smooth_sign
 from twolink_pin.model import RobotModel
 

@@ -23,8 +23,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from twolink_pin.controllers.base import LawInput
 from twolink_pin.controllers.contact_input import ContactInput
+from twolink_pin.controllers.law_io import LawInput
 from twolink_pin.errors import InvalidParameterError
 
 

@@ -8,9 +8,10 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, StateVariable, Terms
+from twolink_pin.controllers.base import Controller, StateVariable
 from twolink_pin.controllers.force_loop import contact_of, force_command
 from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,

@@ -8,9 +8,10 @@ from typing import Any, cast
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, StateVariable, Terms
+from twolink_pin.controllers.base import Controller, StateVariable
 from twolink_pin.controllers.disturbance import DisturbanceObserver
 from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
 from twolink_pin.controllers.relaxation import Relaxations, RunRelaxation
 from twolink_pin.dynamics import joint_inertia
 from twolink_pin.errors import InvalidParameterError, OptimizationError

@@ -7,8 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
+from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,

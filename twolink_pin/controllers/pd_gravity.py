@@ -5,8 +5,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, Terms
-from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.controllers.base import Controller
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
+from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
 from twolink_pin.controllers.pd import pd_gains
 from twolink_pin.model import RobotModel
 

@@ -7,8 +7,10 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.controllers.base import Controller, LawInput, LawOutput, StateVariable, Terms
-from twolink_pin.controllers.gains import Gains, applied_form, apply_gain, gain
+from twolink_pin.controllers.base import Controller, StateVariable
+from twolink_pin.controllers.gains import Gains, gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
+from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
 from twolink_pin.controllers.pd import NATURAL_FREQUENCY
 from twolink_pin.dynamics import joint_space_inertia
 

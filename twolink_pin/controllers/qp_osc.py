@@ -7,9 +7,10 @@ from typing import Any, cast
 
 import numpy as np
 
-from twolink_pin.controllers.base import LawInput, LawOutput, StateVariable, Terms
+from twolink_pin.controllers.base import StateVariable
 from twolink_pin.controllers.disturbance import DisturbanceObserver
 from twolink_pin.controllers.gains import gain
+from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
 from twolink_pin.controllers.osc import OperationalSpace, OSCGains
 from twolink_pin.controllers.relaxation import Relaxations, RunRelaxation
 from twolink_pin.controllers.task_space import posture_acceleration, row_index, task_acceleration

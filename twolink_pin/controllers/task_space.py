@@ -42,7 +42,7 @@ from typing import NamedTuple
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.controllers.base import LawInput, Terms
+from twolink_pin.controllers.law_io import LawInput, Terms
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
 from twolink_pin.small_linalg import inv

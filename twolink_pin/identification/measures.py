@@ -27,7 +27,8 @@ import numpy as np
 
 from twolink_pin.blas import one_blas_thread
 from twolink_pin.controllers import Controller
-from twolink_pin.controllers.gains import gain_solve, one_row
+from twolink_pin.controllers.gains import one_row
+from twolink_pin.controllers.matrix_gains import gain_solve
 from twolink_pin.dynamics import friction_regressor, regressor
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.identification.observation import ParameterSet

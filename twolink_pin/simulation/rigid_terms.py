@@ -45,7 +45,7 @@ from __future__ import annotations
 import numpy as np
 import pinocchio as pin
 
-from twolink_pin.controllers.base import FrameTerms
+from twolink_pin.controllers.law_io import FrameTerms
 from twolink_pin.dynamics import InverseDynamicsDerivatives, inverse_dynamics_derivatives
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
