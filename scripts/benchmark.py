@@ -1479,7 +1479,7 @@ def contact_section(quick: bool, repeats: int) -> dict[str, Any]:
 def _contact_lab(robot: Any, scene: Any, lab: Any, config: SimulationConfig, engine: str) -> dict[str, Any]:
     """The lab's laws against the wall on the plant ``engine``: their contact metrics (printed)."""
     from twolink_pin.contact_metrics import contact_metrics
-    from twolink_pin.plant import PlantOptions
+    from twolink_pin.plant_options import PlantOptions
     from twolink_pin.run_spec import RunSpec
 
     print(
@@ -1508,7 +1508,7 @@ def _contact_cost(
     robot: Any, scene: Any, reference: Any, config: SimulationConfig, engine: str, repeats: int
 ) -> dict[str, Any]:
     """The lab's run with the wall over the same run without it, both on the plant ``engine``."""
-    from twolink_pin.plant import PlantOptions
+    from twolink_pin.plant_options import PlantOptions
     from twolink_pin.run_spec import RunSpec
 
     cost: dict[str, Any] = {}

@@ -62,7 +62,7 @@ def lab(robot_name: str, duration: float, out: Path, plants: list[str]) -> str:
     from twolink_pin import load_robot
     from twolink_pin.contact import read_scene
     from twolink_pin.contact_metrics import contact_metrics
-    from twolink_pin.plant import PlantOptions
+    from twolink_pin.plant_options import PlantOptions
     from twolink_pin.plotting.contact import save_contact_figure
     from twolink_pin.run_spec import RunSpec
     from twolink_pin.simulation import SimulationConfig, simulate

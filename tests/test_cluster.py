@@ -252,7 +252,7 @@ def test_a_sweep_on_the_mujoco_plant_runs_on_the_workers_as_in_process(
 ) -> None:
     """``--plant mujoco`` with the arm's armature and dry friction: each worker builds the MuJoCo
     plant from the run's description (its own ``mujoco.batch``) and the table is the in-process one."""
-    from twolink_pin.plant import PlantOptions
+    from twolink_pin.plant_options import PlantOptions
 
     run = RunSpec(
         law="pd",

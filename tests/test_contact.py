@@ -39,7 +39,8 @@ from twolink_pin.controllers import Controller, Gains, LawInput, LawOutput, Term
 from twolink_pin.errors import ContactError, InvalidParameterError
 from twolink_pin.kinematics import solve_position
 from twolink_pin.model import load_robot
-from twolink_pin.plant import Plant, PlantOptions
+from twolink_pin.plant import Plant
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.batch import simulate_batch

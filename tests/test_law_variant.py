@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from twolink_pin.cli import main
 from twolink_pin.errors import ControllerSpecError, InvalidParameterError
 from twolink_pin.law_variant import file_stem, format_variant, parse_variant, parse_variants
-from twolink_pin.run_spec import RunSpec, build_rows
+from twolink_pin.run_rows import build_rows
+from twolink_pin.run_spec import RunSpec
 from twolink_pin.scenario import law_class
 
 SLIDING = str(Path(__file__).resolve().parents[1] / "examples" / "sliding_mode.py") + ":SlidingMode"

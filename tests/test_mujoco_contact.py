@@ -23,7 +23,7 @@ from twolink_pin.contact import Scene, Surface, read_scene
 from twolink_pin.contact_metrics import contact_metrics
 from twolink_pin.model import load_robot
 from twolink_pin.mujoco_contact import IMPEDANCE, contact_parameters
-from twolink_pin.plant import PlantOptions
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.batch import simulate_batch

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from twolink_pin.model import load_robot
-from twolink_pin.plant import PlantOptions
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.trajectory import default_trajectory

@@ -30,7 +30,8 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel, load_robot
 from twolink_pin.mujoco_model import arm_spec
 from twolink_pin.mujoco_plant import MujocoPlant
-from twolink_pin.plant import Plant, PlantOptions
+from twolink_pin.plant import Plant
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig, simulate
 from twolink_pin.studies.batch import simulate_batch

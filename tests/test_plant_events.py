@@ -261,7 +261,7 @@ def test_saturation_clips_the_motors_torque_never_the_wrench(engine: str, integr
     at an RK4 stage, and over a step that MuJoCo's Euler takes itself (``v ← v + dt q̈``)."""
     import pinocchio as pin
 
-    from twolink_pin.plant import PlantOptions
+    from twolink_pin.plant_options import PlantOptions
     from twolink_pin.simulation.engine import _Steps
     from twolink_pin.simulation.events import PlantEvents
 

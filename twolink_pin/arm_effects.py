@@ -1,6 +1,6 @@
 """The effects a real arm has beyond its rigid bodies: each defined once, for both plants.
 
-A run asks for them in its :class:`~twolink_pin.plant.PlantOptions`; the plant of each engine
+A run asks for them in its :class:`~twolink_pin.plant_options.PlantOptions`; the plant of each engine
 models them as this table says (``both``: the two plants give the same motion, to rounding, with
 the engine's RK4; ``mujoco``: refused on the Pinocchio plant, which has no such element).
 
@@ -34,7 +34,7 @@ from twolink_pin.model import RobotModel
 ARM = "arm"
 """The value of a per-joint effect that asks for the arm's own (profile, else URDF)."""
 PER_JOINT = ("armature", "joint_damping", "frictionloss")
-"""The effects given per joint, in :class:`~twolink_pin.plant.PlantOptions`' order."""
+"""The effects given per joint, in :class:`~twolink_pin.plant_options.PlantOptions`' order."""
 UNITS = {"armature": "kg·m²", "joint_damping": "N·m·s/rad", "frictionloss": "N·m"}
 """Each per-joint effect's unit."""
 MUJOCO_ONLY = ("frictionloss", "soft_limits", "solref", "solimp", "integrator")
@@ -69,7 +69,7 @@ PLANT_KEYS = {
     "saturate": "saturate",
 }
 """A variant's plant keys (``pd@plant=mujoco@armature=arm``) → the
-:class:`~twolink_pin.plant.PlantOptions` field each sets."""
+:class:`~twolink_pin.plant_options.PlantOptions` field each sets."""
 SWITCHES = {"on": True, "off": False}
 """``soft_limits`` and ``saturate`` as text."""
 
@@ -99,7 +99,7 @@ def plant_value(key: str, text: str) -> Any:
 
 
 def check_effect(name: str, value: Any) -> tuple[float, ...] | str | None:
-    """``value`` of the per-joint effect ``name`` as :class:`~twolink_pin.plant.PlantOptions`
+    """``value`` of the per-joint effect ``name`` as :class:`~twolink_pin.plant_options.PlantOptions`
     keeps it: None, :data:`ARM`, or a tuple of finite values >= 0 (one, or one per joint)."""
     if value is None or value == ARM:
         return value
@@ -198,7 +198,7 @@ def _arm_values(robot: RobotModel, name: str) -> tuple[np.ndarray, str]:
 
 
 def refuse_idle(options: Any, robot: RobotModel, method: str) -> None:
-    """Refuse an effect of ``options`` (a :class:`~twolink_pin.plant.PlantOptions`) that would do
+    """Refuse an effect of ``options`` (a :class:`~twolink_pin.plant_options.PlantOptions`) that would do
     nothing on ``robot`` (a silent no-op is a wrong answer), or that ``method`` cannot run.
 
     Raises:

@@ -18,7 +18,7 @@ from typing import Any
 
 from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.plant import PlantOptions
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.simulation import SimulationConfig
 from twolink_pin.trajectory import Trajectory
 

@@ -11,12 +11,12 @@ and the report hold one beside their own options; a saved result records it
 :meth:`RunSpec.build` is the only function that turns a description into a controller and
 its plant: the law once (:func:`~twolink_pin.scenario.make_controller`, believing identified
 parameters from :func:`~twolink_pin.identification.believed` when it is given some), the
-plant once (:meth:`PlantOptions.plant <twolink_pin.plant.PlantOptions.plant>`);
+plant once (:meth:`PlantOptions.plant <twolink_pin.plant_options.PlantOptions.plant>`);
 :func:`make_scenario` is a :class:`RunSpec` built at once. Before building, it refuses an
 option that would do nothing for this law on this robot (:meth:`RunSpec.check_effective`).
 
 Adding a run option: one field (of :class:`RunSpec` here or, for the plant,
-:class:`~twolink_pin.plant.PlantOptions` in ``plant.py``, with its check in ``__post_init__``
+:class:`~twolink_pin.plant_options.PlantOptions` in ``plant_options.py``, with its check in ``__post_init__``
 and its use in :meth:`build` or :meth:`PlantOptions.plant`), one ``add_argument`` in
 ``cli/parser.py``'s run-option group and one line in
 :func:`twolink_pin.cli.commands.common.run_spec`, and a test that the option reaches the
@@ -26,12 +26,11 @@ parser's run options and the fields here agree).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,10 +40,10 @@ from twolink_pin.controllers import Controller
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.law_variant import Variant
 from twolink_pin.model import RobotModel
-from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, PlantOptions, robot_friction
+from twolink_pin.plant import ADAPTIVE_SMOOTHING, FRICTION_CHOICES, robot_friction
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.scenario import Scenario, law_class, make_controller
 from twolink_pin.simulation import SimulationConfig
-from twolink_pin.simulation.step_check import CheckTimeout, require_stable_step
 
 if TYPE_CHECKING:
     from twolink_pin.dynamics import Friction
@@ -401,63 +400,6 @@ def law_spec(spec: RunSpec, variant: Variant) -> RunSpec:
     )
 
 
-class Row(NamedTuple):
-    """One row of several runs (``compare``, ``report``): a variant, its spec and its law and plant."""
-
-    variant: Variant
-    """The law and its own settings, as given."""
-    spec: RunSpec
-    """Its run: the shared spec for its law (:meth:`RunSpec.for_law`), its settings over it."""
-    scenario: Scenario
-    """Its law and plant, built once (:meth:`RunSpec.build`)."""
-
-
-def build_rows(
-    shared: RunSpec,
-    variants: Sequence[Variant],
-    robot: RobotModel,
-    read: Callable[[RunSpec], IdentifiedParameters | None] | None = None,
-    trajectory: Trajectory | None = None,
-) -> dict[str, Row]:
-    """Every variant's run built before any runs, keyed by its row's name
-    (:attr:`~twolink_pin.law_variant.Variant.key`): a bad gain of the third law is refused
-    before the first runs, naming its row (``pd@kp=1,2,3: kp = …``).
-
-    Args:
-        shared: The spec the variants share (``law`` None).
-        variants: The rows, in order.
-        robot: The arm.
-        read: Reads a spec's parameter file (default :meth:`RunSpec.read_parameters`); each
-            file is read once.
-        trajectory: The reference the rows will run: each row's step is then checked against
-            the fastest mode of its start (:mod:`~twolink_pin.simulation.step_check`), before
-            any row runs.
-
-    Raises:
-        InvalidParameterError: a value a law refuses, named ``ROW: NAME``.
-        StepTooLargeError: a row's step beyond the integrator's bound, named ``ROW: --dt``.
-    """
-    files: dict[str, IdentifiedParameters | None] = {}
-    rows: dict[str, Row] = {}
-    for variant in variants:
-        spec = shared.for_law(variant)
-        if spec.parameters is not None and spec.parameters not in files:
-            files[spec.parameters] = read(spec) if read is not None else spec.read_parameters(robot)
-        try:
-            if variant.plant:  # its own plant options: refused where they would do nothing
-                refuse_idle(spec.plant, robot, spec.simulation.method)
-            scenario = spec.build(robot, None if spec.parameters is None else files[spec.parameters])
-            if trajectory is not None:
-                with contextlib.suppress(
-                    CheckTimeout
-                ):  # a law that never returns: its own run fails, the others go on
-                    require_stable_step(scenario.controller, scenario.plant, trajectory, spec.simulation)
-        except InvalidParameterError as exc:
-            raise type(exc)(f"{variant.key}: {exc.name}", exc.value, exc.expected) from None
-        rows[variant.key] = Row(variant, spec, scenario)
-    return rows
-
-
 def gains_used(controller: Controller) -> dict[str, Any]:
     """The gains a law ran with (the robot's presets and derived values resolved), JSON-ready:
     a number, a list per joint or per parameter, a matrix as its rows, or None
@@ -512,9 +454,7 @@ __all__ = [
     "FRICTION_CHOICES",
     "PARAMETER_USES",
     "PlantOptions",
-    "Row",
     "RunSpec",
-    "build_rows",
     "gains_used",
     "law_spec",
     "make_scenario",

@@ -2,7 +2,7 @@
 (:func:`make_controller`).
 
 :meth:`twolink_pin.run_spec.RunSpec.build` is the one place a run is assembled: the law from
-:func:`make_controller`, its plant from :meth:`twolink_pin.plant.PlantOptions.plant`.
+:func:`make_controller`, its plant from :meth:`twolink_pin.plant_options.PlantOptions.plant`.
 A friction-estimating law believes its robot's profile friction (the twolink: the report's
 V = (0.4, 0.2) N·m·s/rad, C = (0.2, 0.1) N·m; its estimates start from
 ``friction_initial_estimate`` × it). Nothing here knows a law by name: what a law

@@ -62,6 +62,7 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
         "surfaces it touches, a law with its plant, a law's variants, the run description, and the engine.",
         (
             "plant",
+            "plant_options",
             "arm_effects",
             "mujoco_model",
             "mujoco_plant",
@@ -71,6 +72,7 @@ GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
             "scenario",
             "law_variant",
             "run_spec",
+            "run_rows",
             "contact_checks",
             "simulation",
         ),

@@ -1,6 +1,6 @@
 """A scene: the surfaces the arm may touch and their contact properties — plain, frozen data.
 
-A :class:`Scene` sits beside the plant's other options (:class:`~twolink_pin.plant.PlantOptions`,
+A :class:`Scene` sits beside the plant's other options (:class:`~twolink_pin.plant_options.PlantOptions`,
 ``--scene FILE`` or ``--wall …``) and is read once; each plant computes its own contact from it
 (the Pinocchio plant: :mod:`twolink_pin.contact.compliant`; a MuJoCo plant: MuJoCo's contacts
 with a geom built from the same data).

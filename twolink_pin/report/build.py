@@ -40,7 +40,8 @@ from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
 from twolink_pin.report.within_limits import limits_section
-from twolink_pin.run_spec import Row, build_rows, gains_used, plant_description
+from twolink_pin.run_rows import Row, build_rows
+from twolink_pin.run_spec import gains_used, plant_description
 from twolink_pin.scenario import builtin_laws
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.simulation.config import joint_offsets

@@ -1,7 +1,7 @@
 """The plant's controls in Viser's GUI (the folder *plant*): the engine the arm runs on
 (``--plant``: Pinocchio's, MuJoCo's), the plant's friction, saturation at the effort limits,
 the payload, a push (force and window), sensor noise and delay, and the
-:class:`~twolink_pin.plant.PlantOptions` they describe.
+:class:`~twolink_pin.plant_options.PlantOptions` they describe.
 
 This is the one place of the page that knows the plant's options: a new one (another
 engine, contact) is a control added where :class:`PlantControls` makes the others, its number boxes
@@ -21,7 +21,8 @@ from typing import Any
 
 from twolink_pin.disturbances import SensorNoise, Wrench
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.plant import ENGINES, FRICTION_CHOICES, PlantOptions
+from twolink_pin.plant import ENGINES, FRICTION_CHOICES
+from twolink_pin.plant_options import PlantOptions
 from twolink_pin.tuning.typed import Channel, read_number
 
 MAX_PUSH = 1000.0

@@ -5,7 +5,8 @@
 ``model.py``      ``info``, ``robots``, ``controllers``, ``fk``, ``ik``, ``trajectory``
 ``identify.py``   ``identify``, ``excite``
 ``optimal.py``    ``optimize``, ``trajectory --time-optimal``
-``run.py``        ``simulate``, ``compare``, ``animate``, ``report``
+``run.py``        ``simulate``, ``compare``, ``report``
+``animate.py``    ``animate``: a run, or a saved one, in 3-D
 ``sweep.py``      ``sweep``
 ``tune.py``       ``tune``
 ``equations.py``  ``equations``: the equations of motion in closed form
@@ -17,6 +18,7 @@ inside each command, so ``--help`` stays fast.
 
 from __future__ import annotations
 
+from twolink_pin.cli.commands.animate import cmd_animate
 from twolink_pin.cli.commands.equations import cmd_equations
 from twolink_pin.cli.commands.identify import cmd_excite, cmd_identify
 from twolink_pin.cli.commands.model import (
@@ -28,7 +30,7 @@ from twolink_pin.cli.commands.model import (
     cmd_trajectory,
 )
 from twolink_pin.cli.commands.optimal import cmd_optimize
-from twolink_pin.cli.commands.run import cmd_animate, cmd_compare, cmd_report, cmd_simulate
+from twolink_pin.cli.commands.run import cmd_compare, cmd_report, cmd_simulate
 from twolink_pin.cli.commands.sweep import cmd_sweep
 from twolink_pin.cli.commands.tune import cmd_tune
 
