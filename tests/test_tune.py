@@ -106,6 +106,9 @@ def _parsed(argv: list[str]) -> RunSpec:
             plant=PlantOptions(wrench=Wrench((0.0, -5.0, 0.0, 0.0, 0.0, 0.5), 0.5)),  # until the end
             simulation=SimulationConfig(duration=1.0, method="adaptive", q0_offset=-0.05),
         ),
+        RunSpec(  # a gain that is a word (mpc's choices) is written as the word
+            law="mpc", gains=(("horizon", 0.2), ("reference_ahead", "extrapolate"), ("on_infeasible", "fail"))
+        ),
     ],
 )
 def test_the_simulate_line_parses_back_to_the_same_run(spec: RunSpec) -> None:

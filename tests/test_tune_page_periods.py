@@ -14,6 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from browser import require_chromium, start_chromium
 from test_tune_browser import CLI, WAIT, Tune, press, ran, slider
@@ -66,9 +67,12 @@ def cells(values: list[float]) -> str:
     return ", ".join(f"{x:.3g}" for x in values)
 
 
-def one_period(law: str, folder: Path, gains: dict[str, list[float]]) -> dict[str, Any]:
-    """``simulate --json`` of one period (4 s) of ``law`` with ``gains``: the second method."""
-    options = [f"--gain={name}={','.join(repr(float(x)) for x in value)}" for name, value in gains.items()]
+def one_period(law: str, folder: Path, gains: dict[str, Any]) -> dict[str, Any]:
+    """``simulate --json`` of one period (4 s) of ``law`` with ``gains`` (a matrix row by row):
+    the second method."""
+    options = [
+        f"--gain={name}={','.join(repr(float(x)) for x in np.ravel(value))}" for name, value in gains.items()
+    ]
     argv = [*CLI, "simulate", law, *options, "--duration=4", "--json"]
     out = subprocess.run(argv, cwd=folder, capture_output=True, text=True, timeout=WAIT)
     assert out.returncode == 0, out.stderr
@@ -118,8 +122,10 @@ def test_a_run_in_flight_shows_its_first_period_with_every_column_cut_to_it(
     WebDriverWait(driver, WAIT).until(lambda d: f"run {first['run']}: 12 s simulated" in d.page_source)
     thumb = slider(driver, "kp joint 1 [N·m/rad]")
     press(thumb, Keys.ARROW_RIGHT)  # kp moves one step: this run waits at t > 6 s
-    moved = {**first["gains"], "kp": [float(thumb.get_attribute("aria-valuenow")), first["gains"]["kp"][1]]}
-    assert moved["kp"][0] > first["gains"]["kp"][0]
+    kp = [list(row) for row in first["gains"]["kp"]]  # a user's PD: Kp = ω² M(q₀), a full (2, 2) matrix
+    kp[0][0] = float(thumb.get_attribute("aria-valuenow"))  # the slider sets its diagonal, the rest kept
+    moved = {**first["gains"], "kp": kp}
+    assert kp[0][0] > first["gains"]["kp"][0][0]
     status = f"run {first['run'] + 1}: period 1 of 3 shown"
     WebDriverWait(driver, WAIT).until(lambda d: status in d.execute_script("return document.body.innerText"))
     text = driver.execute_script("return document.body.innerText")

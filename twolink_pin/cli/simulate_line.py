@@ -20,8 +20,13 @@ def _number(x: float) -> str:
 
 
 def _numbers(values: Any) -> str:
+    """A gain's value as ``--gain`` reads it: a number, numbers joined by commas (a matrix
+    row by row), or a word as it is (a gain declared with ``choices``: mpc's
+    ``reference_ahead=preview``)."""
+    if isinstance(values, str):
+        return values
     if isinstance(values, (list, tuple)):
-        return ",".join(_number(x) for x in values)
+        return ",".join(_numbers(x) for x in values)
     return _number(values)
 
 

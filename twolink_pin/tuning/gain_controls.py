@@ -101,13 +101,14 @@ class GainControls:
         return float(self.sliders[index].value if index < len(self.sliders) else self._knobs[index].value)
 
     def _shown(self, name: str) -> Any:
-        """The value of gain ``name`` the controls ask for (a matrix gain: ``(k, k)``)."""
+        """The value of gain ``name`` the controls ask for: a matrix gain as ``compare`` and the
+        command line name it, its diagonal (k numbers) when diagonal, else ``(k, k)``."""
         value = gains_from(self._knobs, self._settings(), self._matrices)[name]
         full = self._matrices.get(name)
         if full is not None:
             k = full.shape[0]
             array = np.asarray(value, dtype=float)
-            return np.diag(array) if array.size == k else array.reshape(k, k)
+            return array if array.size == k else array.reshape(k, k)
         return value
 
     def _place(self, i: int, value: float) -> None:
