@@ -3,6 +3,8 @@ conditions computed independently of the solver."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -10,6 +12,8 @@ from hypothesis import strategies as st
 
 from twolink_pin.errors import OptimizationError
 from twolink_pin.optimal import QP, kkt_residual, solve_qp, unconstrained_minimiser
+
+FIXTURES = Path(__file__).resolve().parent / "fixtures"
 
 
 def test_equality_constrained_qp_equals_the_kkt_system_solved_by_numpy() -> None:
@@ -143,3 +147,60 @@ def test_bounds_beyond_the_cap_are_none_on_their_loose_side_and_the_cap_on_the_o
     assert scaled.l[0] == BOUND_CAP and np.isfinite(scaled.u[0])
     with pytest.raises(OptimizationError, match="cannot all hold"):
         solve_qp(tight, scale=True, max_iter=200, max_inner=20, infeasibility_eps=1e-9)
+
+
+MPC_SETTINGS = {"infeasibility_eps": 1e-9, "scale": True, "accept": 1e-6, "max_inner": 20}
+"""What mpc asks of :func:`solve_qp` for a replan (``twolink_pin/controllers/mpc.py``)."""
+
+
+def _pr2_replan(side: str) -> QP:
+    """A replan of mpc on the PR2's ``side`` arm at its defaults (issue 50: ``examples/arms``;
+    the left one at t = 0 s, the right one at t = 0.31 s; 56 variables, 536 box rows), saved
+    as mpc built it."""
+    saved = np.load(FIXTURES / f"pr2_{side}_replan_qp.npz")
+    return QP(saved["H"], saved["g"], None, None, saved["C"], saved["l"], saved["u"])
+
+
+def _clarabel_optimum(qp: QP) -> float:
+    """The QP's optimal cost by Clarabel (an interior-point method, through cvxpy): the second
+    method, which never calls ProxQP; raises unless Clarabel finds it feasible and solved."""
+    import cvxpy as cp
+
+    assert qp.C is not None and qp.l is not None and qp.u is not None
+    x = cp.Variable(qp.g.shape[0])
+    rows = [qp.C @ x <= qp.u, qp.C @ x >= qp.l]
+    problem = cp.Problem(cp.Minimize(0.5 * cp.quad_form(x, cp.psd_wrap(qp.H)) + qp.g @ x), rows)
+    problem.solve(solver="CLARABEL")
+    assert problem.status == cp.OPTIMAL, problem.status
+    return float(problem.value)
+
+
+@pytest.mark.parametrize("side", ["left", "right"])
+def test_a_feasible_replan_prox_qp_flags_infeasible_is_solved(side: str) -> None:
+    """ProxQP flags these feasible replans PRIMAL_INFEASIBLE at mpc's tolerance 1e-9 (its
+    iterate within 1e-7 of every row); :func:`solve_qp` solves them: the cost is Clarabel's to
+    1e-7 relative, the KKT conditions (computed here) hold to 1e-6 and every row to 1e-6."""
+    import proxsuite
+
+    from twolink_pin.optimal.qp import _solve_set, equilibrate
+
+    qp = _pr2_replan(side)
+    flagged = _solve_set(equilibrate(qp)[0], None, 1e-9, 200, None, 1e-9, 0.0, 20)
+    assert flagged.info.status == proxsuite.proxqp.PROXQP_PRIMAL_INFEASIBLE  # the case still arises
+    solution = solve_qp(qp, max_iter=200, **MPC_SETTINGS)  # raised OptimizationError before
+    cost = 0.5 * solution.x @ qp.H @ solution.x + qp.g @ solution.x
+    best = _clarabel_optimum(qp)
+    assert abs(cost - best) <= 1e-7 * max(1.0, abs(best)), (cost, best)
+    assert kkt_residual(qp, solution) < 1e-6
+
+
+def test_constraints_that_cannot_hold_still_fail_at_mpc_settings() -> None:
+    """The re-solves do not turn a QP that cannot hold (x0 >= 1 and x0 <= -1, among boxes
+    that can) into an answer: it still raises, naming the row."""
+    C = np.vstack([np.eye(3), [[1.0, 0.0, 0.0]]])
+    qp = QP(np.eye(3), np.ones(3), None, None, C, np.array([1.0, -2, -2, -np.inf]), np.array([np.inf, 2, 2, -1.0]),
+            labels=("lower", "b1", "b2", "upper"))  # fmt: skip
+    with pytest.raises(
+        OptimizationError, match=r"cannot all hold: the closest point misses (lower|upper) by"
+    ):
+        solve_qp(qp, max_iter=200, **MPC_SETTINGS)
