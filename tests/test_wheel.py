@@ -131,11 +131,12 @@ def _shortened(command: str) -> list[str]:
 
 def _documented() -> list[str]:
     """Every ``twolink-pin`` command of the pages and the README that reads a file of
-    ``examples/`` or ``out/`` (made by an earlier one)."""
+    ``examples/`` or ``out/`` (made by an earlier one), its continued lines joined."""
     found = []
     for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
         for block in re.findall(r"```\w*\n(.*?)```", page.read_text(encoding="utf-8"), re.S):
-            for line in block.splitlines():
+            # a command continued with a trailing backslash is one line, as the shell reads it
+            for line in re.sub(r"\\\n\s*", " ", block).splitlines():
                 served = line.startswith("twolink-pin tune ")  # a server: tests/test_tune*.py's
                 if line.startswith("twolink-pin ") and "examples/" in line and not served:
                     found.append(line.strip())
