@@ -13,6 +13,13 @@ FILES = {
     "panda_square_pose.toml": "a 20-cm square with orientations for the Panda (Task space)",
     "ur5_square_pose.toml": "a 20-cm square with orientations for the UR5 (Task space)",
     "ur5_square.toml": "a 20-cm square of end-effector positions for the UR5 (Any robot)",
+    "look_ahead.py": "computed torque that asks for the reference ahead to make up for a delay (Writing a controller)",
+    "baxter_right_arm.toml": "Baxter's right arm as an arm of its own, the rest of its tree locked (Your arm, Any robot)",
+    "wall.toml": "the contact lab's wall for the twolink: a plane at x = 0.55 m, 1000 N/m (Contact)",
+    "wall_slide.toml": "press 10 N on the wall and slide along it, 6 s (Contact)",
+    "table.toml": "a table under the Panda's hand, 5000 N/m (Contact)",
+    "panda_table_slide.toml": "the Panda's hand presses 10 N on the table and slides 0.2 m (Contact)",
+    "twolink_heavy.urdf": "the twolink with every link 20 % heavy: a wrong model to believe (scripts/benchmark.py --mpc-only)",
     "tutorial.ipynb": "the tutorial notebook: model, trajectory, two laws, figures, the arm in 3-D",
     "tutorial.py": "the same tutorial as a script (jupytext's percent format)",
 }

@@ -112,7 +112,8 @@ def _dependencies_pth() -> str:
 
 
 def _shortened(command: str) -> list[str]:
-    """A page's command, quick: 0.05 s of simulation, two samples, no figures, no report's sections."""
+    """A page's command, quick: 0.05 s of simulation, two samples, no figures, no report's sections,
+    an animation written to a file (not served)."""
     argv = shlex.split(command, comments=True)[1:]
     for option, value in (("--duration", "0.05"), ("--samples", "2")):
         if option in argv:
@@ -122,20 +123,25 @@ def _shortened(command: str) -> list[str]:
     if "--wrench" in argv:  # its window is within the pages' 16-s runs: moved into the short one
         argv[argv.index("--wrench") + 1] = re.sub(r"@[^,]*$", "@0.01:0.02", argv[argv.index("--wrench") + 1])
     argv = [a for i, a in enumerate(argv) if a != "--plot" and (i == 0 or argv[i - 1] != "--plot")]
+    if argv[0] == "animate" and "--html" not in argv:  # else it serves the motion live until stopped
+        argv += ["--html", "out/animate.html"]
     if argv[0] in ("compare", "sweep"):
         argv.append("--no-plot")
     if argv[0] == "report":
         argv += ["--workers", "1", "--no-animation", "--no-limits-section"]
+        if "--out" not in argv:  # its default, out/, holds the retimed reference made first: not the report's
+            argv += ["--out", "out/report"]
     return argv
 
 
 def _documented() -> list[str]:
     """Every ``twolink-pin`` command of the pages and the README that reads a file of
-    ``examples/`` or ``out/`` (made by an earlier one)."""
+    ``examples/`` or ``out/`` (made by an earlier one), its continued lines joined."""
     found = []
     for page in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
         for block in re.findall(r"```\w*\n(.*?)```", page.read_text(encoding="utf-8"), re.S):
-            for line in block.splitlines():
+            # a command continued with a trailing backslash is one line, as the shell reads it
+            for line in re.sub(r"\\\n\s*", " ", block).splitlines():
                 served = line.startswith("twolink-pin tune ")  # a server: tests/test_tune*.py's
                 if line.startswith("twolink-pin ") and "examples/" in line and not served:
                     found.append(line.strip())
