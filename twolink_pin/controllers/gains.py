@@ -168,7 +168,7 @@ def _validate(name: str, value: Any, spec: GainSpec) -> Any:
     if spec.choices:
         return _validate_choice(name, value, spec)
     if value is not None and spec.matrix:
-        return validate_matrix(name, value, spec)
+        return validate_matrix(name, value, spec.unit, spec.per)
     if isinstance(value, str):  # a word where a number is expected (--gain kp=abc)
         raise InvalidParameterError(name, value, f"a number, got {value!r}: {_expected(spec)}")
     if value is None:

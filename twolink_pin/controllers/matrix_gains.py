@@ -7,14 +7,11 @@ axes (``K = κ M(q₀)`` from the arm's inertia): how a value is read and checke
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError
-
-if TYPE_CHECKING:
-    from twolink_pin.controllers.gains import GainSpec
 
 GAIN_RANGE = (1e-12, 1e12)
 """Smallest and largest magnitude of a nonzero gain (any unit): beyond them a gain is a typo,
@@ -91,10 +88,11 @@ def _from_numbers(name: str, numbers: np.ndarray, k: int, expected: str) -> np.n
     raise InvalidParameterError(name, numbers.tolist(), f"{expected}; {shape_failed(n, k)}")
 
 
-def validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
+def validate_matrix(name: str, value: Any, unit: str = "", per: str = "joint") -> Any:
     """A matrix gain's value (:data:`MATRIX_EXPECTED`) checked: a number ``s`` (``s I``), a row of
-    numbers whose reading waits for the law's k, or checked (1 or N, k, k) matrices."""
-    expected = MATRIX_EXPECTED.format(unit=f" [{spec.unit}]" if spec.unit else "")
+    numbers whose reading waits for the law's k, or checked (1 or N, k, k) matrices. ``unit``: the
+    gain's unit (in the message); ``per``: its declared shape (``"axis"``: k = 3, the world axes)."""
+    expected = MATRIX_EXPECTED.format(unit=f" [{unit}]" if unit else "")
     if isinstance(value, bool):
         raise InvalidParameterError(name, value, expected)
     try:
@@ -103,7 +101,7 @@ def validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
         raise InvalidParameterError(name, value, expected) from None
     if array.ndim == 2 and array.shape[1] == 1:  # one number per run (a sweep's draws): s_r I
         array = array[:, :, None]
-    if array.ndim == 2 and array.shape[0] == 1 and spec.per != "axis":  # numbers awaiting k, validated again
+    if array.ndim == 2 and array.shape[0] == 1 and per != "axis":  # numbers awaiting k, validated again
         array = array[0]
     if array.ndim > 3 or array.size == 0 or (array.ndim >= 2 and array.shape[-1] != array.shape[-2]):
         raise InvalidParameterError(
@@ -120,7 +118,7 @@ def validate_matrix(name: str, value: Any, spec: GainSpec) -> Any:
             raise InvalidParameterError(name, float(array), expected)
         return float(array)
     if array.ndim == 1:
-        if spec.per == "axis":
+        if per == "axis":
             return _from_numbers(name, array, AXIS_SIZE, expected)
         side = math.isqrt(array.size)
         if side > 1 and side * side == array.size:  # k numbers or k² numbers: the law's k decides
