@@ -394,6 +394,12 @@ def _sim_markdown(r: dict[str, Any]) -> list[str]:
     heads, rows = table["headers"], table["rows"]
     lines = ["## Sim-to-sim", "", "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
     lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    if not table.get("all", True):
+        alone = ", ".join(table.get("effects_alone", []))
+        lines += [
+            "",
+            f"Each effect alone on {alone} only; `twolink-pin report --sim-to-sim-all` runs it on every law.",
+        ]
     return (
         [*lines, "", f"Sources of the effects: {table['sources']}", ""] if table["sources"] else [*lines, ""]
     )
