@@ -39,7 +39,7 @@ from twolink_pin.report import facts, sim_to_sim
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
-from twolink_pin.report.within_limits import limits_section
+from twolink_pin.report.within_limits import fill_report_runs, limits_section, reuses_report_runs
 from twolink_pin.run_rows import Row, build_rows
 from twolink_pin.run_spec import gains_used, plant_description
 from twolink_pin.scenario import builtin_laws
@@ -235,9 +235,10 @@ def _run_all(
     options: ReportOptions,
     tick: Callable[[str], None],
 ) -> _Ran:
-    """Every task of the worker pool: the robot's own sections, each law's run and figures,
-    the desired trajectory's figures; the animation of the animated law (or, if it failed,
-    of the first that ran) while the others finish."""
+    """Every task of the worker pool: the robot's own sections, the limits section, each law's
+    run and figures, the sim-to-sim rows; meanwhile in this process the facts, the desired
+    trajectory's figures, the animation of the animated law (or, if it failed, of the first
+    that ran) and the robot's own sections once the runs they read are in."""
     fig_dir = stage / "figures"
     fig_dir.mkdir()
     declared = robot.profile.report
@@ -257,8 +258,10 @@ def _run_all(
         # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
         # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
         pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
+        limit_rows = [(n, rows[n].variant) for n in names]
+        reused = options.limits_section and reuses_report_runs(options, trajectory)
         limits_future = (  # about as long as a law's run: before them, so the runs fill in around it
-            pool.submit(limits_section, [(n, rows[n].variant) for n in names], options, str(stage))
+            pool.submit(limits_section, limit_rows, options, str(stage), reused)
             if options.limits_section
             else None
         )
@@ -270,10 +273,15 @@ def _run_all(
             if options.sim_to_sim
             else None
         )
-        traj_future = pool.submit(trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
+        # This process's own work while the workers run: the facts, the trajectory's figures, the
+        # animation and the robot's sections as soon as the runs they read are in (not after all).
         model = facts.model_facts(robot)
         own_facts = sections.facts(robot, via) if sections else None
         tick("model and trajectory")
+        traj_figs = trajectory_figures(options, str(fig_dir), numbers.get("trajectory"))
+        tick("trajectory figures")
+        reads = set(sections.reads(names)) if sections and pending is not None else set()
+        identification = None
         for name in order:
             try:
                 runs[name] = interrupts.result_of(futures[name], heard)
@@ -284,28 +292,38 @@ def _run_all(
                 tried, shown = True, name
                 animation = _write_animation(stage, robot, trajectory, runs[name][0], options, warnings)
                 tick("animation")
+            if (
+                sections
+                and pending is not None
+                and identification is None
+                and reads <= set(runs) | set(failed)
+            ):
+                identification = sections.collect(pending, robot, options, str(fig_dir), _results(runs))
+                tick("identification")
         if options.animation and not tried:
             tick("animation")  # every law failed: nothing to animate
-        traj_figs = interrupts.result_of(traj_future, heard)
-        tick("trajectory figures")
         overlays = _write_overlays(fig_dir, rows, runs, options)
         within_limits = None
         if limits_future is not None:
             within_limits = interrupts.result_of(limits_future, heard)
+            if reused:  # its rows on the report's reference: the first seconds of the runs above
+                within_limits = fill_report_runs(within_limits, limit_rows, options, robot, _results(runs))
             tick("the reference within the limits")
         sim_section = None
         if sim_pending is not None:
             sim_section = sim_to_sim.collect(sim_pending, robot, options, str(fig_dir), heard)
             tick("sim-to-sim")
-        identification = None
-        if sections and pending is not None:
-            done_runs = {n: r[0] for n, r in runs.items()}
-            identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
-            tick("identification")
     return _Ran(
         runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays,
         within_limits, sim_section,
     )  # fmt: skip
+
+
+def _results(
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
+) -> dict[str, SimulationResult]:
+    """Each law's simulation result, of its run's ``(result, metrics, figures, seconds)``."""
+    return {name: run[0] for name, run in runs.items()}
 
 
 def _write_overlays(
