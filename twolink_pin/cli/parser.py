@@ -402,8 +402,8 @@ def _add_report(sub: Any, c: Any) -> None:
     p.add_argument(
         "--sim-to-sim-all",
         action="store_true",
-        help="in the section 'Sim-to-sim', every law with each of the arm's effects alone too (default: the "
-        "first law; every law runs with no effect and with every effect)",
+        help="in the section 'Sim-to-sim', every law with MuJoCo's no-effect check and each of the arm's "
+        "effects alone too (default: the first law; every law runs on Pinocchio and with every effect)",
     )
     add_robot_options(p)
     add_disturbance_options(p)

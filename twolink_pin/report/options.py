@@ -42,9 +42,10 @@ class ReportOptions:
         sim_to_sim: Whether the report has its section "Sim-to-sim" (:mod:`twolink_pin.report.sim_to_sim`:
             each law on the Pinocchio plant and on MuJoCo with no effect and with the arm's effects;
             short runs of one period).
-        sim_to_sim_all: Whether every law of that section runs with each effect alone too (35
-            runs on the twolink, about a fifth of the report's CPU time); default False: the
-            report's first law only (19 runs; docs/mujoco.md).
+        sim_to_sim_all: Whether every law of that section has every row: the no-effect check
+            and each effect alone too (35 runs on the twolink, about a fifth of the report's CPU
+            time); default False: the report's first law only, the others on Pinocchio and with
+            every effect (15 runs; docs/mujoco.md).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe

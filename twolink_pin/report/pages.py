@@ -398,7 +398,8 @@ def _sim_markdown(r: dict[str, Any]) -> list[str]:
         alone = ", ".join(table.get("effects_alone", []))
         lines += [
             "",
-            f"Each effect alone on {alone} only; `twolink-pin report --sim-to-sim-all` runs it on every law.",
+            f"The no-effect check and each effect alone on {alone} only, the other laws on Pinocchio and with "
+            "every effect; `twolink-pin report --sim-to-sim-all` runs every row of every law.",
         ]
     return (
         [*lines, "", f"Sources of the effects: {table['sources']}", ""] if table["sources"] else [*lines, ""]

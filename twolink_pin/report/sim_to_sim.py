@@ -13,18 +13,20 @@ the numbers show; at most the report's duration):
 * one row per effect the arm has (:func:`arm_effects`, :mod:`twolink_pin.arm_effects`): that
   effect alone on MuJoCo (its armature, joint damping or dry friction, ``arm``: the robot's
   profile, else its URDF; its soft limits; the effort clamp when the report does not clip; MuJoCo's
-  ``implicitfast`` integrator with the law held over each step) — by default for the report's
-  first law only (:func:`alone_on`), for every law with ``ReportOptions.sim_to_sim_all``
-  (``report --sim-to-sim-all``);
+  ``implicitfast`` integrator with the law held over each step);
 * ``…@plant=mujoco`` with every effect at once.
+
+By default the no-effect check and each effect alone are run on the report's first law only
+(:func:`alone_on`): the other laws have their first and last rows (Pinocchio, every effect).
+``ReportOptions.sim_to_sim_all`` (``report --sim-to-sim-all``) runs every row of every law.
 
 An effect that cannot act on the run is not run again: soft limits on a run that never reaches a
 joint's range, the effort clamp on a commanded torque below :data:`CLAMP_MARGIN` of every limit
 (:func:`inactive`; MuJoCo with no effect is that run until the effect acts). Its row repeats the
 no-effect row's numbers and says why (``derived``). The section costs what
-``PERIODS × (3 + effects acting)`` periods of a law with each effect alone cost, ``PERIODS × 3``
-of the others (on the twolink, 19 runs of one period by default, 35 with every law's effects alone:
-the rows of a law are the same in both).
+``PERIODS × (3 + effects acting)`` periods of a law with every row cost, ``PERIODS × 2`` of the
+others (on the twolink, 15 runs of one period by default, 35 with every row of every law: a row
+is the same run in both).
 
 **The numbers** are :func:`~twolink_pin.metrics.compute_metrics`' per-joint ones, as ``compare``'s
 table has them: ``RMS ‖e‖ = (Σ_j RMS(e_j)²)^½`` [rad] and ``max |e|`` [rad], the largest
@@ -121,12 +123,11 @@ def row_texts(
     variant: Variant, effects: list[dict[str, str]], alone: bool = True
 ) -> list[tuple[str, str, str]]:
     """``(row label, short label, variant text)`` of each row of ``variant``'s law (module
-    docstring); without ``alone``, not the rows of each effect alone."""
+    docstring); without ``alone``, only the first and the last (Pinocchio, every effect)."""
     base = variant.text
-    rows = [
-        ("Pinocchio (the report's plant)", "Pinocchio", base),
-        ("MuJoCo, no effect", "MuJoCo, no effect", base + NO_EFFECT),
-    ]
+    rows = [("Pinocchio (the report's plant)", "Pinocchio", base)]
+    if alone:
+        rows.append(("MuJoCo, no effect", "MuJoCo, no effect", base + NO_EFFECT))
     for effect in effects if alone else ():
         off = "" if effect["key"] == "soft_limits" else "@soft_limits=off"
         rows.append(
@@ -198,8 +199,8 @@ def inactive(key: str, robot: Any, plain: dict[str, Any]) -> str | None:
 
 
 def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions, alone: bool = True) -> dict[str, Any]:
-    """Worker: the rows of one law of the report (module docstring); with ``alone`` those of each
-    effect alone too."""
+    """Worker: the rows of one law of the report (module docstring); with ``alone`` all of them,
+    else Pinocchio's and every effect's."""
     start, cpu = time.perf_counter(), time.process_time()
     robot = options.load_robot()
     trajectory = reference_trajectory(robot, options)
@@ -241,9 +242,9 @@ def skipped(options: ReportOptions, variants: list[tuple[str, Variant]]) -> str 
 
 
 def alone_on(options: ReportOptions, names: list[str]) -> list[str]:
-    """The laws (of the report's ``names``) whose rows include each effect alone: every one with
-    ``options.sim_to_sim_all``, else the first (what each effect does is shown once; every law
-    still runs with no effect and with every effect)."""
+    """The laws (of the report's ``names``) with every row (the no-effect check, each effect
+    alone): every one with ``options.sim_to_sim_all``, else the first (what each effect does is
+    shown once; every law runs on Pinocchio and with every effect)."""
     return list(names) if options.sim_to_sim_all else list(names[:1])
 
 
