@@ -283,7 +283,9 @@ def collect(
         return section | {"note": f"no sim-to-sim section: {pending}"}
     laws = [interrupts.result_of(future, heard) for future in pending.values()]
     alone = [law["law"] for law in laws if law["effects_alone"]]
-    which = "" if len(alone) == len(laws) else f"; each effect alone: {', '.join(alone)}"
+    which = (
+        "" if len(alone) == len(laws) else f"; each effect alone: {', '.join(alone)}, the others every effect"
+    )
     title = f"{robot.name}: what each effect on MuJoCo changes (one period, started on the reference{which})"
     figure = save_sim_to_sim_figure(laws, Path(fig_dir) / FIGURE, title).name
     return section | {
