@@ -322,7 +322,12 @@ def _submit(
         if options.limits_section
         else None
     )
-    futures = {n: pool.submit(run_law, rows[n].variant, options, fig_dir, numbers.get(n)) for n in order}
+    # the animated law first (its animation is written meanwhile), then the laws with the most state
+    # (estimates, plans: each stage integrates it too, the longer runs) so that the short ones come last
+    first = sorted(order[1:], key=lambda n: -rows[n].scenario.controller.state_size)
+    futures = {
+        n: pool.submit(run_law, rows[n].variant, options, fig_dir, numbers.get(n)) for n in order[:1] + first
+    }
     variants = [(n, rows[n].variant) for n in names]
     sim_pending = sim_to_sim.submit(pool, variants, options) if options.sim_to_sim else None
     return pending, limits_future, futures, sim_pending
