@@ -41,7 +41,7 @@ naming the law and the simulated time.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -131,11 +131,9 @@ def integrate(
         np.errstate(all="ignore"),
         bounded(lambda timeout: timed_out(controller, clock.now, timeout), stall=True),
     ):
-        for k0 in range(0, run.total, BLOCK):
-            k1 = min(k0 + BLOCK, run.total)
-            rq, rv, ra, ref = _block_reference(
-                controller, trajectory, k0, k1, n, dt, run.sensor, ahead, run.update_every
-            )
+        for k0, k1, rq, rv, ra, ref in _block_references(
+            controller, trajectory, run.total, n, dt, run.sensor, ahead, run.update_every
+        ):
             if events is not None:
                 events.draw(k0, k1)
             run.advance(k0, k1, ref)
@@ -372,6 +370,35 @@ class _Run:
                 q, v, z = q.copy(), v.copy(), z.copy()  # the law saw them read-only
                 q[newly], v[newly], z[newly] = rq[j][0], rv[j][0], self.z_start[newly]
                 self.q, self.v, self.z = q, v, z
+
+
+REFERENCE_BLOCKS = 8
+"""Blocks whose reference is sampled in one call: a trajectory's ``sample`` costs a fixed ~75 µs
+per call besides ~0.1 µs per time (the twolink's polynomials), 2 µs per step of a single run at one
+block per call; eight blocks per call save most of it, and the memory stays O(:data:`BLOCK`)."""
+
+
+def _block_references(
+    controller: Controller,
+    trajectory: Trajectory,
+    total: int,
+    n: int,
+    dt: float,
+    sensor: ForceSensor | None = None,
+    ahead: np.ndarray | None = None,
+    update_every: int | None = None,
+) -> Iterator[tuple[int, int, np.ndarray, np.ndarray, np.ndarray, Any]]:
+    """Per block of samples ``k0 … k1 − 1`` (of ``total``): ``k0``, ``k1`` and its reference as
+    :func:`_block_reference` gives it, sampled :data:`REFERENCE_BLOCKS` blocks at a time (every
+    quantity is a function of its own time: the same values, element by element)."""
+    chunk = BLOCK * REFERENCE_BLOCKS
+    for c0 in range(0, total, chunk):
+        c1 = min(c0 + chunk, total)
+        rq, rv, ra, ref = _block_reference(controller, trajectory, c0, c1, n, dt, sensor, ahead, update_every)
+        for k0 in range(c0, c1, BLOCK):
+            k1 = min(k0 + BLOCK, c1)
+            rows = slice(2 * (k0 - c0), 2 * (k1 - c0) + 1)  # half-steps 2 k0 … min(2 k1, 2 n)
+            yield k0, k1, rq[rows], rv[rows], ra[rows], ref[rows]
 
 
 def _block_reference(
