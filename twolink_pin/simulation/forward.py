@@ -3,6 +3,7 @@ plant's own engine's (:meth:`~twolink_pin.plant.Plant.dynamics`: MuJoCo's)."""
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -26,7 +27,8 @@ class SingleRunDynamics:
         self._friction = (
             None if friction is None else (np.array([friction.viscous]), np.array([friction.coulomb]))
         )
-        self._smoothing = 0.0 if friction is None else friction.smoothing
+        smoothing = 0.0 if friction is None else friction.smoothing
+        self._sign = np.sign if smoothing == 0 else partial(smooth_sign, smoothing=smoothing)
         self._damping = plant.joint_damping[None] if plant.joint_damping.any() else None
         # plant.applied_torque's clip as maximum then minimum against (1, nv) rows: the same
         # values (clip is min(max(τ, −limit), limit), NaN passed through) at a third of
@@ -43,7 +45,7 @@ class SingleRunDynamics:
         u = tau if saturate is None else np.minimum(np.maximum(tau, saturate[0]), saturate[1])
         if self._friction is not None:
             viscous, coulomb = self._friction
-            u = u - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
+            u = u - (viscous * v + coulomb * self._sign(v))
         if self._damping is not None:
             u = u - self._damping * v
         if external is not None:
