@@ -92,7 +92,7 @@ class Adaptive(Controller[AdaptiveGains]):
         smoothing = 0.0 if friction is None else friction.smoothing
         self._sign = np.sign if smoothing == 0 else partial(smooth_sign, smoothing=smoothing)
         self._minus_k = -applied_form(self.gains.k)
-        self._lam = applied_scalar(self.gains.lam, nv)
+        self._lam = applied_scalar(self.gains.lam)
         self._minus_rate = -1.0 / np.asarray(self.gains.gamma)
 
     def initial_state(self) -> np.ndarray:

@@ -58,7 +58,7 @@ class ComputedTorque(Controller[SlotineLiGains]):
 
     def __init__(self, robot: RobotModel, gains: SlotineLiGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
-        self._k, self._lam = applied_form(self.gains.k), applied_scalar(self.gains.lam, robot.nv)
+        self._k, self._lam = applied_form(self.gains.k), applied_scalar(self.gains.lam)
 
     def scaled_gains(self) -> dict[str, Any]:
         return {"k": sliding_gain(self.robot)}

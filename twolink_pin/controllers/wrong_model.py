@@ -47,11 +47,11 @@ class WrongModel(Controller[WrongModelGains]):
 
     def __init__(self, robot: RobotModel, gains: WrongModelGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
-        g, nv = self.gains, robot.nv
+        g = self.gains
         self._k, self._lam, self._beta = (
             applied_form(g.k),
-            applied_scalar(g.lam, nv),
-            applied_scalar(g.model_scale, nv),
+            applied_scalar(g.lam),
+            applied_scalar(g.model_scale),
         )
 
     def scaled_gains(self) -> dict[str, Any]:

@@ -219,7 +219,7 @@ class _Run:
             self.q, self.v = self.stop(0.0, self.q, self.v)
         if events is not None:  # none starts inside a surface
             events.check_start(self.q)
-        self.steps = Steps.of(dt, nv, nz)
+        self.steps = Steps.of(dt)
         self.no_state = np.zeros((runs, 0))
         # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
         self.tau1: Any = None
