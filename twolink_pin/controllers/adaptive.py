@@ -12,7 +12,7 @@ from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.dynamics import Friction, regressor, smooth_sign
 from twolink_pin.model import RobotModel
 
@@ -91,7 +91,7 @@ class Adaptive(Controller[AdaptiveGains]):
         )
         smoothing = 0.0 if friction is None else friction.smoothing
         self._sign = np.sign if smoothing == 0 else partial(smooth_sign, smoothing=smoothing)
-        self._minus_k = -applied_form(self.gains.k)
+        self._minus_k = applied_form(-np.asarray(self.gains.k))
         self._lam = applied_scalar(self.gains.lam)
         self._minus_rate = -1.0 / np.asarray(self.gains.gamma)
 
@@ -122,7 +122,7 @@ class Adaptive(Controller[AdaptiveGains]):
         lam, v, z = self._lam, x.v, x.z
         lam_e, edot = lam * (x.q - x.q_des), v - x.v_des
         s = edot + lam_e
-        tau = apply_gain(self._minus_k, s)
+        tau = self._minus_k(s)
         if self._inertial:
             Y = terms.regressor(x.q, v, x.v_des - lam_e, x.a_des - lam * edot)
             tau = tau + np.matvec(Y, z[self._p_hat])

@@ -10,7 +10,7 @@ import numpy as np
 from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.dynamics import joint_space_inertia
 from twolink_pin.model import RobotModel
 
@@ -67,7 +67,7 @@ class ComputedTorque(Controller[SlotineLiGains]):
         lam = self._lam
         lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
         tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
-        return LawOutput(tau - apply_gain(self._k, edot + lam_e))
+        return LawOutput(tau - self._k(edot + lam_e))
 
 
 def sliding_gain(robot: RobotModel) -> np.ndarray:

@@ -9,7 +9,7 @@ from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.model import RobotModel
 
 
@@ -61,4 +61,4 @@ class WrongModel(Controller[WrongModelGains]):
         lam = self._lam
         lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
         tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
-        return LawOutput(self._beta * tau - apply_gain(self._k, edot + lam_e))
+        return LawOutput(self._beta * tau - self._k(edot + lam_e))
