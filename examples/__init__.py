@@ -24,3 +24,39 @@ FILES = {
     "tutorial.py": "the same tutorial as a script (jupytext's percent format)",
 }
 """Each shipped file with what it is (and the page that uses it)."""
+
+ARMS = (
+    "asr_twodof",
+    "baxter_left",
+    "baxter_right",
+    "double_pendulum",
+    "double_pendulum_continuous",
+    "double_pendulum_simple",
+    "finger_edu",
+    "five_link_chain",
+    "kinova",
+    "panda",
+    "pr2_left",
+    "pr2_right",
+    "so100",
+    "so101",
+    "talos_left_arm",
+    "tiago_arm",
+    "ur10",
+    "ur10_joint_limited",
+    "ur3",
+    "ur3_joint_limited",
+    "ur5",
+    "ur5_joint_limited",
+    "xarm7",
+    "z1",
+)
+"""The published arms of ``arms/``, each a profile (``--robot examples/arms/NAME.toml``) that
+``scripts/arms.py`` runs at every law's defaults (Your arm)."""
+FILES.update(
+    {
+        f"arms/{name}.toml": "a published arm's profile, run at every law's defaults (Your arm)"
+        for name in ARMS
+    }
+)
+FILES["arms/five_link_chain.urdf"] = "five links about parallel axes, the arms' generated pendulum (Your arm)"

@@ -25,21 +25,12 @@ assert _spec is not None and _spec.loader is not None
 arms = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(arms)
 
-SOLVER_STOPPED = "PROXQP_MAX_ITER_REACHED"
-"""mpc's replan stopped by ProxQP's iteration cap at residuals within tolerance (the UR10, the
-xArm7, TIAGo): issue 50 §5, the QP's scaling on light wrists — another change's; accepted here."""
-
-
-def _known(law: str, why: str | None) -> bool:
-    return law == "mpc" and why is not None and SOLVER_STOPPED in why
-
 
 @pytest.mark.slow
 @pytest.mark.parametrize("profile", arms.arm_profiles(), ids=lambda p: p.stem)
 def test_every_law_runs_on_the_arm_at_its_defaults(profile: Path) -> None:
     rows = arms.run_arm(profile)
     failed = {law: row["failure"] for law, row in rows.items() if law != "nv" and not row["ok"]}
-    failed = {law: why for law, why in failed.items() if not _known(law, why)}
     assert not failed, failed
     exact = rows["computed-torque"]["error"]
     assert exact is not None and exact <= arms.EXACT_GOAL, exact

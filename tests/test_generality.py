@@ -47,7 +47,7 @@ def test_a_urdf_by_path_lists_the_installed_robots_once_per_process(
     listed once, not once per robot and per load (0.1 s each: six per load before)."""
     import importlib.metadata
 
-    from twolink_pin.model import catalog
+    from twolink_pin.model import catalog, robot_data
 
     listed = []
     files = importlib.metadata.files
@@ -59,8 +59,8 @@ def test_a_urdf_by_path_lists_the_installed_robots_once_per_process(
     path = tmp_path / "my_pendulum.urdf"
     path.write_bytes(example_robot_urdf(ROBOTS[0]).read_bytes())
     monkeypatch.setattr(importlib.metadata, "files", counted)
-    catalog._located.cache_clear()  # what this process looked up before is forgotten
-    catalog._distribution_files.cache_clear()
+    robot_data._located.cache_clear()  # what this process looked up before is forgotten
+    robot_data._distribution_files.cache_clear()
     for _ in range(3):
         assert catalog.resolve(path)[1].name == "my_pendulum"
     assert catalog.resolve(example_robot_urdf(ROBOTS[0]))[1].name == "double_pendulum"

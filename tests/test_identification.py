@@ -40,7 +40,7 @@ from twolink_pin.identification import (
     write_log,
 )
 from twolink_pin.identification.excitation import ExcitationLimits
-from twolink_pin.identification.least_squares import solve
+from twolink_pin.identification.weighted_solve import solve
 from twolink_pin.identification.simulated import plant_friction
 from twolink_pin.simulation import SimulationConfig
 from twolink_pin.trajectory import FourierTrajectory, default_trajectory, read_trajectory_file

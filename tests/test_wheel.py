@@ -176,8 +176,11 @@ def test_the_pages_use_only_shipped_examples() -> None:
         sys.path.remove(str(ROOT))
     used = {m for c in _documented() for m in re.findall(r"examples/([\w.]+?\.(?:py|toml|urdf))", c)}
     assert used and used <= set(FILES), used - set(FILES)
-    on_disk = {p.name for p in (ROOT / "examples").iterdir() if p.is_file() and p.name != "__init__.py"}
-    assert set(FILES) == on_disk
+    folder = ROOT / "examples"
+    on_disk = {
+        p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file() and p.name != "__init__.py"
+    }
+    assert set(FILES) == {name for name in on_disk if "__pycache__" not in name}
 
 
 def test_the_docs_commands_run_from_the_wheel_outside_the_clone(installed: Path, tmp_path: Path) -> None:

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.arrays import readonly_masked
 from twolink_pin.errors import InvalidParameterError, require_type
 from twolink_pin.limits.crossings import Crossings, RunningCrossings
 from twolink_pin.limits.joint_limits import JointLimits
@@ -199,11 +200,7 @@ class RunningMetrics:
         mx = Norms(*(self.peak[k] for k in _SIGNALS))
 
         def clean(x: np.ndarray) -> np.ndarray:
-            x = np.array(x, dtype=float)
-            if dead is not None:
-                x[dead] = np.nan
-            x.setflags(write=False)
-            return x
+            return readonly_masked(x, dead)
 
         return Metrics(
             Norms(*(clean(x) for x in rms)),

@@ -63,7 +63,8 @@ def cmd_examples(args: argparse.Namespace) -> int:
                 f.write(content)
             written.append(str(target))
     rows = [{"name": name, "what": what, "bytes": len(content)} for name, (what, content) in files.items()]
-    lines = [f"  {row['name']:<24} {row['what']}" for row in rows]
+    width = max(len(name) for name in files)
+    lines = [f"  {row['name']:<{width}}  {row['what']}" for row in rows]
     if args.copy is not None:
         kept = len(files) - len(written)
         lines.append(

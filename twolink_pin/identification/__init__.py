@@ -14,8 +14,10 @@ and the command line use it, never the reverse.
                          and the Coulomb column filtered alike; samples dropped near the ends
 ``observation.py``       :class:`ParameterSet` (base parameters + friction) and the
                          observation matrix ``W`` with ``τ = W θ``
-``least_squares.py``     :func:`identify`: Gautier's weighted least squares, standard
-                         deviations, condition number, residuals, the validation period
+``least_squares.py``     :func:`identify`: the fitted rows, standard deviations, condition
+                         number, residuals, the validation period
+``weighted_solve.py``    Gautier's weighted least squares (or instrumental variables) on the
+                         stacked rows and its lag-window sandwich covariance
 ``physical.py``          physically consistent fit (every link's pseudo-inertia ⪰ 0, friction
                          ⪰ 0; cvxpy + Clarabel) and how far base parameters are from physical
 ``measures.py``          how a trajectory excites: ``cond(W)``, the Gram matrix, and the

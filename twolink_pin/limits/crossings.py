@@ -23,6 +23,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from twolink_pin.arrays import readonly_masked
 from twolink_pin.limits.joint_limits import JointLimits
 from twolink_pin.limits.kinds import EFFORT, POSITION, VELOCITY, LimitKind, Motion
 
@@ -157,11 +158,7 @@ class RunningCrossings:
         """The crossings so far; rows of ``dead`` runs (mask, shape (N,)) are NaN."""
 
         def clean(x: np.ndarray) -> np.ndarray:
-            x = np.array(x, dtype=float)
-            if dead is not None:
-                x[dead] = np.nan
-            x.setflags(write=False)
-            return x
+            return readonly_masked(x, dead)
 
         return Crossings(
             *(KindCrossings(k, clean(self.first[k.name]), clean(self.largest[k.name])) for k in CROSSED_KINDS)

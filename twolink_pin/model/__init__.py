@@ -2,7 +2,9 @@
 
 ==========================  ================================================================
 ``robot.py``                :class:`RobotModel`, :func:`load_robot` (URDF → Pinocchio model)
-``catalog.py``              robots by name: the registry ``--robot NAME`` resolves
+``catalog.py``              robots by name: what ``--robot NAME|PATH`` resolves to
+``registry.py``             the registry of named robots (a robot's package registers itself)
+``robot_data.py``           where example-robot-data's URDFs and mesh folders are
 ``profile.py``              what a named robot brings beyond its URDF (home, gains, ...)
 ``profile_file.py``         a profile as a TOML file: any URDF, one arm of it (the catalog's, a user's)
 ``home.py``                 a home for an arm whose profile gives none (dexterous, mid-range)

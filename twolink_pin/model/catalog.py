@@ -3,87 +3,25 @@
 The catalog is a registry: a robot's own package adds its entry with :func:`register`
 (the twolink's, :mod:`twolink_pin.twolink.profile`, when the package is imported), so this
 module names no robot's code. :func:`resolve` turns what a user typed
-(``--robot NAME|PATH.urdf``) into a URDF path and a profile.
+(``--robot NAME|PATH.urdf``) into a URDF path and a profile. The registry itself is
+:mod:`~twolink_pin.model.registry` and example-robot-data's files are found by
+:mod:`~twolink_pin.model.robot_data` (both re-exported here): a profile file that names a
+catalog robot reads them without importing this module, which reads profile files.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import functools
-import importlib.metadata
 import os
-from collections.abc import Callable
 from pathlib import Path
 
-from twolink_pin.errors import InvalidURDFError, require_type
+from twolink_pin.errors import InvalidURDFError
 from twolink_pin.model.profile import RobotProfile, generic_profile
 from twolink_pin.model.profile_file import is_profile_path, read_profile_file, user_folder
+from twolink_pin.model.registry import CATALOG, DEFAULT_ROBOT, names, register
+from twolink_pin.model.robot_data import example_robot_urdf, share_folder
 from twolink_pin.model.urdf_profile import declared_profile
-
-
-def share_folder(urdf: Path) -> Path:
-    """The folder ``package://example-robot-data/...`` mesh paths are relative to."""
-    for parent in urdf.parents:
-        if parent.name == "example-robot-data":
-            return parent.parent
-    return urdf.parent
-
-
-def example_robot_urdf(relative: str) -> Path:
-    """Path of a URDF shipped by ``example-robot-data``.
-
-    Args:
-        relative: Path below the package's ``robots/`` folder, e.g.
-            ``"double_pendulum_description/urdf/double_pendulum.urdf"``.
-
-    Raises:
-        InvalidURDFError: the distribution is not installed or has no such file.
-    """
-    require_type(relative, str, "relative", "a path inside example-robot-data's robots folder (str)")
-    return _located("robots/" + relative.lstrip("/"))
-
-
-@functools.cache
-def _located(suffix: str) -> Path:
-    """The installed file whose path ends in ``suffix``, looked up once per process: listing
-    the distribution's ~1000 files costs ~0.1 s, and a URDF given by path is compared with
-    every catalog robot's (:func:`resolve`). A failed lookup raises and is not remembered."""
-    files = _distribution_files()
-    if files is None:
-        raise InvalidURDFError(
-            suffix.removeprefix("robots/"),
-            "example-robot-data",
-            "not installed (pip install example-robot-data)",
-        )
-    for text, file in files:
-        if text.endswith(suffix):
-            return Path(str(file.locate()))
-    raise InvalidURDFError(
-        suffix.removeprefix("robots/"),
-        "example-robot-data",
-        f"no file ending in {suffix!r} in the installed distribution",
-    )
-
-
-@functools.cache
-def _distribution_files() -> tuple[tuple[str, importlib.metadata.PackagePath], ...] | None:
-    """example-robot-data's files with their paths as text, None if it is not installed."""
-    try:
-        files = importlib.metadata.files("example-robot-data") or []
-    except importlib.metadata.PackageNotFoundError:
-        return None
-    return tuple((str(file), file) for file in files)
-
-
-CATALOG: dict[str, Callable[[], tuple[Path, RobotProfile]]] = {}
-"""Named robots: name → a function giving its URDF path and profile (located on use)."""
-DEFAULT_ROBOT = "twolink"
-"""The robot a command or :func:`~twolink_pin.model.load_robot` uses when none is named."""
-
-
-def register(name: str, entry: Callable[[], tuple[Path, RobotProfile]]) -> None:
-    """Add a named robot: ``entry()`` gives its URDF path and profile."""
-    CATALOG[name] = entry
 
 
 def register_folder(folder: Path) -> None:
@@ -107,11 +45,6 @@ def package_folder() -> Path:
     from importlib import resources
 
     return Path(str(resources.files("twolink_pin.robots")))
-
-
-def names() -> tuple[str, ...]:
-    """The catalog's robot names, the default robot first."""
-    return tuple(sorted(CATALOG, key=lambda name: name != DEFAULT_ROBOT))
 
 
 def resolve(robot: str | os.PathLike[str] | None) -> tuple[Path, RobotProfile]:
@@ -169,3 +102,18 @@ def catalog_profile_name(profile: RobotProfile) -> str | None:
     if entry is None or entry()[1].description != profile.description:
         return None
     return profile.name
+
+
+__all__ = [
+    "CATALOG",
+    "DEFAULT_ROBOT",
+    "catalog_profile_name",
+    "example_robot_urdf",
+    "names",
+    "package_folder",
+    "register",
+    "register_folder",
+    "resolve",
+    "share_folder",
+    "user_profiles",
+]

@@ -46,6 +46,8 @@ import tomllib
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.files import read_input_file
 from twolink_pin.model.profile import ArmEffects, RobotProfile, TrajectorySpec
+from twolink_pin.model.registry import CATALOG
+from twolink_pin.model.robot_data import example_robot_urdf, share_folder
 
 PROFILE_SUFFIX = ".toml"
 """What a profile file's name ends with (``--robot FILE.toml``)."""
@@ -130,16 +132,14 @@ def _is_number(x: Any) -> bool:
 
 def _urdf(reader: _Reader) -> tuple[Path, tuple[Path, ...]]:
     """The URDF the file names and the folders its ``package://`` meshes resolve from."""
-    from twolink_pin.model import catalog
-
     text = reader.text("urdf")
     if text is None:
         raise reader.fail("urdf", None, "the robot's URDF: a path, a catalog name or example-robot-data:PATH")
     if text.startswith(EXAMPLE_ROBOT_DATA):
-        path = catalog.example_robot_urdf(text.removeprefix(EXAMPLE_ROBOT_DATA))
-        return path, (catalog.share_folder(path),)
-    if text in catalog.CATALOG:
-        path, profile = catalog.CATALOG[text]()
+        path = example_robot_urdf(text.removeprefix(EXAMPLE_ROBOT_DATA))
+        return path, (share_folder(path),)
+    if text in CATALOG:
+        path, profile = CATALOG[text]()
         return path, profile.package_dirs
     path = Path(text).expanduser()
     path = path if path.is_absolute() else reader.path.parent / path

@@ -4,19 +4,35 @@ joint 2 (joint2) at t = 0.31 s``), for the message of a QP whose rows cannot all
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
-if TYPE_CHECKING:
-    from twolink_pin.optimal.transcription import TrajectoryProblem
+from twolink_pin.limits import JointLimits, LimitKind
+from twolink_pin.optimal.layout import SplineLayout
+
+
+class LabelledProblem(Protocol):
+    """What the labels read of a problem
+    (:class:`~twolink_pin.optimal.transcription.TrajectoryProblem` has it)."""
+
+    @property
+    def layout(self) -> SplineLayout: ...
+    @property
+    def limits(self) -> JointLimits: ...
+    @property
+    def kinds(self) -> tuple[LimitKind, ...]: ...
+    @property
+    def hull(self) -> tuple[LimitKind, ...]: ...
+    @property
+    def min_duration(self) -> float: ...
 
 
 class RowLabels(Sequence[str]):
     """The labels of a problem's inequality rows, made when one is read (a failed solve
     reads one; thousands of rows are built every iteration)."""
 
-    def __init__(self, problem: TrajectoryProblem, times: np.ndarray) -> None:
+    def __init__(self, problem: LabelledProblem, times: np.ndarray) -> None:
         self.times = times
         self.names = problem.limits.joint_names
         self.blocks: list[tuple[str, np.ndarray]] = []
@@ -57,4 +73,4 @@ class RowLabels(Sequence[str]):
         return f"the duration of segment {i} >= {self.min_duration:g} s"
 
 
-__all__ = ["RowLabels"]
+__all__ = ["LabelledProblem", "RowLabels"]

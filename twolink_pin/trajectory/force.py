@@ -22,11 +22,12 @@ from typing import Any, TypeVar
 import numpy as np
 
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.trajectory.base import Trajectory
 
 MAX_FORCE = 1e6
 """Largest desired force [N] accepted."""
-T = TypeVar("T", bound=Trajectory)
+T = TypeVar("T")
+"""A reference (:class:`~twolink_pin.trajectory.Trajectory`): not imported here, the base
+class names :class:`ForceReference` as its attribute's type."""
 
 
 @dataclass(frozen=True)
