@@ -185,6 +185,13 @@ class SingleRunTerms(RigidBodyTermsMixin):
 # -- N runs ----------------------------------------------------------------------------------
 
 
+def _rows(x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``x`` as ``shape`` (N, nv): itself when it has that shape already (a law's (N, nv) state and
+    products; ``np.broadcast_to`` is a Python function: ~2 µs a call, a dozen calls a step), else
+    a read-only broadcast view of it (a (1, nv) reference row)."""
+    return x if getattr(x, "shape", None) == shape else np.broadcast_to(x, shape)
+
+
 FOREST_NV = 48
 """Largest number of joints of one polarisation forest. Pinocchio's ``Data`` holds nv × nv × nv
 second-derivative tensors, so one forest of all the regressor's column models (the UR5's 37
@@ -216,7 +223,7 @@ class _PolarisedTerms:
         nv = self.nv
         n = q.shape[0]
         plus, minus = 0.5 * (v + w), 0.5 * (v - w)
-        a_full = np.broadcast_to(a, (n, nv))
+        a_full = _rows(a, (n, nv))
         terms: list[np.ndarray] = []
         for k, pool, (Q, V, A, out) in self.groups:
             Q.reshape(n, 2 * k, nv)[:] = q[:, None, :]
@@ -277,7 +284,7 @@ class _Regressor:
 
     def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
         out: list[np.ndarray | None] = [None] * self.size
-        a_full = np.broadcast_to(a, q.shape)
+        a_full = _rows(a, q.shape)
         for j, Ct in self.constant.items():
             out[j] = a_full @ Ct
         if self.terms is not None:
@@ -397,7 +404,8 @@ class BatchTerms(RigidBodyTermsMixin):
         return self._regressor
 
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        shape = (self._runs, self._nv)
+        q, v, w = _rows(q, shape), _rows(v, shape), _rows(w, shape)
         if self._shared is not None:
             return frozen(self._shared(q, v, w, a)[0])
         assert self._p_rows is not None
@@ -409,7 +417,8 @@ class BatchTerms(RigidBodyTermsMixin):
         return frozen(tau)
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        shape = (self._runs, self._nv)
+        q, v, w = _rows(q, shape), _rows(v, shape), _rows(w, shape)
         columns = self._columns()
         if isinstance(columns, _RegressorByRun):
             return frozen(columns.matrix(q, v, w, a))
