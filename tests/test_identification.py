@@ -40,8 +40,8 @@ from twolink_pin.identification import (
     write_log,
 )
 from twolink_pin.identification.excitation import ExcitationLimits
-from twolink_pin.identification.weighted_solve import solve
 from twolink_pin.identification.simulated import plant_friction
+from twolink_pin.identification.weighted_solve import solve
 from twolink_pin.simulation import SimulationConfig
 from twolink_pin.trajectory import FourierTrajectory, default_trajectory, read_trajectory_file
 from twolink_pin.trajectory.file import write_trajectory_file
