@@ -6,10 +6,10 @@ run with the law at every stage, the single run with the law sampled at 1 kHz (z
 hold), and the batch engine per simulation at N = 1000 on 2 threads; each also as a ratio
 ``Nx`` to the baseline — the report's PD job as a plain Python loop over floats with the
 closed-form M and C (no Pinocchio, no numpy per stage), timed in the same run and
-interleaved with the others. The issue's targets are printed beside: single runs of pd,
-computed-torque and robust at most 12× the baseline (MuJoCo 4.0 with a Python controller
-at every RK4 stage on this job, as measured in the issue: 1.35 s against 0.111 s), the
-adaptive laws at most 18×; the batch at most 1.0× per simulation. The UR5 (pd, computed-torque,
+interleaved with the others. The targets are printed beside (:data:`SINGLE_TARGET`: pd and
+robust at most 12× the baseline — MuJoCo 4.0 with a Python controller at every RK4 stage on
+this job, as first measured: 1.35 s against 0.111 s —, computed-torque 12.8×, adaptive 18×,
+adaptive-friction 26×); the batch at most 1.0× per simulation (``--batch-only`` runs just that). The UR5 (pd, computed-torque,
 adaptive) beside it: a single run and the batch at N = 1000, against the same baseline
 (``--ur5-only`` runs just that). Then the batch engine's
 scaling from N = 1 to 10 000 runs with 1 and 2 threads, the peak memory of sweeps of 1 000
