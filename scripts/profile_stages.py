@@ -1,7 +1,7 @@
 """Per-stage profile of a single run (N = 1): microseconds per RK4 stage in the law, in
 Pinocchio (the ``Terms`` the law asks for and the plant's ABA) and in the engine.
 
-An instrumented run: the engine's three doors (``contained`` — the law behind its
+An instrumented run: the engine's three doors (``law_call`` — the law behind its
 containment —, ``terms_for`` and ``dynamics_for``) are wrapped with
 ``time.perf_counter_ns`` accumulators, then one timed single run per law is made with the
 wrappers and one without (the plain wall time). Split per stage (4 stages per step):
@@ -58,13 +58,13 @@ class _Clock:
 
 
 def _instrument(clock: _Clock) -> tuple[Any, Any, Any]:
-    originals = (engine.contained, engine.terms_for, engine.dynamics_for)
-    contained, terms_for, dynamics_for = originals
+    originals = (engine.law_call, engine.terms_for, engine.dynamics_for)
+    law_call, terms_for, dynamics_for = originals
     ns = clock.ns
     now = time.perf_counter_ns
 
-    def timed_contained(controller: Any) -> Any:
-        call = contained(controller)
+    def timed_law_call(controller: Any, noise: Any, method: str = "compute") -> Any:
+        call = law_call(controller, noise, method)
 
         def law(x: Any, terms: Any) -> Any:
             start = now()
@@ -110,8 +110,8 @@ def _instrument(clock: _Clock) -> tuple[Any, Any, Any]:
 
         return timed
 
-    engine.contained, engine.terms_for, engine.dynamics_for = (  # type: ignore[assignment]
-        timed_contained,
+    engine.law_call, engine.terms_for, engine.dynamics_for = (  # type: ignore[assignment]
+        timed_law_call,
         timed_terms_for,
         timed_dynamics_for,
     )
@@ -140,7 +140,7 @@ def profile(robot_name: str, spec: str, duration: float, repeats: int) -> dict[s
             simulate(controller, plant, reference, config)
             elapsed = time.perf_counter_ns() - start
         finally:
-            engine.contained, engine.terms_for, engine.dynamics_for = originals  # type: ignore[assignment]
+            engine.law_call, engine.terms_for, engine.dynamics_for = originals  # type: ignore[assignment]
         law = (clock.ns["law"] - clock.ns["terms"]) / stages / 1e3
         pinocchio = (clock.ns["terms"] + clock.ns["aba"]) / stages / 1e3
         rest = elapsed / stages / 1e3 - law - pinocchio

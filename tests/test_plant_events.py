@@ -262,8 +262,8 @@ def test_saturation_clips_the_motors_torque_never_the_wrench(engine: str, integr
     import pinocchio as pin
 
     from twolink_pin.plant_options import PlantOptions
-    from twolink_pin.simulation.engine import _Steps
     from twolink_pin.simulation.events import PlantEvents
+    from twolink_pin.simulation.rk4 import Steps
 
     force = np.array([0.0, 800.0, 0.0, 0.0, 0.0, 30.0])  # [N, N·m]: beyond both limits
     extra = {"integrator": integrator} if engine == "mujoco" else {}
@@ -278,7 +278,7 @@ def test_saturation_clips_the_motors_torque_never_the_wrench(engine: str, integr
     accel = PlantEvents(plant, 1, None, ROBOT.nv).accel_at(0.1)
     if integrator == "euler":
         dt = 1e-4
-        _, v1, _ = accel.held_step(q, v, np.zeros((1, 0)), tau, np.zeros((1, 0)), _Steps.of(dt, 2, 0), 0)  # type: ignore[attr-defined]
+        _, v1, _ = accel.held_step(q, v, np.zeros((1, 0)), tau, np.zeros((1, 0)), Steps.of(dt), 0)  # type: ignore[attr-defined]
         np.testing.assert_allclose((v1[0] - v[0]) / dt, expected, rtol=1e-8, atol=1e-8)
     else:
         np.testing.assert_allclose(accel(q, v, tau)[0], expected, rtol=1e-10, atol=1e-8)

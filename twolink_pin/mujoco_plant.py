@@ -282,7 +282,7 @@ class SteppedDynamics(MujocoDynamics):
             model.opt.timestep = steps.dt
         self._load(q, v, tau, external)
         self._mujoco.mj_step(model, self.data)
-        return self._qpos.copy(), self._qvel.copy(), (z + steps.hz * dz if nz else z)
+        return self._qpos.copy(), self._qvel.copy(), (z + steps.h * dz if nz else z)
 
 
 class MujocoBatchDynamics:
@@ -383,7 +383,7 @@ class SteppedBatchDynamics(MujocoBatchDynamics):
             self._datas = None  # the contacts' reads bound to the new batch
         self._load(q, v, tau, external)
         self.batch.step()
-        return self._qpos.copy(), self._qvel.copy(), (z + steps.hz * dz if nz else z)
+        return self._qpos.copy(), self._qvel.copy(), (z + steps.h * dz if nz else z)
 
 
 def _resume(qpos: np.ndarray, qvel: np.ndarray, applied: np.ndarray, ctrl: np.ndarray, previous: Any) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 from typing import Any, ClassVar
 
 import numpy as np
@@ -11,7 +12,7 @@ from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.dynamics import Friction, regressor, smooth_sign
 from twolink_pin.model import RobotModel
 
@@ -78,10 +79,20 @@ class Adaptive(Controller[AdaptiveGains]):
         and the values the friction estimates start from."""
         super().__init__(robot, gains, model_parameters=model_parameters)
         # Derived once: the law below runs 10⁵ times per simulated minute.
+        nv = robot.nv
         self._inertial = "inertial" in self.estimates
-        self._friction_start = self.robot.parameter_map.size if self._inertial else 0
-        self._smoothing = 0.0 if friction is None else friction.smoothing
-        self._minus_k = -applied_form(self.gains.k)
+        self._friction = "friction" in self.estimates
+        start = self.robot.parameter_map.size if self._inertial else 0
+        # z's columns as index tuples made once: p̂, then V̂ and Ĉ per joint
+        self._p_hat, self._v_hat, self._c_hat = (
+            (slice(None), slice(0, start)),
+            (slice(None), slice(start, start + nv)),
+            (slice(None), slice(start + nv, start + 2 * nv)),
+        )
+        smoothing = 0.0 if friction is None else friction.smoothing
+        self._sign = np.sign if smoothing == 0 else partial(smooth_sign, smoothing=smoothing)
+        self._minus_k = applied_form(-np.asarray(self.gains.k))
+        self._lam = applied_scalar(self.gains.lam)
         self._minus_rate = -1.0 / np.asarray(self.gains.gamma)
 
     def initial_state(self) -> np.ndarray:
@@ -108,20 +119,19 @@ class Adaptive(Controller[AdaptiveGains]):
         return {"k": k, "gamma": _gram_diagonal(self, k) / ADAPTATION_RATE}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        lam = self.gains.lam
-        lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
+        lam, v, z = self._lam, x.v, x.z
+        lam_e, edot = lam * (x.q - x.q_des), v - x.v_des
         s = edot + lam_e
-        tau = apply_gain(self._minus_k, s)
+        tau = self._minus_k(s)
         if self._inertial:
-            Y = terms.regressor(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
-            tau = tau + np.matvec(Y, x.z[:, : self._friction_start])
+            Y = terms.regressor(x.q, v, x.v_des - lam_e, x.a_des - lam * edot)
+            tau = tau + np.matvec(Y, z[self._p_hat])
             projection = np.vecmat(s, Y)
-        if "friction" in self.estimates:  # Y_f = [diag(q̇), diag(sgn q̇)]: element-wise terms
-            nv, start = self.robot.nv, self._friction_start
-            sign = smooth_sign(x.v, self._smoothing)
-            tau = tau + x.z[:, start : start + nv] * x.v + x.z[:, start + nv :] * sign
-            friction = (x.v * s, sign * s)
-            projection = np.concatenate((projection, *friction) if self._inertial else friction, axis=1)
+        if self._friction:  # Y_f = [diag(q̇), diag(sgn q̇)]: element-wise terms
+            sign = self._sign(v)
+            tau = tau + z[self._v_hat] * v + z[self._c_hat] * sign
+            friction = (v * s, sign * s)
+            projection = np.concatenate((projection, *friction) if self._inertial else friction, 1)
         return LawOutput(tau, projection * self._minus_rate)
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.dynamics import joint_space_inertia
 from twolink_pin.model import RobotModel
 
@@ -58,16 +58,16 @@ class ComputedTorque(Controller[SlotineLiGains]):
 
     def __init__(self, robot: RobotModel, gains: SlotineLiGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
-        self._k = applied_form(self.gains.k)
+        self._k, self._lam = applied_form(self.gains.k), applied_scalar(self.gains.lam)
 
     def scaled_gains(self) -> dict[str, Any]:
         return {"k": sliding_gain(self.robot)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        g = self.gains
-        lam_e, edot = g.lam * (x.q - x.q_des), x.v - x.v_des
-        tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - g.lam * edot)
-        return LawOutput(tau - apply_gain(self._k, edot + lam_e))
+        lam = self._lam
+        lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
+        tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
+        return LawOutput(tau - self._k(edot + lam_e))
 
 
 def sliding_gain(robot: RobotModel) -> np.ndarray:

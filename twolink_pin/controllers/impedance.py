@@ -11,7 +11,7 @@ import pinocchio as pin
 from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form
 from twolink_pin.controllers.task_space import (
     TaskInertia,
     block_gain,
@@ -155,7 +155,7 @@ class Impedance(Controller[ImpedanceGains]):
         force = -(np.matvec(self._K, e) + np.matvec(self._D, e_dot))
         tau = terms.gravity(x.q) + np.vecmat(force, J)
         if self._redundant:
-            tau0 = -(apply_gain(self._kp_null, x.q - x.q_des) + apply_gain(self._kd_null, x.v - x.v_des))
+            tau0 = -(self._kp_null(x.q - x.q_des) + self._kd_null(x.v - x.v_des))
             MinvJt = terms.solve_mass(x.q, J.transpose(0, 2, 1))
             Lam = self._inertia(np.matmul(J, MinvJt), x.t)
             tau = tau + null_space_torque(J, MinvJt, Lam, tau0)

@@ -1,12 +1,14 @@
 """Matrix gains: a symmetric positive-definite ``K`` (k, k) of a law whose gain couples joints or
 axes (``K = κ M(q₀)`` from the arm's inertia): how a value is read and checked
 (:func:`validate_matrix`, :func:`as_matrix`) and how a law applies it (:func:`applied_form`,
-:func:`apply_gain`, :func:`gain_solve`). The gains' declaration is :mod:`twolink_pin.controllers.gains`.
+:func:`applied_scalar`, :func:`gain_solve`). The gains' declaration is :mod:`twolink_pin.controllers.gains`.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -144,17 +146,33 @@ def as_matrix(value: Any, k: int, name: str = "gain", unit: str = "") -> np.ndar
     return array
 
 
-def applied_form(matrix: np.ndarray) -> np.ndarray:
-    """A matrix gain ``(1 or N, k, k)`` (:func:`as_matrix`) as a law applies it
-    (:func:`apply_gain`): its diagonals ``(1 or N, k)`` when every matrix is diagonal — applied
-    element-wise, the same operations (and bits) as a per-joint gain —, else the matrices."""
+def applied_form(matrix: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """A matrix gain ``(1 or N, k, k)`` (:func:`as_matrix`) as a law applies it: ``x ↦ K x`` for
+    N runs (``x`` (N, k)), one C-level call (a ``functools.partial`` of a ufunc: no Python frame,
+    several times per RK4 stage) — element-wise with the diagonals ``(1 or N, k)`` when every
+    matrix is diagonal (the same operations, and bits, as a per-joint gain), else ``np.matvec``
+    with the matrices."""
     array = np.asarray(matrix, dtype=float)
     k = array.shape[-1]
     if not np.any(array * (1.0 - np.eye(k))):
         diagonal = np.ascontiguousarray(array.diagonal(0, 1, 2))
         diagonal.setflags(write=False)
-        return diagonal
-    return array
+        return partial(np.multiply, diagonal)
+    array = np.array(array)
+    array.setflags(write=False)
+    return partial(np.matvec, array)
+
+
+def applied_scalar(value: Any) -> Any:
+    """A scalar gain (a number, or one per run as an (N, 1) column: :mod:`~twolink_pin.controllers.gains`)
+    as a law multiplies it into (N, k) arrays: a number as a read-only 0-d array — numpy's fast
+    path at any N (a Python float costs 1.6 times as much at N = 1, a (1, k) row 8 times as much
+    at N = 1000), the same products —, a column as it is."""
+    if isinstance(value, np.ndarray):
+        return value
+    number = np.array(float(value))
+    number.setflags(write=False)
+    return number
 
 
 def gain_solve(gain: Any, Y: np.ndarray) -> np.ndarray:
@@ -169,12 +187,6 @@ def gain_solve(gain: Any, Y: np.ndarray) -> np.ndarray:
         array = np.diag(matrix)
     diagonal = np.broadcast_to(array.reshape(-1), (Y.shape[0],))
     return Y / diagonal.reshape((-1,) + (1,) * (Y.ndim - 1))
-
-
-def apply_gain(gain: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``K x`` for N runs: ``gain`` from :func:`applied_form` (rows: element-wise; matrices:
-    ``np.matvec``), ``x`` (N, k)."""
-    return gain * x if gain.ndim == 2 else np.matvec(gain, x)
 
 
 def shape_failed(n: int, k: int) -> str:

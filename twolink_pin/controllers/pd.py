@@ -8,7 +8,7 @@ from typing import Any
 from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form
 from twolink_pin.dynamics import joint_space_inertia
 from twolink_pin.model import RobotModel
 
@@ -58,7 +58,7 @@ class PDFeedforward(Controller[PDGains]):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         tau = terms.model(x.q, x.v, x.v_des, x.a_des)
-        return LawOutput(tau - (apply_gain(self._kp, x.q - x.q_des) + apply_gain(self._kd, x.v - x.v_des)))
+        return LawOutput(tau - (self._kp(x.q - x.q_des) + self._kd(x.v - x.v_des)))
 
 
 def pd_gains(robot: RobotModel) -> dict[str, Any]:

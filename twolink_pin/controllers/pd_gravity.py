@@ -8,7 +8,7 @@ from typing import Any
 from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form
 from twolink_pin.controllers.pd import pd_gains
 from twolink_pin.model import RobotModel
 
@@ -51,5 +51,5 @@ class PDGravity(Controller[PDGravityGains]):
         return pd_gains(self.robot)
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        feedback = apply_gain(self._kp, x.q - x.q_des) + apply_gain(self._kd, x.v - x.v_des)
+        feedback = self._kp(x.q - x.q_des) + self._kd(x.v - x.v_des)
         return LawOutput(terms.gravity(x.q) - feedback)

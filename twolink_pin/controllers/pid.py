@@ -10,7 +10,7 @@ import numpy as np
 from twolink_pin.controllers.base import Controller, StateVariable
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form
 from twolink_pin.controllers.pd import NATURAL_FREQUENCY
 from twolink_pin.dynamics import joint_space_inertia
 
@@ -71,9 +71,9 @@ class PID(Controller[PIDGains]):
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
         e = x.q - x.q_des
-        integral = apply_gain(self._ki, x.z)
-        feedback = apply_gain(self._kp, e) + integral + apply_gain(self._kd, x.v - x.v_des)
+        integral = self._ki(x.z)
+        feedback = self._kp(e) + integral + self._kd(x.v - x.v_des)
         tau = terms.model(x.q, x.v, x.v_des, x.a_des) - feedback
         # -K_i e is the direction the integral term moves τ in: stop when that is outwards.
-        winding = (np.abs(tau) >= self._limits) & (np.sign(-apply_gain(self._ki, e)) == np.sign(tau))
+        winding = (np.abs(tau) >= self._limits) & (np.sign(-self._ki(e)) == np.sign(tau))
         return LawOutput(tau, np.where(winding, 0.0, e))

@@ -9,7 +9,7 @@ from twolink_pin.controllers.base import Controller
 from twolink_pin.controllers.computed_torque import DEFAULT_LAMBDA, sliding_gain
 from twolink_pin.controllers.gains import Gains, gain
 from twolink_pin.controllers.law_io import LawInput, LawOutput, Terms
-from twolink_pin.controllers.matrix_gains import applied_form, apply_gain
+from twolink_pin.controllers.matrix_gains import applied_form, applied_scalar
 from twolink_pin.model import RobotModel
 
 
@@ -47,13 +47,18 @@ class WrongModel(Controller[WrongModelGains]):
 
     def __init__(self, robot: RobotModel, gains: WrongModelGains | None = None, **kwargs: Any) -> None:
         super().__init__(robot, gains, **kwargs)
-        self._k = applied_form(self.gains.k)
+        g = self.gains
+        self._k, self._lam, self._beta = (
+            applied_form(g.k),
+            applied_scalar(g.lam),
+            applied_scalar(g.model_scale),
+        )
 
     def scaled_gains(self) -> dict[str, Any]:
         return {"k": sliding_gain(self.robot)}
 
     def compute(self, x: LawInput, terms: Terms) -> LawOutput:
-        g = self.gains
-        lam_e, edot = g.lam * (x.q - x.q_des), x.v - x.v_des
-        tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - g.lam * edot)
-        return LawOutput(g.model_scale * tau - apply_gain(self._k, edot + lam_e))
+        lam = self._lam
+        lam_e, edot = lam * (x.q - x.q_des), x.v - x.v_des
+        tau = terms.model(x.q, x.v, x.v_des - lam_e, x.a_des - lam * edot)
+        return LawOutput(self._beta * tau - self._k(edot + lam_e))

@@ -6,6 +6,7 @@
 ``rigid_terms.py``     M̂, ĝ, Ĉq̇ + ĝ, M̂⁻¹b and the frame kinematics a law asks for
 ``forward.py``         the plant's accelerations (ABA) for one run or N
 ``engine.py``          :func:`integrate`: RK4, per-stage or sampled law, N runs, blocks, plant events
+``rk4.py``             the engine's RK4 step: the law at every stage, or the plant under a held torque
 ``samples.py``         what the engine writes: :class:`Samples` (blocks of N runs), the buffers, observers
 ``divergence.py``      which runs diverged in a block, when, and what was seen (non-finite or too large)
 ``events.py``          what a plant that pushes back does to a step: wrench, payload step, noise, delay, contact

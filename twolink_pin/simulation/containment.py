@@ -71,7 +71,6 @@ def contained(controller: Controller, method: str = "compute") -> Callable[[LawI
         # adaptive-step method passes views. The reference is made read-only where the
         # engine samples it (once per block).
         # setflags(False) is setflags(write=False) without keyword parsing (half the cost).
-        t = x[0]
         x[1].setflags(False)  # type: ignore[call-arg]
         x[2].setflags(False)  # type: ignore[call-arg]
         x[3].setflags(False)  # type: ignore[call-arg]
@@ -82,17 +81,17 @@ def contained(controller: Controller, method: str = "compute") -> Callable[[LawI
         except SystemExit as exc:  # sys.exit, or os._exit while the CLI contains it (user_code.HardExit)
             how = "os._exit" if isinstance(exc, HardExit) else "sys.exit"
             raise ControllerError(
-                name, float(t), f"{method} called {how}({exc.code!r}); a law must return or raise"
+                name, float(x[0]), f"{method} called {how}({exc.code!r}); a law must return or raise"
             ) from None
         except MemoryError as exc:
             raise ControllerError(
                 name,
-                float(t),
+                float(x[0]),
                 f"{method} ran out of memory (MemoryError{': ' + str(exc) if str(exc) else ''})",
             ) from None
         except ValueError as exc:
             if "read-only" in str(exc):
-                raise ControllerError(name, float(t), f"{READ_ONLY_HINT} ({exc})") from exc
+                raise ControllerError(name, float(x[0]), f"{READ_ONLY_HINT} ({exc})") from exc
             raise
 
     return call

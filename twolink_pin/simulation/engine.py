@@ -41,7 +41,7 @@ naming the law and the simulated time.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -63,6 +63,7 @@ from twolink_pin.simulation.divergence import flag_block, late_divergence, law_r
 from twolink_pin.simulation.events import DelayLine, PlantEvents
 from twolink_pin.simulation.forward import dynamics_for
 from twolink_pin.simulation.preview import preview_offsets
+from twolink_pin.simulation.rk4 import Clock, Steps, held_rk4, stage_step
 from twolink_pin.simulation.samples import Observer, Outputs, Samples
 from twolink_pin.simulation.sensing import ForceSensor
 from twolink_pin.simulation.task_reference import reference_rows
@@ -130,11 +131,9 @@ def integrate(
         np.errstate(all="ignore"),
         bounded(lambda timeout: timed_out(controller, clock.now, timeout), stall=True),
     ):
-        for k0 in range(0, run.total, BLOCK):
-            k1 = min(k0 + BLOCK, run.total)
-            rq, rv, ra, ref = _block_reference(
-                controller, trajectory, k0, k1, n, dt, run.sensor, ahead, run.update_every
-            )
+        for k0, k1, rq, rv, ra, ref in _block_references(
+            controller, trajectory, run.total, n, dt, run.sensor, ahead, run.update_every
+        ):
             if events is not None:
                 events.draw(k0, k1)
             run.advance(k0, k1, ref)
@@ -220,13 +219,13 @@ class _Run:
             self.q, self.v = self.stop(0.0, self.q, self.v)
         if events is not None:  # none starts inside a surface
             events.check_start(self.q)
-        self.steps = _Steps.of(dt, nv, nz)
+        self.steps = Steps.of(dt)
         self.no_state = np.zeros((runs, 0))
         # The law's outputs: dz is an (N, nz) array whenever nz > 0 (checked at the first evaluation).
         self.tau1: Any = None
         self.dz1: Any = None
         self.first = True
-        self.clock = _Clock()  # time of the law evaluation under way (for error messages)
+        self.clock = Clock()  # time of the law evaluation under way (for error messages)
 
     def sensed(self, law: Callable[[Any, Any], Any]) -> Callable[[Any, Any], Any]:
         """``law`` with the force sensor's reading in ``LawInput.contact`` (a scene), else itself."""
@@ -304,9 +303,9 @@ class _Run:
                 if k == n:
                     break
                 if sampled:  # zero-order hold (or delay): τ and ż fixed over the step
-                    q, v, z = getattr(accel, "held_step", _held_rk4(accel))(q, v, z, tau_k, dz_k, steps, nz)
+                    q, v, z = getattr(accel, "held_step", held_rk4(accel))(q, v, z, tau_k, dz_k, steps, nz)
                 else:
-                    q, v, z = _stage_step(
+                    q, v, z = stage_step(
                         compute, terms, accel, q, v, z, tau_k, dz_k, ref, i, t, steps, nz, clock
                     )
                 if stop is not None:  # joint stops: back within the ranges
@@ -373,6 +372,35 @@ class _Run:
                 self.q, self.v, self.z = q, v, z
 
 
+REFERENCE_BLOCKS = 8
+"""Blocks whose reference is sampled in one call: a trajectory's ``sample`` costs a fixed ~75 µs
+per call besides ~0.1 µs per time (the twolink's polynomials), 2 µs per step of a single run at one
+block per call; eight blocks per call save most of it, and the memory stays O(:data:`BLOCK`)."""
+
+
+def _block_references(
+    controller: Controller,
+    trajectory: Trajectory,
+    total: int,
+    n: int,
+    dt: float,
+    sensor: ForceSensor | None = None,
+    ahead: np.ndarray | None = None,
+    update_every: int | None = None,
+) -> Iterator[tuple[int, int, np.ndarray, np.ndarray, np.ndarray, Any]]:
+    """Per block of samples ``k0 … k1 − 1`` (of ``total``): ``k0``, ``k1`` and its reference as
+    :func:`_block_reference` gives it, sampled :data:`REFERENCE_BLOCKS` blocks at a time (every
+    quantity is a function of its own time: the same values, element by element)."""
+    chunk = BLOCK * REFERENCE_BLOCKS
+    for c0 in range(0, total, chunk):
+        c1 = min(c0 + chunk, total)
+        rq, rv, ra, ref = _block_reference(controller, trajectory, c0, c1, n, dt, sensor, ahead, update_every)
+        for k0 in range(c0, c1, BLOCK):
+            k1 = min(k0 + BLOCK, c1)
+            rows = slice(2 * (k0 - c0), 2 * (k1 - c0) + 1)  # half-steps 2 k0 … min(2 k1, 2 n)
+            yield k0, k1, rq[rows], rv[rows], ra[rows], ref[rows]
+
+
 def _block_reference(
     controller: Controller,
     trajectory: Trajectory,
@@ -399,102 +427,3 @@ def _block_reference(
     rq, rv, ra = (read_only(np.ascontiguousarray(x)[:, None, :]) for x in (half.q, half.v, half.a))
     contact = None if sensor is None else sensor.rows(half_t)
     return rq, rv, ra, reference_rows(controller, trajectory, half_t, half, rq, rv, ra, contact, ahead, at)
-
-
-class _Clock:
-    """The simulated time of the law evaluation under way [s] (error messages, ``--timeout``)."""
-
-    now = 0.0
-
-
-class _Steps(NamedTuple):
-    """The step's factors as (1, width) rows: numpy multiplies two 2-D operands on its fast
-    path, while a Python float (or a 1-D row) against a (1, nv) array costs twice as much at N = 1."""
-
-    dt: float
-    h: np.ndarray
-    h2: np.ndarray
-    h6: np.ndarray
-    two: np.ndarray
-    hz: np.ndarray
-    h2z: np.ndarray
-    h6z: np.ndarray
-    twoz: np.ndarray
-
-    @classmethod
-    def of(cls, dt: float, nv: int, nz: int) -> _Steps:
-        """The factors of a step of ``dt`` [s] for nv joints and a law state of nz entries."""
-        return cls(
-            dt,
-            *(np.full((1, nv), x) for x in (dt, dt / 2, dt / 6, 2.0)),
-            *(np.full((1, nz), x) for x in (dt, dt / 2, dt / 6, 2.0)),
-        )
-
-
-def _stage_step(
-    compute: Callable[[Any, Any], Any],
-    terms: Any,
-    accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
-    q: np.ndarray,
-    v: np.ndarray,
-    z: np.ndarray,
-    tau1: np.ndarray,
-    dz1: np.ndarray,
-    ref: Any,
-    i: int,
-    t: float,
-    steps: _Steps,
-    nz: int,
-    clock: _Clock,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One classical RK4 step from ``(q, v, z)`` at ``t`` with the law at every stage (its first
-    output ``tau1``, ``dz1`` given; ``ref[i]``: the reference rows of half-step i)."""
-    new = tuple.__new__  # LawInput(...) through tuple.__new__: twice as cheap as its __new__
-    dt, h, h2, h6, two, hz, h2z, h6z, twoz = steps
-    a1 = accel(q, v, tau1)
-    clock.now = now = t + dt / 2
-    q2, v2 = q + h2 * v, v + h2 * a1
-    z2 = z + h2z * dz1 if nz else z
-    tau2, dz2 = compute(new(LawInput, (now, q2, v2, z2, *ref[i + 1])), terms)
-    a2 = accel(q2, v2, tau2)
-    q3, v3 = q + h2 * v2, v + h2 * a2
-    z3 = z + h2z * dz2 if nz else z
-    tau3, dz3 = compute(new(LawInput, (now, q3, v3, z3, *ref[i + 1])), terms)
-    a3 = accel(q3, v3, tau3)
-    clock.now = now = t + dt
-    q4, v4 = q + h * v3, v + h * a3
-    z4 = z + hz * dz3 if nz else z
-    tau4, dz4 = compute(new(LawInput, (now, q4, v4, z4, *ref[i + 2])), terms)
-    a4 = accel(q4, v4, tau4)
-    if nz:
-        z = z + h6z * (dz1 + twoz * (dz2 + dz3) + dz4)
-    return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z
-
-
-def _held_rk4(accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]) -> Callable[..., Any]:
-    """The engine's held step on ``accel`` (a plant that steps itself has its own ``held_step``)."""
-    return lambda *state: _held_step(accel, *state)
-
-
-def _held_step(
-    accel: Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray],
-    q: np.ndarray,
-    v: np.ndarray,
-    z: np.ndarray,
-    tau: np.ndarray,
-    dz: np.ndarray,
-    steps: _Steps,
-    nz: int,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """One RK4 step of the plant under the held torque ``tau``; ``z ← z + dt ż``."""
-    _, h, h2, h6, two, hz = steps[:6]
-    a1 = accel(q, v, tau)
-    q2, v2 = q + h2 * v, v + h2 * a1
-    a2 = accel(q2, v2, tau)
-    q3, v3 = q + h2 * v2, v + h2 * a2
-    a3 = accel(q3, v3, tau)
-    q4, v4 = q + h * v3, v + h * a3
-    a4 = accel(q4, v4, tau)
-    if nz:
-        z = z + hz * dz
-    return q + h6 * (v + two * (v2 + v3) + v4), v + h6 * (a1 + two * (a2 + a3) + a4), z

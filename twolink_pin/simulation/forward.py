@@ -3,6 +3,8 @@ plant's own engine's (:meth:`~twolink_pin.plant.Plant.dynamics`: MuJoCo's)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -14,41 +16,61 @@ from twolink_pin.simulation.terms import check_parallel, threads_for
 
 
 class SingleRunDynamics:
-    """``q̈`` [rad/s²] of one run, shape (1, nv), from ``(1, nv)`` state and torque."""
+    """``q̈`` [rad/s²] of one run, shape (1, nv), from ``(1, nv)`` state and torque.
+
+    The engine calls :attr:`accel` itself, four times a step: a closure over the plant's rows
+    (no attribute lookups), with only the effects this plant has."""
 
     def __init__(self, plant: Plant) -> None:
         self._plant = plant
-        self._model = plant.model
-        self._data = plant.model.createData()
-        self._nv = plant.model.nv
-        friction = plant.friction
-        # (1, nv) rows: numpy's fast path against the (1, nv) state
-        self._friction = (
-            None if friction is None else (np.array([friction.viscous]), np.array([friction.coulomb]))
-        )
-        self._smoothing = 0.0 if friction is None else friction.smoothing
-        self._damping = plant.joint_damping[None] if plant.joint_damping.any() else None
-        # plant.applied_torque's clip as maximum then minimum against (1, nv) rows: the same
-        # values (clip is min(max(τ, −limit), limit), NaN passed through) at a third of
-        # np.clip's cost
-        self._saturate = (-plant.limits[None], plant.limits[None]) if plant.saturate else None
+        self.accel = _single_run_accel(plant)
+        """``accel(q, v, tau, external=None)``: what calling this object does."""
 
     def __call__(
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
     ) -> np.ndarray:
         """``external``: a joint torque [N·m] the world adds (a wrench's or a contact's ``Jᵀ f``), never
         saturated, (1, nv) or None."""
-        # plant.motor_torque, spelled out with the rows above: this runs four times per step.
-        saturate = self._saturate
-        u = tau if saturate is None else np.minimum(np.maximum(tau, saturate[0]), saturate[1])
-        if self._friction is not None:
-            viscous, coulomb = self._friction
-            u = u - (viscous * v + coulomb * smooth_sign(v, self._smoothing))
-        if self._damping is not None:
-            u = u - self._damping * v
+        return self.accel(q, v, tau, external)
+
+
+def _single_run_accel(plant: Plant) -> Callable[..., np.ndarray]:
+    """:class:`SingleRunDynamics`' function: ``plant.motor_torque`` spelled out with (1, nv) rows
+    (numpy's fast path against the (1, nv) state), then ABA."""
+    model, data, aba, convention = plant.model, plant.model.createData(), pin.aba, ABA_CONVENTION
+    friction = plant.friction
+    viscous, coulomb = (
+        (None, None) if friction is None else (np.array([friction.viscous]), np.array([friction.coulomb]))
+    )
+    smoothing = 0.0 if friction is None else friction.smoothing
+    sign = np.sign if smoothing == 0 else partial(smooth_sign, smoothing=smoothing)
+    damping = plant.joint_damping[None] if plant.joint_damping.any() else None
+    # plant.applied_torque's clip as maximum then minimum against (1, nv) rows: the same values
+    # (clip is min(max(τ, −limit), limit), NaN passed through) at a third of np.clip's cost
+    saturate, low, high = plant.saturate, -plant.limits[None], plant.limits[None]
+    if viscous is None and damping is None and not saturate:  # the plain arm: ABA alone
+
+        def plain(
+            q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+        ) -> np.ndarray:
+            u = tau if external is None else tau + external
+            return aba(model, data, q[0], v[0], u[0], convention)[None]
+
+        return plain
+
+    def accel(
+        q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
+    ) -> np.ndarray:
+        u = np.minimum(np.maximum(tau, low), high) if saturate else tau
+        if viscous is not None:
+            u = u - (viscous * v + coulomb * sign(v))
+        if damping is not None:
+            u = u - damping * v
         if external is not None:
             u = u + external
-        return pin.aba(self._model, self._data, q[0], v[0], u[0], ABA_CONVENTION)[None]
+        return aba(model, data, q[0], v[0], u[0], convention)[None]
+
+    return accel
 
 
 class BatchDynamics:
@@ -91,4 +113,4 @@ def dynamics_for(plant: Plant, runs: int, threads: int | None = None) -> Any:
     own = plant.dynamics(runs, threads_for(runs, threads) if runs > 1 else 1)
     if own is not None:
         return own
-    return SingleRunDynamics(plant) if runs == 1 else BatchDynamics(plant, runs, threads)
+    return SingleRunDynamics(plant).accel if runs == 1 else BatchDynamics(plant, runs, threads)

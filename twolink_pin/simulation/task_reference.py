@@ -137,10 +137,8 @@ def reference_rows(
     px, pr, pw, pa = task_reference(controller, trajectory, t, joint)
     touch = contact if contact is not None else [None] * len(t)
     preview = previews(ahead, trajectory, t, at)
-    # Rows by iteration (the same read-only views as rq[i]; no Python __getitem__ of NONES per row)
+    # Rows by iteration in C (zip over the arrays: the same read-only views as rq[i]; no
+    # Python __getitem__ of NONES, no Python loop per row)
     if px is NONES:
-        return [
-            (q, v, a, None, None, None, None, c, p)
-            for q, v, a, c, p in zip(rq, rv, ra, touch, preview, strict=True)
-        ]
+        px = pr = pw = pa = [None] * len(t)
     return list(zip(rq, rv, ra, px, pr, pw, pa, touch, preview, strict=True))

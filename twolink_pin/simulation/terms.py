@@ -33,7 +33,7 @@ single runs to rounding and a run's result does not depend on how a sweep is chu
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -101,44 +101,49 @@ def threads_for(runs: int, threads: int | None) -> int:
 # -- one run ---------------------------------------------------------------------------------
 
 
-class _PairInputs:
-    """The pair's RNEA inputs ``Q = (q, q)``, ``V = ((v+w)/2, (v−w)/2)``, ``A = (a, 0)``.
+_CONCATENATE = getattr(np.concatenate, "_implementation", np.concatenate)
+"""``np.concatenate``'s C function without NumPy's array-function dispatch (a Python-level
+dispatcher around it: a third of the call's cost on four (1, nv) rows, ~1 µs a step); the
+arrays it joins here are the engine's and a law's, handed on to Pinocchio."""
+
+
+def _pair_inputs(
+    nv: int,
+) -> Callable[[np.ndarray, np.ndarray, np.ndarray, np.ndarray], tuple[np.ndarray, ...]]:
+    """``fill(q, v, w, a)``: the pair's RNEA inputs ``Q = (q, q)``, ``V = ((v+w)/2, (v−w)/2)``,
+    ``A = (a, 0)``, each of shape (2 nv,), valid until the next call.
 
     Built in one product ``[q v w a] T`` with a constant 0/±1/±½ matrix ``T``: two numpy
     calls instead of five (each entry is one input, or a half-sum that FMA or not rounds
-    exactly like ``(v ± w)/2``).
+    exactly like ``(v ± w)/2``). A closure over its buffers: no attribute lookups, four
+    times per RK4 step.
     """
+    eye = np.eye(nv)
+    T = np.zeros((4 * nv, 6 * nv))
+    T[0:nv, 0:nv] = T[0:nv, nv : 2 * nv] = eye  # q -> both copies
+    T[nv : 2 * nv, 2 * nv : 3 * nv] = T[nv : 2 * nv, 3 * nv : 4 * nv] = 0.5 * eye  # v/2 -> both
+    T[2 * nv : 3 * nv, 2 * nv : 3 * nv] = 0.5 * eye  # +w/2 -> copy A
+    T[2 * nv : 3 * nv, 3 * nv : 4 * nv] = -0.5 * eye  # −w/2 -> copy B
+    T[3 * nv :, 4 * nv : 5 * nv] = eye  # a -> copy A; copy B's acceleration stays 0
+    # Written in place at every call: the arguments and the product live in these two
+    # buffers, and (Q, V, A) are views of the product made once. They only ever reach
+    # Pinocchio, which copies them; never a law.
+    x = np.empty((1, 4 * nv))
+    b = np.empty((1, 6 * nv))
+    views = (b[0, : 2 * nv], b[0, 2 * nv : 4 * nv], b[0, 4 * nv :])
+    concatenate, product = _CONCATENATE, x.dot
 
-    def __init__(self, nv: int) -> None:
-        self.nv = nv
-        eye = np.eye(nv)
-        T = np.zeros((4 * nv, 6 * nv))
-        T[0:nv, 0:nv] = T[0:nv, nv : 2 * nv] = eye  # q -> both copies
-        T[nv : 2 * nv, 2 * nv : 3 * nv] = T[nv : 2 * nv, 3 * nv : 4 * nv] = 0.5 * eye  # v/2 -> both
-        T[2 * nv : 3 * nv, 2 * nv : 3 * nv] = 0.5 * eye  # +w/2 -> copy A
-        T[2 * nv : 3 * nv, 3 * nv : 4 * nv] = -0.5 * eye  # −w/2 -> copy B
-        T[3 * nv :, 4 * nv : 5 * nv] = eye  # a -> copy A; copy B's acceleration stays 0
-        self._T = T
-        # Written in place at every call: the arguments and the product live in these two
-        # buffers, and (Q, V, A) are views of the product made once. They only ever reach
-        # Pinocchio, which copies them; never a law.
-        self._x = np.empty((1, 4 * nv))
-        self._b = np.empty((1, 6 * nv))
-        b = self._b[0]
-        self._views = (b[: 2 * nv], b[2 * nv : 4 * nv], b[4 * nv :])
-
-    def fill(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, ...]:
-        """``(Q, V, A)``, each of shape (2 nv,), valid until the next call."""
-        x = self._x
+    def fill(q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> tuple[np.ndarray, ...]:
         try:
-            np.concatenate((q, v, w, a), axis=1, out=x)
+            concatenate((q, v, w, a), 1, x)  # axis, out: positionally
         except (ValueError, np.exceptions.AxisError):  # a (nv,) argument: bring it to (1, nv)
-            nv = self.nv
-            np.concatenate([np.reshape(y, (1, nv)) for y in (q, v, w, a)], axis=1, out=x)
+            concatenate([np.reshape(y, (1, nv)) for y in (q, v, w, a)], 1, x)
         # ndarray.dot: the same BLAS product as matmul at half its per-call cost (each entry
         # sums at most two exact products: rounded once either way).
-        x.dot(self._T, out=self._b)
-        return self._views
+        product(T, b)
+        return views
+
+    return fill
 
 
 class SingleRunTerms(RigidBodyTermsMixin):
@@ -153,19 +158,24 @@ class SingleRunTerms(RigidBodyTermsMixin):
         self._pair = polarisation_pair(model)
         self._data = self._pair.createData()
         self._nv = robot.nv
-        self._inputs = _PairInputs(robot.nv)
+        self._fill = _pair_inputs(robot.nv)
         self._n_pi = N_BODY_PARAMETERS * (model.njoints - 1)
         self._P = np.ascontiguousarray(robot.parameter_map.matrix)
         self._rigid = RigidBodyTerms(robot, p)
+        # τ_A − τ_B as one product with [I; −I] (2 nv, nv): each entry sums one exact product of
+        # each copy (the others are zeros), rounded once as the subtraction is — at half the cost
+        # of two slices and a subtraction, four times a step
+        eye = np.eye(robot.nv)
+        self._difference = np.concatenate((eye, -eye))
 
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        nv = self._nv
-        tau = pin.rnea(self._pair, self._data, *self._inputs.fill(q, v, w, a))
-        return frozen(tau[None, :nv] - tau[None, nv:])
+        tau = pin.rnea(self._pair, self._data, *self._fill(q, v, w, a))[None].dot(self._difference)
+        tau.setflags(False)  # frozen(), inline: write=False, positionally
+        return tau
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
         nv, n_pi = self._nv, self._n_pi
-        R = pin.computeJointTorqueRegressor(self._pair, self._data, *self._inputs.fill(q, v, w, a))
+        R = pin.computeJointTorqueRegressor(self._pair, self._data, *self._fill(q, v, w, a))
         return frozen((R[:nv, :n_pi] - R[nv:, n_pi:]).dot(self._P)[None])  # dot: matmul's BLAS call, cheaper
 
     def friction_regressor(self, v: np.ndarray, smoothing: float = 0.0) -> np.ndarray:
@@ -173,6 +183,13 @@ class SingleRunTerms(RigidBodyTermsMixin):
 
 
 # -- N runs ----------------------------------------------------------------------------------
+
+
+def _rows(x: np.ndarray, shape: tuple[int, ...]) -> np.ndarray:
+    """``x`` as ``shape`` (N, nv): itself when it has that shape already (a law's (N, nv) state and
+    products; ``np.broadcast_to`` is a Python function: ~2 µs a call, a dozen calls a step), else
+    a read-only broadcast view of it (a (1, nv) reference row)."""
+    return x if getattr(x, "shape", None) == shape else np.broadcast_to(x, shape)
 
 
 FOREST_NV = 48
@@ -206,7 +223,7 @@ class _PolarisedTerms:
         nv = self.nv
         n = q.shape[0]
         plus, minus = 0.5 * (v + w), 0.5 * (v - w)
-        a_full = np.broadcast_to(a, (n, nv))
+        a_full = _rows(a, (n, nv))
         terms: list[np.ndarray] = []
         for k, pool, (Q, V, A, out) in self.groups:
             Q.reshape(n, 2 * k, nv)[:] = q[:, None, :]
@@ -267,7 +284,7 @@ class _Regressor:
 
     def __call__(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> list[np.ndarray]:
         out: list[np.ndarray | None] = [None] * self.size
-        a_full = np.broadcast_to(a, q.shape)
+        a_full = _rows(a, q.shape)
         for j, Ct in self.constant.items():
             out[j] = a_full @ Ct
         if self.terms is not None:
@@ -387,7 +404,8 @@ class BatchTerms(RigidBodyTermsMixin):
         return self._regressor
 
     def model(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        shape = (self._runs, self._nv)
+        q, v, w = _rows(q, shape), _rows(v, shape), _rows(w, shape)
         if self._shared is not None:
             return frozen(self._shared(q, v, w, a)[0])
         assert self._p_rows is not None
@@ -399,7 +417,8 @@ class BatchTerms(RigidBodyTermsMixin):
         return frozen(tau)
 
     def regressor(self, q: np.ndarray, v: np.ndarray, w: np.ndarray, a: np.ndarray) -> np.ndarray:
-        q, v, w = (np.broadcast_to(x, (self._runs, self._nv)) for x in (q, v, w))
+        shape = (self._runs, self._nv)
+        q, v, w = _rows(q, shape), _rows(v, shape), _rows(w, shape)
         columns = self._columns()
         if isinstance(columns, _RegressorByRun):
             return frozen(columns.matrix(q, v, w, a))
