@@ -14,7 +14,7 @@ from twolink_pin.cli import main
 from twolink_pin.law_variant import parse_variant
 from twolink_pin.model import load_robot
 from twolink_pin.report import ReportOptions, build_report
-from twolink_pin.report.sim_to_sim import arm_effects, sim_to_sim_law
+from twolink_pin.report.sim_to_sim import alone_on, arm_effects, sim_to_sim_law
 from twolink_pin.run_spec import RunSpec
 from twolink_pin.simulation import SimulationConfig
 
@@ -60,6 +60,49 @@ def test_the_sections_rows_are_the_compare_runs_they_name(tmp_path: Path) -> Non
     assert "+ soft limits" in derived
     assert abs(rows[1]["delta_rms_e"]) < 1e-12 and abs(rows[1]["delta_max_e"]) < 1e-12
     assert all(abs(row["delta_rms_e"]) > 1e-7 for row in rows[2:5])  # armature, damping, dry friction act
+    # the report's laws after its first: the first and last rows, the same runs, the same numbers
+    fewer = sim_to_sim_law("pd", parse_variant("pd"), options, alone=False)
+    assert [row["short"] for row in fewer["rows"]] == ["Pinocchio", "+ every effect"]
+    assert fewer["effects_alone"] is False and section["effects_alone"] is True
+    for row in fewer["rows"]:
+        same = next(r for r in rows if r["variant"] == row["variant"])
+        assert {k: v for k, v in row.items() if k != "seconds"} == {
+            k: v for k, v in same.items() if k != "seconds"
+        }
+
+
+def test_each_effect_alone_on_the_first_law_unless_every_law_is_asked_for() -> None:
+    """:func:`alone_on`: the report's first law by default, every law with sim_to_sim_all."""
+    names = ["pd", "computed-torque", "adaptive"]
+    assert alone_on(ReportOptions(workers=1), names) == ["pd"]
+    assert alone_on(ReportOptions(workers=1, sim_to_sim_all=True), names) == names
+    assert alone_on(ReportOptions(workers=1), []) == []
+
+
+def test_the_figure_centres_the_bars_a_row_has(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A law without the rows of each effect alone has no bar in their groups; each group's bars
+    are centred on its label (one bar: on it), the every-effect group has a bar per law."""
+    from matplotlib.figure import Figure
+
+    import twolink_pin.plotting.sim_to_sim as plot
+
+    def law(name: str, shorts: list[str]) -> dict[str, object]:
+        rows = [{"short": s, "finished": True, "delta_rms_e": 1e-3, "delta_max_e": 2e-3} for s in shorts]
+        return {"law": name, "rows": rows}
+
+    full = ["Pinocchio", "MuJoCo, no effect", "+ armature", "+ every effect"]
+    laws = [law("pd", full), law("adaptive", [full[0], full[3]])]
+    drawn: list[Figure] = []
+    original = plot.save_figure
+    monkeypatch.setattr(plot, "save_figure", lambda fig, path: (drawn.append(fig), original(fig, path))[1])
+    plot.save_sim_to_sim_figure(laws, tmp_path / "f.png", "t")
+    ax = drawn[0].axes[0]
+    centres = {}
+    for container, name in zip(ax.containers, ("pd", "adaptive"), strict=True):
+        centres[name] = sorted(round(bar.get_y() + bar.get_height() / 2, 9) for bar in container)
+    # groups from the top: no effect (y = 2), armature (y = 1), every effect (y = 0); height 0.4
+    assert centres["pd"] == [-0.2 + 0.4, 1.0, 2.0]
+    assert centres["adaptive"] == [-0.2]
 
 
 @pytest.mark.report
@@ -84,8 +127,11 @@ def test_the_report_shows_the_section_and_its_figure(tmp_path: Path) -> None:
     assert without["controllers"]["pd"]["metrics"] == results["controllers"]["pd"]["metrics"]
 
 
-def test_no_sim_to_sim_is_the_options_field(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    """``report --no-sim-to-sim`` sets ReportOptions.sim_to_sim to False (default True)."""
+def test_no_sim_to_sim_and_sim_to_sim_all_are_the_options_fields(
+    monkeypatch: pytest.MonkeyPatch, tmp_path: Path
+) -> None:
+    """``report --no-sim-to-sim`` sets ReportOptions.sim_to_sim to False (default True),
+    ``--sim-to-sim-all`` ReportOptions.sim_to_sim_all to True (default False)."""
     import twolink_pin.report as report_package
 
     seen: list[ReportOptions] = []
@@ -97,4 +143,6 @@ def test_no_sim_to_sim_is_the_options_field(monkeypatch: pytest.MonkeyPatch, tmp
     monkeypatch.setattr(report_package, "build_report", capture)
     assert main(["report", "--out", str(tmp_path / "a")]) == 0
     assert main(["report", "--no-sim-to-sim", "--out", str(tmp_path / "b")]) == 0
-    assert [o.sim_to_sim for o in seen] == [True, False]
+    assert main(["report", "--sim-to-sim-all", "--out", str(tmp_path / "c")]) == 0
+    assert [o.sim_to_sim for o in seen] == [True, False, True]
+    assert [o.sim_to_sim_all for o in seen] == [False, False, True]

@@ -242,3 +242,49 @@ def test_a_robot_without_velocity_limits_gets_a_note_instead_of_a_retiming(tmp_p
     assert (
         read_trajectory_file(tmp_path / "references" / "minimum_effort.json", load_robot(urdf)).period == 4.0
     )
+
+
+@pytest.mark.parametrize("law", ["pd", "adaptive"])
+def test_a_row_on_the_reference_read_from_the_reports_run_is_the_row_run_again(law: str) -> None:
+    """With runs at least as long as a tracking row's (the default 30 s), the report reads each
+    law's row on its own reference from its run (:func:`report_run_row`: the first 5 s of a
+    6-s run here) instead of running it again: every number is the row run on its own
+    (:func:`_track`, a second run), bit for bit — adaptive's estimates included; runs shorter
+    than the row's are not read."""
+    from dataclasses import replace
+
+    from twolink_pin.law_variant import parse_variants
+    from twolink_pin.report.runs import reference_trajectory
+    from twolink_pin.report.within_limits import _track, report_run_row, reuses_report_runs
+    from twolink_pin.simulation import simulate
+
+    options = ReportOptions(run=RunSpec(shared=True, simulation=SimulationConfig(duration=6.0)), workers=1)
+    robot = load_robot(None)
+    reference = reference_trajectory(robot, options)
+    assert reuses_report_runs(options, reference)
+    short = replace(options, run=replace(options.run, simulation=SimulationConfig(duration=4.0)))
+    assert not reuses_report_runs(short, reference)  # a 4-s run is shorter than the 5-s row
+    variant = parse_variants((law,))[0]
+    controller, plant = options.run.for_law(variant).build(robot)
+    run = simulate(controller, plant, reference, options.run.simulation)
+    read = report_run_row(options, reference, run)
+    again = _track(robot, variant, options, reference)
+    assert read.pop("from_report_run") is True
+    read.pop("seconds"), again.pop("seconds")
+    assert read == again and read["duration_s"] == 5.0
+
+
+def test_a_row_whose_report_run_failed_is_run_again(tmp_path: Path) -> None:
+    """:func:`fill_report_runs`: a pending row whose law has no report run (it failed) is run
+    on its own, as the section would have; the other rows are kept as they are."""
+    from twolink_pin.law_variant import parse_variants
+    from twolink_pin.report.within_limits import fill_report_runs
+
+    options = ReportOptions(run=RunSpec(shared=True, simulation=SimulationConfig(duration=6.0)), workers=1)
+    rows = [("pd", parse_variants(("pd",))[0])]
+    kept = {"law": "mpc", "reference": "reference", "finished": False, "failed": "kept"}
+    section = {"tracking": [{"law": "pd", "reference": "reference", "pending": True}, kept]}
+    filled = fill_report_runs(section, rows, options, load_robot(None), {})
+    first = filled["tracking"][0]
+    assert first["finished"] and "from_report_run" not in first and "pending" not in first
+    assert first["duration_s"] == 5.0 and filled["tracking"][1] == kept

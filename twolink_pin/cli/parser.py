@@ -399,6 +399,12 @@ def _add_report(sub: Any, c: Any) -> None:
         action="store_true",
         help="skip the section 'Sim-to-sim': each law on Pinocchio and on MuJoCo with the arm's effects (docs/mujoco.md)",
     )
+    p.add_argument(
+        "--sim-to-sim-all",
+        action="store_true",
+        help="in the section 'Sim-to-sim', every law with MuJoCo's no-effect check and each of the arm's "
+        "effects alone too (default: the first law; every law runs on Pinocchio and with every effect)",
+    )
     add_robot_options(p)
     add_disturbance_options(p)
     p.set_defaults(func=c.cmd_report)

@@ -68,11 +68,17 @@ class ReportSections(Protocol):
         the via points of the robot's default trajectory, None for another trajectory."""
         ...
 
+    def reads(self, laws: Sequence[str]) -> Sequence[str]:
+        """The laws (of the report's ``laws``) whose runs :meth:`collect` reads: the report
+        collects the sections as soon as those are in, while the other laws still run."""
+        ...
+
     def collect(
         self, pending: Any, robot: Any, options: Any, fig_dir: str, runs: Mapping[str, Any]
     ) -> dict[str, Any] | None:
         """The section built from :meth:`submit`'s tasks and the laws' ``runs`` (law name →
-        simulation result); ``results.json``'s ``identification`` entry."""
+        simulation result; at least those :meth:`reads` names that finished);
+        ``results.json``'s ``identification`` entry."""
         ...
 
     def errata(

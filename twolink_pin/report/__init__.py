@@ -3,7 +3,7 @@
 ======================  ===============================================================
 ``build.py``            :func:`build_report`: the assembly (which laws, the pool, results)
 ``options.py``          :class:`ReportOptions`: a ``RunSpec`` and the report's own options
-``runs.py``             worker tasks: one law's run and figures, the trajectory's figures
+``runs.py``             one law's run and figures (a worker task), the trajectory's figures
 ``pool.py``             worker processes that never outlive the report (or in-process)
 ``facts.py``            the model, the torque check, the versions
 ``within_limits.py``    the section "The reference within the limits": three references, the laws on each

@@ -39,7 +39,7 @@ from twolink_pin.report import facts, sim_to_sim
 from twolink_pin.report.options import MAX_WORKERS, ReportOptions
 from twolink_pin.report.pool import worker_pool
 from twolink_pin.report.runs import reference_trajectory, run_law, trajectory_figures
-from twolink_pin.report.within_limits import limits_section
+from twolink_pin.report.within_limits import fill_report_runs, limits_section, reuses_report_runs
 from twolink_pin.run_rows import Row, build_rows
 from twolink_pin.run_spec import gains_used, plant_description
 from twolink_pin.scenario import builtin_laws
@@ -235,9 +235,10 @@ def _run_all(
     options: ReportOptions,
     tick: Callable[[str], None],
 ) -> _Ran:
-    """Every task of the worker pool: the robot's own sections, each law's run and figures,
-    the desired trajectory's figures; the animation of the animated law (or, if it failed,
-    of the first that ran) while the others finish."""
+    """Every task of the worker pool: the robot's own sections, the limits section, each law's
+    run and figures, the sim-to-sim rows; meanwhile in this process the facts, the desired
+    trajectory's figures, the animation of the animated law (or, if it failed, of the first
+    that ran) and the robot's own sections once the runs they read are in."""
     fig_dir = stage / "figures"
     fig_dir.mkdir()
     declared = robot.profile.report
@@ -253,27 +254,20 @@ def _run_all(
     animation = None
     workers = min(options.workers or 1, len(order) + 1)  # None was resolved to the cores
     heard = len(interrupts.received)  # a signal from here on stops the waits below (result_of)
+    limit_rows = [(n, rows[n].variant) for n in names]
+    reused = options.limits_section and reuses_report_runs(options, trajectory)
     with worker_pool(workers) as pool:
-        # The robot's own sections first: their tasks are the longest (the twolink's: 3 adaptive
-        # runs and a logged run of 30 s), so the laws' runs fill the other worker meanwhile.
-        pending = sections.submit(pool, options, str(fig_dir), names) if sections else None
-        limits_future = (  # about as long as a law's run: before them, so the runs fill in around it
-            pool.submit(limits_section, [(n, rows[n].variant) for n in names], options, str(stage))
-            if options.limits_section
-            else None
-        )
-        futures = {
-            n: pool.submit(run_law, rows[n].variant, options, str(fig_dir), numbers.get(n)) for n in order
-        }
-        sim_pending = (  # short runs: after the laws' own
-            sim_to_sim.submit(pool, [(n, rows[n].variant) for n in names], options)
-            if options.sim_to_sim
-            else None
-        )
-        traj_future = pool.submit(trajectory_figures, options, str(fig_dir), numbers.get("trajectory"))
+        submitted = _submit(pool, stage, sections, numbers, rows, order, options, reused)
+        pending, limits_future, futures, sim_pending = submitted
+        # This process's own work while the workers run: the facts, the trajectory's figures, the
+        # animation and the robot's sections as soon as the runs they read are in (not after all).
         model = facts.model_facts(robot)
         own_facts = sections.facts(robot, via) if sections else None
         tick("model and trajectory")
+        traj_figs = trajectory_figures(options, str(fig_dir), numbers.get("trajectory"))
+        tick("trajectory figures")
+        reads = set(sections.reads(names)) if sections and pending is not None else set()
+        identification, collected = None, not (sections and pending is not None)
         for name in order:
             try:
                 runs[name] = interrupts.result_of(futures[name], heard)
@@ -284,28 +278,80 @@ def _run_all(
                 tried, shown = True, name
                 animation = _write_animation(stage, robot, trajectory, runs[name][0], options, warnings)
                 tick("animation")
+            if sections and not collected and reads <= set(runs) | set(failed):
+                identification = sections.collect(pending, robot, options, str(fig_dir), _results(runs))
+                collected = True
+                tick("identification")
         if options.animation and not tried:
             tick("animation")  # every law failed: nothing to animate
-        traj_figs = interrupts.result_of(traj_future, heard)
-        tick("trajectory figures")
         overlays = _write_overlays(fig_dir, rows, runs, options)
         within_limits = None
         if limits_future is not None:
-            within_limits = interrupts.result_of(limits_future, heard)
+            reused_runs = _results(runs) if reused else None
+            within_limits = _limits_collected(limits_future, limit_rows, options, robot, reused_runs, heard)
             tick("the reference within the limits")
         sim_section = None
         if sim_pending is not None:
             sim_section = sim_to_sim.collect(sim_pending, robot, options, str(fig_dir), heard)
             tick("sim-to-sim")
-        identification = None
-        if sections and pending is not None:
-            done_runs = {n: r[0] for n, r in runs.items()}
-            identification = sections.collect(pending, robot, options, str(fig_dir), done_runs)
-            tick("identification")
     return _Ran(
         runs, failed, warnings, animation, shown, traj_figs, identification, model, own_facts, overlays,
         within_limits, sim_section,
     )  # fmt: skip
+
+
+def _submit(
+    pool: Any,
+    stage: Path,
+    sections: Any,
+    numbers: dict[str, dict[str, int]],
+    rows: dict[str, Row],
+    order: list[str],
+    options: ReportOptions,
+    reused: bool,
+) -> tuple[Any, Any, dict[str, Any], Any]:
+    """Every worker task, longest first so that the short ones fill in at the end: the robot's own
+    sections (the twolink's: 3 adaptive runs and a logged run of 30 s), the limits section (about
+    as long as a law's run; its rows on the report's reference left to the laws' runs when
+    ``reused``), each law's run and figures in ``order``, the sim-to-sim rows (short runs).
+    Returns the sections' pending tasks, the limits section's future, each law's, the sim-to-sim's."""
+    fig_dir, names = str(stage / "figures"), list(rows)
+    pending = sections.submit(pool, options, fig_dir, names) if sections else None
+    limits_future = (
+        pool.submit(limits_section, [(n, rows[n].variant) for n in names], options, str(stage), reused)
+        if options.limits_section
+        else None
+    )
+    # the animated law first (its animation is written meanwhile), then the laws with the most state
+    # (estimates, plans: each stage integrates it too, the longer runs) so that the short ones come last
+    first = sorted(order[1:], key=lambda n: -rows[n].scenario.controller.state_size)
+    futures = {
+        n: pool.submit(run_law, rows[n].variant, options, fig_dir, numbers.get(n)) for n in order[:1] + first
+    }
+    variants = [(n, rows[n].variant) for n in names]
+    sim_pending = sim_to_sim.submit(pool, variants, options) if options.sim_to_sim else None
+    return pending, limits_future, futures, sim_pending
+
+
+def _limits_collected(
+    future: Any,
+    rows: list[tuple[str, Any]],
+    options: ReportOptions,
+    robot: Any,
+    reused: dict[str, SimulationResult] | None,
+    heard: int,
+) -> dict[str, Any]:
+    """The limits section (waited for), its rows on the report's reference read from the laws'
+    runs when it left them to them (``reused``: :func:`~twolink_pin.report.within_limits.fill_report_runs`)."""
+    section: dict[str, Any] = interrupts.result_of(future, heard)
+    return section if reused is None else fill_report_runs(section, rows, options, robot, reused)
+
+
+def _results(
+    runs: dict[str, tuple[SimulationResult, Metrics, list[str], float]],
+) -> dict[str, SimulationResult]:
+    """Each law's simulation result, of its run's ``(result, metrics, figures, seconds)``."""
+    return {name: run[0] for name, run in runs.items()}
 
 
 def _write_overlays(

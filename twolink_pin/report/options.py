@@ -40,8 +40,12 @@ class ReportOptions:
             retiming and the minimum-effort trajectory, the laws tracking each; about
             a tenth of the report's CPU time, docs/performance.md).
         sim_to_sim: Whether the report has its section "Sim-to-sim" (:mod:`twolink_pin.report.sim_to_sim`:
-            each law on the Pinocchio plant and on MuJoCo with the arm's effects, one effect at a
-            time; short runs of 2 periods).
+            each law on the Pinocchio plant and on MuJoCo with no effect and with the arm's effects;
+            short runs of one period).
+        sim_to_sim_all: Whether every law of that section has every row: the no-effect check
+            and each effect alone too (35 runs on the twolink, about a fifth of the report's CPU
+            time); default False: the report's first law only, the others on Pinocchio and with
+            every effect (15 runs; docs/mujoco.md).
         trajectory: A trajectory file (:func:`~twolink_pin.trajectory.read_trajectory_file`)
             to track instead of the robot's default; the twolink's sections about the
             report's own trajectory (Table 1, the printed coefficients) then still describe
@@ -61,6 +65,7 @@ class ReportOptions:
     trajectory: str | None = None
     repair_inertias: bool | None = None
     sim_to_sim: bool = True
+    sim_to_sim_all: bool = False
 
     def load_robot(self) -> Any:
         """The robot these options name (a :class:`~twolink_pin.model.RobotModel`), loaded here."""

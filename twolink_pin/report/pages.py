@@ -170,7 +170,11 @@ def sim_to_sim_table(r: dict[str, Any]) -> dict[str, Any] | None:
             shown = ["" if row is law["rows"][0] else _signed(d) for d in deltas]
             label = row["row"] + (" — cannot act here, not rerun" if row.get("derived") else "")
             rows.append([law["law"], label, fmt(row["rms_e"]), fmt(row["max_e"]), *shown])
-    return section | {"headers": headers, "rows": rows}
+    every = {
+        "all": section.get("all", True),
+        "effects_alone": section.get("effects_alone", []),
+    }  # older files: all
+    return section | every | {"headers": headers, "rows": rows}
 
 
 def _signed(x: float | None) -> str:
@@ -241,6 +245,7 @@ def _limits_tables(r: dict[str, Any], nv: int) -> dict[str, Any] | None:
         "reference_rows": ref_rows,
         "tracking_headers": track_headers,
         "tracking_rows": track_rows,
+        "read_from_runs": any(row.get("from_report_run") for row in section["tracking"]),
     }
 
 
@@ -394,6 +399,13 @@ def _sim_markdown(r: dict[str, Any]) -> list[str]:
     heads, rows = table["headers"], table["rows"]
     lines = ["## Sim-to-sim", "", "| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
     lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    if not table["all"]:
+        alone = ", ".join(table["effects_alone"])
+        lines += [
+            "",
+            f"The no-effect check and each effect alone on {alone} only, the other laws on Pinocchio and with "
+            "every effect; `twolink-pin report --sim-to-sim-all` runs every row of every law.",
+        ]
     return (
         [*lines, "", f"Sources of the effects: {table['sources']}", ""] if table["sources"] else [*lines, ""]
     )

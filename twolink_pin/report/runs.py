@@ -1,5 +1,5 @@
-"""The report's worker tasks for the laws: the reference, one law's run with its figures,
-the desired trajectory's figures (picklable arguments only)."""
+"""The report's tasks for the laws: the reference, one law's run with its figures (a worker
+task: picklable arguments only), the desired trajectory's figures."""
 
 from __future__ import annotations
 
@@ -67,7 +67,8 @@ def run_law(
 def trajectory_figures(
     options: ReportOptions, fig_dir: str, figure_numbers: dict[str, int] | None
 ) -> list[str]:
-    """Worker: the desired trajectory's figures (picklable arguments only)."""
+    """The desired trajectory's figures (the report makes them in its own process while the
+    workers run the laws)."""
     from twolink_pin.plotting import save_trajectory_figures
 
     robot = options.load_robot()

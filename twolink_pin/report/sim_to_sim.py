@@ -16,11 +16,17 @@ the numbers show; at most the report's duration):
   ``implicitfast`` integrator with the law held over each step);
 * ``…@plant=mujoco`` with every effect at once.
 
+By default the no-effect check and each effect alone are run on the report's first law only
+(:func:`alone_on`): the other laws have their first and last rows (Pinocchio, every effect).
+``ReportOptions.sim_to_sim_all`` (``report --sim-to-sim-all``) runs every row of every law.
+
 An effect that cannot act on the run is not run again: soft limits on a run that never reaches a
 joint's range, the effort clamp on a commanded torque below :data:`CLAMP_MARGIN` of every limit
 (:func:`inactive`; MuJoCo with no effect is that run until the effect acts). Its row repeats the
 no-effect row's numbers and says why (``derived``). The section costs what
-``PERIODS × (3 + effects acting)`` periods of each law cost.
+``PERIODS × (3 + effects acting)`` periods of a law with every row cost, ``PERIODS × 2`` of the
+others (on the twolink, 15 runs of one period by default, 35 with every row of every law: a row
+is the same run in both).
 
 **The numbers** are :func:`~twolink_pin.metrics.compute_metrics`' per-joint ones, as ``compare``'s
 table has them: ``RMS ‖e‖ = (Σ_j RMS(e_j)²)^½`` [rad] and ``max |e|`` [rad], the largest
@@ -66,6 +72,7 @@ __all__ = [
     "MUJOCO",
     "NO_EFFECT",
     "PERIODS",
+    "alone_on",
     "arm_effects",
     "collect",
     "inactive",
@@ -112,14 +119,16 @@ def _effect(key: str, short: str, label: str, setting: str) -> dict[str, str]:
     return {"key": key, "short": short, "label": label, "setting": setting}
 
 
-def row_texts(variant: Variant, effects: list[dict[str, str]]) -> list[tuple[str, str, str]]:
-    """``(row label, short label, variant text)`` of each row of ``variant``'s law (module docstring)."""
+def row_texts(
+    variant: Variant, effects: list[dict[str, str]], alone: bool = True
+) -> list[tuple[str, str, str]]:
+    """``(row label, short label, variant text)`` of each row of ``variant``'s law (module
+    docstring); without ``alone``, only the first and the last (Pinocchio, every effect)."""
     base = variant.text
-    rows = [
-        ("Pinocchio (the report's plant)", "Pinocchio", base),
-        ("MuJoCo, no effect", "MuJoCo, no effect", base + NO_EFFECT),
-    ]
-    for effect in effects:
+    rows = [("Pinocchio (the report's plant)", "Pinocchio", base)]
+    if alone:
+        rows.append(("MuJoCo, no effect", "MuJoCo, no effect", base + NO_EFFECT))
+    for effect in effects if alone else ():
         off = "" if effect["key"] == "soft_limits" else "@soft_limits=off"
         rows.append(
             (f"MuJoCo + {effect['label']}", f"+ {effect['short']}", base + MUJOCO + off + effect["setting"])
@@ -189,15 +198,16 @@ def inactive(key: str, robot: Any, plain: dict[str, Any]) -> str | None:
     return None
 
 
-def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[str, Any]:
-    """Worker: the rows of one law of the report (module docstring)."""
+def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions, alone: bool = True) -> dict[str, Any]:
+    """Worker: the rows of one law of the report (module docstring); with ``alone`` all of them,
+    else Pinocchio's and every effect's."""
     start, cpu = time.perf_counter(), time.process_time()
     robot = options.load_robot()
     trajectory = reference_trajectory(robot, options)
     effects = arm_effects(robot, options)
     keys = {f"MuJoCo + {e['label']}": e["key"] for e in effects}
     rows: list[dict[str, Any]] = []
-    for label, short, text in row_texts(variant, effects):
+    for label, short, text in row_texts(variant, effects, alone):
         row: dict[str, Any] = {"row": label, "short": short, "variant": text}
         why = inactive(keys.get(label, ""), robot, rows[1]) if len(rows) > 1 else None
         if why is None:
@@ -212,6 +222,7 @@ def sim_to_sim_law(name: str, variant: Variant, options: ReportOptions) -> dict[
             row["delta_max_e"] = row["max_e"] - first["max_e"]
     return {
         "law": name,
+        "effects_alone": alone,
         "rows": rows,
         "duration_s": section_config(options.run.simulation, trajectory).duration,
         "seconds": time.perf_counter() - start,
@@ -230,13 +241,24 @@ def skipped(options: ReportOptions, variants: list[tuple[str, Variant]]) -> str 
     return None
 
 
+def alone_on(options: ReportOptions, names: list[str]) -> list[str]:
+    """The laws (of the report's ``names``) with every row (the no-effect check, each effect
+    alone): every one with ``options.sim_to_sim_all``, else the first (what each effect does is
+    shown once; every law runs on Pinocchio and with every effect)."""
+    return list(names) if options.sim_to_sim_all else list(names[:1])
+
+
 def submit(pool: Any, variants: list[tuple[str, Variant]], options: ReportOptions) -> dict[str, Any] | str:
     """Each law's rows submitted to the report's worker ``pool`` (law → future), or why the
-    report has no such section (:func:`skipped`)."""
+    report has no such section (:func:`skipped`); each effect alone on the laws :func:`alone_on`
+    names."""
     why = skipped(options, variants)
     if why is not None:
         return why
-    return {name: pool.submit(sim_to_sim_law, name, variant, options) for name, variant in variants}
+    alone = alone_on(options, [name for name, _ in variants])
+    return {
+        name: pool.submit(sim_to_sim_law, name, variant, options, name in alone) for name, variant in variants
+    }
 
 
 def collect(
@@ -251,6 +273,7 @@ def collect(
     sources = robot.profile.effects.source if robot.profile.effects is not None else ""
     section: dict[str, Any] = {
         "periods": PERIODS,
+        "all": options.sim_to_sim_all,
         "effects": effects,
         "sources": sources,
         "laws": [],
@@ -259,9 +282,14 @@ def collect(
     if isinstance(pending, str):
         return section | {"note": f"no sim-to-sim section: {pending}"}
     laws = [interrupts.result_of(future, heard) for future in pending.values()]
-    title = f"{robot.name}: what each effect on MuJoCo changes (one period, started on the reference)"
+    alone = [law["law"] for law in laws if law["effects_alone"]]
+    which = (
+        "" if len(alone) == len(laws) else f"; each effect alone: {', '.join(alone)}, the others every effect"
+    )
+    title = f"{robot.name}: what each effect on MuJoCo changes (one period, started on the reference{which})"
     figure = save_sim_to_sim_figure(laws, Path(fig_dir) / FIGURE, title).name
     return section | {
+        "effects_alone": alone,
         "duration_s": laws[0]["duration_s"] if laws else None,
         "laws": laws,
         "figure": figure,

@@ -40,7 +40,7 @@ the figures and the runs; it returns the section as ``results.json`` holds it un
 from __future__ import annotations
 
 import time
-from dataclasses import replace
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -57,7 +57,7 @@ from twolink_pin.limits import ACCELERATION, EFFORT, VELOCITY, LimitsCheck, chec
 from twolink_pin.metrics import compute_metrics
 from twolink_pin.report.options import ReportOptions
 from twolink_pin.report.runs import reference_trajectory
-from twolink_pin.simulation import simulate
+from twolink_pin.simulation import SimulationResult, simulate
 from twolink_pin.trajectory import Trajectory
 
 REFERENCES = {
@@ -80,7 +80,17 @@ laws settle the 0.1-rad offset in well under a second on the twolink)."""
 PLANNER = "mpc"
 """The law that plans within the limits, tracked on every reference beside the report's."""
 
-__all__ = ["FIGURE_PREFIX", "PLANNER", "REFERENCES", "SETTLE", "limits_section", "reference_row"]
+__all__ = [
+    "FIGURE_PREFIX",
+    "PLANNER",
+    "REFERENCES",
+    "SETTLE",
+    "fill_report_runs",
+    "limits_section",
+    "reference_row",
+    "report_run_row",
+    "reuses_report_runs",
+]
 
 
 def _design(robot: Any, reference: Any) -> tuple[dict[str, Any], list[str]]:
@@ -135,18 +145,43 @@ def reference_row(robot: Any, trajectory: Trajectory) -> tuple[dict[str, Any], L
     return row, check
 
 
+def _tracking_duration(options: ReportOptions, trajectory: Trajectory) -> float:
+    """A tracking row's simulated time [s]: :data:`SETTLE` (at most a period) and a period."""
+    cfg = options.run.simulation
+    period = float(trajectory.period)
+    return max(period + min(SETTLE, period), cfg.control_period or 0.0, cfg.dt)
+
+
+def reuses_report_runs(options: ReportOptions, reference: Trajectory) -> bool:
+    """Whether each tracking row on the report's own reference is the first seconds of the
+    report's run of that law, which the report then reads instead of running it again
+    (:func:`report_run_row`): fixed-step RK4 without sensor noise (each sample is then made
+    from the ones before only, and the first samples of a longer run are the shorter run's,
+    bit for bit) and runs at least as long as the row's."""
+    cfg = options.run.simulation
+    return (
+        cfg.method == "rk4"
+        and options.run.plant.sensor_noise is None
+        and _tracking_duration(options, reference) <= cfg.duration
+    )
+
+
 def _track(robot: Any, variant: Variant, options: ReportOptions, trajectory: Trajectory) -> dict[str, Any]:
     """One law on one reference, :data:`SETTLE` and a period (module docstring): its metrics
     and crossings, or what stopped it."""
-    cfg = options.run.simulation
-    period = float(trajectory.period)
-    duration = max(period + min(SETTLE, period), cfg.control_period or 0.0, cfg.dt)
+    duration = _tracking_duration(options, trajectory)
     start = time.perf_counter()
     try:
         controller, plant = options.run.for_law(variant).build(robot)
-        result = simulate(controller, plant, trajectory, replace(cfg, duration=duration))
+        result = simulate(controller, plant, trajectory, replace(options.run.simulation, duration=duration))
     except (SimulationDivergedError, ControllerError, OptimizationError, InvalidParameterError) as exc:
         return {"finished": False, "failed": str(exc), "duration_s": duration}
+    return _row(result, duration, start)
+
+
+def _row(result: SimulationResult, duration: float, start: float) -> dict[str, Any]:
+    """A finished tracking row of ``result`` (run for ``duration`` [s]; made since ``start``,
+    a ``perf_counter`` reading)."""
     metrics = compute_metrics(result)
     return {
         "finished": True,
@@ -159,10 +194,36 @@ def _track(robot: Any, variant: Variant, options: ReportOptions, trajectory: Tra
     }
 
 
-def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stage: str) -> dict[str, Any]:
+def report_run_row(options: ReportOptions, reference: Trajectory, result: SimulationResult) -> dict[str, Any]:
+    """The tracking row on the report's ``reference`` read from the report's run ``result`` of
+    the law (when :func:`reuses_report_runs`): its first samples, as long as the row's run.
+    Its ``seconds`` are the reading's."""
+    start = time.perf_counter()
+    duration = _tracking_duration(options, reference)
+    samples = replace(options.run.simulation, duration=duration).steps + 1
+    per_sample: dict[str, Any] = {  # every array recorded per sample: the first ``samples`` of them
+        f.name: value[:samples]
+        for f in fields(result)
+        if isinstance(value := getattr(result, f.name), np.ndarray) and f.name not in _RUN_SUMMARIES
+    }
+    return _row(replace(result, **per_sample), duration, start) | {"from_report_run": True}
+
+
+_RUN_SUMMARIES = frozenset(
+    {"torque_limits", "p_true", "position_limits", "velocity_limits", "contact_normal"}
+    | {"relaxed_first_time", "relaxed_largest", "relaxed_span"}
+)
+"""The arrays of a :class:`SimulationResult` that are not one row per sample."""
+
+
+def limits_section(
+    rows: list[tuple[str, Variant]], options: ReportOptions, stage: str, reused: bool = False
+) -> dict[str, Any]:
     """Worker: the section (module docstring) for the report's ``rows`` (name, variant), its
     reference files under ``stage/references`` and figures under ``stage/figures``; returns
-    what ``results.json`` holds under ``within_limits``."""
+    what ``results.json`` holds under ``within_limits``. With ``reused`` (:func:`reuses_report_runs`)
+    the rows' tracking rows on the report's reference are left to :func:`fill_report_runs`
+    (``{"law", "reference", "pending": True}``)."""
     from twolink_pin.limits import reference_motion
     from twolink_pin.plotting.within_limits import save_references_figures
     from twolink_pin.trajectory.file import write_trajectory_file
@@ -189,8 +250,14 @@ def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stag
         from twolink_pin.law_variant import parse_variants
 
         laws.append((PLANNER, parse_variants((PLANNER,))[0]))
+    own = {name for name, _ in rows} if reused else set()
     tracking = [
-        {"law": name, "reference": key} | _track(robot, variant, options, trajectory)
+        {"law": name, "reference": key}
+        | (
+            {"pending": True}
+            if key == "reference" and name in own
+            else _track(robot, variant, options, trajectory)
+        )
         for key, trajectory in designed.items()
         for name, variant in laws
     ]
@@ -201,3 +268,27 @@ def limits_section(rows: list[tuple[str, Variant]], options: ReportOptions, stag
         "tracking": tracking,
         "seconds": time.perf_counter() - start,
     }
+
+
+def fill_report_runs(
+    section: dict[str, Any],
+    rows: list[tuple[str, Variant]],
+    options: ReportOptions,
+    robot: Any,
+    runs: dict[str, SimulationResult],
+) -> dict[str, Any]:
+    """``section`` (from :func:`limits_section` with ``reused``) with each pending tracking row
+    read from the report's run of its law in ``runs`` (:func:`report_run_row`), or run here
+    when that run did not finish."""
+    reference = reference_trajectory(robot, options)
+    variants = dict(rows)
+    tracking = []
+    for row in section["tracking"]:
+        if row.pop("pending", False):
+            name = row["law"]
+            if name in runs:
+                row |= report_run_row(options, reference, runs[name])
+            else:
+                row |= _track(robot, variants[name], options, reference)
+        tracking.append(row)
+    return section | {"tracking": tracking}

@@ -59,6 +59,11 @@ class CourseReport:
             "report_table2_columns": list(REPORT_TABLE2_COLUMNS),
         }
 
+    def reads(self, laws: Sequence[str]) -> Sequence[str]:
+        """The report's own adaptive run, when it runs (the identification section's run along
+        the report's trajectory)."""
+        return (REUSED_LAW,) if REUSED_LAW in laws else ()
+
     def collect(
         self, pending: Any, robot: Any, options: Any, fig_dir: str, runs: Mapping[str, Any]
     ) -> dict[str, Any] | None:

@@ -321,6 +321,7 @@ def cmd_report(args: argparse.Namespace) -> int:
         identification=not args.no_identification,
         limits_section=not args.no_limits_section,
         sim_to_sim=not args.no_sim_to_sim,
+        sim_to_sim_all=args.sim_to_sim_all,
         trajectory=args.trajectory,
         repair_inertias=args.repair_inertias or None,
     )
