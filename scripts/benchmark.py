@@ -940,23 +940,11 @@ def _mpc_split(law: Any, plant: Any, reference: Any, config: SimulationConfig) -
     """One run of ``law`` with its replans timed apart: total (wall and this process's CPU),
     replans (building the QPs and solving them; the rest is the plant and the law between
     replans), in seconds, and the number of replans."""
-    spent = {"update": 0.0, "replans": 0, "proxqp": 0}
-    update = law.update
+    from mpc_anchor import replans_timed  # scripts/mpc_anchor.py, beside this file
 
-    def timed_update(x: Any, terms: Any) -> Any:
-        start = time.perf_counter()
-        try:
-            return update(x, terms)
-        finally:
-            spent["update"] += time.perf_counter() - start
-            spent["replans"] += 1
-
-    law.update = timed_update
     cpu = time.process_time()
-    try:
+    with replans_timed(law) as spent:
         total = _timed(lambda: simulate(law, plant, reference, config))
-    finally:
-        del law.update
     return {
         "total": total,
         "cpu": time.process_time() - cpu,

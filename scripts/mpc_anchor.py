@@ -13,11 +13,13 @@ the effort (commanded), velocity and position limits; then the anchor's error ov
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import subprocess
 import tempfile
 import time
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -45,9 +47,10 @@ def peer_python() -> str | None:
     return path if Path(path).exists() else None
 
 
-def _project(robot: Any, reference: Any, duration: float) -> dict[str, Any]:
-    """``mpc``'s run on ``reference``: the same figures the peer prints."""
-    law = ModelPredictive(robot)
+@contextlib.contextmanager
+def replans_timed(law: Any) -> Iterator[dict[str, float]]:
+    """Within the block, ``law.update`` (its replans) timed: the yielded dict's ``update`` [s]
+    and ``replans`` (a count) grow with each call; the law's own method is back afterwards."""
     spent = {"update": 0.0, "replans": 0}
     update = law.update
 
@@ -59,10 +62,20 @@ def _project(robot: Any, reference: Any, duration: float) -> dict[str, Any]:
             spent["update"] += time.perf_counter() - start
             spent["replans"] += 1
 
-    law.update = timed  # type: ignore[method-assign]
-    start = time.perf_counter()
-    run = simulate(law, Plant(robot), reference, SimulationConfig(duration=duration))
-    wall = time.perf_counter() - start
+    law.update = timed
+    try:
+        yield spent
+    finally:
+        del law.update
+
+
+def _project(robot: Any, reference: Any, duration: float) -> dict[str, Any]:
+    """``mpc``'s run on ``reference``: the same figures the peer prints."""
+    law = ModelPredictive(robot)
+    with replans_timed(law) as spent:
+        start = time.perf_counter()
+        run = simulate(law, Plant(robot), reference, SimulationConfig(duration=duration))
+        wall = time.perf_counter() - start
     limits = joint_limits(robot)
     last = run.t >= run.t[-1] - reference.period - 1e-12
     return {
