@@ -105,6 +105,24 @@ def test_the_figure_centres_the_bars_a_row_has(tmp_path: Path, monkeypatch: pyte
     assert centres["adaptive"] == [-0.2]
 
 
+def test_eleven_laws_bars_are_told_apart(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The UR5 has eleven laws and matplotlib's cycle ten colours: no two laws' bars look the
+    same (colour and hatch), so mpc's bars are not taken for pd's."""
+    from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
+
+    import twolink_pin.plotting.sim_to_sim as plot
+
+    rows = [{"short": s, "finished": True, "delta_rms_e": 1e-3, "delta_max_e": 2e-3} for s in ("P", "+ all")]
+    laws = [{"law": f"law{k}", "rows": rows} for k in range(11)]
+    drawn: list[Figure] = []
+    original = plot.save_figure
+    monkeypatch.setattr(plot, "save_figure", lambda fig, path: (drawn.append(fig), original(fig, path))[1])
+    plot.save_sim_to_sim_figure(laws, tmp_path / "f.png", "t")
+    looks = {(to_rgba(c[0].get_facecolor()), c[0].get_hatch()) for c in drawn[0].axes[0].containers}
+    assert len(looks) == 11
+
+
 @pytest.mark.report
 def test_the_report_shows_the_section_and_its_figure(tmp_path: Path) -> None:
     """A one-law report: the section's table on the page (a row per plant), in report.md and in

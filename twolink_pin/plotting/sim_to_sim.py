@@ -49,7 +49,7 @@ def save_sim_to_sim_figure(laws: Sequence[Mapping[str, Any]], path: Path, title:
             ]
             # the group's bars centred on its label: this law's place among the laws that have the row
             places = [(len(present[k]) - 1 - 2 * present[k].index(i)) * height / 2 for k in shown]
-            ax.barh(y[shown] + np.asarray(places), values, height=height, label=law["law"])
+            ax.barh(y[shown] + np.asarray(places), values, height=height, label=law["law"], **_bar_style(i))
         ax.set_xscale("symlog", linthresh=LINEAR_BAND)
         ax.axvline(0.0, color="0.3", lw=0.8)
         ax.set_xlabel(xlabel + ", symmetric log")
@@ -60,6 +60,15 @@ def save_sim_to_sim_figure(laws: Sequence[Mapping[str, Any]], path: Path, title:
     fig.legend(handles, names, loc="outside lower center", ncol=min(count, 5), fontsize="small")
     fig.suptitle(title)
     return save_figure(fig, path)
+
+
+def _bar_style(i: int) -> dict[str, Any]:
+    """The ``i``-th law's bars: matplotlib's ten cycle colours, hatched from the eleventh law on
+    (the UR5's eleven laws: mpc's bars would take pd's colour)."""
+    style: dict[str, Any] = {"color": f"C{i % 10}"}
+    if i >= 10:
+        style |= {"hatch": "///", "edgecolor": "white"}
+    return style
 
 
 __all__ = ["LINEAR_BAND", "PANELS", "save_sim_to_sim_figure"]
