@@ -87,11 +87,11 @@ def test_one_run_saturated_acceleration_is_the_plants(name: str) -> None:
     # beyond the limits both ways, and a NaN passed through as NaN.
     from twolink_pin.model import load_robot
     from twolink_pin.plant import Plant
-    from twolink_pin.simulation.forward import SingleRunDynamics
+    from twolink_pin.simulation.forward import single_run_dynamics
 
     robot = load_robot(name)
     plant = Plant(robot, saturate=True)
-    accel = SingleRunDynamics(plant)
+    accel = single_run_dynamics(plant)
     rng = np.random.default_rng(5)
     for scale in (0.5, 3.0):
         q, v = rng.normal(size=(1, robot.nv)), rng.normal(size=(1, robot.nv))

@@ -15,28 +15,14 @@ from twolink_pin.plant import Plant
 from twolink_pin.simulation.terms import check_parallel, threads_for
 
 
-class SingleRunDynamics:
-    """``q̈`` [rad/s²] of one run, shape (1, nv), from ``(1, nv)`` state and torque.
+def single_run_dynamics(plant: Plant) -> Callable[..., np.ndarray]:
+    """``accel(q, v, tau, external=None)``: ``q̈`` [rad/s²] of one run, shape (1, nv), from
+    ``(1, nv)`` state and torque; ``external`` is a joint torque [N·m] the world adds (a wrench's
+    or a contact's ``Jᵀ f``), never saturated, (1, nv) or None.
 
-    The engine calls :attr:`accel` itself, four times a step: a closure over the plant's rows
-    (no attribute lookups), with only the effects this plant has."""
-
-    def __init__(self, plant: Plant) -> None:
-        self._plant = plant
-        self.accel = _single_run_accel(plant)
-        """``accel(q, v, tau, external=None)``: what calling this object does."""
-
-    def __call__(
-        self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
-    ) -> np.ndarray:
-        """``external``: a joint torque [N·m] the world adds (a wrench's or a contact's ``Jᵀ f``), never
-        saturated, (1, nv) or None."""
-        return self.accel(q, v, tau, external)
-
-
-def _single_run_accel(plant: Plant) -> Callable[..., np.ndarray]:
-    """:class:`SingleRunDynamics`' function: ``plant.motor_torque`` spelled out with (1, nv) rows
-    (numpy's fast path against the (1, nv) state), then ABA."""
+    ``plant.motor_torque`` spelled out with (1, nv) rows (numpy's fast path against the (1, nv)
+    state), then ABA: a closure over the plant's rows with only the effects this plant has (the
+    engine calls it four times a step; no attribute lookups)."""
     model, data, aba, convention = plant.model, plant.model.createData(), pin.aba, ABA_CONVENTION
     friction = plant.friction
     viscous, coulomb = (
@@ -90,7 +76,7 @@ class BatchDynamics:
         self, q: np.ndarray, v: np.ndarray, tau: np.ndarray, external: np.ndarray | None = None
     ) -> np.ndarray:
         """The result is valid until the fourth call after this one; ``external`` as in
-        :meth:`SingleRunDynamics.__call__`, (N, nv)."""
+        :func:`single_run_dynamics`, (N, nv)."""
         u = tau if self._plain else self._plant.motor_torque(v, tau)
         if external is not None:
             u = u + external
@@ -113,4 +99,4 @@ def dynamics_for(plant: Plant, runs: int, threads: int | None = None) -> Any:
     own = plant.dynamics(runs, threads_for(runs, threads) if runs > 1 else 1)
     if own is not None:
         return own
-    return SingleRunDynamics(plant).accel if runs == 1 else BatchDynamics(plant, runs, threads)
+    return single_run_dynamics(plant) if runs == 1 else BatchDynamics(plant, runs, threads)
