@@ -201,19 +201,13 @@ def report_run_row(options: ReportOptions, reference: Trajectory, result: Simula
     start = time.perf_counter()
     duration = _tracking_duration(options, reference)
     samples = replace(options.run.simulation, duration=duration).steps + 1
-    per_sample: dict[str, Any] = {  # every array recorded per sample: the first ``samples`` of them
+    size = result.t.shape
+    per_sample: dict[str, Any] = {  # every array recorded per sample (one row per time): its first rows
         f.name: value[:samples]
         for f in fields(result)
-        if isinstance(value := getattr(result, f.name), np.ndarray) and f.name not in _RUN_SUMMARIES
+        if isinstance(value := getattr(result, f.name), np.ndarray) and value.shape[:1] == size
     }
     return _row(replace(result, **per_sample), duration, start) | {"from_report_run": True}
-
-
-_RUN_SUMMARIES = frozenset(
-    {"torque_limits", "p_true", "position_limits", "velocity_limits", "contact_normal"}
-    | {"relaxed_first_time", "relaxed_largest", "relaxed_span"}
-)
-"""The arrays of a :class:`SimulationResult` that are not one row per sample."""
 
 
 def limits_section(
