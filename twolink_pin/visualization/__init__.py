@@ -14,6 +14,8 @@ Three ways to look at a run, all built from the same scene:
 ``scene.py``             the scene from Pinocchio geometry: arm, ghost, trail, desired path,
                          via markers, floor grid, camera; :func:`visual_model`,
                          :func:`ghost_visual_model`, the node names; the recorded commands
+``_drawables.py``        how each geometry object is drawn: a mesh's triangles, a URDF primitive
+                         (box, cylinder, sphere) made without importing Pinocchio's visualizers
 ``camera.py``            where the camera looks from, and the floor grid sized to the motion
 ``html.py``              msgpack packing and the self-contained page: :func:`write_html`,
                          :func:`scene_page`

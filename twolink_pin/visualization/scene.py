@@ -14,8 +14,9 @@ What the scene holds (node paths below ``/meshcat``):
 
 Meshes are drawn from the triangles Pinocchio loaded (``coal`` BVH models: mesh scale,
 units and up axis already applied by the loader), so the page shows exactly the geometry
-Pinocchio uses, in one compact binary block per mesh; primitives (boxes, cylinders,
-spheres...) go through Pinocchio's ``MeshcatVisualizer.loadPrimitive``.
+Pinocchio uses, in one compact binary block per mesh; a URDF's primitives (box, cylinder, sphere)
+are made as Pinocchio's ``MeshcatVisualizer.loadPrimitive`` makes them (:mod:`._drawables`,
+without importing Pinocchio's visualizers), other shapes go through that loader.
 
 :func:`scene_commands` records every command in-process (no server, no browser): a
 window object given to ``meshcat.Visualizer(window=...)`` keeps the lowered commands that
@@ -31,13 +32,11 @@ world origin, which is then ``c``. Read positions in our frame from three.js wit
 
 from __future__ import annotations
 
-import functools
-import itertools
 import math
 import os
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -47,6 +46,7 @@ import pinocchio as pin
 from twolink_pin.errors import InvalidParameterError, InvalidURDFError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel
+from twolink_pin.visualization._drawables import Drawable, drawables_of
 from twolink_pin.visualization._meshcat_bridge import import_meshcat
 from twolink_pin.visualization.camera import GRID_COLORS, floor_grid, frame_camera, threejs_vector
 from twolink_pin.visualization.motion import Motion
@@ -212,60 +212,8 @@ def ghost_visual_model(
     return ghost
 
 
-class _Drawable:
-    """One geometry object as meshcat draws it: a geometry (or a whole object) and whether
-    the object's ``meshScale`` still has to be applied by its transform."""
-
-    def __init__(self, make: Callable[[], Any], scaled_by_transform: bool, corners: np.ndarray) -> None:
-        self.make = make
-        """Builds a fresh meshcat geometry (or ``mg.Object``)."""
-        self.scaled_by_transform = scaled_by_transform
-        self.corners = corners
-        """Corners of the drawn geometry's local bounding box [m], shape (8, 3) (or (0, 3))."""
-
-
-def _box_corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """The 8 corners of the box ``lo <= p <= hi`` [m], shape (8, 3); none if it is unbounded."""
-    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
-        return np.empty((0, 3))
-    return np.array(list(itertools.product(*zip(lo, hi))), dtype=float)
-
-
-def _drawables(robot: RobotModel, geom: pin.GeometryModel) -> list[_Drawable | None]:
-    """How to draw each object of ``geom`` (``None``: a kind meshcat cannot show)."""
-    import coal
-    import meshcat.geometry as mg
-    from pinocchio.visualize import MeshcatVisualizer
-
-    primitives = MeshcatVisualizer(robot.model, None, geom)
-    out: list[_Drawable | None] = []
-    for obj in geom.geometryObjects:
-        shape = obj.geometry
-        if isinstance(shape, coal.BVHModelBase):
-            vertices = np.asarray(shape.vertices(), dtype=np.float32).reshape(-1, 3)
-            faces = np.array(
-                [[t[0], t[1], t[2]] for t in (shape.tri_indices(k) for k in range(shape.num_tris))],
-                dtype=np.uint32,
-            ).reshape(-1, 3)
-            if len(faces) == 0:
-                out.append(None)
-                continue
-            corners = _box_corners(vertices.min(axis=0).astype(float), vertices.max(axis=0).astype(float))
-            out.append(
-                _Drawable(functools.partial(mg.TriangularMeshGeometry, vertices, faces), False, corners)
-            )
-            continue
-        if primitives.loadPrimitive(obj) is None:  # warns, as Pinocchio does
-            out.append(None)
-            continue
-        shape.computeLocalAABB()
-        corners = _box_corners(np.array(shape.aabb_local.min_), np.array(shape.aabb_local.max_))
-        out.append(_Drawable(functools.partial(primitives.loadPrimitive, obj), True, corners))
-    return out
-
-
 def _placements(
-    model: pin.Model, geom: pin.GeometryModel, drawables: Sequence[_Drawable | None], q_frames: np.ndarray
+    model: pin.Model, geom: pin.GeometryModel, drawables: Sequence[Drawable | None], q_frames: np.ndarray
 ) -> np.ndarray:
     """Transform of each drawn object at each frame (``meshScale`` where the transform
     carries it), shape (F, n_objects, 4, 4)."""
@@ -305,7 +253,7 @@ def _add_arm(
     vis: Any,
     animation: Any,
     geom: pin.GeometryModel,
-    drawables: Sequence[_Drawable | None],
+    drawables: Sequence[Drawable | None],
     placements: np.ndarray,
     root: str,
     motion: Motion,
@@ -414,7 +362,7 @@ def scene_commands(robot: RobotModel, motion: Motion, *, loop: bool = False, pla
     vis["/Grid"].set_property("visible", False)  # replaced by one sized to the motion (floor_grid)
 
     geom = visual_model(robot)
-    drawables = _drawables(robot, geom)
+    drawables = drawables_of(robot, geom)
     arms = [(ARM_NODE, geom, motion.q, False)]
     if motion.q_des is not None:
         arms.append((GHOST_NODE, ghost_visual_model(geom, GHOST_ALPHA, GHOST_RGB), motion.q_des, True))
