@@ -57,7 +57,7 @@ def _rotated_cylinder() -> type:
     meshcat is imported lazily)."""
     import meshcat.geometry as mg
 
-    class RotatedCylinder(mg.Cylinder):  # type: ignore[misc]
+    class RotatedCylinder(mg.Cylinder):
         def intrinsic_transform(self) -> np.ndarray:
             return CYLINDER_AXIS
 
