@@ -78,3 +78,13 @@ def test_make_clean_leaves_a_folder_without_the_marker_and_removes_a_whole_repor
 def test_the_clean_script_knows_the_reports_marker() -> None:
     text = (ROOT / "scripts" / "clean_report.py").read_text()
     assert f'MARKER = "{MARKER}"' in text and f'ENTRY = "{MANIFEST_PREFIX}"' in text
+
+
+def test_the_demo_runs_on_compiled_bytecode() -> None:
+    """``make demo`` writes the package's bytecode before the report: with PYTHONDONTWRITEBYTECODE
+    set, an editable install's processes (the report's workers) would otherwise compile every
+    module they import, each time."""
+    printed = _make("-n", "demo", cwd=ROOT).stdout.splitlines()
+    compiled = [i for i, line in enumerate(printed) if "-m compileall -q twolink_pin" in line]
+    report = [i for i, line in enumerate(printed) if "twolink-pin report" in line]
+    assert compiled and report and compiled[0] < report[0]
