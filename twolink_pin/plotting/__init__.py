@@ -11,7 +11,7 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ===================  =====================================================================
 ``_style.py``        sizes, DPI, colours; the Agg figure, fixed margins per figure type,
                      figure titles
-``_save.py``         rendering and saving: one draw on the Agg canvas,
+``_save.py``         rendering and saving: one draw on the Agg canvas (one mathtext parser),
                      the check that the labels fit the fixed margins, the atomic file
 ``_panels.py``       helpers on a panel: limit lines and their note, annotation placement,
                      legends moved off the curves, the max-|e| envelope, shaded spans,

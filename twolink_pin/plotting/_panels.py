@@ -17,6 +17,7 @@ from matplotlib.legend import Legend
 from matplotlib.ticker import LogFormatter
 from matplotlib.transforms import Bbox
 
+from twolink_pin.plotting._save import figure_renderer
 from twolink_pin.plotting._style import LIMIT_COLOR, LOG_FLOOR
 
 OFF_SCALE_RATIO = 3.0
@@ -151,7 +152,7 @@ def unblock_legends(fig: Figure, curves: Sequence[tuple[Axes, np.ndarray, np.nda
     draw, but also avoids the ±limit lines the legend is meant to sit above, and it warns
     on long runs.
     """
-    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]  # the Agg canvas has one
+    renderer = figure_renderer(fig)
     for ax, x, y in curves:
         legend = ax.get_legend()
         if legend is None:

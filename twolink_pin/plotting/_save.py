@@ -2,19 +2,29 @@
 labels fit its fixed margins (else constrained layout and a second draw), the file written
 atomically.
 
+Every figure's renderer reads its mathtext (``$\\dot\\theta_{1}$``) with one parser per process
+(:func:`figure_renderer`), which keeps :data:`KEPT_PARSES` parses. Matplotlib gives each new
+renderer a parser of its own and keys its parse cache (50 parses, over all parsers) on the
+parser, so each figure parsed again, with pyparsing, the labels the figures before it had
+parsed (a sixth of a figure's drawing time). A parse depends only on the text, the font and
+the resolution: the pixels are the same, byte for byte (``tests/test_plotting_render.py``).
 """
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Mapping
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 import matplotlib.image
 from matplotlib.axes import Axes
-from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
 from matplotlib.figure import Figure
+from matplotlib.font_manager import FontProperties
+from matplotlib.mathtext import MathTextParser, VectorParse
 from matplotlib.text import Text
 from matplotlib.transforms import Bbox
 
@@ -25,6 +35,66 @@ from twolink_pin.plotting.titles import shown_title
 PNG_COMPRESS_LEVEL = 1
 """zlib level of the PNG writer: 1 encodes a figure in about half the time of the default 6
 for files about 7 % larger."""
+
+
+if TYPE_CHECKING:
+    _PathParser = MathTextParser[VectorParse]  # generic in matplotlib's stubs only
+else:
+    _PathParser = MathTextParser
+
+KEPT_PARSES = 1024
+"""Mathtext parses the process keeps [count]: matplotlib keeps 50 over all its parsers, fewer
+than the labels of a six-joint arm's figures (132 for three laws on the UR5)."""
+
+
+class _KeptParses(_PathParser):
+    """Matplotlib's parser of mathtext into glyphs and boxes (``"path"``, the Agg renderer's),
+    keeping its last :data:`KEPT_PARSES` parses, keyed by what the parse reads: the text, the
+    resolution, a copy of the font (a mutable object), antialiasing and hinting."""
+
+    def __init__(self) -> None:
+        super().__init__("path")
+        self._kept = functools.lru_cache(maxsize=KEPT_PARSES)(self._parse)
+
+    def parse(
+        self, s: str, dpi: float = 72, prop: FontProperties | None = None, *, antialiased: bool | None = None
+    ) -> VectorParse:
+        rc = matplotlib.rcParams
+        aa = rc["text.antialiased"] if antialiased is None else antialiased
+        font = None if prop is None else prop.copy()
+        return self._kept(s, dpi, font, aa, rc["text.hinting"], rc["text.hinting_factor"])
+
+    def _parse(
+        self, s: str, dpi: float, prop: FontProperties | None, aa: bool, *_hinting: object
+    ) -> VectorParse:
+        return super().parse(s, dpi, prop, antialiased=aa)
+
+
+_SHARED: list[_KeptParses] = []
+"""The process's parser (made by the first figure), lent to every renderer. A forked child
+starts without it: its kept parses hold the parent's fonts, which FreeType cannot use across a
+fork (matplotlib empties its own font cache in the child for the same reason; a report worker
+drawing with them failed with "FT_Load_Glyph … too many hints")."""
+if hasattr(os, "register_at_fork"):  # not on Windows, which does not fork
+    os.register_at_fork(after_in_child=_SHARED.clear)
+_PLAIN = vars(MathTextParser("path"))
+"""The settings of a plain ``"path"`` parser: a renderer's parser is replaced only when it has them."""
+
+
+def figure_renderer(fig: Figure) -> RendererAgg:
+    """``fig``'s Agg renderer (its canvas keeps one while the pixel size stays), reading mathtext
+    with the process's parser (:class:`_KeptParses`) where its own is a plain ``"path"`` parser.
+    A matplotlib whose renderer has no ``mathtext_parser``, or one of another kind or type,
+    keeps its own: slower, the same pixels."""
+    canvas = fig.canvas
+    assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (new_figure)
+    renderer = canvas.get_renderer()
+    parser = getattr(renderer, "mathtext_parser", None)
+    if type(parser) is MathTextParser and vars(parser) == _PLAIN:
+        if not _SHARED:
+            _SHARED.append(_KeptParses())
+        renderer.mathtext_parser = _SHARED[0]
+    return renderer
 
 
 def _drawn_labels(ax: Axes) -> list[Text]:
@@ -44,7 +114,7 @@ def _labels_fit(fig: Figure) -> bool:
     """After a draw: every tick label, axis label, offset and panel title lies inside the
     figure and outside every other panel's plotting area, and the suptitle overlaps none of
     them (1 px of rounding allowed)."""
-    renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]  # the Agg canvas has one
+    renderer = figure_renderer(fig)
     areas = [ax.get_window_extent() for ax in fig.axes]
     box = fig.bbox
     suptitle = fig._suptitle  # type: ignore[attr-defined]  # the Text of fig.suptitle, or None
@@ -82,12 +152,13 @@ def _lay_out_once(fig: Figure) -> None:
 def save_figure(fig: Figure, path: Path) -> Path:
     """Render ``fig`` into ``path`` atomically (format from the suffix, PNG by default).
 
-    The figure is drawn once on its Agg canvas; a figure with fixed :class:`Margins` whose
+    The figure is drawn once on its Agg canvas (:func:`figure_renderer`); a figure with fixed :class:`Margins` whose
     labels do not fit (:func:`_labels_fit`) is then laid out by constrained layout and drawn
     again. A PNG's pixels are written as drawn (zlib level :data:`PNG_COMPRESS_LEVEL`); other
     formats go through ``savefig``. The file carries the figure's title
     (:func:`~twolink_pin.plotting.titles.shown_title`) as its ``Title``."""
     fmt = path.suffix[1:].lower() or "png"
+    figure_renderer(fig)  # the layout and the draw below use it
     _lay_out_once(fig)
     canvas = fig.canvas
     assert isinstance(canvas, FigureCanvasAgg)  # every figure here has its own (new_figure)
