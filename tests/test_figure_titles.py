@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from twolink_pin.plotting._style import new_figure, save_figure
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import new_figure
 from twolink_pin.plotting.titles import shown_title
 from twolink_pin.report.pages import figure_captions
 

@@ -196,7 +196,7 @@ def test_the_overlay_draws_each_run_as_its_envelope_and_torque() -> None:
     """The overlay's curves are each run's own max|e| envelope and torque (second method:
     the runs' arrays), one line per run and panel, labelled by the row's name."""
     from twolink_pin.model import load_robot
-    from twolink_pin.plotting._style import envelope
+    from twolink_pin.plotting._panels import envelope
     from twolink_pin.plotting.overlay import _overlay_figure
     from twolink_pin.simulation import SimulationConfig, simulate
     from twolink_pin.trajectory import default_trajectory

@@ -36,7 +36,7 @@ from twolink_pin.errors import InvalidParameterError, OutputError
 from twolink_pin.feasibility import TorqueCheck, check_torques
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel, example_robot_urdf, load_robot
-from twolink_pin.plotting import _style
+from twolink_pin.plotting import _panels, _save, _style
 from twolink_pin.plotting.distribution import _distribution_figure
 from twolink_pin.plotting.parameters import (
     MANY_PARAMETERS,
@@ -639,10 +639,10 @@ def test_any_number_of_joints(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, n
         assert labels == ["normalised", *(f"final [{u}]" for u in units), *(f"relative [{u}]" for u in units)]
         assert sum(len(_final_bars(param.axes[1 + k])) for k in range(len(units))) == n_p
 
-    real_save = _style.save_figure
+    real_save = _save.save_figure
     rendered = ("trajectory_workspace.png", "adaptive_torque.png", "adaptive_param_error.png")
     monkeypatch.setattr(  # render the three largest figures, only name the others (speed)
-        _style, "save_figure", lambda fig, path: real_save(fig, path) if path.name in rendered else path
+        _save, "save_figure", lambda fig, path: real_save(fig, path) if path.name in rendered else path
     )
     with warnings.catch_warnings():
         warnings.simplefilter("error", UserWarning)
@@ -807,7 +807,7 @@ def test_the_report_figures_fit_their_fixed_margins(
                     fig.axes[k].get_label(),
                     overlap,
                 )
-        assert _style._labels_fit(fig), key
+        assert _save._labels_fit(fig), key
 
 
 def test_a_label_wider_than_the_fixed_margins_gets_constrained_layout(tmp_path: Path) -> None:
@@ -822,7 +822,7 @@ def test_a_label_wider_than_the_fixed_margins_gets_constrained_layout(tmp_path: 
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()  # type: ignore[attr-defined]
     assert min(t.get_window_extent(renderer).x0 for t in ax.get_yticklabels()) < 0  # cut off
-    path = _style.save_figure(fig, tmp_path / "wide.png")
+    path = _save.save_figure(fig, tmp_path / "wide.png")
     _assert_inside_figure(fig)
     assert ax.get_position().x0 * 4.0 > 1.0  # room made for the labels
     _assert_png(path, (4.0, 3.0))
@@ -835,7 +835,7 @@ def test_log_tick_labels_read_as_matplotlibs(pd_figures: dict[str, Figure]) -> N
     ax = fig.subplots()
     ax.set_yscale("log")
     ax.set_ylim(1e-16, 1e6)
-    ours, theirs = _style.PowerOfTenFormatter(), LogFormatterSciNotation()
+    ours, theirs = _panels.PowerOfTenFormatter(), LogFormatterSciNotation()
     ours.set_axis(ax.yaxis)
     theirs.set_axis(ax.yaxis)
     digits = str.maketrans("⁻⁰¹²³⁴⁵⁶⁷⁸⁹", "-0123456789")
@@ -846,11 +846,11 @@ def test_log_tick_labels_read_as_matplotlibs(pd_figures: dict[str, Figure]) -> N
         got = ours(x)
         assert got.startswith("10") and "$" not in got, (x, got)
         assert got[2:].translate(digits) == expected, (x, got, text)
-    between = _style.PowerOfTenFormatter(labelOnlyBase=False)
+    between = _panels.PowerOfTenFormatter(labelOnlyBase=False)
     between.set_axis(ax.yaxis)
     assert between(2e-3) == "2×10⁻³"
     log = _axes(pd_figures["theta1"], "error-log")
-    assert isinstance(log.yaxis.get_major_formatter(), _style.PowerOfTenFormatter)
+    assert isinstance(log.yaxis.get_major_formatter(), _panels.PowerOfTenFormatter)
 
 
 def test_a_torque_legend_moves_off_a_curve_near_the_top(pd_figures: dict[str, Figure]) -> None:
@@ -937,13 +937,13 @@ def test_custom_prefix_and_every_friction_figure(
     """A given prefix replaces the controller's name (the default, see the test above),
     every figure of an adaptive-friction run is saved, and the friction figure decodes."""
     written: list[str] = []
-    real_save = _style.save_figure
+    real_save = _save.save_figure
 
     def record(fig: Figure, path: Path) -> Path:
         written.append(path.name)
         return real_save(fig, path) if path.name.endswith("friction_error.png") else path
 
-    monkeypatch.setattr(_style, "save_figure", record)
+    monkeypatch.setattr(_save, "save_figure", record)
     suffixes = [*RUN_SUFFIXES, "param_error", "friction_error"]
     paths = plotting.save_simulation_figures(friction, tmp_path, prefix="run7")
     assert written == [p.name for p in paths] == [f"run7_{k}.png" for k in suffixes]
@@ -1041,7 +1041,7 @@ def test_figures_are_freed_after_saving(
 ) -> None:
     """No figure survives a save (no pyplot registry, nothing cached)."""
     refs: list[weakref.ref[Figure]] = []
-    monkeypatch.setattr(_style, "save_figure", lambda fig, path: refs.append(weakref.ref(fig)) or path)
+    monkeypatch.setattr(_save, "save_figure", lambda fig, path: refs.append(weakref.ref(fig)) or path)
     plotting.save_trajectory_figures(ROBOT, TRAJ, check, tmp_path)
     plotting.save_simulation_figures(pd, tmp_path)
     gc.collect()

@@ -12,7 +12,7 @@ import pytest
 from matplotlib.patches import Rectangle
 
 from twolink_pin.cli import main
-from twolink_pin.plotting import _style
+from twolink_pin.plotting import _save
 
 
 class Axis(NamedTuple):
@@ -38,7 +38,7 @@ def drawn(monkeypatch: pytest.MonkeyPatch) -> dict[str, list[Axis]]:
         ]
         return Path(path)
 
-    monkeypatch.setattr(_style, "save_figure", keep)
+    monkeypatch.setattr(_save, "save_figure", keep)
     return figures
 
 

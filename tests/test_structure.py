@@ -32,8 +32,9 @@ the law's output check was ``containment.check_output``; 47 once the report's wo
 pool and the sweep's shared pieces (``PreparedSweep``, ``RowSink``, ``json_row_writer``,
 ``write_figure``, ``law_source``, ``versions_text``) were public; 45 with ``gains_echo``; 3 once
 the plotting helpers of ``_style`` and ``parameters``, the sweep's, the URDF checks',
-``gain_spec`` and ``claimed_values`` were public: the three left import the ``_style`` module
-itself, whose ``save_figure`` the plotting tests monkeypatch). Lower it when one is."""
+``gain_spec`` and ``claimed_values`` were public: the three left import the ``_save`` module
+itself (``_style`` until it was split), whose ``save_figure`` the plotting tests monkeypatch).
+Lower it when one is."""
 
 
 def _modules() -> list[tuple[str, ast.Module]]:

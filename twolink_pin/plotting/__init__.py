@@ -9,9 +9,13 @@ of a particular report: a caller that wants "cf. report Fig. N" in the titles pa
 ``figure_numbers`` (figure key → number), and the law's long name as ``title``.
 
 ===================  =====================================================================
-``_style.py``        sizes, DPI, colours; the Agg figure, fixed margins per figure type
-                     (checked after the draw), atomic saving, titles, limit lines,
-                     annotation placement, the max-|e| envelope, plain log labels
+``_style.py``        sizes, DPI, colours; the Agg figure, fixed margins per figure type,
+                     figure titles
+``_save.py``         rendering and saving: one draw on the Agg canvas (one mathtext parser),
+                     the check that the labels fit the fixed margins, the atomic file
+``_panels.py``       helpers on a panel: limit lines and their note, annotation placement,
+                     legends moved off the curves, the max-|e| envelope, shaded spans,
+                     plain log labels
 ``trajectory.py``    :func:`save_trajectory_figures`: each joint's desired motion, the arm
                      and end-effector path (in its plane, or a 3-D view and two projections),
                      the desired torque against the limits

@@ -12,7 +12,8 @@ from matplotlib.figure import Figure
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.kinematics import joint_positions
 from twolink_pin.model import RobotModel
-from twolink_pin.plotting import _style
+from twolink_pin.plotting import _save
+from twolink_pin.plotting._style import ACTUAL_COLOR, DESIRED_COLOR, ERROR_COLOR, LOG_FLOOR, new_figure
 from twolink_pin.simulation import SimulationResult
 
 CARTESIAN_FIGSIZE = (12.0, 5.0)
@@ -31,13 +32,13 @@ def _end_effector_figure(robot: RobotModel, result: SimulationResult, title: str
     actual, desired = end_effector_paths(robot, result)
     spread = np.ptp(desired, axis=0)
     h, v = (int(i) for i in np.sort(np.argsort(spread)[-2:]))  # the plane the desired path spans most
-    fig = _style.new_figure(CARTESIAN_FIGSIZE)
+    fig = new_figure(CARTESIAN_FIGSIZE)
     path_ax, error_ax = fig.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.4]})
     path_ax.set_label("path")
     error_ax.set_label("distance")
-    path_ax.plot(desired[:, h], desired[:, v], color=_style.DESIRED_COLOR, lw=1.2, ls="--", label="desired")
-    path_ax.plot(actual[:, h], actual[:, v], color=_style.ACTUAL_COLOR, lw=1.0, label="actual")
-    path_ax.plot(actual[0, h], actual[0, v], "o", color=_style.ACTUAL_COLOR, ms=5, label="start")
+    path_ax.plot(desired[:, h], desired[:, v], color=DESIRED_COLOR, lw=1.2, ls="--", label="desired")
+    path_ax.plot(actual[:, h], actual[:, v], color=ACTUAL_COLOR, lw=1.0, label="actual")
+    path_ax.plot(actual[0, h], actual[0, v], "o", color=ACTUAL_COLOR, ms=5, label="start")
     path_ax.set_aspect("equal", adjustable="datalim")
     path_ax.set_xlabel(f"{AXES[h]} [m]")
     path_ax.set_ylabel(f"{AXES[v]} [m]")
@@ -45,9 +46,7 @@ def _end_effector_figure(robot: RobotModel, result: SimulationResult, title: str
     path_ax.legend(loc="best", fontsize=8)
     path_ax.grid(True, alpha=0.3)
     distance = np.linalg.norm(actual - desired, axis=1)
-    error_ax.semilogy(
-        result.t, np.maximum(distance * 1e3, _style.LOG_FLOOR), color=_style.ERROR_COLOR, lw=1.0
-    )
+    error_ax.semilogy(result.t, np.maximum(distance * 1e3, LOG_FLOOR), color=ERROR_COLOR, lw=1.0)
     error_ax.set_xlabel("t [s]")
     error_ax.set_ylabel("|x − x_d| [mm]")
     last = result.t >= result.t[-1] - result.reference_period
@@ -69,4 +68,4 @@ def save_end_effector_figure(
     path spans most. Right: ``|x − x_d|`` [mm] over time on a log scale, with the last
     period's maximum in the title.
     """
-    return _style.save_figure(_end_effector_figure(robot, result, title), Path(path))
+    return _save.save_figure(_end_effector_figure(robot, result, title), Path(path))

@@ -13,7 +13,8 @@ from matplotlib.figure import Figure
 from twolink_pin.contact_metrics import SETTLE, contact_metrics
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.model import RobotModel
-from twolink_pin.plotting._style import DESIRED_COLOR, new_figure, save_figure
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import DESIRED_COLOR, new_figure
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.task_metrics import frame_positions
 

@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.plotting import _style
+from twolink_pin.plotting import _save
 from twolink_pin.plotting._style import ACTUAL_COLOR, ERROR_COLOR, new_figure
 
 DEFAULT_TITLE = "Distribution of metrics over the sweep"
@@ -99,6 +99,6 @@ def save_distribution_figure(
     """
     fig = _distribution_figure(rows, title)
     try:
-        return _style.save_figure(fig, Path(out_path))
+        return _save.save_figure(fig, Path(out_path))
     finally:
         fig.clear()

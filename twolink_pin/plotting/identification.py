@@ -28,6 +28,8 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import joint_limits
+from twolink_pin.plotting._panels import plain_log_ticks
+from twolink_pin.plotting._save import save_figure, save_figures
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     COMMAND_COLOR,
@@ -37,9 +39,6 @@ from twolink_pin.plotting._style import (
     Margins,
     fix_margins,
     new_figure,
-    plain_log_ticks,
-    save_figure,
-    save_figures,
 )
 
 ROW_HEIGHT = 2.3

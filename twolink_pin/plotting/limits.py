@@ -12,7 +12,9 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import POSITION, JointLimits
-from twolink_pin.plotting._style import LIMIT_COLOR, limit_lines, new_figure, save_figure
+from twolink_pin.plotting._panels import limit_lines
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import LIMIT_COLOR, new_figure
 from twolink_pin.simulation import SimulationResult
 
 LIMITS_FIGSIZE = (9.0, 6.5)

@@ -17,17 +17,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
-from twolink_pin.plotting._style import (
-    LOG_FLOOR,
-    Margins,
-    envelope,
-    fix_margins,
-    new_figure,
-    plain_log_ticks,
-    rows_figsize,
-    save_figure,
-    shade_spans,
-)
+from twolink_pin.plotting._panels import envelope, plain_log_ticks, shade_spans
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import LOG_FLOOR, Margins, fix_margins, new_figure, rows_figsize
 from twolink_pin.simulation import SimulationResult
 
 OVERLAY_FIGSIZE = (12.0, 5.0)

@@ -27,6 +27,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.plotting._panels import unblock_legends
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     BAR_HEIGHT,
@@ -40,7 +41,6 @@ from twolink_pin.plotting._style import (
     figure_title,
     fix_margins,
     new_figure,
-    unblock_legends,
 )
 from twolink_pin.simulation import SimulationResult
 

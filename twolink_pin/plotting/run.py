@@ -22,31 +22,33 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.plotting._panels import (
+    LEGEND_BOX,
+    NOTE_BOX,
+    envelope,
+    free_spot,
+    limit_lines,
+    plain_log_ticks,
+    shade_spans,
+    unblock_legends,
+)
+from twolink_pin.plotting._save import save_figures
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     COMMAND_COLOR,
     DESIRED_COLOR,
     ERROR_COLOR,
-    LEGEND_BOX,
     LIMIT_COLOR,
     LOG_FLOOR,
-    NOTE_BOX,
     SIM_TORQUE_FIGSIZE,
     SIM_TORQUE_MARGINS,
     STATE_FIGSIZE,
     STATE_MARGINS,
     check_figure_numbers,
-    envelope,
     figure_title,
     fix_margins,
-    free_spot,
-    limit_lines,
     new_figure,
-    plain_log_ticks,
     rows_figsize,
-    save_figures,
-    shade_spans,
-    unblock_legends,
 )
 from twolink_pin.plotting.parameters import check_parameters, parameter_figures
 from twolink_pin.simulation import SimulationResult

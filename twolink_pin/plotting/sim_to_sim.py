@@ -16,7 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from twolink_pin.plotting._style import new_figure, save_figure
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import new_figure
 
 LINEAR_BAND = 1e-3
 """The symmetric-log axis is linear within ±this [mrad] (differences at rounding level)."""

@@ -11,7 +11,9 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from twolink_pin.model import RobotModel
-from twolink_pin.plotting import _style
+from twolink_pin.plotting import _save
+from twolink_pin.plotting._panels import shade_spans
+from twolink_pin.plotting._style import ERROR_COLOR, LOG_FLOOR, new_figure
 from twolink_pin.simulation import SimulationResult
 from twolink_pin.task_metrics import task_errors, task_metrics
 
@@ -25,14 +27,14 @@ def _task_error_figure(robot: RobotModel, result: SimulationResult, title: str |
     t = np.asarray(result.t)
     position = 1e3 * np.linalg.norm(errors.position, axis=1)
     angle = np.degrees(np.linalg.norm(errors.orientation, axis=1))
-    fig = _style.new_figure(TASK_FIGSIZE)
+    fig = new_figure(TASK_FIGSIZE)
     axes = fig.subplots(2, 1, sharex=True)
     for ax, values, label, unit, (rms, peak, late) in (
         (axes[0], position, "position error |p − p_d|", "mm", m[0:3]),
         (axes[1], angle, "orientation error |log(R R_dᵀ)|", "deg", m[3:6]),
     ):
         ax.set_label(unit)
-        ax.semilogy(t, np.maximum(values, _style.LOG_FLOOR), color=_style.ERROR_COLOR, lw=1.0)
+        ax.semilogy(t, np.maximum(values, LOG_FLOOR), color=ERROR_COLOR, lw=1.0)
         ax.set_ylabel(f"[{unit}]")
         ax.set_title(
             f"{label}: RMS {rms:.3g} {unit}, max {peak:.3g} {unit}, last period max {late:.3g} {unit}",
@@ -57,5 +59,5 @@ def save_task_error_figure(
     RMS, max and last-period max (:func:`~twolink_pin.task_metrics.task_metrics`) in the
     titles; ``spans`` (``(start, stop)`` [s], a wrench acting) shaded."""
     fig = _task_error_figure(robot, result, title)
-    _style.shade_spans(fig, spans, np.asarray(result.t))
-    return _style.save_figure(fig, Path(path))
+    shade_spans(fig, spans, np.asarray(result.t))
+    return _save.save_figure(fig, Path(path))

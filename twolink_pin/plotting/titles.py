@@ -1,6 +1,6 @@
 """A figure's title as plain text: what the figure says it shows, carried in its file.
 
-:func:`~twolink_pin.plotting._style.save_figure` writes :func:`shown_title` into each figure file
+:func:`~twolink_pin.plotting._save.save_figure` writes :func:`shown_title` into each figure file
 (a PNG's ``Title`` text chunk, a PDF's or SVG's ``Title``): the report captions its figures
 with it, where they were bare file names. Mathtext (``$\\dot\\theta_{1}$``), which only
 matplotlib draws, becomes plain Unicode (``θ̇₁``).

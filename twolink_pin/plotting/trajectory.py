@@ -23,13 +23,13 @@ from twolink_pin.errors import InvalidParameterError
 from twolink_pin.feasibility import TorqueCheck
 from twolink_pin.kinematics import joint_positions, workspace
 from twolink_pin.model import RobotModel
+from twolink_pin.plotting._panels import LEGEND_BOX, NOTE_BOX, free_spot, limit_lines, unblock_legends
+from twolink_pin.plotting._save import save_figures
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     ERROR_COLOR,
     JOINT_FIGSIZE,
     JOINT_MARGINS,
-    LEGEND_BOX,
-    NOTE_BOX,
     REACH_COLOR,
     TORQUE_FIGSIZE,
     TORQUE_MARGINS,
@@ -39,12 +39,8 @@ from twolink_pin.plotting._style import (
     check_figure_numbers,
     figure_title,
     fix_margins,
-    free_spot,
-    limit_lines,
     new_figure,
     rows_figsize,
-    save_figures,
-    unblock_legends,
 )
 from twolink_pin.trajectory import JointTrajectory
 

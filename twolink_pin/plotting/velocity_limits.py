@@ -13,7 +13,8 @@ from matplotlib.figure import Figure
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.limits import EFFORT, VELOCITY, JointLimits
-from twolink_pin.plotting._style import LIMIT_COLOR, new_figure, save_figure
+from twolink_pin.plotting._save import save_figure
+from twolink_pin.plotting._style import LIMIT_COLOR, new_figure
 from twolink_pin.plotting.limits import LIMITS_FIGSIZE, RUN_STYLES
 from twolink_pin.simulation import SimulationResult
 

@@ -24,6 +24,7 @@ from matplotlib.figure import Figure
 
 from twolink_pin.limits import ACCELERATION, EFFORT, VELOCITY, JointLimits, LimitKind, Motion
 from twolink_pin.limits.active import ActiveLimit
+from twolink_pin.plotting._save import save_figures
 from twolink_pin.plotting._style import (
     ACTUAL_COLOR,
     LIMIT_COLOR,
@@ -31,7 +32,6 @@ from twolink_pin.plotting._style import (
     TORQUE_ROW_HEIGHT,
     new_figure,
     rows_figsize,
-    save_figures,
 )
 
 PANELS = ((VELOCITY, "velocity", "q̇"), (ACCELERATION, "acceleration", "q̈"), (EFFORT, "torque", "τ"))

@@ -102,7 +102,7 @@ def _discussion(r: dict[str, Any]) -> dict[str, Any] | None:
 
 def figure_captions(folder: Path) -> dict[str, str]:
     """File name → caption of the PNG figures in ``folder``: the title each carries (what the
-    figure says it shows, written by :func:`twolink_pin.plotting._style.save_figure`)."""
+    figure says it shows, written by :func:`twolink_pin.plotting._save.save_figure`)."""
     from PIL import Image  # matplotlib's own dependency
 
     captions = {}
