@@ -53,7 +53,11 @@ def test_a_box_is_pinocchios_box(x: float, y: float, z: float) -> None:
 def test_a_cylinder_is_pinocchios_cylinder_about_z(radius: float, length: float) -> None:
     _same(coal.Cylinder(radius, length))
     # about z: the intrinsic turn takes three.js's y axis (the cylinder's) to z
-    axis = np.asarray(primitive(coal.Cylinder(radius, length)).intrinsic_transform())[:3, :3] @ [0.0, 1.0, 0.0]
+    axis = np.asarray(primitive(coal.Cylinder(radius, length)).intrinsic_transform())[:3, :3] @ [
+        0.0,
+        1.0,
+        0.0,
+    ]
     np.testing.assert_array_equal(axis, [0.0, 0.0, 1.0])
 
 
