@@ -36,11 +36,14 @@ CYLINDER_AXIS = np.array(
 (Pinocchio's loader applies the same)."""
 
 
+URDF_PRIMITIVES = (coal.Box, coal.Cylinder, coal.Sphere)
+"""The shapes :func:`primitive` makes (exact types: a subclass goes to Pinocchio's loader)."""
+
+
 def primitive(shape: Any) -> Any:
     """The meshcat geometry of a coal ``Box``, ``Cylinder`` or ``Sphere`` (sizes [m]), else None."""
     import meshcat.geometry as mg
 
-    # exact types: a subclass (a capsule is not a cylinder) goes to Pinocchio's loader
     kind = type(shape)
     if kind is coal.Box:
         return mg.Box(tuple((2.0 * np.asarray(shape.halfSide)).tolist()))
@@ -107,7 +110,7 @@ def drawables_of(robot: RobotModel, geom: pin.GeometryModel) -> list[Drawable | 
         # a URDF primitive made here; another shape (or a kind meshcat cannot show: None) by Pinocchio
         make = (
             functools.partial(primitive, shape)
-            if primitive(shape) is not None
+            if type(shape) in URDF_PRIMITIVES
             else _pinocchio_loader(robot, geom, obj)
         )
         if make is None:
