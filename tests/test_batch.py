@@ -417,7 +417,7 @@ def test_both_batch_regressors_equal_pinocchios_regressor_on_the_ur5() -> None:
     q, v, w, a = (rng.uniform(-1.5, 1.5, (5, ur5.nv)) for _ in range(4))
     by_run = np.stack(_RegressorByRun(model, ur5.parameter_map)(q, v, v, a), axis=2)
     forest = _Regressor(model, ur5.parameter_map, 1, 5)
-    assert forest.terms is not None and all(2 * k * ur5.nv <= FOREST_NV for k, _, _ in forest.terms.groups)
+    assert forest.terms is not None and all(2 * k * ur5.nv <= FOREST_NV for k, *_ in forest.terms.groups)
     by_rnea = np.stack(forest(q, v, v, a), axis=2)
     data = model.createData()
     for i in range(5):

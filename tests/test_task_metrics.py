@@ -85,13 +85,13 @@ def test_poses_of_many_configurations_are_pinocchios_forward_kinematics(source: 
     ``framesForwardKinematics`` of each, to 1e-12."""
     from pathlib import Path
 
-    from twolink_pin.task_metrics import _poses
+    from twolink_pin.frame_poses import poses
 
     if source is not None and source.startswith("urdf:"):
         source = str(Path(__file__).parent / "corpus" / "urdf" / f"{source[5:]}.urdf")
     robot = load_robot(source)
     q = np.random.default_rng(3).uniform(-3.0, 3.0, (60, robot.nq))
-    position, rotation = _poses(robot, q, robot.ee_frame_id)
+    position, rotation = poses(robot, q, robot.ee_frame_id)
     data = robot.model.createData()
     for k in range(len(q)):
         pin.framesForwardKinematics(robot.model, data, q[k])
@@ -101,7 +101,7 @@ def test_poses_of_many_configurations_are_pinocchios_forward_kinematics(source: 
 
 
 def test_rotation_angle_is_the_norm_of_log3_near_0_and_near_pi() -> None:
-    from twolink_pin.task_metrics import rotation_angle
+    from twolink_pin.frame_poses import Pose, angle_between
 
     rng = np.random.default_rng(4)
     axes = rng.normal(size=(40, 3))
@@ -112,7 +112,9 @@ def test_rotation_angle_is_the_norm_of_log3_near_0_and_near_pi() -> None:
     R_des = np.array([pin.exp3(v) for v in rng.normal(size=(40, 3))])
     R = np.array([pin.exp3(a * v) @ Rd for a, v, Rd in zip(angles, axes, R_des, strict=True)])
     expected = [np.linalg.norm(pin.log3(r @ rd.T)) for r, rd in zip(R, R_des, strict=True)]
-    np.testing.assert_allclose(rotation_angle(R, R_des), expected, rtol=0, atol=1e-9)
+    entries = [[[R[:, i, j] for j in range(3)] for i in range(3)] for R in (R, R_des)]
+    angle = angle_between(Pose([0.0] * 3, entries[0]), Pose([0.0] * 3, entries[1]))
+    np.testing.assert_allclose(angle, expected, rtol=0, atol=1e-9)
 
 
 def reference_task_metrics(robot: object, result: object) -> dict[str, float]:

@@ -31,10 +31,10 @@ from typing import TYPE_CHECKING, Any, NamedTuple
 import numpy as np
 
 from twolink_pin.contact.stability import contact_frame
+from twolink_pin.frame_poses import frame_positions
 from twolink_pin.model import RobotModel
 from twolink_pin.plant import Plant
 from twolink_pin.simulation.result import SimulationResult
-from twolink_pin.task_metrics import frame_positions
 from twolink_pin.trajectory import ForceReference, Trajectory
 
 if TYPE_CHECKING:

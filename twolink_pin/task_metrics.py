@@ -27,10 +27,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any, NamedTuple
 
 import numpy as np
-import pinocchio as pin
 
 from twolink_pin.controllers.task_space import rotation_error
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.frame_poses import angle_between, distance, frame_pose, poses
 from twolink_pin.model import RobotModel
 from twolink_pin.simulation.result import SimulationResult
 
@@ -116,124 +116,6 @@ class TaskMetrics(NamedTuple):
         )
 
 
-AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
-COLUMNS = {"X": (1, 2), "Y": (2, 0), "Z": (0, 1)}
-"""The columns ``(a, b)`` of ``R`` that a rotation by θ about an aligned axis mixes:
-``R R_axis(θ)`` has ``c R_a + s R_b`` and ``c R_b − s R_a`` there (c = cos θ, s = sin θ)."""
-
-
-class Link(NamedTuple):
-    """One joint of the chain to a frame, as :func:`_chain` reads it from the model."""
-
-    placement: pin.SE3
-    """The joint's placement in its parent's frame."""
-    kind: str
-    """``"R"`` (revolute) or ``"P"`` (prismatic)."""
-    axis: np.ndarray
-    """Its unit axis in its own frame."""
-    aligned: str
-    """``"X"``, ``"Y"``, ``"Z"`` for a revolute joint about that axis, else ``""``."""
-    coordinate: int
-    """Its index in ``q``."""
-
-
-def _joint_axis(joint: Any) -> tuple[str, np.ndarray, str] | None:
-    """``("R" | "P", unit axis, aligned axis or "")`` of a revolute or prismatic joint, else None."""
-    name = joint.shortname().removeprefix("JointModel")
-    if name in ("RevoluteUnaligned", "PrismaticUnaligned"):
-        return name[0], np.asarray(joint.extract().axis, dtype=float), ""
-    if len(name) == 2 and name[0] in "RP" and name[1] in AXES:
-        return name[0], np.array(AXES[name[1]]), name[1] if name[0] == "R" else ""
-    return None
-
-
-def _chain(model: pin.Model, frame_id: int) -> list[Link] | None:
-    """The joints from the root to ``frame_id``'s; None when one is not a revolute or prismatic
-    joint of one coordinate."""
-    chain = []
-    joint = int(model.frames[frame_id].parentJoint)
-    while joint > 0:
-        found = _joint_axis(model.joints[joint])
-        if found is None or model.joints[joint].nq != 1:
-            return None
-        chain.append(Link(model.jointPlacements[joint], *found, int(model.joints[joint].idx_q)))
-        joint = int(model.parents[joint])
-    return chain[::-1]
-
-
-def _times(rotation: np.ndarray, matrix: np.ndarray) -> np.ndarray:
-    """``rotation @ matrix`` for a stack of rotations (K, 3, 3) and one matrix (3, 3) or vector
-    (3,): numpy's own sum of products (no BLAS), so each row's result is the same whatever K
-    (a sweep's rows do not depend on its chunks)."""
-    return np.einsum("kij,jl->kil" if matrix.ndim == 2 else "kij,j->ki", rotation, matrix)
-
-
-def _poses(robot: RobotModel, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray]:
-    """The frame's position [m] (K, 3) and rotation (K, 3, 3) at the configurations ``q`` (K, nq):
-    Pinocchio's forward kinematics, composed for all K at once along the chain of revolute and
-    prismatic joints (a joint of another kind: one configuration at a time). A revolute joint
-    about the unit axis ``a`` turns ``R`` into ``R exp(θ [a]×) = R + sin θ R[a]× + (1 − cos θ) R[a]×²``
-    (about x, y or z: two columns of ``R`` mixed, :data:`COLUMNS`)."""
-    model = robot.model
-    chain = _chain(model, frame_id)
-    if chain is None:
-        return _poses_one_by_one(model, q, frame_id)
-    return _chain_poses(model, chain, q, frame_id)
-
-
-def _placed(rotation: np.ndarray, position: np.ndarray, placement: pin.SE3) -> tuple[np.ndarray, np.ndarray]:
-    """``(R, p)`` composed with a fixed placement: ``(R R_c, p + R p_c)``, skipping an identity part."""
-    if np.any(placement.translation):
-        position = position + _times(rotation, placement.translation)
-    if not np.array_equal(placement.rotation, np.eye(3)):
-        rotation = _times(rotation, placement.rotation)
-    return rotation, position
-
-
-def frame_positions(robot: RobotModel, q: np.ndarray, frame_id: int) -> np.ndarray:
-    """The frame's origin [m] at the configurations ``q`` (K, nq) [rad], shape (K, 3): the
-    forward kinematics the task metrics use, for all K at once."""
-    return _poses(robot, np.asarray(q, dtype=float), frame_id)[0]
-
-
-def _chain_poses(
-    model: pin.Model, chain: list[Link], q: np.ndarray, frame_id: int
-) -> tuple[np.ndarray, np.ndarray]:
-    k = len(q)
-    rotation, position = np.array(np.broadcast_to(np.eye(3), (k, 3, 3))), np.zeros((k, 3))
-    for link in chain:
-        rotation, position = _placed(rotation, position, link.placement)
-        angle = q[:, link.coordinate]
-        if link.aligned:
-            a, b = COLUMNS[link.aligned]
-            c, s = np.cos(angle)[:, None], np.sin(angle)[:, None]
-            # in place: every array here is this function's own
-            col_a, col_b = rotation[:, :, a].copy(), rotation[:, :, b]
-            rotation[:, :, a] = c * col_a + s * col_b
-            rotation[:, :, b] = c * col_b - s * col_a
-        elif link.kind == "R":
-            x, y, z = link.axis
-            cross = np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-            rotation = (
-                rotation
-                + np.sin(angle)[:, None, None] * _times(rotation, cross)
-                + (1.0 - np.cos(angle))[:, None, None] * _times(rotation, cross @ cross)
-            )
-        else:
-            position = position + _times(rotation, link.axis) * angle[:, None]
-    return _placed(rotation, position, model.frames[frame_id].placement)[::-1]
-
-
-def _poses_one_by_one(model: pin.Model, q: np.ndarray, frame_id: int) -> tuple[np.ndarray, np.ndarray]:
-    data = model.createData()
-    position, rotation = np.empty((len(q), 3)), np.empty((len(q), 3, 3))
-    for k in range(len(q)):
-        pin.forwardKinematics(model, data, q[k])
-        placement = pin.updateFramePlacement(model, data, frame_id)
-        position[k], rotation[k] = placement.translation, placement.rotation
-    return position, rotation
-
-
 def _frame_id(robot: RobotModel, frame: str | None) -> int:
     if frame is None:
         return int(robot.ee_frame_id)
@@ -249,22 +131,9 @@ def task_errors(robot: RobotModel, q: np.ndarray, q_des: np.ndarray, frame: str 
     if q.shape != q_des.shape or q.shape[1] != robot.nq:
         raise InvalidParameterError("q", f"shape {q.shape}", f"(K, {robot.nq}) like q_des {q_des.shape}")
     frame_id = _frame_id(robot, frame)
-    p, R = _poses(robot, q, frame_id)
-    p_d, R_d = _poses(robot, q_des, frame_id)
+    p, R = poses(robot, q, frame_id)
+    p_d, R_d = poses(robot, q_des, frame_id)
     return TaskErrors(p - p_d, rotation_error(R, R_d))
-
-
-def rotation_angle(R: np.ndarray, R_des: np.ndarray) -> np.ndarray:
-    """The angle ``|log(R R_dᵀ)|`` [rad] in [0, π] of rotations ``R`` against ``R_des`` (any
-    shapes ``(…, 3, 3)`` that broadcast, ``R_des`` not repeated in memory): the norm of
-    :func:`~twolink_pin.controllers.task_space.rotation_error`, as ``atan2(|w|, (tr E − 1)/2)``
-    with ``E = R R_dᵀ`` and ``w`` its skew part."""
-    E = np.matmul(R, np.swapaxes(R_des, -1, -2))
-    trace = E[..., 0, 0] + E[..., 1, 1] + E[..., 2, 2]
-    w = np.stack(
-        [E[..., 2, 1] - E[..., 1, 2], E[..., 0, 2] - E[..., 2, 0], E[..., 1, 0] - E[..., 0, 1]], axis=-1
-    )
-    return np.arctan2(0.5 * np.sqrt(np.add.reduce(w * w, axis=-1)), 0.5 * (trace - 1.0))
 
 
 class RunningTaskMetrics:
@@ -294,10 +163,11 @@ class RunningTaskMetrics:
         """Add a block of samples (``q`` (B, N, nv), ``q_des`` (B, 1, nv))."""
         q = np.asarray(samples.q, dtype=float)
         blocks, runs, nv = q.shape
-        p, R = _poses(self.robot, np.nan_to_num(q.reshape(-1, nv)), self.frame_id)
-        p_d, R_d = _poses(self.robot, np.asarray(samples.q_des, dtype=float)[:, 0], self.frame_id)
-        position = 1e3 * np.linalg.norm(p.reshape(blocks, runs, 3) - p_d[:, None], axis=2)
-        angle = np.degrees(rotation_angle(R.reshape(blocks, runs, 3, 3), R_d[:, None]))
+        pose = frame_pose(self.robot, np.nan_to_num(q.reshape(-1, nv)), self.frame_id).shaped((blocks, runs))
+        desired = frame_pose(self.robot, np.asarray(samples.q_des, dtype=float)[:, 0], self.frame_id)
+        desired = desired.shaped((blocks, 1))
+        position = np.broadcast_to(1e3 * distance(pose, desired), (blocks, runs))
+        angle = np.broadcast_to(np.degrees(angle_between(pose, desired)), (blocks, runs))
         both = np.stack([position, angle], axis=1)  # (B, 2, N)
         self.square += (both * both).sum(axis=0)
         np.maximum(self.peak, both.max(axis=0), out=self.peak)

@@ -28,7 +28,12 @@ LOG = logging.getLogger("mkdocs.hooks.api_pages")
 
 GROUPS: tuple[tuple[str, str, str, tuple[str, ...]], ...] = (
     ("model", "Model", "Robots from URDF, their parameters and profiles.", ("model",)),
-    ("kinematics", "Kinematics", "Forward kinematics, Jacobians, inverse kinematics.", ("kinematics",)),
+    (
+        "kinematics",
+        "Kinematics",
+        "Forward kinematics, Jacobians, inverse kinematics; a frame's poses at many configurations.",
+        ("kinematics", "frame_poses"),
+    ),
     (
         "limits",
         "Joint limits",

@@ -144,15 +144,25 @@ class RunningCrossings:
         commanded torques [N·m], each (B, N, nv)."""
         for kind in self.checked:
             values = (q, v, tau)[CROSSED_KINDS.index(kind)]
-            excess = self.limits.excess(kind, values)  # (B, N, nv), -inf without a limit
-            over = excess > 0
-            if not over.any():
+            largest = self._largest(kind, values)  # (N, nv)
+            if not (largest > 0).any():
                 continue
             first = self.first[kind.name]
-            newly = over.any(axis=0) & np.isnan(first)
+            newly = (largest > 0) & np.isnan(first)
             if newly.any():
+                over = self.limits.excess(kind, values) > 0  # (B, N, nv)
                 first[newly] = t[np.argmax(over, axis=0)][newly]
-            np.maximum(self.largest[kind.name], excess.max(axis=0), out=self.largest[kind.name])
+            np.maximum(self.largest[kind.name], largest, out=self.largest[kind.name])
+
+    def _largest(self, kind: LimitKind, values: np.ndarray) -> np.ndarray:
+        """``excess(kind, values).max(axis=0)`` from the block's extremes, the same bits: rounding
+        is monotonic, so ``max_s max(v_s − u, l − v_s) = max(max_s v_s − u, l − min_s v_s)``;
+        ``fmax``/``fmin`` skip a NaN sample, as ``excess`` makes it ``-inf`` (two reductions of
+        the block instead of five passes over it)."""
+        lower, upper = self.limits.bounds(kind)
+        with np.errstate(invalid="ignore"):
+            largest = np.fmax(np.fmax.reduce(values, axis=0) - upper, lower - np.fmin.reduce(values, axis=0))
+        return np.where(np.isnan(largest), -np.inf, largest)
 
     def result(self, dead: np.ndarray | None = None) -> Crossings:
         """The crossings so far; rows of ``dead`` runs (mask, shape (N,)) are NaN."""

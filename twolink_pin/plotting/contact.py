@@ -12,11 +12,11 @@ from matplotlib.figure import Figure
 
 from twolink_pin.contact_metrics import SETTLE, contact_metrics
 from twolink_pin.errors import InvalidParameterError
+from twolink_pin.frame_poses import frame_positions
 from twolink_pin.model import RobotModel
 from twolink_pin.plotting._save import save_figure
 from twolink_pin.plotting._style import DESIRED_COLOR, new_figure
 from twolink_pin.simulation import SimulationResult
-from twolink_pin.task_metrics import frame_positions
 
 CONTACT_FIGSIZE = (9.0, 8.5)
 """Size of the contact figure [in]."""
