@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -10,6 +11,7 @@ import pytest
 
 from twolink_pin.errors import InvalidParameterError
 from twolink_pin.report import ReportOptions
+from twolink_pin.report.build import WORKERS_SHARE
 
 _CHILD = """
 import os, sys
@@ -33,3 +35,28 @@ def test_a_process_pinned_to_one_core_runs_the_report_in_one_process() -> None:
 def test_a_bad_worker_count_is_refused_naming_it(bad: object) -> None:
     with pytest.raises(InvalidParameterError, match="workers"):
         ReportOptions(workers=bad)  # type: ignore[arg-type]
+
+
+_SHARED = """
+import json, sys
+from twolink_pin.report.build import WORKERS_SHARE
+from twolink_pin.report.pool import worker_pool
+
+def imported(names):
+    return [name in sys.modules for name in names]
+
+assert not any(imported(WORKERS_SHARE)), "the test needs a process that has not imported them"
+with worker_pool(2) as pool:
+    alone = pool.submit(imported, WORKERS_SHARE).result()
+with worker_pool(2, WORKERS_SHARE) as pool:
+    shared = pool.submit(imported, WORKERS_SHARE).result()
+print(json.dumps([alone, shared]))
+"""
+
+
+def test_the_workers_fork_with_the_shared_modules_already_imported() -> None:
+    """matplotlib and SciPy imported once before the fork, not again in each worker: a worker
+    of a pool without them has none of them; a worker of the report's pool has all."""
+    out = subprocess.run([sys.executable, "-c", _SHARED], capture_output=True, text=True, check=True).stdout
+    n = len(WORKERS_SHARE)
+    assert json.loads(out) == [[False] * n, [True] * n]
