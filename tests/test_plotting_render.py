@@ -1,7 +1,7 @@
-"""Rendering with one mathtext parser per process (``plotting/_save.py``): a figure drawn after
-others, reading their parses from the shared parser's cache, is the same file, byte for byte,
-as the figure drawn with matplotlib's own parser; and a renderer whose parser is of another
-kind keeps its own."""
+"""Rendering with one mathtext parser and one text-size cache per process (``plotting/_save.py``):
+a figure drawn after others, reading their parses and text sizes from the shared caches, is the
+same file, byte for byte, as the figure drawn with matplotlib's own parser and cache; and a
+renderer whose parser is of another kind keeps its own."""
 
 from __future__ import annotations
 
@@ -61,13 +61,22 @@ def test_a_figure_drawn_with_the_shared_parser_is_the_file_drawn_with_its_own(
             alone[key] = _save.save_figure(fig, tmp_path / f"alone_{key}.png").read_bytes()
 
     monkeypatch.setattr(_save, "_SHARED", [])
+    monkeypatch.setattr(_save, "_METRICS", {})
     first = _figure(*kinds["same"])
     _save.save_figure(first, tmp_path / "first.png")
+    cache = _save._matplotlib_metrics_cache()
+    assert cache is not None  # this matplotlib's per-renderer cache is as expected
     for key, kind in kinds.items():
         fig = _figure(*kind)
         assert _parser(fig) is _parser(first) is _save._SHARED[0], key  # the parser is shared …
+        renderer, first_renderer = fig.canvas.get_renderer(), first.canvas.get_renderer()  # type: ignore[attr-defined]
+        # … and so is the text-size cache, between renderers of one resolution only
+        assert (cache[renderer] is cache[first_renderer]) == (kind[0] == kinds["same"][0]), key
         shared = _save.save_figure(fig, tmp_path / f"shared_{key}.png").read_bytes()
         assert shared == alone[key], key  # … and the file is the same
+    assert len(_save._METRICS) == 2  # the two resolutions
+    hits = sum(metrics.cache_info().hits for _, metrics in _save._METRICS.values())
+    assert hits > 0  # the figures after the first read sizes the first measured
 
 
 def test_a_parser_of_another_kind_is_kept() -> None:
@@ -83,8 +92,8 @@ def test_a_parser_of_another_kind_is_kept() -> None:
 
 
 def _draw_in_child(folder: str) -> None:
-    """In a forked child: how many parsers it inherited, then the figure drawn."""
-    Path(folder, "inherited.txt").write_text(str(len(_save._SHARED)))
+    """In a forked child: how many parsers and text-size caches it inherited, then the figure drawn."""
+    Path(folder, "inherited.txt").write_text(f"{len(_save._SHARED)} {len(_save._METRICS)}")
     _save.save_figure(_figure(110.0, 10.0), Path(folder, "child.png"))
 
 
@@ -94,10 +103,10 @@ def test_a_forked_child_draws_with_a_parser_of_its_own(tmp_path: Path) -> None:
     figures) does not inherit the parser, whose kept parses hold the parent's fonts (FreeType
     failed on them in the child: "too many hints"); it draws the same file."""
     parent = _save.save_figure(_figure(110.0, 10.0), tmp_path / "parent.png").read_bytes()
-    assert _save._SHARED  # the parent holds a parser with the figure's parses
+    assert _save._SHARED and _save._METRICS  # the parent holds a parser and sizes of the figure
     child = multiprocessing.get_context("fork").Process(target=_draw_in_child, args=(str(tmp_path),))
     child.start()
     child.join(120.0)
     assert child.exitcode == 0
-    assert (tmp_path / "inherited.txt").read_text() == "0"
+    assert (tmp_path / "inherited.txt").read_text() == "0 0"
     assert (tmp_path / "child.png").read_bytes() == parent

@@ -8,6 +8,13 @@ renderer a parser of its own and keys its parse cache (50 parses, over all parse
 parser, so each figure parsed again, with pyparsing, the labels the figures before it had
 parsed (a sixth of a figure's drawing time). A parse depends only on the text, the font and
 the resolution: the pixels are the same, byte for byte (``tests/test_plotting_render.py``).
+
+Likewise the size of a text (a tick label's, a title's: ``get_text_width_height_descent``), which
+matplotlib caches per renderer, so that each figure measured "0", "10" and "time [s]" again:
+every Agg renderer of one resolution and one set of text settings reads one cache
+(:func:`_share_text_metrics`). A figure is not cleared after it is saved (``Figure.clear``
+builds the empty figure again, about a twentieth of the drawing time): a figure dropped is
+collected with everything it holds.
 """
 
 from __future__ import annotations
@@ -16,7 +23,7 @@ import functools
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import matplotlib
 import matplotlib.image
@@ -79,6 +86,51 @@ if hasattr(os, "register_at_fork"):  # not on Windows, which does not fork
     os.register_at_fork(after_in_child=_SHARED.clear)
 _PLAIN = vars(MathTextParser("path"))
 """The settings of a plain ``"path"`` parser: a renderer's parser is replaced only when it has them."""
+_TEXT_SETTINGS = tuple(k for k in matplotlib.rcParams if k.startswith(("font.", "text.", "mathtext.")))
+"""The settings a text's size depends on besides its own font and the resolution (the fonts each
+family names, hinting, kerning, mathtext's fonts)."""
+_METRICS: dict[str, tuple[list[RendererAgg], Any]] = {}
+"""One text-size cache per resolution and text settings: the renderer it measures with (the
+latest of them) and matplotlib's kind of cache around it. A forked child starts without them
+(the renderer's parser holds the parent's fonts, as :data:`_SHARED`)."""
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_METRICS.clear)
+
+
+def _matplotlib_metrics_cache() -> Any:
+    """Matplotlib's per-renderer text-size cache (``matplotlib.text._get_text_metrics_function``'s
+    ``WeakKeyDictionary`` of renderer → cached function), or None if it is not one."""
+    import weakref
+
+    import matplotlib.text
+
+    function = getattr(matplotlib.text, "_get_text_metrics_function", None)
+    defaults: tuple[Any, ...] = getattr(function, "__defaults__", None) or ()
+    cache = defaults[0] if len(defaults) == 1 else None
+    return cache if isinstance(cache, weakref.WeakKeyDictionary) else None
+
+
+def _share_text_metrics(renderer: RendererAgg) -> None:
+    """Give ``renderer`` the text-size cache of every Agg renderer of its resolution and the
+    current text settings (module docstring). A text's size is computed by the renderer as
+    matplotlib's own cache does, with the latest renderer of the kind (a renderer's size in
+    pixels does not enter it). A matplotlib whose cache is not as expected keeps its own."""
+    cache = _matplotlib_metrics_cache()
+    if cache is None or type(renderer) is not RendererAgg or renderer in cache:
+        return
+    rc = matplotlib.rcParams
+    key = repr((renderer.dpi, tuple(rc[k] for k in _TEXT_SETTINGS)))
+    entry = _METRICS.get(key)
+    if entry is None:
+        holder = [renderer]
+
+        @functools.lru_cache(4096)  # matplotlib's own size, keyed as matplotlib keys it
+        def metrics(text: str, fontprop: FontProperties, ismath: Any, dpi: float) -> Any:
+            return holder[0].get_text_width_height_descent(text, fontprop, ismath)
+
+        entry = _METRICS[key] = (holder, metrics)
+    entry[0][0] = renderer  # measure with a live renderer of the kind (the latest)
+    cache[renderer] = entry[1]
 
 
 def figure_renderer(fig: Figure) -> RendererAgg:
@@ -94,6 +146,7 @@ def figure_renderer(fig: Figure) -> RendererAgg:
         if not _SHARED:
             _SHARED.append(_KeptParses())
         renderer.mathtext_parser = _SHARED[0]
+        _share_text_metrics(renderer)  # its mathtext is measured with the shared parser too
     return renderer
 
 
@@ -186,10 +239,6 @@ def save_figure(fig: Figure, path: Path) -> Path:
 
 
 def save_figures(figures: Mapping[str, Figure], out_dir: str | os.PathLike[str], prefix: str) -> list[Path]:
-    """Save each figure as ``out_dir/<prefix><key>.png`` in order, then clear them all."""
+    """Save each figure as ``out_dir/<prefix><key>.png`` in order."""
     out = Path(out_dir)
-    try:
-        return [save_figure(fig, out / f"{prefix}{key}.png") for key, fig in figures.items()]
-    finally:
-        for fig in figures.values():
-            fig.clear()
+    return [save_figure(fig, out / f"{prefix}{key}.png") for key, fig in figures.items()]

@@ -98,7 +98,4 @@ def save_distribution_figure(
         OutputError: ``out_path`` cannot be written.
     """
     fig = _distribution_figure(rows, title)
-    try:
-        return _save.save_figure(fig, Path(out_path))
-    finally:
-        fig.clear()
+    return _save.save_figure(fig, Path(out_path))

@@ -329,10 +329,7 @@ def save_convergence_figure(
     if not runs:
         raise InvalidParameterError("runs", runs, "at least one run")
     fig = _convergence_figure(runs, fraction, title)
-    try:
-        return save_figure(fig, Path(path))
-    finally:
-        fig.clear()
+    return save_figure(fig, Path(path))
 
 
 def _coverage_figure(z: np.ndarray, names: Sequence[str], title: str) -> Figure:
@@ -379,7 +376,4 @@ def save_coverage_figure(
     if z.ndim != 2 or z.shape[1] != len(names):
         raise InvalidParameterError("z", f"shape {z.shape}", f"(seeds, {len(names)}): one column per name")
     fig = _coverage_figure(z, names, title)
-    try:
-        return save_figure(fig, Path(path))
-    finally:
-        fig.clear()
+    return save_figure(fig, Path(path))
