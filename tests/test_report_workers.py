@@ -60,3 +60,30 @@ def test_the_workers_fork_with_the_shared_modules_already_imported() -> None:
     out = subprocess.run([sys.executable, "-c", _SHARED], capture_output=True, text=True, check=True).stdout
     n = len(WORKERS_SHARE)
     assert json.loads(out) == [[False] * n, [True] * n]
+
+
+_FROZEN = """
+import gc, json, os
+from twolink_pin.report.pool import worker_pool
+
+def state():
+    return os.getpid(), gc.get_freeze_count(), gc.isenabled()
+
+gc.collect()
+held = [[i] for i in range(50_000)]  # tracked objects this process holds when the workers fork
+with worker_pool(2) as pool:
+    first = pool.submit(state)
+    after = gc.get_freeze_count()  # this process, right after the fork
+    workers = [first.result(), *(pool.submit(state).result() for _ in range(3))]
+print(json.dumps({"after": after, "workers": workers, "parent": os.getpid(), "enabled": gc.isenabled()}))
+"""
+
+
+def test_the_workers_fork_with_the_parents_objects_frozen_out_of_their_collector() -> None:
+    """A worker's garbage collector never walks the objects it inherited (``gc.freeze`` before the
+    fork): each worker holds at least the 50 000 lists its parent had, frozen; the parent's own
+    are unfrozen right after the fork, and its collector stays on."""
+    out = subprocess.run([sys.executable, "-c", _FROZEN], capture_output=True, text=True, check=True).stdout
+    found = json.loads(out)
+    assert found["after"] == 0 and found["enabled"]
+    assert all(pid != found["parent"] and frozen >= 50_000 and on for pid, frozen, on in found["workers"])
