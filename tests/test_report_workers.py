@@ -87,3 +87,22 @@ def test_the_workers_fork_with_the_parents_objects_frozen_out_of_their_collector
     found = json.loads(out)
     assert found["after"] == 0 and found["enabled"]
     assert all(pid != found["parent"] and frozen >= 50_000 and on for pid, frozen, on in found["workers"])
+
+
+_KEPT = """
+import gc, json
+from twolink_pin.report.pool import worker_pool
+
+gc.freeze()  # this process's own choice
+before = gc.get_freeze_count()
+with worker_pool(2) as pool:
+    pool.submit(int).result()
+    after = gc.get_freeze_count()
+print(json.dumps([before, after]))
+"""
+
+
+def test_a_process_that_froze_its_objects_itself_keeps_them_frozen() -> None:
+    out = subprocess.run([sys.executable, "-c", _KEPT], capture_output=True, text=True, check=True).stdout
+    before, after = json.loads(out)
+    assert before > 0 and after == before  # not unfrozen by the pool

@@ -64,7 +64,8 @@ class _Workers:
     every object of this process frozen out of the cyclic garbage collector (``gc.freeze``,
     undone here right after): a worker's collections then walk only the objects it made, not the
     ~240 000 it inherits (the modules of matplotlib, SciPy, SymPy, Pinocchio), each full one
-    ~0.1 s of CPU — the pre-fork use the ``gc`` documentation describes."""
+    ~0.1 s of CPU — the pre-fork use the ``gc`` documentation describes. A process that has
+    frozen objects itself is left as it is (unfreezing would undo its own freeze)."""
 
     def __init__(self, pool: ProcessPoolExecutor) -> None:
         self._pool = pool
@@ -72,7 +73,7 @@ class _Workers:
 
     def submit(self, fn: Callable[..., Any], *args: Any) -> Future[Any]:
         with interrupts.deferred():
-            if self._forked:
+            if self._forked or gc.get_freeze_count():  # a process that froze objects itself: its choice
                 return self._pool.submit(_contained, fn, *args)
             gc.freeze()
             try:
