@@ -145,10 +145,11 @@ class RunningCrossings:
         for kind in self.checked:
             values = (q, v, tau)[CROSSED_KINDS.index(kind)]
             largest = self._largest(kind, values)  # (N, nv)
-            if not (largest > 0).any():
+            crossed = largest > 0
+            if not crossed.any():
                 continue
             first = self.first[kind.name]
-            newly = (largest > 0) & np.isnan(first)
+            newly = crossed & np.isnan(first)
             if newly.any():
                 over = self.limits.excess(kind, values) > 0  # (B, N, nv)
                 first[newly] = t[np.argmax(over, axis=0)][newly]
